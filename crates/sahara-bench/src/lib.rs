@@ -1,0 +1,1 @@
+//! `sahara-bench`: the ray-casting benchmark protocol.

@@ -1,0 +1,1 @@
+//! `sahara-formats`: files in, plain arrays out.

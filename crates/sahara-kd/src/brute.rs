@@ -1,0 +1,47 @@
+//! The brute-force oracle: every query answered by testing every triangle.
+//!
+//! It uses the same watertight test and the same tie-breaking as the tree
+//! (smallest `t`, then smallest triangle index), so a correct tree returns
+//! bit-identical answers.
+
+use crate::geometry::triangle::RayShear;
+use crate::geometry::{Ray, Triangle};
+use crate::traverse::Hit;
+
+/// The closest hit among all finite triangles.
+pub fn closest_hit(triangles: &[Triangle], ray: &Ray) -> Option<Hit> {
+    if !ray.is_valid() {
+        return None;
+    }
+    let shear = RayShear::from_ray(ray);
+    let mut best: Option<Hit> = None;
+    let mut best_t = ray.tmax;
+    for (i, tri) in triangles.iter().enumerate() {
+        if !tri.is_finite() {
+            continue;
+        }
+        if let Some(h) = shear.intersect(tri, ray.tmin, best_t) {
+            if best.is_none_or(|b| h.t < b.t) {
+                best_t = h.t;
+                best = Some(Hit {
+                    t: h.t,
+                    tri: i as u32,
+                    u: h.u,
+                    v: h.v,
+                });
+            }
+        }
+    }
+    best
+}
+
+/// True if any finite triangle is hit.
+pub fn any_hit(triangles: &[Triangle], ray: &Ray) -> bool {
+    if !ray.is_valid() {
+        return false;
+    }
+    let shear = RayShear::from_ray(ray);
+    triangles
+        .iter()
+        .any(|tri| tri.is_finite() && shear.intersect(tri, ray.tmin, ray.tmax).is_some())
+}

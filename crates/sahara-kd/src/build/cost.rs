@@ -1,0 +1,99 @@
+//! The surface area heuristic for one candidate plane.
+
+use crate::build::BuildParams;
+use crate::geometry::Aabb;
+
+/// Which side triangles lying in the split plane go to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PlanarSide {
+    /// Below the plane.
+    Left,
+    /// Above the plane.
+    Right,
+}
+
+/// A candidate split and its SAH cost.
+#[derive(Clone, Copy, Debug)]
+pub struct Split {
+    /// Axis 0, 1, 2.
+    pub axis: usize,
+    /// Plane position.
+    pub pos: f32,
+    /// Side of the triangles lying in the plane.
+    pub planar: PlanarSide,
+    /// Expected cost, in the same units as `K_I * n` for a leaf.
+    pub cost: f64,
+}
+
+/// The SAH cost model of one node (Wald & Havran 2006, section 4).
+pub struct SahModel {
+    cell: Aabb,
+    inv_area: f64,
+    k_t: f64,
+    k_i: f64,
+    lambda: f64,
+}
+
+impl SahModel {
+    /// The model for splitting `cell`; `None` if the cell has no area.
+    pub fn new(cell: Aabb, p: &BuildParams) -> Option<Self> {
+        let area = cell.surface_area();
+        (area > 0.0).then(|| Self {
+            cell,
+            inv_area: 1.0 / area,
+            k_t: p.traversal_cost as f64,
+            k_i: p.intersection_cost as f64,
+            lambda: 1.0 - p.empty_bonus as f64,
+        })
+    }
+
+    /// Cost of a leaf with `n` triangles.
+    pub fn leaf_cost(&self, n: usize) -> f64 {
+        self.k_i * n as f64
+    }
+
+    /// Cost of splitting at `axis = pos` with `nl`, `nr` triangles on each
+    /// side; `None` for a plane that makes no progress (it cuts off an empty
+    /// zero-volume slab at the cell's face).
+    #[inline]
+    pub fn cost(&self, axis: usize, pos: f32, nl: usize, nr: usize) -> Option<f64> {
+        let at_min = pos <= self.cell.min[axis];
+        let at_max = pos >= self.cell.max[axis];
+        if (at_min && nl == 0) || (at_max && nr == 0) {
+            return None;
+        }
+        let (l, r) = self.cell.split(axis, pos);
+        let pl = l.surface_area() * self.inv_area;
+        let pr = r.surface_area() * self.inv_area;
+        let c = self.k_t + self.k_i * (pl * nl as f64 + pr * nr as f64);
+        // Bonus for cutting off empty space, but not for a flat empty side.
+        let bonus = (nl == 0 || nr == 0) && !at_min && !at_max;
+        Some(if bonus { self.lambda * c } else { c })
+    }
+
+    /// The better of the two placements of `np` planar triangles.
+    #[inline]
+    pub fn best_planar(
+        &self,
+        axis: usize,
+        pos: f32,
+        nl: usize,
+        np: usize,
+        nr: usize,
+    ) -> Option<Split> {
+        let left = self.cost(axis, pos, nl + np, nr);
+        let right = self.cost(axis, pos, nl, nr + np);
+        let pick = match (left, right) {
+            (Some(a), Some(b)) if a <= b => Some((a, PlanarSide::Left)),
+            (_, Some(b)) => Some((b, PlanarSide::Right)),
+            (Some(a), None) => Some((a, PlanarSide::Left)),
+            (None, None) => None,
+        };
+        pick.map(|(cost, planar)| Split {
+            axis,
+            pos,
+            planar,
+            cost,
+        })
+    }
+}

@@ -1,0 +1,49 @@
+//! Tree construction: one entry point, [`KdTree::build`], and one module per
+//! algorithm.
+
+pub mod binned;
+pub mod cost;
+pub mod naive;
+pub mod params;
+pub mod partition;
+pub mod sah_sweep;
+pub mod subtree;
+
+pub use params::{AxisRule, BuildParams, Builder, PositionRule};
+
+use crate::geometry::{Aabb, Triangle};
+use crate::tree::KdTree;
+
+impl KdTree {
+    /// Build a tree over `triangles` (their indices are the ones hits report).
+    ///
+    /// Triangles with a non-finite coordinate are left out: no ray hits them.
+    pub fn build(triangles: Vec<Triangle>, params: &BuildParams) -> KdTree {
+        let live: Vec<u32> = (0..triangles.len() as u32)
+            .filter(|&i| triangles[i as usize].is_finite())
+            .collect();
+        let bounds = live
+            .iter()
+            .fold(Aabb::EMPTY, |b, &i| b.union(triangles[i as usize].bounds()));
+        let sub = if live.is_empty() {
+            subtree::Subtree::leaf(Vec::new(), &bounds, params)
+        } else {
+            match params.builder {
+                Builder::Sah => sah_sweep::build(&triangles, live, bounds, params),
+                Builder::Binned { bins } => {
+                    binned::build(&triangles, live, bounds, bins as usize, params)
+                }
+                Builder::Naive { axis, position } => {
+                    naive::build(&triangles, live, bounds, axis, position, params)
+                }
+            }
+        };
+        KdTree {
+            nodes: sub.nodes,
+            indices: sub.indices,
+            triangles,
+            bounds,
+            params: *params,
+        }
+    }
+}

@@ -1,0 +1,161 @@
+//! Build parameters shared by every builder.
+
+/// Which algorithm builds the tree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Builder {
+    /// Exact SAH by sorted event sweep, O(N log N), with split clipping
+    /// (Wald & Havran 2006).
+    Sah,
+    /// SAH evaluated at the boundaries of `bins` equal bins per axis.
+    Binned {
+        /// Bins per axis (16 is the lecture's "often enough").
+        bins: u32,
+    },
+    /// The "intuitive" baselines: a fixed axis rule and position rule,
+    /// stopping at `max_leaf_size` or `max_depth`.
+    Naive {
+        /// How the split axis is chosen.
+        axis: AxisRule,
+        /// Where the split plane goes.
+        position: PositionRule,
+    },
+}
+
+/// Split-axis rule of the naive builders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AxisRule {
+    /// x, y, z, x, ... by depth.
+    RoundRobin,
+    /// The cell's longest axis.
+    LargestExtent,
+}
+
+/// Split-position rule of the naive builders.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PositionRule {
+    /// The middle of the cell.
+    Middle,
+    /// The median of the triangles' (clipped) bounding-box centres.
+    Median,
+}
+
+impl Builder {
+    /// Every builder, for comparisons and tests.
+    pub const ALL: [Builder; 6] = [
+        Builder::Sah,
+        Builder::Binned { bins: 16 },
+        Builder::Naive {
+            axis: AxisRule::RoundRobin,
+            position: PositionRule::Middle,
+        },
+        Builder::Naive {
+            axis: AxisRule::RoundRobin,
+            position: PositionRule::Median,
+        },
+        Builder::Naive {
+            axis: AxisRule::LargestExtent,
+            position: PositionRule::Middle,
+        },
+        Builder::Naive {
+            axis: AxisRule::LargestExtent,
+            position: PositionRule::Median,
+        },
+    ];
+
+    /// A short name (`sah`, `binned`, `rr-middle`, ...).
+    pub fn name(&self) -> String {
+        match self {
+            Builder::Sah => "sah".into(),
+            Builder::Binned { bins: 16 } => "binned".into(),
+            Builder::Binned { bins } => format!("binned{bins}"),
+            Builder::Naive { axis, position } => {
+                let a = match axis {
+                    AxisRule::RoundRobin => "rr",
+                    AxisRule::LargestExtent => "largest",
+                };
+                let p = match position {
+                    PositionRule::Middle => "middle",
+                    PositionRule::Median => "median",
+                };
+                format!("{a}-{p}")
+            }
+        }
+    }
+
+    /// Parse a name given by [`Builder::name`]; `median` and `middle` alone
+    /// mean the largest-extent variants, `binnedN` sets the bin count.
+    pub fn parse(s: &str) -> Option<Builder> {
+        let naive = |axis, position| Some(Builder::Naive { axis, position });
+        match s {
+            "sah" => Some(Builder::Sah),
+            "binned" => Some(Builder::Binned { bins: 16 }),
+            "rr-middle" => naive(AxisRule::RoundRobin, PositionRule::Middle),
+            "rr-median" => naive(AxisRule::RoundRobin, PositionRule::Median),
+            "largest-middle" | "middle" => naive(AxisRule::LargestExtent, PositionRule::Middle),
+            "largest-median" | "median" => naive(AxisRule::LargestExtent, PositionRule::Median),
+            _ => {
+                let bins: u32 = s.strip_prefix("binned")?.parse().ok()?;
+                (2..=1024)
+                    .contains(&bins)
+                    .then_some(Builder::Binned { bins })
+            }
+        }
+    }
+}
+
+/// Parameters of a build.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuildParams {
+    /// The algorithm.
+    pub builder: Builder,
+    /// Cost of one traversal step, K_T, relative to `intersection_cost`.
+    pub traversal_cost: f32,
+    /// Cost of one ray/triangle test, K_I.
+    pub intersection_cost: f32,
+    /// Fraction of the split cost forgiven when one side is empty
+    /// (cutting off empty space; Wald & Havran's lambda = 1 - bonus).
+    pub empty_bonus: f32,
+    /// Depth cap; `None` means `8 + 1.3 log2 N` (pbrt-v3's rule).
+    pub max_depth: Option<u32>,
+    /// Naive builders make a leaf at this many triangles; the SAH builders
+    /// make one at or below it without evaluating splits.
+    pub max_leaf_size: u32,
+    /// Build subtrees in parallel on rayon's pool.
+    pub parallel: bool,
+}
+
+impl Default for BuildParams {
+    fn default() -> Self {
+        Self::new(Builder::Sah)
+    }
+}
+
+impl BuildParams {
+    /// Default parameters for a builder.
+    ///
+    /// K_T = 15, K_I = 20 and an empty bonus of 0.2 are Wald & Havran's
+    /// (2006, section 5) values.
+    pub fn new(builder: Builder) -> Self {
+        let max_leaf_size = match builder {
+            Builder::Naive { .. } => 4,
+            _ => 1,
+        };
+        Self {
+            builder,
+            traversal_cost: 15.0,
+            intersection_cost: 20.0,
+            empty_bonus: 0.2,
+            max_depth: None,
+            max_leaf_size,
+            parallel: true,
+        }
+    }
+
+    /// The depth cap for `n` triangles, clamped to the traversal stack.
+    pub fn depth_limit(&self, n: usize) -> u32 {
+        let d = self
+            .max_depth
+            .unwrap_or_else(|| (8.0 + 1.3 * (n.max(1) as f64).log2()).round() as u32);
+        d.min(crate::traverse::MAX_DEPTH as u32 - 1)
+    }
+}

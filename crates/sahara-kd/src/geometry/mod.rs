@@ -1,0 +1,10 @@
+//! Geometric primitives: rays, axis-aligned boxes, triangles and clipping.
+
+pub mod aabb;
+pub mod clip;
+pub mod ray;
+pub mod triangle;
+
+pub use aabb::Aabb;
+pub use ray::Ray;
+pub use triangle::{Triangle, TriangleHit};

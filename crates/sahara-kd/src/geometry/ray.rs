@@ -1,0 +1,55 @@
+//! Rays with a parametric interval.
+
+use glam::Vec3;
+
+/// A ray `o + t d` restricted to `t` in `[tmin, tmax]`.
+///
+/// The direction need not be normalised; `t` is measured in units of `d`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Origin.
+    pub origin: Vec3,
+    /// Direction (not necessarily unit length, must not be zero).
+    pub dir: Vec3,
+    /// Smallest accepted hit distance.
+    pub tmin: f32,
+    /// Largest accepted hit distance (may be `f32::INFINITY`).
+    pub tmax: f32,
+}
+
+impl Ray {
+    /// A ray over `[0, inf)`.
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        Self {
+            origin,
+            dir,
+            tmin: 0.0,
+            tmax: f32::INFINITY,
+        }
+    }
+
+    /// A ray over `[tmin, tmax]`.
+    pub fn with_interval(origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Self {
+        Self {
+            origin,
+            dir,
+            tmin,
+            tmax,
+        }
+    }
+
+    /// The point at parameter `t`.
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+
+    /// True when the ray can be traced: finite origin, finite non-zero
+    /// direction, and an interval that is not NaN.
+    pub fn is_valid(&self) -> bool {
+        self.origin.is_finite()
+            && self.dir.is_finite()
+            && self.dir != Vec3::ZERO
+            && !self.tmin.is_nan()
+            && !self.tmax.is_nan()
+    }
+}

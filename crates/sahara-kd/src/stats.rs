@@ -1,0 +1,101 @@
+//! Statistics of a finished tree, including its true SAH cost.
+
+use crate::tree::KdTree;
+
+/// Shape, size and cost of a tree.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TreeStats {
+    /// Triangles given to the build.
+    pub triangles: usize,
+    /// All nodes.
+    pub nodes: usize,
+    /// Inner nodes.
+    pub inner: usize,
+    /// Leaves, empty ones included.
+    pub leaves: usize,
+    /// Leaves with no triangle.
+    pub empty_leaves: usize,
+    /// Depth of the deepest leaf (the root has depth 0).
+    pub max_depth: u32,
+    /// Mean depth over all leaves.
+    pub mean_leaf_depth: f64,
+    /// Mean triangle count over non-empty leaves.
+    pub mean_leaf_triangles: f64,
+    /// Largest leaf.
+    pub max_leaf_triangles: usize,
+    /// Triangle references stored in leaves.
+    pub references: usize,
+    /// References per referenced triangle (1 = no duplication).
+    pub duplication: f64,
+    /// Bytes of nodes + index array + triangle data.
+    pub memory_bytes: usize,
+    /// The tree's SAH cost with its build's K_T and K_I:
+    /// `sum_inner SA/SA_root K_T + sum_leaves SA/SA_root K_I n`.
+    pub sah_cost: f64,
+    /// What the SAH predicts a ray meeting the root visits (no early exit):
+    /// inner nodes `sum_inner SA/SA_root`.
+    pub expected_inner: f64,
+    /// Leaves: `sum_leaves SA/SA_root`.
+    pub expected_leaves: f64,
+    /// Triangle tests: `sum_leaves SA/SA_root n`.
+    pub expected_triangles: f64,
+}
+
+impl KdTree {
+    /// Compute the statistics (one pass over the nodes).
+    pub fn stats(&self) -> TreeStats {
+        let mut s = TreeStats {
+            triangles: self.triangles.len(),
+            ..Default::default()
+        };
+        let root_area = self.bounds.surface_area();
+        let inv_root = if root_area > 0.0 {
+            1.0 / root_area
+        } else {
+            0.0
+        };
+        let (k_t, k_i) = (
+            self.params.traversal_cost as f64,
+            self.params.intersection_cost as f64,
+        );
+        let mut depth_sum = 0u64;
+        let mut referenced = vec![false; self.triangles.len()];
+        self.visit(|_, n, cell, depth| {
+            s.nodes += 1;
+            let p = cell.surface_area() * inv_root;
+            if n.is_leaf() {
+                let c = n.leaf_count() as usize;
+                s.leaves += 1;
+                s.empty_leaves += (c == 0) as usize;
+                s.max_depth = s.max_depth.max(depth);
+                s.max_leaf_triangles = s.max_leaf_triangles.max(c);
+                depth_sum += depth as u64;
+                s.references += c;
+                s.expected_leaves += p;
+                s.expected_triangles += p * c as f64;
+                for &t in self.leaf_triangles(n) {
+                    referenced[t as usize] = true;
+                }
+            } else {
+                s.inner += 1;
+                s.expected_inner += p;
+            }
+        });
+        if root_area == 0.0 {
+            // A degenerate root (a point or a segment): one leaf, visited by
+            // every ray that reaches it.
+            s.expected_leaves = 1.0;
+            s.expected_triangles = s.references as f64;
+        }
+        s.sah_cost = s.expected_inner * k_t + s.expected_triangles * k_i;
+        s.mean_leaf_depth = depth_sum as f64 / s.leaves.max(1) as f64;
+        let non_empty = s.leaves - s.empty_leaves;
+        s.mean_leaf_triangles = s.references as f64 / non_empty.max(1) as f64;
+        let distinct = referenced.iter().filter(|&&r| r).count();
+        s.duplication = s.references as f64 / distinct.max(1) as f64;
+        s.memory_bytes = std::mem::size_of_val(self.nodes.as_slice())
+            + std::mem::size_of_val(self.indices.as_slice())
+            + std::mem::size_of_val(self.triangles.as_slice());
+        s
+    }
+}

@@ -1,0 +1,301 @@
+//! Front-to-back traversal: closest hit and any hit, single rays and batches.
+//!
+//! The scheme is Havran's sequential traversal with a stack of far children
+//! (Havran 2000, "Heuristic Ray Shooting Algorithms", as used by pbrt-v3's
+//! `KdTreeAccel::Intersect`): walk down to the near child, push the far one
+//! with its parametric interval, test the leaf, pop. A cell whose entry
+//! distance lies beyond the closest hit found so far cannot hold a closer hit,
+//! so it is skipped.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use crate::geometry::triangle::RayShear;
+use crate::geometry::Ray;
+use crate::tree::KdTree;
+
+/// The closest hit of a ray: distance, triangle and barycentrics (hit point
+/// `(1 - u - v) v0 + u v1 + v v2`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter of the hit.
+    pub t: f32,
+    /// Index of the triangle, as given to the build.
+    pub tri: u32,
+    /// Barycentric weight of `v1`.
+    pub u: f32,
+    /// Barycentric weight of `v2`.
+    pub v: f32,
+}
+
+/// Relative slack on the traversal's distance comparisons.
+///
+/// Cell distances and triangle distances are rounded separately, so a
+/// triangle in the next cell may report a `t` a few ulps below the boundary
+/// it lies behind. Skipping a cell or a child only when it is farther than
+/// this margin keeps the result bit-identical to testing every triangle
+/// (what the brute-force oracle does); the price is an occasional extra leaf
+/// visit at a boundary. 2^-12 is ~500 ulps: far above the rounding of the
+/// watertight test on the test suite's scales, far below any cell size.
+const MARGIN: f32 = 1.0 / 4096.0;
+
+/// Depth bound of the traversal stack; builders never exceed it.
+pub const MAX_DEPTH: usize = 64;
+
+/// Per-ray work counters for `sahara bench --counters`.
+pub trait Counters {
+    /// An inner node was visited.
+    fn inner(&mut self);
+    /// A leaf was visited.
+    fn leaf(&mut self);
+    /// A ray/triangle test was made.
+    fn triangle(&mut self);
+}
+
+/// Counting nothing: the production traversal compiles to no counter code.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NoCounters;
+
+impl Counters for NoCounters {
+    #[inline(always)]
+    fn inner(&mut self) {}
+    #[inline(always)]
+    fn leaf(&mut self) {}
+    #[inline(always)]
+    fn triangle(&mut self) {}
+}
+
+/// Totals of traversal work over many rays.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraversalCounters {
+    /// Inner nodes visited.
+    pub inner: u64,
+    /// Leaves visited (empty ones included).
+    pub leaves: u64,
+    /// Ray/triangle tests.
+    pub triangles: u64,
+}
+
+impl Counters for TraversalCounters {
+    fn inner(&mut self) {
+        self.inner += 1;
+    }
+    fn leaf(&mut self) {
+        self.leaves += 1;
+    }
+    fn triangle(&mut self) {
+        self.triangles += 1;
+    }
+}
+
+impl std::ops::AddAssign for TraversalCounters {
+    fn add_assign(&mut self, o: Self) {
+        self.inner += o.inner;
+        self.leaves += o.leaves;
+        self.triangles += o.triangles;
+    }
+}
+
+#[derive(Clone, Copy, Default)]
+struct StackEntry {
+    node: u32,
+    t0: f32,
+    t1: f32,
+}
+
+/// What a leaf visit asks of the traversal.
+enum LeafResult {
+    Continue,
+    Stop,
+}
+
+impl KdTree {
+    /// The closest hit with `t` in `[ray.tmin, ray.tmax]`; among hits at the
+    /// same `t`, the one with the smallest triangle index.
+    pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        self.closest_hit_counted(ray, &mut NoCounters)
+    }
+
+    /// [`KdTree::closest_hit`], counting the work done.
+    pub fn closest_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
+        let shear = RayShear::from_ray(ray);
+        let mut best_t = ray.tmax;
+        let mut best = Hit {
+            t: f32::INFINITY,
+            tri: u32::MAX,
+            u: 0.0,
+            v: 0.0,
+        };
+        self.walk(ray, counters, |tree, tris, counters, best_t_out| {
+            for &i in tris {
+                counters.triangle();
+                // SAFETY of indexing: the builder stores only valid indices.
+                let tri = &tree.triangles[i as usize];
+                if let Some(h) = shear.intersect(tri, ray.tmin, best_t) {
+                    if h.t < best_t || i < best.tri {
+                        best_t = h.t;
+                        best = Hit {
+                            t: h.t,
+                            tri: i,
+                            u: h.u,
+                            v: h.v,
+                        };
+                    }
+                }
+            }
+            *best_t_out = if best.tri == u32::MAX {
+                f32::INFINITY
+            } else {
+                best_t
+            };
+            LeafResult::Continue
+        });
+        (best.tri != u32::MAX).then_some(best)
+    }
+
+    /// True if any triangle is hit with `t` in `[ray.tmin, ray.tmax]`
+    /// (occlusion; stops at the first hit found).
+    pub fn any_hit(&self, ray: &Ray) -> bool {
+        self.any_hit_counted(ray, &mut NoCounters)
+    }
+
+    /// [`KdTree::any_hit`], counting the work done.
+    pub fn any_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+        let shear = RayShear::from_ray(ray);
+        let mut found = false;
+        self.walk(ray, counters, |tree, tris, counters, _| {
+            for &i in tris {
+                counters.triangle();
+                if shear
+                    .intersect(&tree.triangles[i as usize], ray.tmin, ray.tmax)
+                    .is_some()
+                {
+                    found = true;
+                    return LeafResult::Stop;
+                }
+            }
+            LeafResult::Continue
+        });
+        found
+    }
+
+    /// Closest hits of many rays, in parallel; `out[i]` answers `rays[i]`.
+    pub fn closest_hits(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), out.len(), "one output slot per ray");
+        rays.par_iter()
+            .zip(out.par_iter_mut())
+            .with_min_len(256)
+            .for_each(|(r, o)| *o = self.closest_hit(r));
+    }
+
+    /// Occlusion of many rays, in parallel; `out[i]` answers `rays[i]`.
+    pub fn any_hits(&self, rays: &[Ray], out: &mut [bool]) {
+        assert_eq!(rays.len(), out.len(), "one output slot per ray");
+        rays.par_iter()
+            .zip(out.par_iter_mut())
+            .with_min_len(256)
+            .for_each(|(r, o)| *o = self.any_hit(r));
+    }
+
+    /// The traversal shared by both queries: visits the leaves the ray passes
+    /// through, front to back, calling `leaf` with their triangles.
+    ///
+    /// `leaf` reports the closest hit distance found so far through its last
+    /// argument (infinity while there is none); cells entered beyond it are
+    /// skipped.
+    #[inline(always)]
+    fn walk<C: Counters>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+        mut leaf: impl FnMut(&KdTree, &[u32], &mut C, &mut f32) -> LeafResult,
+    ) {
+        if self.nodes.is_empty() || !ray.is_valid() || !(ray.tmin <= ray.tmax) {
+            return;
+        }
+        let inv_dir = Vec3::ONE / ray.dir;
+        let Some((mut t0, mut t1)) = self
+            .bounds
+            .intersect_ray(ray.origin, inv_dir, ray.tmin, ray.tmax)
+        else {
+            return;
+        };
+        let origin = ray.origin.to_array();
+        let dir = ray.dir.to_array();
+        let inv = inv_dir.to_array();
+        let mut stack = [StackEntry::default(); MAX_DEPTH];
+        let mut sp = 0usize;
+        let mut node = 0u32;
+        let mut closest = f32::INFINITY;
+        loop {
+            let n = self.nodes[node as usize];
+            if !n.is_leaf() {
+                counters.inner();
+                let axis = n.axis();
+                let split = n.split();
+                let (o, d) = (origin[axis], dir[axis]);
+                let below = node + 1;
+                let above = n.above_child();
+                if o == split {
+                    // The origin lies on the plane: the ray is in the side it
+                    // moves into and touches the other one only at t = 0 (or
+                    // lies in the plane, d = 0, and touches both all along).
+                    let (near, far) = if d > 0.0 {
+                        (above, below)
+                    } else {
+                        (below, above)
+                    };
+                    if d == 0.0 || t0 <= 0.0 {
+                        stack[sp] = StackEntry { node: far, t0, t1 };
+                        sp += 1;
+                    }
+                    node = near;
+                    continue;
+                }
+                let (near, far) = if o < split {
+                    (below, above)
+                } else {
+                    (above, below)
+                };
+                // Never NaN here: split - o != 0. Infinite when d = 0.
+                let t_plane = (split - o) * inv[axis];
+                if t_plane < 0.0 || t_plane > t1 * (1.0 + MARGIN) {
+                    node = near;
+                } else if t_plane < t0 * (1.0 - MARGIN) {
+                    node = far;
+                } else {
+                    stack[sp] = StackEntry {
+                        node: far,
+                        t0: t_plane.min(t1),
+                        t1,
+                    };
+                    sp += 1;
+                    node = near;
+                    t1 = t_plane.max(t0);
+                }
+                continue;
+            }
+            counters.leaf();
+            let tris = self.leaf_triangles(&n);
+            if !tris.is_empty() {
+                if let LeafResult::Stop = leaf(self, tris, counters, &mut closest) {
+                    return;
+                }
+            }
+            // Pop the next cell that may still hold a closer hit.
+            loop {
+                if sp == 0 {
+                    return;
+                }
+                sp -= 1;
+                let e = stack[sp];
+                if e.t0 <= closest * (1.0 + MARGIN) {
+                    node = e.node;
+                    t0 = e.t0;
+                    t1 = e.t1;
+                    break;
+                }
+            }
+        }
+    }
+}

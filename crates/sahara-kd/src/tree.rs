@@ -1,0 +1,182 @@
+//! The finished tree: 8-byte nodes and the flat triangle-index array.
+
+use crate::build::BuildParams;
+use crate::geometry::{Aabb, Triangle};
+
+/// One kd-tree node in 8 bytes (the layout of pbrt-v3's `KdAccelNode`,
+/// itself after Havran's thesis).
+///
+/// The low two bits of `word1` are the split axis (0, 1, 2) or 3 for a leaf.
+/// - Inner node: `word0` is the split position (f32 bits); `word1 >> 2` is
+///   the index of the child above the plane. The child below the plane is the
+///   next node in the array (depth-first order).
+/// - Leaf: `word0` is the offset of its first entry in the index array;
+///   `word1 >> 2` is the number of triangles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(C)]
+pub struct Node {
+    word0: u32,
+    word1: u32,
+}
+
+const LEAF: u32 = 3;
+
+/// The largest child index or leaf size a node can encode (30 bits).
+pub const MAX_NODE_FIELD: u32 = (1 << 30) - 1;
+
+impl Node {
+    /// An inner node splitting `axis` at `pos`, its upper child at `above`.
+    #[inline]
+    pub fn inner(axis: usize, pos: f32, above: u32) -> Self {
+        debug_assert!(axis < 3 && above <= MAX_NODE_FIELD);
+        Self {
+            word0: pos.to_bits(),
+            word1: (above << 2) | axis as u32,
+        }
+    }
+
+    /// A leaf with `count` triangles starting at `offset` in the index array.
+    #[inline]
+    pub fn leaf(offset: u32, count: u32) -> Self {
+        debug_assert!(count <= MAX_NODE_FIELD);
+        Self {
+            word0: offset,
+            word1: (count << 2) | LEAF,
+        }
+    }
+
+    /// True for a leaf.
+    #[inline(always)]
+    pub fn is_leaf(&self) -> bool {
+        self.word1 & 3 == LEAF
+    }
+
+    /// Split axis of an inner node.
+    #[inline(always)]
+    pub fn axis(&self) -> usize {
+        (self.word1 & 3) as usize
+    }
+
+    /// Split position of an inner node.
+    #[inline(always)]
+    pub fn split(&self) -> f32 {
+        f32::from_bits(self.word0)
+    }
+
+    /// Index of the child above the split plane (inner nodes).
+    #[inline(always)]
+    pub fn above_child(&self) -> u32 {
+        self.word1 >> 2
+    }
+
+    /// Offset into the index array (leaves).
+    #[inline(always)]
+    pub fn leaf_offset(&self) -> u32 {
+        self.word0
+    }
+
+    /// Triangle count (leaves).
+    #[inline(always)]
+    pub fn leaf_count(&self) -> u32 {
+        self.word1 >> 2
+    }
+
+    /// This node with its child pointer or leaf offset moved by `delta`
+    /// (used when subtrees built apart are concatenated).
+    #[inline]
+    pub(crate) fn shifted(self, node_delta: u32, index_delta: u32) -> Self {
+        if self.is_leaf() {
+            Self {
+                word0: self.word0 + index_delta,
+                ..self
+            }
+        } else {
+            Self {
+                word1: self.word1 + (node_delta << 2),
+                ..self
+            }
+        }
+    }
+}
+
+/// A kd-tree over a triangle soup.
+///
+/// Build it with [`KdTree::build`]; query it with
+/// [`KdTree::closest_hit`] and [`KdTree::any_hit`] (see `traverse`).
+#[derive(Clone, Debug)]
+pub struct KdTree {
+    pub(crate) nodes: Vec<Node>,
+    pub(crate) indices: Vec<u32>,
+    pub(crate) triangles: Vec<Triangle>,
+    pub(crate) bounds: Aabb,
+    pub(crate) params: BuildParams,
+}
+
+impl KdTree {
+    /// The nodes, root first, in depth-first order.
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The leaves' triangle indices, one run per leaf.
+    pub fn indices(&self) -> &[u32] {
+        &self.indices
+    }
+
+    /// The triangles, indexed as given to the build.
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.triangles
+    }
+
+    /// The root cell: the bounds of all finite triangles.
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// The parameters the tree was built with.
+    pub fn params(&self) -> &BuildParams {
+        &self.params
+    }
+
+    /// The triangle indices of leaf `node`.
+    #[inline(always)]
+    pub fn leaf_triangles(&self, node: &Node) -> &[u32] {
+        let o = node.leaf_offset() as usize;
+        &self.indices[o..o + node.leaf_count() as usize]
+    }
+
+    /// Visit every node with its cell and depth (root depth 0), depth first.
+    pub fn visit(&self, mut f: impl FnMut(u32, &Node, &Aabb, u32)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack = vec![(0u32, self.bounds, 0u32)];
+        while let Some((i, cell, depth)) = stack.pop() {
+            let n = &self.nodes[i as usize];
+            f(i, n, &cell, depth);
+            if !n.is_leaf() {
+                let (lo, hi) = cell.split(n.axis(), n.split());
+                stack.push((n.above_child(), hi, depth + 1));
+                stack.push((i + 1, lo, depth + 1));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn node_is_eight_bytes_and_round_trips() {
+        assert_eq!(std::mem::size_of::<Node>(), 8);
+        let n = Node::inner(2, -1.5, 12345);
+        assert!(!n.is_leaf());
+        assert_eq!((n.axis(), n.split(), n.above_child()), (2, -1.5, 12345));
+        let l = Node::leaf(77, MAX_NODE_FIELD);
+        assert!(l.is_leaf());
+        assert_eq!((l.leaf_offset(), l.leaf_count()), (77, MAX_NODE_FIELD));
+        assert_eq!(n.shifted(5, 9).above_child(), 12350);
+        assert_eq!(l.shifted(5, 9).leaf_offset(), 86);
+    }
+}

@@ -1,0 +1,150 @@
+//! A structural validator for trees: used by the test suite on every builder.
+
+use glam::DVec3;
+
+use crate::geometry::{Aabb, Triangle};
+use crate::tree::KdTree;
+
+/// Check a tree's structure and coverage; the first problem found is
+/// returned as a message.
+///
+/// - Layout: nodes depth first, the child below the plane right after its
+///   parent, every node reached once, leaf ranges inside the index array,
+///   split planes inside their cells.
+/// - Coverage: every finite triangle that overlaps the interior of a leaf's
+///   cell is referenced by that leaf, and every referenced triangle touches
+///   the cell. ("Interior" shrinks the cell by 1e-5 of its extent on each
+///   axis that has one; a flat cell keeps its plane.)
+pub fn validate(tree: &KdTree) -> Result<(), String> {
+    let nodes = tree.nodes();
+    if nodes.is_empty() {
+        return Err("no root node".into());
+    }
+    let mut seen = vec![false; nodes.len()];
+    let mut err = None;
+    let mut leaves = Vec::new();
+    tree.visit(|i, n, cell, _| {
+        if err.is_some() {
+            return;
+        }
+        if std::mem::replace(&mut seen[i as usize], true) {
+            err = Some(format!("node {i} reached twice"));
+            return;
+        }
+        if n.is_leaf() {
+            let end = n.leaf_offset() as usize + n.leaf_count() as usize;
+            if end > tree.indices().len() {
+                err = Some(format!("leaf {i} indexes past the index array"));
+            } else if let Some(&t) = tree
+                .leaf_triangles(n)
+                .iter()
+                .find(|&&t| t as usize >= tree.triangles().len())
+            {
+                err = Some(format!(
+                    "leaf {i} references triangle {t} of {}",
+                    tree.triangles().len()
+                ));
+            } else {
+                leaves.push((i, *n, *cell));
+            }
+        } else {
+            let (a, p) = (n.axis(), n.split());
+            let above = n.above_child() as usize;
+            if above <= i as usize + 1 || above >= nodes.len() {
+                err = Some(format!(
+                    "node {i}: child above at {above} breaks the depth-first layout"
+                ));
+            } else if !(p >= cell.min[a] && p <= cell.max[a]) {
+                err = Some(format!(
+                    "node {i}: split {p} outside its cell [{}, {}] on axis {a}",
+                    cell.min[a], cell.max[a]
+                ));
+            }
+        }
+    });
+    if let Some(e) = err {
+        return Err(e);
+    }
+    if let Some(i) = seen.iter().position(|&s| !s) {
+        return Err(format!("node {i} is unreachable"));
+    }
+    for (i, n, cell) in leaves {
+        let refs = tree.leaf_triangles(&n);
+        let interior = shrink(&cell, 1e-5);
+        let outside = shrink(&cell, -1e-5);
+        for (t, tri) in tree.triangles().iter().enumerate() {
+            if !tri.is_finite() {
+                continue;
+            }
+            let referenced = refs.contains(&(t as u32));
+            if !referenced && overlaps(tri, &interior) {
+                return Err(format!(
+                    "leaf {i} (cell {cell:?}) misses triangle {t}, which overlaps it"
+                ));
+            }
+            if referenced && !overlaps(tri, &outside) {
+                return Err(format!(
+                    "leaf {i} (cell {cell:?}) references triangle {t}, which does not touch it"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The cell shrunk (`f > 0`) or grown (`f < 0`) by `f` of its extent on
+/// every axis with an extent; growth also pads flat axes.
+fn shrink(c: &Aabb, f: f64) -> (DVec3, DVec3) {
+    let (lo, hi) = (c.min.as_dvec3(), c.max.as_dvec3());
+    let e = hi - lo;
+    let scale = lo.abs().max(hi.abs()).max_element().max(e.max_element());
+    let d = DVec3::new(e.x, e.y, e.z) * f;
+    let pad = if f < 0.0 {
+        DVec3::splat(-f * scale)
+    } else {
+        DVec3::ZERO
+    };
+    (lo + d - pad, hi - d + pad)
+}
+
+/// Triangle / box overlap by the separating axis theorem (Akenine-Möller
+/// 2001), in f64; touching counts as overlapping.
+fn overlaps(tri: &Triangle, (lo, hi): &(DVec3, DVec3)) -> bool {
+    let c = (*lo + *hi) * 0.5;
+    let h = (*hi - *lo) * 0.5;
+    if h.min_element() < 0.0 {
+        return false;
+    }
+    let v = tri.v.map(|p| p.as_dvec3() - c);
+    // The box's face normals.
+    for a in 0..3 {
+        let (mn, mx) = (
+            v[0][a].min(v[1][a]).min(v[2][a]),
+            v[0][a].max(v[1][a]).max(v[2][a]),
+        );
+        if mn > h[a] || mx < -h[a] {
+            return false;
+        }
+    }
+    let e = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
+    let mut axes: Vec<DVec3> = vec![e[0].cross(e[1])];
+    for ei in e {
+        for a in [DVec3::X, DVec3::Y, DVec3::Z] {
+            axes.push(ei.cross(a));
+        }
+    }
+    for ax in axes {
+        if ax == DVec3::ZERO {
+            continue;
+        }
+        let p = v.map(|q| q.dot(ax));
+        let r = h.x * ax.x.abs() + h.y * ax.y.abs() + h.z * ax.z.abs();
+        let (mn, mx) = (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2]));
+        // A small relative slack keeps rounding from separating touching shapes.
+        let slack = 1e-12 * (r + mn.abs().max(mx.abs()));
+        if mn > r + slack || mx < -r - slack {
+            return false;
+        }
+    }
+    true
+}
