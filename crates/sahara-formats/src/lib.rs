@@ -1,1 +1,49 @@
 //! `sahara-formats`: files in, plain arrays out.
+//!
+//! Meshes come out as [`sahara_render::mesh::Mesh`]: one merged triangle list
+//! in file order, polygons fan-triangulated as `(v0, vi, vi+1)`, so triangle
+//! number `k` is the `k`-th triangle of the file after triangulation.
+
+#![warn(missing_docs)]
+
+pub mod camera;
+pub mod error;
+mod fan;
+pub mod obj;
+pub mod ply;
+
+use std::path::{Path, PathBuf};
+
+use sahara_render::mesh::Mesh;
+
+pub use error::FormatError;
+
+/// Loads a mesh, choosing the format by extension (`.obj` or `.ply`, any case).
+pub fn load_mesh(path: &Path) -> Result<Mesh, FormatError> {
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match extension.as_str() {
+        "obj" => obj::load_obj(path),
+        "ply" => ply::load_ply(path),
+        _ => Err(FormatError::UnsupportedExtension {
+            path: path.display().to_string(),
+            extension,
+        }),
+    }
+}
+
+/// The shared scene folder: `$SAHARA_SCENES` if set, else `shared/scenes` beside the workspace.
+pub fn scenes_dir() -> PathBuf {
+    match std::env::var_os("SAHARA_SCENES") {
+        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
+        _ => {
+            let dir = Path::new(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../../shared/scenes"
+            ));
+            dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf())
+        }
+    }
+}

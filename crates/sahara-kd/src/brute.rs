@@ -1,4 +1,5 @@
-//! The brute-force oracle: every query answered by testing every triangle.
+//! The brute-force oracle: every query answered by testing every triangle
+//! (every hittable one: see [`Triangle::is_hittable`]).
 //!
 //! It uses the same watertight test and the same tie-breaking as the tree
 //! (smallest `t`, then smallest triangle index), so a correct tree returns
@@ -17,7 +18,7 @@ pub fn closest_hit(triangles: &[Triangle], ray: &Ray) -> Option<Hit> {
     let mut best: Option<Hit> = None;
     let mut best_t = ray.tmax;
     for (i, tri) in triangles.iter().enumerate() {
-        if !tri.is_finite() {
+        if !tri.is_hittable() {
             continue;
         }
         if let Some(h) = shear.intersect(tri, ray.tmin, best_t) {
@@ -43,5 +44,5 @@ pub fn any_hit(triangles: &[Triangle], ray: &Ray) -> bool {
     let shear = RayShear::from_ray(ray);
     triangles
         .iter()
-        .any(|tri| tri.is_finite() && shear.intersect(tri, ray.tmin, ray.tmax).is_some())
+        .any(|tri| tri.is_hittable() && shear.intersect(tri, ray.tmin, ray.tmax).is_some())
 }

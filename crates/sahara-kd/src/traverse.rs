@@ -210,7 +210,8 @@ impl KdTree {
         counters: &mut C,
         mut leaf: impl FnMut(&KdTree, &[u32], &mut C, &mut f32) -> LeafResult,
     ) {
-        if self.nodes.is_empty() || !ray.is_valid() || !(ray.tmin <= ray.tmax) {
+        // `is_valid` rules out NaN bounds, so `>` is the whole test.
+        if self.nodes.is_empty() || !ray.is_valid() || ray.tmin > ray.tmax {
             return;
         }
         let inv_dir = Vec3::ONE / ray.dir;

@@ -128,7 +128,7 @@ impl KdTree {
         &self.triangles
     }
 
-    /// The root cell: the bounds of all finite triangles.
+    /// The root cell: the bounds of all hittable triangles.
     pub fn bounds(&self) -> Aabb {
         self.bounds
     }

@@ -11,7 +11,7 @@ use crate::tree::KdTree;
 /// - Layout: nodes depth first, the child below the plane right after its
 ///   parent, every node reached once, leaf ranges inside the index array,
 ///   split planes inside their cells.
-/// - Coverage: every finite triangle that overlaps the interior of a leaf's
+/// - Coverage: every hittable triangle that overlaps the interior of a leaf's
 ///   cell is referenced by that leaf, and every referenced triangle touches
 ///   the cell. ("Interior" shrinks the cell by 1e-5 of its extent on each
 ///   axis that has one; a flat cell's interior is the inside of its plane
@@ -74,7 +74,7 @@ pub fn validate(tree: &KdTree) -> Result<(), String> {
         let interior = shrink(&cell, 1e-5);
         let outside = shrink(&cell, -1e-5);
         for (t, tri) in tree.triangles().iter().enumerate() {
-            if !tri.is_finite() {
+            if !tri.is_hittable() {
                 continue;
             }
             let referenced = refs.contains(&(t as u32));

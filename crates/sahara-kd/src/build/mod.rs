@@ -17,10 +17,11 @@ use crate::tree::KdTree;
 impl KdTree {
     /// Build a tree over `triangles` (their indices are the ones hits report).
     ///
-    /// Triangles with a non-finite coordinate are left out: no ray hits them.
+    /// Triangles with a non-finite coordinate or zero area are left out: no
+    /// ray hits them (see [`Triangle::is_hittable`]).
     pub fn build(triangles: Vec<Triangle>, params: &BuildParams) -> KdTree {
         let live: Vec<u32> = (0..triangles.len() as u32)
-            .filter(|&i| triangles[i as usize].is_finite())
+            .filter(|&i| triangles[i as usize].is_hittable())
             .collect();
         let bounds = live
             .iter()

@@ -281,7 +281,7 @@ fn child(
         sort_events(&mut fresh, big);
         let kept = w.events[axis].iter().filter_map(|e| {
             let r = remap[e.tri() as usize];
-            (r != DROPPED && side[e.tri() as usize] == keep).then(|| Event {
+            (r != DROPPED && side[e.tri() as usize] == keep).then_some(Event {
                 pos: e.pos,
                 key: (e.key & !TRI_MASK) | r,
             })

@@ -54,6 +54,23 @@ impl Triangle {
         self.v.iter().all(|p| p.is_finite())
     }
 
+    /// True if the triangle can be hit: finite coordinates and a non-zero
+    /// area. Only such triangles are stored in trees or hit by the oracle.
+    ///
+    /// A zero-area triangle (repeated or collinear vertices) has edge
+    /// functions that are pure rounding noise, so the watertight test can
+    /// report a "hit" with an arbitrary `t` on it; leaving such triangles out
+    /// everywhere keeps every query well defined. The cross product is taken
+    /// in f64, where it is exactly zero for exactly collinear f32 vertices
+    /// (the two products of each component are equal and round alike).
+    pub fn is_hittable(&self) -> bool {
+        if !self.is_finite() {
+            return false;
+        }
+        let [a, b, c] = self.v.map(|p| p.as_dvec3());
+        (b - a).cross(c - a) != glam::DVec3::ZERO
+    }
+
     /// Twice the area (length of the edge cross product).
     pub fn double_area(&self) -> f32 {
         (self.v[1] - self.v[0])

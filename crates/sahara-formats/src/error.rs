@@ -1,0 +1,93 @@
+//! The one error type of this crate: what went wrong, in which file, where.
+//!
+//! Every message is a single line of the form `<file>: <where>: <what>` so a
+//! person can go straight to the offending spot.
+
+use std::io;
+use std::path::Path;
+
+/// Why a file could not be loaded; `Display` is one actionable line naming the file.
+#[derive(Debug, thiserror::Error)]
+pub enum FormatError {
+    /// The file could not be opened or read.
+    #[error("{path}: cannot read the file: {source}")]
+    Io {
+        /// The file, as given by the caller.
+        path: String,
+        /// What the operating system said.
+        #[source]
+        source: io::Error,
+    },
+    /// A problem at a 1-based line of a text file (or of a PLY header).
+    #[error("{path}: line {line}: {message}")]
+    AtLine {
+        /// The file, as given by the caller.
+        path: String,
+        /// 1-based line number.
+        line: usize,
+        /// What was wrong.
+        message: String,
+    },
+    /// A problem at a 0-based byte offset (from the start of the file) of binary data.
+    #[error("{path}: byte {offset}: {message}")]
+    AtByte {
+        /// The file, as given by the caller.
+        path: String,
+        /// 0-based byte offset from the start of the file.
+        offset: u64,
+        /// What was wrong.
+        message: String,
+    },
+    /// A problem that could not be pinned to a line or byte (the message says why).
+    #[error("{path}: {message}")]
+    InFile {
+        /// The file, as given by the caller.
+        path: String,
+        /// What was wrong.
+        message: String,
+    },
+    /// `load_mesh` was given a file whose extension is not a mesh format it knows.
+    #[error("{path}: unsupported mesh file extension {extension:?}; expected .obj or .ply")]
+    UnsupportedExtension {
+        /// The file, as given by the caller.
+        path: String,
+        /// The extension found ("" if there is none).
+        extension: String,
+    },
+}
+
+impl FormatError {
+    /// An I/O error while reading `path`.
+    pub fn io(path: &Path, source: io::Error) -> Self {
+        FormatError::Io {
+            path: path.display().to_string(),
+            source,
+        }
+    }
+
+    /// A problem at 1-based `line` of the file called `path`.
+    pub fn at_line(path: &str, line: usize, message: impl Into<String>) -> Self {
+        FormatError::AtLine {
+            path: path.to_owned(),
+            line,
+            message: message.into(),
+        }
+    }
+
+    /// A problem at 0-based byte `offset` of the file called `path`.
+    pub fn at_byte(path: &str, offset: u64, message: impl Into<String>) -> Self {
+        FormatError::AtByte {
+            path: path.to_owned(),
+            offset,
+            message: message.into(),
+        }
+    }
+
+    /// A problem in the file called `path` that has no known position.
+    pub fn in_file(path: &str, message: impl Into<String>) -> Self {
+        FormatError::InFile {
+            path: path.to_owned(),
+            message: message.into(),
+        }
+    }
+}

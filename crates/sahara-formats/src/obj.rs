@@ -1,0 +1,153 @@
+//! Wavefront OBJ meshes, read with `tobj`.
+//!
+//! All objects, groups and material runs are merged into one mesh in file
+//! order. Polygons are fan-triangulated here as `(v0, vi, vi+1)` (tobj is asked
+//! not to triangulate, so the order is ours, not tobj's). Relative (negative)
+//! indices work. Points (`p`, and `f` with fewer than three corners) and
+//! polylines (`l`) give no triangles. Materials (`mtllib`) are not read.
+//!
+//! `positions` are not the file's `v` list verbatim: tobj compacts them per
+//! object in first-use order, so unreferenced vertices are dropped and vertices
+//! shared by two objects appear twice. Triangle corner coordinates are exactly
+//! the file's.
+
+mod locate;
+
+use std::borrow::Cow;
+use std::fs;
+use std::path::Path;
+
+use glam::Vec3;
+use sahara_render::mesh::Mesh;
+
+use crate::error::FormatError;
+use crate::fan::fan_triangulate;
+
+/// Loads an OBJ file; errors name the file and, when it can be found, the line.
+pub fn load_obj(path: &Path) -> Result<Mesh, FormatError> {
+    let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
+    parse_obj(&bytes, &path.display().to_string())
+}
+
+/// Parses an OBJ file held in memory; `name` is used in error messages.
+pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, FormatError> {
+    // Another crate enabling tobj's `merging`/`reordering` features adds
+    // fields to LoadOptions; the struct update keeps them at their defaults.
+    #[allow(clippy::needless_update)]
+    let options = tobj::LoadOptions {
+        single_index: false,
+        triangulate: false,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let source = without_polylines(bytes);
+    let (models, _materials) = tobj::load_obj_buf(&mut &source[..], &options, |_| {
+        Ok((Vec::new(), Default::default()))
+    })
+    .map_err(|e| locate::describe(bytes, name, e))?;
+    merge(&models, name)
+}
+
+/// `bytes` with every `l` (polyline) statement turned into a comment.
+///
+/// tobj parses `l` like `f`, so a polyline with three or more points would
+/// otherwise become a polygon. Line structure is kept, so line numbers hold.
+fn without_polylines(bytes: &[u8]) -> Cow<'_, [u8]> {
+    let mut out: Option<Vec<u8>> = None;
+    let mut start = 0;
+    for line in bytes.split(|&b| b == b'\n') {
+        if let Some(i) = line.iter().position(|b| !b.is_ascii_whitespace()) {
+            let is_polyline =
+                line[i] == b'l' && line.get(i + 1).is_none_or(|b| b.is_ascii_whitespace());
+            if is_polyline {
+                out.get_or_insert_with(|| bytes.to_vec())[start + i] = b'#';
+            }
+        }
+        start += line.len() + 1;
+    }
+    out.map_or(Cow::Borrowed(bytes), Cow::Owned)
+}
+
+/// Concatenates tobj's models into one fan-triangulated mesh, checking every index.
+fn merge(models: &[tobj::Model], name: &str) -> Result<Mesh, FormatError> {
+    let inconsistent = |what: String| {
+        FormatError::in_file(
+            name,
+            format!("tobj returned inconsistent data ({what}); please report this file"),
+        )
+    };
+    let mut mesh = Mesh::default();
+    mesh.positions
+        .reserve(models.iter().map(|m| m.mesh.positions.len() / 3).sum());
+    mesh.indices
+        .reserve(models.iter().map(|m| m.mesh.indices.len() / 3).sum());
+    let mut polygon = Vec::new();
+    for model in models {
+        let m = &model.mesh;
+        let base = mesh.positions.len();
+        let count = m.positions.len() / 3;
+        if base + count > u32::MAX as usize {
+            return Err(FormatError::in_file(
+                name,
+                format!(
+                    "more than {} vertices; Sahara's meshes use 32-bit indices",
+                    u32::MAX
+                ),
+            ));
+        }
+        mesh.positions.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|p| Vec3::new(p[0], p[1], p[2])),
+        );
+        let global = |i: u32| {
+            if (i as usize) < count {
+                Ok(base as u32 + i)
+            } else {
+                Err(inconsistent(format!(
+                    "object '{}' has index {i} but {count} positions",
+                    model.name
+                )))
+            }
+        };
+        // tobj leaves face_arities empty when every face is a triangle.
+        let triangles_only = m.face_arities.is_empty();
+        if triangles_only && m.indices.len() % 3 != 0 {
+            return Err(inconsistent(format!(
+                "object '{}' has {} indices and no face sizes",
+                model.name,
+                m.indices.len()
+            )));
+        }
+        let implied_triangles = if triangles_only {
+            m.indices.len() / 3
+        } else {
+            0
+        };
+        let face_sizes =
+            std::iter::repeat_n(3, implied_triangles).chain(m.face_arities.iter().copied());
+        let mut at = 0;
+        for n in face_sizes {
+            let face = m.indices.get(at..at + n as usize).ok_or_else(|| {
+                inconsistent(format!(
+                    "object '{}' face sizes exceed its indices",
+                    model.name
+                ))
+            })?;
+            at += n as usize;
+            polygon.clear();
+            for &i in face {
+                polygon.push(global(i)?);
+            }
+            fan_triangulate(&polygon, &mut mesh.indices);
+        }
+        if at != m.indices.len() {
+            return Err(inconsistent(format!(
+                "object '{}' has indices beyond its face sizes",
+                model.name
+            )));
+        }
+    }
+    Ok(mesh)
+}
