@@ -41,11 +41,11 @@ pub struct TreeStats {
     pub expected_triangles: f64,
 }
 
-impl KdTree {
+impl<P> KdTree<P> {
     /// Compute the statistics (one pass over the nodes).
     pub fn stats(&self) -> TreeStats {
         let mut s = TreeStats {
-            triangles: self.triangles.len(),
+            triangles: self.prims.len(),
             ..Default::default()
         };
         let root_area = self.bounds.surface_area();
@@ -59,7 +59,7 @@ impl KdTree {
             self.params.intersection_cost as f64,
         );
         let mut depth_sum = 0u64;
-        let mut referenced = vec![false; self.triangles.len()];
+        let mut referenced = vec![false; self.prims.len()];
         self.visit(|_, n, cell, depth| {
             s.nodes += 1;
             let p = cell.surface_area() * inv_root;
@@ -73,7 +73,7 @@ impl KdTree {
                 s.references += c;
                 s.expected_leaves += p;
                 s.expected_triangles += p * c as f64;
-                for &t in self.leaf_triangles(n) {
+                for &t in self.leaf_primitives(n) {
                     referenced[t as usize] = true;
                 }
             } else {
@@ -95,7 +95,7 @@ impl KdTree {
         s.duplication = s.references as f64 / distinct.max(1) as f64;
         s.memory_bytes = std::mem::size_of_val(self.nodes.as_slice())
             + std::mem::size_of_val(self.indices.as_slice())
-            + std::mem::size_of_val(self.triangles.as_slice());
+            + std::mem::size_of_val(self.prims.as_slice());
         s
     }
 }

@@ -11,7 +11,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use crate::geometry::triangle::RayShear;
-use crate::geometry::Ray;
+use crate::geometry::{Aabb, Ray, Triangle};
 use crate::tree::KdTree;
 
 /// The closest hit of a ray: distance, triangle and barycentrics (hit point
@@ -109,7 +109,7 @@ enum LeafResult {
     Stop,
 }
 
-impl KdTree {
+impl KdTree<Triangle> {
     /// The closest hit with `t` in `[ray.tmin, ray.tmax]`; among hits at the
     /// same `t`, the one with the smallest triangle index.
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
@@ -126,11 +126,11 @@ impl KdTree {
             u: 0.0,
             v: 0.0,
         };
-        self.walk(ray, counters, |tree, tris, counters, best_t_out| {
+        self.walk(ray, counters, |tris, counters, best_t_out| {
             for &i in tris {
                 counters.triangle();
                 // SAFETY of indexing: the builder stores only valid indices.
-                let tri = &tree.triangles[i as usize];
+                let tri = &self.prims[i as usize];
                 if let Some(h) = shear.intersect(tri, ray.tmin, best_t) {
                     if h.t < best_t || i < best.tri {
                         best_t = h.t;
@@ -163,11 +163,11 @@ impl KdTree {
     pub fn any_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
         let shear = RayShear::from_ray(ray);
         let mut found = false;
-        self.walk(ray, counters, |tree, tris, counters, _| {
+        self.walk(ray, counters, |tris, counters, _| {
             for &i in tris {
                 counters.triangle();
                 if shear
-                    .intersect(&tree.triangles[i as usize], ray.tmin, ray.tmax)
+                    .intersect(&self.prims[i as usize], ray.tmin, ray.tmax)
                     .is_some()
                 {
                     found = true;
@@ -196,7 +196,58 @@ impl KdTree {
             .with_min_len(256)
             .for_each(|(r, o)| *o = self.any_hit(r));
     }
+}
 
+impl KdTree<Aabb> {
+    /// Closest hit over the boxes' contents: `hit(i, tmax)` intersects
+    /// object `i` and returns its hit distance if it is at most `tmax`.
+    /// Objects are offered front to back, cell by cell; the traversal stops
+    /// once no cell ahead can hold a closer hit. Returns the closest object
+    /// and its distance. An object that spans several cells may be offered
+    /// more than once.
+    pub fn closest_with(
+        &self,
+        ray: &Ray,
+        mut hit: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<(u32, f32)> {
+        let mut best: Option<(u32, f32)> = None;
+        let mut best_t = ray.tmax;
+        self.walk(ray, &mut NoCounters, |items, _, closest| {
+            for &i in items {
+                if let Some(t) = hit(i, best_t) {
+                    if t <= best_t && best.is_none_or(|(bi, bt)| t < bt || (t == bt && i < bi)) {
+                        best_t = t;
+                        best = Some((i, t));
+                    }
+                }
+            }
+            *closest = if best.is_some() {
+                best_t
+            } else {
+                f32::INFINITY
+            };
+            LeafResult::Continue
+        });
+        best
+    }
+
+    /// True if `hit(i)` is true for an object whose box the ray passes
+    /// through; stops at the first.
+    pub fn any_with(&self, ray: &Ray, mut hit: impl FnMut(u32) -> bool) -> bool {
+        let mut found = false;
+        self.walk(ray, &mut NoCounters, |items, _, _| {
+            if items.iter().any(|&i| hit(i)) {
+                found = true;
+                LeafResult::Stop
+            } else {
+                LeafResult::Continue
+            }
+        });
+        found
+    }
+}
+
+impl<P> KdTree<P> {
     /// The traversal shared by both queries: visits the leaves the ray passes
     /// through, front to back, calling `leaf` with their triangles.
     ///
@@ -208,7 +259,7 @@ impl KdTree {
         &self,
         ray: &Ray,
         counters: &mut C,
-        mut leaf: impl FnMut(&KdTree, &[u32], &mut C, &mut f32) -> LeafResult,
+        mut leaf: impl FnMut(&[u32], &mut C, &mut f32) -> LeafResult,
     ) {
         // `is_valid` rules out NaN bounds, so `>` is the whole test.
         if self.nodes.is_empty() || !ray.is_valid() || ray.tmin > ray.tmax {
@@ -277,9 +328,9 @@ impl KdTree {
                 continue;
             }
             counters.leaf();
-            let tris = self.leaf_triangles(&n);
+            let tris = self.leaf_primitives(&n);
             if !tris.is_empty() {
-                if let LeafResult::Stop = leaf(self, tris, counters, &mut closest) {
+                if let LeafResult::Stop = leaf(tris, counters, &mut closest) {
                     return;
                 }
             }

@@ -99,20 +99,21 @@ impl Node {
     }
 }
 
-/// A kd-tree over a triangle soup.
+/// A kd-tree over primitives: triangles by default.
 ///
-/// Build it with [`KdTree::build`]; query it with
-/// [`KdTree::closest_hit`] and [`KdTree::any_hit`] (see `traverse`).
+/// Build it with [`KdTree::build`]; query a triangle tree with
+/// [`KdTree::closest_hit`] and [`KdTree::any_hit`], a [`BoxTree`] with
+/// closures (see `traverse`).
 #[derive(Clone, Debug)]
-pub struct KdTree {
+pub struct KdTree<P = Triangle> {
     pub(crate) nodes: Vec<Node>,
     pub(crate) indices: Vec<u32>,
-    pub(crate) triangles: Vec<Triangle>,
+    pub(crate) prims: Vec<P>,
     pub(crate) bounds: Aabb,
     pub(crate) params: BuildParams,
 }
 
-impl KdTree {
+impl<P> KdTree<P> {
     /// The nodes, root first, in depth-first order.
     pub fn nodes(&self) -> &[Node] {
         &self.nodes
@@ -123,9 +124,9 @@ impl KdTree {
         &self.indices
     }
 
-    /// The triangles, indexed as given to the build.
-    pub fn triangles(&self) -> &[Triangle] {
-        &self.triangles
+    /// The primitives, indexed as given to the build.
+    pub fn primitives(&self) -> &[P] {
+        &self.prims
     }
 
     /// The root cell: the bounds of all hittable triangles.
@@ -138,9 +139,9 @@ impl KdTree {
         &self.params
     }
 
-    /// The triangle indices of leaf `node`.
+    /// The primitive indices of leaf `node`.
     #[inline(always)]
-    pub fn leaf_triangles(&self, node: &Node) -> &[u32] {
+    pub fn leaf_primitives(&self, node: &Node) -> &[u32] {
         let o = node.leaf_offset() as usize;
         &self.indices[o..o + node.leaf_count() as usize]
     }
@@ -160,6 +161,23 @@ impl KdTree {
                 stack.push((i + 1, lo, depth + 1));
             }
         }
+    }
+}
+
+/// A kd-tree over boxes (e.g. a scene's object instances), queried with
+/// closures that intersect the objects themselves.
+pub type BoxTree = KdTree<Aabb>;
+
+impl KdTree<Triangle> {
+    /// The triangles, indexed as given to the build.
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.prims
+    }
+
+    /// The triangle indices of leaf `node`.
+    #[inline(always)]
+    pub fn leaf_triangles(&self, node: &Node) -> &[u32] {
+        self.leaf_primitives(node)
     }
 }
 

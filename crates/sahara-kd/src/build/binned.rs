@@ -9,21 +9,21 @@ use super::cost::{SahModel, Split};
 use super::partition::{partition, root_refs, Ref};
 use super::subtree::Subtree;
 use super::BuildParams;
-use crate::geometry::{Aabb, Triangle};
+use crate::geometry::{Aabb, Primitive};
 
 /// Below this many references a subtree is built on the current thread.
 const PARALLEL_MIN: usize = 2048;
 
-struct Ctx<'a> {
-    triangles: &'a [Triangle],
+struct Ctx<'a, P> {
+    triangles: &'a [P],
     params: &'a BuildParams,
     bins: usize,
     max_depth: u32,
 }
 
 /// Build the tree over `live` inside `bounds` with `bins` bins per axis.
-pub fn build(
-    triangles: &[Triangle],
+pub fn build<P: Primitive>(
+    triangles: &[P],
     live: Vec<u32>,
     bounds: Aabb,
     bins: usize,
@@ -38,7 +38,7 @@ pub fn build(
     recurse(&ctx, root_refs(triangles, &live), bounds, 0)
 }
 
-fn recurse(ctx: &Ctx, refs: Vec<Ref>, cell: Aabb, depth: u32) -> Subtree {
+fn recurse<P: Primitive>(ctx: &Ctx<P>, refs: Vec<Ref>, cell: Aabb, depth: u32) -> Subtree {
     let p = ctx.params;
     let n = refs.len();
     let leaf = |refs: Vec<Ref>| Subtree::leaf(refs.iter().map(|r| r.tri).collect(), &cell, p);
@@ -103,8 +103,8 @@ impl Bins {
     }
 }
 
-fn best_split(
-    ctx: &Ctx,
+fn best_split<P: Primitive>(
+    ctx: &Ctx<P>,
     model: &SahModel,
     refs: &[Ref],
     cell: &Aabb,

@@ -11,15 +11,15 @@ pub mod subtree;
 
 pub use params::{AxisRule, BuildParams, Builder, PositionRule};
 
-use crate::geometry::{Aabb, Triangle};
+use crate::geometry::{Aabb, Primitive};
 use crate::tree::KdTree;
 
-impl KdTree {
+impl<P: Primitive> KdTree<P> {
     /// Build a tree over `triangles` (their indices are the ones hits report).
     ///
-    /// Triangles with a non-finite coordinate or zero area are left out: no
-    /// ray hits them (see [`Triangle::is_hittable`]).
-    pub fn build(triangles: Vec<Triangle>, params: &BuildParams) -> KdTree {
+    /// Primitives no ray can hit (for triangles: a non-finite coordinate or
+    /// zero area, see [`crate::Triangle::is_hittable`]) are left out.
+    pub fn build(triangles: Vec<P>, params: &BuildParams) -> KdTree<P> {
         let live: Vec<u32> = (0..triangles.len() as u32)
             .filter(|&i| triangles[i as usize].is_hittable())
             .collect();
@@ -42,7 +42,7 @@ impl KdTree {
         KdTree {
             nodes: sub.nodes,
             indices: sub.indices,
-            triangles,
+            prims: triangles,
             bounds,
             params: *params,
         }

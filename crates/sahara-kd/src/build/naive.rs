@@ -6,10 +6,10 @@
 use super::partition::{partition, root_refs, Ref};
 use super::subtree::Subtree;
 use super::{AxisRule, BuildParams, PositionRule};
-use crate::geometry::{Aabb, Triangle};
+use crate::geometry::{Aabb, Primitive};
 
-struct Ctx<'a> {
-    triangles: &'a [Triangle],
+struct Ctx<'a, P> {
+    triangles: &'a [P],
     params: &'a BuildParams,
     axis: AxisRule,
     position: PositionRule,
@@ -20,8 +20,8 @@ struct Ctx<'a> {
 const PARALLEL_MIN: usize = 2048;
 
 /// Build the tree over `live` inside `bounds` with the given rules.
-pub fn build(
-    triangles: &[Triangle],
+pub fn build<P: Primitive>(
+    triangles: &[P],
     live: Vec<u32>,
     bounds: Aabb,
     axis: AxisRule,
@@ -38,7 +38,7 @@ pub fn build(
     recurse(&ctx, root_refs(triangles, &live), bounds, 0)
 }
 
-fn recurse(ctx: &Ctx, mut refs: Vec<Ref>, cell: Aabb, depth: u32) -> Subtree {
+fn recurse<P: Primitive>(ctx: &Ctx<P>, mut refs: Vec<Ref>, cell: Aabb, depth: u32) -> Subtree {
     let p = ctx.params;
     let n = refs.len();
     let leaf = |refs: Vec<Ref>| Subtree::leaf(refs.iter().map(|r| r.tri).collect(), &cell, p);

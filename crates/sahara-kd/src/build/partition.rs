@@ -3,8 +3,7 @@
 
 use rayon::prelude::*;
 
-use crate::geometry::clip::clipped_bounds;
-use crate::geometry::{Aabb, Triangle};
+use crate::geometry::{Aabb, Primitive};
 
 /// A triangle in a cell, with the bounds of its part inside the cell.
 #[derive(Clone, Copy, Debug)]
@@ -16,7 +15,7 @@ pub struct Ref {
 }
 
 /// The references of the root cell.
-pub fn root_refs(triangles: &[Triangle], live: &[u32]) -> Vec<Ref> {
+pub fn root_refs<P: Primitive>(triangles: &[P], live: &[u32]) -> Vec<Ref> {
     live.iter()
         .map(|&t| Ref {
             tri: t,
@@ -33,8 +32,8 @@ const PARALLEL_MIN: usize = 1 << 14;
 /// A reference that lies in the plane goes below; one that only touches the
 /// plane goes to its own side; one that crosses it is clipped to each child
 /// cell (perfect splits), so its child bounds are exact.
-pub fn partition(
-    triangles: &[Triangle],
+pub fn partition<P: Primitive>(
+    triangles: &[P],
     refs: Vec<Ref>,
     axis: usize,
     pos: f32,
@@ -50,13 +49,13 @@ pub fn partition(
             above.push(*r);
         } else {
             let tri = &triangles[r.tri as usize];
-            if let Some(b) = clipped_bounds(tri, below_cell) {
+            if let Some(b) = tri.clipped_bounds(below_cell) {
                 below.push(Ref {
                     tri: r.tri,
                     bounds: b.intersection(r.bounds),
                 });
             }
-            if let Some(b) = clipped_bounds(tri, above_cell) {
+            if let Some(b) = tri.clipped_bounds(above_cell) {
                 above.push(Ref {
                     tri: r.tri,
                     bounds: b.intersection(r.bounds),

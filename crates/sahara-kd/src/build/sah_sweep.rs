@@ -14,8 +14,7 @@ use rayon::prelude::*;
 use super::cost::{PlanarSide, SahModel, Split};
 use super::subtree::Subtree;
 use super::BuildParams;
-use crate::geometry::clip::clipped_bounds;
-use crate::geometry::{Aabb, Triangle};
+use crate::geometry::{Aabb, Primitive};
 
 /// Event kinds, in their sort order at equal position: a triangle that ends
 /// at `p` is left of `p` before one that lies in `p` or starts at `p`.
@@ -91,16 +90,16 @@ struct Work {
 /// Below this many triangles a subtree is built on the current thread.
 const PARALLEL_MIN: usize = 2048;
 
-struct Ctx<'a> {
-    triangles: &'a [Triangle],
+struct Ctx<'a, P> {
+    triangles: &'a [P],
     params: &'a BuildParams,
     max_depth: u32,
 }
 
 /// Build the tree over the triangles `live` (indices into `triangles`)
 /// inside `bounds`.
-pub fn build(
-    triangles: &[Triangle],
+pub fn build<P: Primitive>(
+    triangles: &[P],
     live: Vec<u32>,
     bounds: Aabb,
     params: &BuildParams,
@@ -132,7 +131,7 @@ pub fn build(
     )
 }
 
-fn recurse(ctx: &Ctx, w: Work) -> Subtree {
+fn recurse<P: Primitive>(ctx: &Ctx<P>, w: Work) -> Subtree {
     let p = ctx.params;
     let n = w.tris.len();
     let Some(model) = SahModel::new(w.cell, p) else {
@@ -221,7 +220,7 @@ enum Side {
 }
 
 /// Distribute the node's triangles and events to its two children.
-fn split_work(ctx: &Ctx, w: Work, s: &Split) -> (Work, Work) {
+fn split_work<P: Primitive>(ctx: &Ctx<P>, w: Work, s: &Split) -> (Work, Work) {
     let n = w.tris.len();
     let mut side = vec![Side::Both; n];
     for e in &w.events[s.axis] {
@@ -250,8 +249,8 @@ fn split_work(ctx: &Ctx, w: Work, s: &Split) -> (Work, Work) {
 /// One child's work: the triangles wholly on its side keep their (filtered,
 /// still sorted) events; straddlers are clipped to the child's cell and their
 /// new events merged in.
-fn child(
-    ctx: &Ctx,
+fn child<P: Primitive>(
+    ctx: &Ctx<P>,
     w: &Work,
     side: &[Side],
     keep: Side,
@@ -268,7 +267,7 @@ fn child(
             remap[local] = tris.len() as u32;
             tris.push(global);
         } else if sd == Side::Both {
-            if let Some(b) = clipped_bounds(&ctx.triangles[global as usize], &cell) {
+            if let Some(b) = ctx.triangles[global as usize].clipped_bounds(&cell) {
                 push_events(&mut straddlers, &b, tris.len() as u32);
                 tris.push(global);
             }

@@ -2,9 +2,11 @@
 
 pub mod aabb;
 pub mod clip;
+pub mod primitive;
 pub mod ray;
 pub mod triangle;
 
 pub use aabb::Aabb;
+pub use primitive::Primitive;
 pub use ray::Ray;
 pub use triangle::{Triangle, TriangleHit};
