@@ -1,1 +1,34 @@
-fn main() {}
+//! `sahara`: the command line of the Sahara ray tracer.
+//!
+//! `sahara bench` runs the ray-casting benchmark protocol
+//! (`shared/bench/PROTOCOL.md`), `sahara stats` prints a tree's statistics;
+//! with no subcommand it benchmarks a built-in procedural scene.
+
+mod bench;
+mod cli;
+mod demo_scene;
+mod human;
+mod input;
+mod stats;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use cli::{Cli, Command};
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Some(Command::Bench(args)) => bench::run_file(args),
+        Some(Command::Stats(args)) => stats::run(args),
+        None => bench::run_builtin(),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

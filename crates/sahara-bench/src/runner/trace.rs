@@ -1,0 +1,92 @@
+//! Tracing a set of rays into hit records, in chunks handed out to the
+//! threads of the current rayon pool.
+
+use rayon::prelude::*;
+use sahara_kd::{KdTree, Ray};
+
+use crate::record::HitRecord;
+
+/// Rays per work item in multi-threaded tracing.
+pub const CHUNK: usize = 4096;
+
+/// What a set asks of the tracer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Query {
+    /// The nearest hit (`t`, triangle).
+    ClosestHit,
+    /// Occlusion: is anything hit in `[tmin, tmax]`?
+    AnyHit,
+}
+
+/// The record of one ray.
+#[inline]
+pub fn trace_one(tree: &KdTree, ray: &Ray, query: Query) -> HitRecord {
+    match query {
+        Query::ClosestHit => HitRecord::from_closest(tree.closest_hit(ray)),
+        Query::AnyHit => HitRecord::from_occluded(tree.any_hit(ray)),
+    }
+}
+
+/// Trace `rays` into `out` (`out[i]` answers `rays[i]`) on the current rayon
+/// pool, in chunks of [`CHUNK`] rays.
+///
+/// # Panics
+/// If `out` and `rays` differ in length.
+pub fn trace_into(tree: &KdTree, rays: &[Ray], query: Query, out: &mut [HitRecord]) {
+    assert_eq!(rays.len(), out.len(), "one record per ray");
+    rays.par_chunks(CHUNK)
+        .zip(out.par_chunks_mut(CHUNK))
+        .for_each(|(rs, os)| match query {
+            Query::ClosestHit => {
+                for (r, o) in rs.iter().zip(os) {
+                    *o = HitRecord::from_closest(tree.closest_hit(r));
+                }
+            }
+            Query::AnyHit => {
+                for (r, o) in rs.iter().zip(os) {
+                    *o = HitRecord::from_occluded(tree.any_hit(r));
+                }
+            }
+        });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+    use sahara_kd::{BuildParams, Triangle};
+
+    #[test]
+    fn records_match_single_ray_queries() {
+        let tris = vec![
+            Triangle::new(
+                Vec3::new(-1.0, -1.0, 2.0),
+                Vec3::new(1.0, -1.0, 2.0),
+                Vec3::new(0.0, 1.0, 2.0),
+            ),
+            Triangle::new(
+                Vec3::new(-1.0, -1.0, 4.0),
+                Vec3::new(1.0, -1.0, 4.0),
+                Vec3::new(0.0, 1.0, 4.0),
+            ),
+        ];
+        let tree = KdTree::build(tris, &BuildParams::default());
+        // More than one chunk, alternating hits and misses.
+        let rays: Vec<Ray> = (0..CHUNK + 100)
+            .map(|i| {
+                let x = if i % 2 == 0 { 0.0 } else { 5.0 };
+                Ray::new(Vec3::new(x, -0.5, 0.0), Vec3::Z)
+            })
+            .collect();
+        let mut out = vec![HitRecord::MISS; rays.len()];
+        trace_into(&tree, &rays, Query::ClosestHit, &mut out);
+        for (i, (r, o)) in rays.iter().zip(&out).enumerate() {
+            assert_eq!(*o, trace_one(&tree, r, Query::ClosestHit));
+            assert_eq!(o.is_hit(), i % 2 == 0);
+        }
+        assert_eq!(out[0], HitRecord { t: 2.0, tri: 0 });
+        trace_into(&tree, &rays, Query::AnyHit, &mut out);
+        assert_eq!(out[0], HitRecord::OCCLUDED);
+        assert_eq!(out[1], HitRecord::MISS);
+    }
+}

@@ -1,0 +1,263 @@
+//! The command line: subcommands and options (clap derive).
+
+use std::path::PathBuf;
+
+use clap::{ArgAction, Args, Parser, Subcommand};
+use sahara_bench::SetKind;
+use sahara_kd::Builder;
+
+/// Default timed runs per set.
+pub const DEFAULT_RUNS: usize = 3;
+
+/// Sahara: a ray tracer built around an SAH kd-tree.
+///
+/// With no subcommand, benchmarks a built-in procedural scene (as `sahara
+/// bench` would, with default options).
+#[derive(Debug, Parser)]
+#[command(name = "sahara", version, propagate_version = true)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run the ray-casting benchmark protocol (shared/bench/PROTOCOL.md) on a mesh.
+    #[command(long_about = BENCH_ABOUT)]
+    Bench(BenchArgs),
+    /// Build a kd-tree over a mesh and print its statistics and build time.
+    Stats(StatsArgs),
+}
+
+const BENCH_ABOUT: &str = "\
+Run the ray-casting benchmark protocol (shared/bench/PROTOCOL.md) on a mesh.
+
+Builds the tree (best of 3 builds), generates the protocol's ray sets on a
+1024x1024 image (primary; shadow and diffuse from Sahara's own primary hits;
+1,048,576 random rays) and traces each set once as a warm-up, then --runs
+times on 1 thread and --runs times on --threads threads (chunks of 4096
+rays). Reports rays, hits, the f64 t-sum and the best Mrays/s of each.
+
+The camera is --camera FILE, else the sidecar <dir>/<stem>.camera.json next
+to the mesh if it exists, else the protocol's auto camera.
+
+Comparing ray by ray with another tracer (e.g. embree_bench):
+  --dump-rays SET FILE  writes the generated rays of SET (32 bytes per ray:
+                        f32 ox oy oz tmin dx dy dz tmax, little endian);
+  --dump SET FILE       writes Sahara's hits on SET (8 bytes per ray: f32 t,
+                        u32 triangle; miss = +inf/0xFFFFFFFF, occluded shadow
+                        ray = 0/0xFFFFFFFE); SET must be one of --sets;
+  --rays FILE           traces the rays of a ray file instead of generating
+                        sets; they form the set named `file` (closest hit, or
+                        any hit with --any-hit), so its hits are dumped with
+                        `--dump file HITS`.
+  --primary-hits FILE   generates shadow and diffuse from another tracer's
+                        primary hit file instead of Sahara's primary hits:
+                        secondary rays start at the hit points, so a 1-ulp
+                        difference in a primary t moves them, and a few
+                        grazing rays change their result; with the other
+                        tracer's hits both trace bit-identical rays.
+--dump and --dump-rays may be given several times.
+
+Human-readable results go to stdout, progress to stderr; with --json stdout
+holds exactly one JSON object: mesh, triangles, builder, build_ms,
+memory_bytes, sah_cost, threads, runs, tree_depth, leaves, camera, and
+sets.<name>.{rays, hits, t_sum, mrays_1t, mrays_all[, counters]}.";
+
+/// Options of `sahara bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// The mesh (.obj or .ply).
+    pub mesh: PathBuf,
+    /// How to run.
+    #[command(flatten)]
+    pub opts: BenchOptions,
+}
+
+/// Options of `sahara bench` other than the mesh.
+#[derive(Debug, Args)]
+pub struct BenchOptions {
+    /// Tree builder: sah, binned, binnedN (N bins, 2..=1024), rr-middle,
+    /// rr-median, largest-middle, largest-median, middle, median.
+    #[arg(long, default_value = "sah", value_parser = parse_builder)]
+    pub builder: Builder,
+    /// Threads of the multi-threaded runs (and of the build) [default: all
+    /// hardware threads].
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    pub threads: Option<u16>,
+    /// Timed runs per set and thread count; the best is reported.
+    #[arg(long, default_value_t = DEFAULT_RUNS, value_parser = parse_runs)]
+    pub runs: usize,
+    /// Sets to trace, comma-separated.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        value_parser = parse_set,
+        default_value = "primary,shadow,diffuse,random",
+        conflicts_with = "rays"
+    )]
+    pub sets: Vec<SetKind>,
+    /// Print one JSON object on stdout instead of tables.
+    #[arg(long)]
+    pub json: bool,
+    /// Also count traversal work (inner nodes, leaves, triangle tests per
+    /// ray) and show the SAH's expectation next to it.
+    #[arg(long)]
+    pub counters: bool,
+    /// Write the hits of SET (or `file` with --rays) to FILE.
+    #[arg(long, num_args = 2, value_names = ["SET", "FILE"], action = ArgAction::Append)]
+    pub dump: Vec<String>,
+    /// Write the generated rays of SET to FILE.
+    #[arg(
+        long = "dump-rays",
+        num_args = 2,
+        value_names = ["SET", "FILE"],
+        action = ArgAction::Append,
+        conflicts_with = "rays"
+    )]
+    pub dump_rays: Vec<String>,
+    /// Trace the rays of this ray file (the set `file`) instead of the
+    /// generated sets.
+    #[arg(long, value_name = "FILE")]
+    pub rays: Option<PathBuf>,
+    /// With --rays: trace any-hit (occlusion) queries instead of closest hit.
+    #[arg(long, requires = "rays")]
+    pub any_hit: bool,
+    /// Generate shadow and diffuse from the primary hits in this hit file
+    /// (e.g. another tracer's `--dump primary`) instead of Sahara's own, so
+    /// that both tracers trace bit-identical secondary rays.
+    #[arg(long, value_name = "FILE", conflicts_with = "rays")]
+    pub primary_hits: Option<PathBuf>,
+    /// Camera sidecar JSON to use instead of <dir>/<stem>.camera.json.
+    #[arg(long, value_name = "FILE", conflicts_with = "rays")]
+    pub camera: Option<PathBuf>,
+}
+
+impl Default for BenchOptions {
+    fn default() -> Self {
+        Self {
+            builder: Builder::Sah,
+            threads: None,
+            runs: DEFAULT_RUNS,
+            sets: SetKind::ALL.to_vec(),
+            json: false,
+            counters: false,
+            dump: Vec::new(),
+            dump_rays: Vec::new(),
+            rays: None,
+            any_hit: false,
+            primary_hits: None,
+            camera: None,
+        }
+    }
+}
+
+/// Options of `sahara stats`.
+#[derive(Debug, Args)]
+pub struct StatsArgs {
+    /// The mesh (.obj or .ply).
+    pub mesh: PathBuf,
+    /// Tree builder (see `sahara bench --help`).
+    #[arg(long, default_value = "sah", value_parser = parse_builder)]
+    pub builder: Builder,
+    /// Builds to time; the best is reported.
+    #[arg(long, default_value_t = 1, value_parser = parse_runs)]
+    pub runs: usize,
+    /// Print one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A builder by name, with the list of names in the error.
+fn parse_builder(s: &str) -> Result<Builder, String> {
+    Builder::parse(s).ok_or_else(|| {
+        format!(
+            "unknown builder '{s}'; expected one of: sah, binned, binnedN (N = 2..=1024), \
+             rr-middle, rr-median, largest-middle, largest-median, middle, median"
+        )
+    })
+}
+
+/// A set by name.
+fn parse_set(s: &str) -> Result<SetKind, String> {
+    SetKind::parse(s)
+        .ok_or_else(|| format!("unknown set '{s}'; expected primary, shadow, diffuse or random"))
+}
+
+/// A run count, 1 to 1000.
+fn parse_runs(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if (1..=1000).contains(&n) => Ok(n),
+        _ => Err(format!("'{s}' is not a run count from 1 to 1000")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn cli_is_well_formed() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn bench_options_parse() {
+        let cli = Cli::try_parse_from([
+            "sahara",
+            "bench",
+            "m.obj",
+            "--builder",
+            "binned32",
+            "--sets",
+            "primary,random",
+            "--dump",
+            "primary",
+            "a.bin",
+            "--dump",
+            "random",
+            "b.bin",
+            "--runs",
+            "2",
+        ])
+        .unwrap();
+        let Some(Command::Bench(b)) = cli.command else {
+            panic!("bench expected")
+        };
+        assert_eq!(b.opts.builder, Builder::Binned { bins: 32 });
+        assert_eq!(b.opts.sets, vec![SetKind::Primary, SetKind::Random]);
+        assert_eq!(b.opts.dump, vec!["primary", "a.bin", "random", "b.bin"]);
+        assert_eq!(b.opts.runs, 2);
+        let d = BenchOptions::default();
+        let cli = Cli::try_parse_from(["sahara", "bench", "m.obj"]).unwrap();
+        let Some(Command::Bench(b)) = cli.command else {
+            panic!("bench expected")
+        };
+        assert_eq!(
+            (b.opts.builder, b.opts.runs, b.opts.sets),
+            (d.builder, d.runs, d.sets)
+        );
+    }
+
+    #[test]
+    fn bad_options_are_rejected() {
+        for args in [
+            &["sahara", "bench", "m.obj", "--builder", "kd"][..],
+            &["sahara", "bench", "m.obj", "--sets", "primary,bogus"],
+            &["sahara", "bench", "m.obj", "--runs", "0"],
+            &["sahara", "bench", "m.obj", "--threads", "0"],
+            &["sahara", "bench", "m.obj", "--any-hit"],
+            &[
+                "sahara", "bench", "m.obj", "--rays", "r.bin", "--sets", "primary",
+            ],
+            &["sahara", "bench", "m.obj", "--dump", "primary"],
+        ] {
+            assert!(Cli::try_parse_from(args).is_err(), "{args:?}");
+        }
+        let e = Cli::try_parse_from(["sahara", "stats", "m.obj", "--builder", "kd"]).unwrap_err();
+        assert!(e.to_string().contains("unknown builder 'kd'"), "{e}");
+    }
+}

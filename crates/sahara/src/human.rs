@@ -1,0 +1,209 @@
+//! Human-readable tables of the reports.
+
+use std::fmt::Write;
+
+use sahara_bench::report::{BenchReport, StatsReport};
+
+/// `1234567` as `1,234,567`.
+pub fn thousands(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// `n` with `word`, pluralised: `1 run`, `3 runs`.
+pub fn count(n: usize, word: &str) -> String {
+    if n == 1 {
+        format!("1 {word}")
+    } else {
+        format!("{n} {word}s")
+    }
+}
+
+/// Bytes with a MiB figure.
+fn bytes(n: usize) -> String {
+    format!(
+        "{} bytes ({:.2} MiB)",
+        thousands(n as u64),
+        n as f64 / 1048576.0
+    )
+}
+
+/// A vector as `(x y z)`.
+fn vec3(v: [f32; 3]) -> String {
+    format!("({} {} {})", v[0], v[1], v[2])
+}
+
+/// The header and one table row per set.
+pub fn bench_report(r: &BenchReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "mesh       {}", r.mesh);
+    let _ = writeln!(s, "triangles  {}", thousands(r.triangles as u64));
+    if let Some(c) = &r.camera {
+        let _ = writeln!(
+            s,
+            "camera     {}: eye {} target {} up {} vfov {}",
+            c.source,
+            vec3(c.eye),
+            vec3(c.target),
+            vec3(c.up),
+            c.vfov_deg
+        );
+    }
+    let _ = writeln!(s, "builder    {}", r.builder);
+    let _ = writeln!(
+        s,
+        "build      {:.1} ms (best of {} on {})",
+        r.build_ms,
+        sahara_bench::runner::BUILD_RUNS,
+        count(r.threads, "thread")
+    );
+    let _ = writeln!(s, "memory     {}", bytes(r.memory_bytes));
+    let _ = writeln!(s, "SAH cost   {:.3}", r.sah_cost);
+    let _ = writeln!(
+        s,
+        "tree       depth {}, {} leaves",
+        r.tree_depth,
+        thousands(r.leaves as u64)
+    );
+    let _ = writeln!(
+        s,
+        "timing     best of {} after one warm-up; 1 thread and {}",
+        count(r.runs, "run"),
+        count(r.threads, "thread")
+    );
+    let _ = writeln!(s);
+    let all = format!("Mrays/s {}T", r.threads);
+    let _ = writeln!(
+        s,
+        "{:<8} {:>11} {:>11} {:>22} {:>11} {:>11}",
+        "set", "rays", "hits", "t-sum", "Mrays/s 1T", all
+    );
+    let entries = r.sets.entries();
+    for (name, e) in &entries {
+        let _ = writeln!(
+            s,
+            "{:<8} {:>11} {:>11} {:>22.6} {:>11.3} {:>11.3}",
+            name,
+            thousands(e.rays as u64),
+            thousands(e.hits),
+            e.t_sum,
+            e.mrays_1t,
+            e.mrays_all
+        );
+    }
+    if entries.iter().any(|(_, e)| e.counters.is_some()) {
+        let _ = writeln!(s);
+        let _ = writeln!(
+            s,
+            "traversal work per ray meeting the root (and the SAH's expectation, no early exit)"
+        );
+        let _ = writeln!(
+            s,
+            "{:<8} {:>7} {:>17} {:>17} {:>19}",
+            "set", "root %", "inner (SAH)", "leaves (SAH)", "triangles (SAH)"
+        );
+        for (name, e) in &entries {
+            if let Some(c) = &e.counters {
+                let (i, l, t) = c.per_root_ray();
+                let _ = writeln!(
+                    s,
+                    "{:<8} {:>7.2} {:>8.2} ({:>6.2}) {:>8.2} ({:>6.2}) {:>9.2} ({:>7.2})",
+                    name,
+                    100.0 * c.root_fraction,
+                    i,
+                    c.expected_inner,
+                    l,
+                    c.expected_leaves,
+                    t,
+                    c.expected_triangles
+                );
+            }
+        }
+    }
+    s
+}
+
+/// The statistics, one per line.
+pub fn stats_report(r: &StatsReport) -> String {
+    let t = &r.tree;
+    let mut s = String::new();
+    let lines: Vec<(&str, String)> = vec![
+        ("mesh", r.mesh.clone()),
+        ("builder", r.builder.clone()),
+        (
+            "build",
+            format!(
+                "{:.1} ms (best of {})",
+                r.build_ms,
+                count(r.build_runs, "build")
+            ),
+        ),
+        ("triangles", thousands(t.triangles as u64)),
+        ("nodes", thousands(t.nodes as u64)),
+        ("inner", thousands(t.inner as u64)),
+        (
+            "leaves",
+            format!(
+                "{} ({} empty)",
+                thousands(t.leaves as u64),
+                thousands(t.empty_leaves as u64)
+            ),
+        ),
+        (
+            "depth",
+            format!("max {}, mean leaf {:.2}", t.max_depth, t.mean_leaf_depth),
+        ),
+        (
+            "leaf size",
+            format!(
+                "mean {:.2} (non-empty), max {}",
+                t.mean_leaf_triangles, t.max_leaf_triangles
+            ),
+        ),
+        (
+            "references",
+            format!(
+                "{} ({:.3} per triangle)",
+                thousands(t.references as u64),
+                t.duplication
+            ),
+        ),
+        ("memory", bytes(t.memory_bytes)),
+        ("SAH cost", format!("{:.3}", t.sah_cost)),
+        (
+            "expected",
+            format!(
+                "{:.2} inner nodes, {:.2} leaves, {:.2} triangle tests per ray meeting the root",
+                t.expected_inner, t.expected_leaves, t.expected_triangles
+            ),
+        ),
+    ];
+    for (k, v) in lines {
+        let _ = writeln!(s, "{k:<11} {v}");
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thousands_separators() {
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(999), "999");
+        assert_eq!(thousands(1000), "1,000");
+        assert_eq!(thousands(1048576), "1,048,576");
+        assert_eq!(
+            (count(1, "run"), count(3, "run")),
+            ("1 run".into(), "3 runs".into())
+        );
+    }
+}

@@ -1,0 +1,44 @@
+//! `sahara stats`: a tree's statistics and build time.
+
+use anyhow::{Context, Result};
+use sahara_bench::report::{StatsReport, TreeStatsReport};
+use sahara_bench::runner::{build_timed, Pools};
+use sahara_kd::BuildParams;
+
+use crate::cli::StatsArgs;
+use crate::human;
+use crate::input::load_mesh;
+
+/// `sahara stats MESH ...`.
+pub fn run(args: &StatsArgs) -> Result<()> {
+    let mesh = load_mesh(&args.mesh)?;
+    let pools = Pools::new(Pools::available_threads()).context("cannot start the thread pool")?;
+    eprintln!(
+        "building the {} tree over {} triangles ({})...",
+        args.builder.name(),
+        mesh.triangle_count(),
+        human::count(args.runs, "build")
+    );
+    let (tree, build_ms) = build_timed(
+        &mesh.triangles(),
+        &BuildParams::new(args.builder),
+        args.runs,
+        &pools.all,
+    );
+    let report = StatsReport {
+        mesh: args.mesh.display().to_string(),
+        builder: args.builder.name(),
+        build_ms,
+        build_runs: args.runs,
+        tree: TreeStatsReport::from(&tree.stats()),
+    };
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).context("cannot format the report")?
+        );
+    } else {
+        print!("{}", human::stats_report(&report));
+    }
+    Ok(())
+}

@@ -1,0 +1,314 @@
+//! End-to-end tests of the `sahara` binary on small generated files.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+const SAHARA: &str = env!("CARGO_BIN_EXE_sahara");
+
+/// A fresh directory for one test.
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sahara-cli-{}-{name}", std::process::id()));
+    let _ = fs::remove_dir_all(&d);
+    fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Run `sahara` with `args`.
+fn sahara(args: &[&str]) -> Output {
+    Command::new(SAHARA)
+        .args(args)
+        .output()
+        .expect("run sahara")
+}
+
+fn stdout_json(out: &Output) -> Value {
+    assert!(
+        out.status.success(),
+        "sahara failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "stdout is not one JSON object ({e}):\n{}",
+            String::from_utf8_lossy(&out.stdout)
+        )
+    })
+}
+
+/// Half the side of the test quad.
+const HALF: f64 = 2.5;
+/// Distance from the eye to the quad.
+const DIST: f64 = 10.0;
+
+/// A square quad `[-2.5, 2.5]^2` at z = 0 facing +z (one OBJ polygon, fanned
+/// into 2 triangles), with a sidecar camera at z = 10 looking down -z with a
+/// 90 degree field of view.
+fn write_quad_scene(dir: &Path) -> PathBuf {
+    let obj = dir.join("quad.obj");
+    fs::write(
+        &obj,
+        "# test quad\nv -2.5 -2.5 0\nv 2.5 -2.5 0\nv 2.5 2.5 0\nv -2.5 2.5 0\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    fs::write(
+        dir.join("quad.camera.json"),
+        r#"{"eye":[0,0,10],"target":[0,0,0],"up":[0,1,0],"vfov_deg":90}"#,
+    )
+    .unwrap();
+    obj
+}
+
+/// Brute force, in f64, independent of the crate: the primary rays of the
+/// 1024 x 1024 image that hit the quad, and the sum of their distances.
+fn brute_force_primary() -> (u64, f64) {
+    let n = 1024;
+    let h = (45f64).to_radians().tan();
+    let (mut hits, mut t_sum) = (0u64, 0.0f64);
+    for y in 0..n {
+        for x in 0..n {
+            let a = (2.0 * (x as f64 + 0.5) / n as f64 - 1.0) * h;
+            let b = (1.0 - 2.0 * (y as f64 + 0.5) / n as f64) * h;
+            // Direction (a, b, -1) before normalising: it meets z = 0 at
+            // (10 a, 10 b), at distance 10 |(a, b, -1)|.
+            let (px, py) = (DIST * a, DIST * b);
+            if px.abs() <= HALF && py.abs() <= HALF {
+                hits += 1;
+                t_sum += DIST * (a * a + b * b + 1.0).sqrt();
+            }
+        }
+    }
+    (hits, t_sum)
+}
+
+#[test]
+fn bench_json_matches_a_brute_force_count() {
+    let dir = temp_dir("bench");
+    let obj = write_quad_scene(&dir);
+    let out = sahara(&[
+        "bench",
+        obj.to_str().unwrap(),
+        "--json",
+        "--runs",
+        "1",
+        "--threads",
+        "2",
+        "--counters",
+    ]);
+    let j = stdout_json(&out);
+    for key in [
+        "mesh",
+        "triangles",
+        "builder",
+        "build_ms",
+        "memory_bytes",
+        "sah_cost",
+        "threads",
+        "sets",
+    ] {
+        assert!(j.get(key).is_some(), "missing {key} in {j}");
+    }
+    assert_eq!(j["triangles"], 2);
+    assert_eq!(j["builder"], "sah");
+    assert_eq!(j["threads"], 2);
+    assert_eq!(j["camera"]["vfov_deg"], 90.0);
+    let sets = &j["sets"];
+    for set in ["primary", "shadow", "diffuse", "random"] {
+        for key in ["rays", "hits", "t_sum", "mrays_1t", "mrays_all"] {
+            assert!(sets[set].get(key).is_some(), "missing sets.{set}.{key}");
+        }
+        assert!(sets[set]["counters"]["mean_triangles"].is_number());
+    }
+
+    let (hits, t_sum) = brute_force_primary();
+    // Pixel centres lie 1/1024 of the half-width away from the quad's edges,
+    // far more than f32 rounding: the counts must agree exactly.
+    assert_eq!(hits, 256 * 256);
+    let p = &sets["primary"];
+    assert_eq!(p["rays"], 1024 * 1024);
+    assert_eq!(p["hits"].as_u64().unwrap(), hits);
+    let got = p["t_sum"].as_f64().unwrap();
+    assert!(
+        ((got - t_sum) / t_sum).abs() < 1e-6,
+        "t_sum {got} vs brute force {t_sum}"
+    );
+    // One shadow and one diffuse ray per primary hit; they leave the quad's
+    // front towards a light in front of it or into the open hemisphere.
+    assert_eq!(sets["shadow"]["rays"].as_u64().unwrap(), hits);
+    assert_eq!(sets["shadow"]["hits"], 0);
+    assert_eq!(sets["shadow"]["t_sum"], 0.0);
+    assert_eq!(sets["diffuse"]["rays"].as_u64().unwrap(), hits);
+    assert_eq!(sets["diffuse"]["hits"], 0);
+    assert_eq!(sets["random"]["rays"], 1_048_576);
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn dumped_rays_traced_again_give_the_same_hits() {
+    let dir = temp_dir("dump");
+    let obj = write_quad_scene(&dir);
+    let (rays, hits, again) = (
+        dir.join("p.rays"),
+        dir.join("p.hits"),
+        dir.join("again.hits"),
+    );
+    let out = sahara(&[
+        "bench",
+        obj.to_str().unwrap(),
+        "--json",
+        "--runs",
+        "1",
+        "--sets",
+        "primary",
+        "--dump-rays",
+        "primary",
+        rays.to_str().unwrap(),
+        "--dump",
+        "primary",
+        hits.to_str().unwrap(),
+    ]);
+    let j = stdout_json(&out);
+    assert!(j["sets"].get("shadow").is_none());
+    assert_eq!(fs::metadata(&rays).unwrap().len(), 32 * 1024 * 1024);
+    let h = fs::read(&hits).unwrap();
+    assert_eq!(h.len(), 8 * 1024 * 1024);
+    let n_hits = h
+        .chunks_exact(8)
+        .filter(|c| u32::from_le_bytes([c[4], c[5], c[6], c[7]]) != u32::MAX)
+        .count() as u64;
+    assert_eq!(n_hits, j["sets"]["primary"]["hits"].as_u64().unwrap());
+
+    let out = sahara(&[
+        "bench",
+        obj.to_str().unwrap(),
+        "--json",
+        "--runs",
+        "1",
+        "--rays",
+        rays.to_str().unwrap(),
+        "--dump",
+        "file",
+        again.to_str().unwrap(),
+    ]);
+    let k = stdout_json(&out);
+    assert_eq!(k["sets"]["file"]["hits"], j["sets"]["primary"]["hits"]);
+    assert_eq!(k["sets"]["file"]["t_sum"], j["sets"]["primary"]["t_sum"]);
+    assert!(k.get("camera").is_none());
+    assert_eq!(fs::read(&again).unwrap(), h);
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn stats_json_has_the_tree_statistics() {
+    let dir = temp_dir("stats");
+    let obj = write_quad_scene(&dir);
+    let out = sahara(&[
+        "stats",
+        obj.to_str().unwrap(),
+        "--json",
+        "--builder",
+        "binned",
+    ]);
+    let j = stdout_json(&out);
+    assert_eq!(j["triangles"], 2);
+    assert_eq!(j["builder"], "binned");
+    for key in [
+        "build_ms",
+        "nodes",
+        "leaves",
+        "max_depth",
+        "memory_bytes",
+        "sah_cost",
+        "expected_triangles",
+    ] {
+        assert!(j[key].is_number(), "missing {key} in {j}");
+    }
+    assert!(j["nodes"].as_u64().unwrap() >= 1);
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn human_output_has_a_header_and_a_table() {
+    let dir = temp_dir("human");
+    let obj = write_quad_scene(&dir);
+    let out = sahara(&[
+        "bench",
+        obj.to_str().unwrap(),
+        "--runs",
+        "1",
+        "--sets",
+        "primary",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for needle in [
+        "triangles  2",
+        "builder    sah",
+        "SAH cost",
+        "primary    1,048,576",
+    ] {
+        assert!(text.contains(needle), "no {needle:?} in:\n{text}");
+    }
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_missing_mesh_is_an_error_naming_the_file() {
+    let dir = temp_dir("missing");
+    let missing = dir.join("no_such_mesh.obj");
+    for cmd in ["bench", "stats"] {
+        let out = sahara(&[cmd, missing.to_str().unwrap()]);
+        assert!(!out.status.success());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("no_such_mesh.obj"), "{cmd}: {err}");
+        assert!(out.stdout.is_empty());
+    }
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn an_unknown_builder_is_a_clear_error() {
+    let dir = temp_dir("builder");
+    let obj = write_quad_scene(&dir);
+    let out = sahara(&["bench", obj.to_str().unwrap(), "--builder", "octree"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("unknown builder 'octree'"), "{err}");
+    assert!(err.contains("sah"), "the error lists the builders: {err}");
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn a_truncated_ray_file_is_a_clear_error() {
+    let dir = temp_dir("rays");
+    let obj = write_quad_scene(&dir);
+    let bad = dir.join("bad.rays");
+    fs::write(&bad, [0u8; 33]).unwrap();
+    let out = sahara(&[
+        "bench",
+        obj.to_str().unwrap(),
+        "--rays",
+        bad.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("bad.rays") && err.contains("33 bytes"),
+        "{err}"
+    );
+    // --dump of a set that is not traced is refused before any work.
+    let out = sahara(&[
+        "bench",
+        obj.to_str().unwrap(),
+        "--sets",
+        "primary",
+        "--dump",
+        "random",
+        dir.join("r.hits").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--dump random"));
+    fs::remove_dir_all(dir).unwrap();
+}
