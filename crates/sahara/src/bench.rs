@@ -9,7 +9,7 @@ use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize, RANDOM_RAYS
 use sahara_bench::report::{BenchReport, CameraReport, SetReport, SetReports};
 use sahara_bench::runner::{Bench, Pools};
 use sahara_bench::{HitRecord, ProtocolCamera, Query, SceneFrame, SetKind};
-use sahara_kd::{BuildParams, Ray};
+use sahara_kd::Ray;
 use sahara_render::mesh::Mesh;
 
 use crate::cli::{BenchArgs, BenchOptions};
@@ -22,7 +22,7 @@ const FILE_SET: &str = "file";
 
 /// `sahara bench MESH ...`.
 pub fn run_file(args: &BenchArgs) -> Result<()> {
-    let mesh = load_mesh(&args.mesh)?;
+    let mesh = args.opts.tree.select(load_mesh(&args.mesh)?);
     run(
         &args.mesh.display().to_string(),
         Some(&args.mesh),
@@ -154,12 +154,12 @@ fn run(label: &str, mesh_path: Option<&Path>, mesh: &Mesh, opts: &BenchOptions) 
 
     eprintln!(
         "building the {} tree over {} triangles ({}, {})...",
-        opts.builder.name(),
+        opts.tree.builder.name(),
         mesh.triangle_count(),
         human::count(sahara_bench::runner::BUILD_RUNS, "build"),
         human::count(threads, "thread")
     );
-    let bench = Bench::new(mesh, &BuildParams::new(opts.builder), threads, opts.runs)
+    let bench = Bench::new(mesh, &opts.tree.params(), threads, opts.runs)
         .context("cannot start the thread pools")?;
     eprintln!("built in {:.1} ms (best)", bench.build_ms());
 

@@ -4,7 +4,8 @@ use std::path::PathBuf;
 
 use clap::{ArgAction, Args, Parser, Subcommand};
 use sahara_bench::SetKind;
-use sahara_kd::Builder;
+use sahara_kd::{BuildParams, Builder};
+use sahara_render::mesh::Mesh;
 
 /// Default timed runs per set.
 pub const DEFAULT_RUNS: usize = 3;
@@ -79,10 +80,9 @@ pub struct BenchArgs {
 /// Options of `sahara bench` other than the mesh.
 #[derive(Debug, Args)]
 pub struct BenchOptions {
-    /// Tree builder: sah, binned, binnedN (N bins, 2..=1024), rr-middle,
-    /// rr-median, largest-middle, largest-median, middle, median.
-    #[arg(long, default_value = "sah", value_parser = parse_builder)]
-    pub builder: Builder,
+    /// The tree to build.
+    #[command(flatten)]
+    pub tree: TreeOptions,
     /// Threads of the multi-threaded runs (and of the build) [default: all
     /// hardware threads].
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
@@ -138,7 +138,7 @@ pub struct BenchOptions {
 impl Default for BenchOptions {
     fn default() -> Self {
         Self {
-            builder: Builder::Sah,
+            tree: TreeOptions::default(),
             threads: None,
             runs: DEFAULT_RUNS,
             sets: SetKind::ALL.to_vec(),
@@ -159,15 +159,101 @@ impl Default for BenchOptions {
 pub struct StatsArgs {
     /// The mesh (.obj or .ply).
     pub mesh: PathBuf,
-    /// Tree builder (see `sahara bench --help`).
-    #[arg(long, default_value = "sah", value_parser = parse_builder)]
-    pub builder: Builder,
+    /// The tree to build.
+    #[command(flatten)]
+    pub tree: TreeOptions,
     /// Builds to time; the best is reported.
     #[arg(long, default_value_t = 1, value_parser = parse_runs)]
     pub runs: usize,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Which tree to build over which triangles (shared by `bench` and `stats`).
+#[derive(Debug, Args, Clone, PartialEq)]
+pub struct TreeOptions {
+    /// Tree builder: sah, binned, binnedN (N bins, 2..=1024), rr-middle,
+    /// rr-median, largest-middle, largest-median, middle, median.
+    #[arg(long, default_value = "sah", value_parser = parse_builder)]
+    pub builder: Builder,
+    /// SAH cost of a traversal step, K_T [default: the builder's].
+    #[arg(long, value_parser = parse_positive)]
+    pub traversal_cost: Option<f32>,
+    /// SAH cost of a ray/triangle test, K_I [default: the builder's].
+    #[arg(long, value_parser = parse_positive)]
+    pub intersection_cost: Option<f32>,
+    /// Fraction of the SAH cost forgiven for cutting off empty space, in
+    /// [0, 1) [default: the builder's].
+    #[arg(long, value_parser = parse_bonus)]
+    pub empty_bonus: Option<f32>,
+    /// Depth cap [default: 8 + 1.3 log2 N].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=63))]
+    pub max_depth: Option<u32>,
+    /// Leaf size at which the naive builders stop [default: 4].
+    #[arg(long)]
+    pub max_leaf_size: Option<u32>,
+    /// Use only the first FRACTION of the triangles, in file order (0 < F
+    /// <= 1; for build-scaling measurements).
+    #[arg(long, value_name = "FRACTION", value_parser = parse_subset)]
+    pub subset: Option<f64>,
+}
+
+impl Default for TreeOptions {
+    fn default() -> Self {
+        Self {
+            builder: Builder::Sah,
+            traversal_cost: None,
+            intersection_cost: None,
+            empty_bonus: None,
+            max_depth: None,
+            max_leaf_size: None,
+            subset: None,
+        }
+    }
+}
+
+impl TreeOptions {
+    /// The build parameters these options ask for.
+    pub fn params(&self) -> BuildParams {
+        let mut p = BuildParams::new(self.builder);
+        p.traversal_cost = self.traversal_cost.unwrap_or(p.traversal_cost);
+        p.intersection_cost = self.intersection_cost.unwrap_or(p.intersection_cost);
+        p.empty_bonus = self.empty_bonus.unwrap_or(p.empty_bonus);
+        p.max_depth = self.max_depth.or(p.max_depth);
+        p.max_leaf_size = self.max_leaf_size.unwrap_or(p.max_leaf_size);
+        p
+    }
+
+    /// The mesh cut down to `--subset`, if given.
+    pub fn select(&self, mut mesh: Mesh) -> Mesh {
+        if let Some(f) = self.subset {
+            let n = ((mesh.indices.len() as f64 * f).round() as usize).max(1);
+            mesh.indices.truncate(n);
+        }
+        mesh
+    }
+}
+
+fn parse_positive(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("'{s}' is not a positive number")),
+    }
+}
+
+fn parse_bonus(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if (0.0..1.0).contains(&v) => Ok(v),
+        _ => Err(format!("'{s}' is not a number in [0, 1)")),
+    }
+}
+
+fn parse_subset(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 1.0 => Ok(v),
+        _ => Err(format!("'{s}' is not a fraction in (0, 1]")),
+    }
 }
 
 /// A builder by name, with the list of names in the error.
@@ -227,7 +313,7 @@ mod tests {
         let Some(Command::Bench(b)) = cli.command else {
             panic!("bench expected")
         };
-        assert_eq!(b.opts.builder, Builder::Binned { bins: 32 });
+        assert_eq!(b.opts.tree.builder, Builder::Binned { bins: 32 });
         assert_eq!(b.opts.sets, vec![SetKind::Primary, SetKind::Random]);
         assert_eq!(b.opts.dump, vec!["primary", "a.bin", "random", "b.bin"]);
         assert_eq!(b.opts.runs, 2);
@@ -237,8 +323,8 @@ mod tests {
             panic!("bench expected")
         };
         assert_eq!(
-            (b.opts.builder, b.opts.runs, b.opts.sets),
-            (d.builder, d.runs, d.sets)
+            (b.opts.tree.builder, b.opts.runs, b.opts.sets),
+            (d.tree.builder, d.runs, d.sets)
         );
     }
 

@@ -3,7 +3,6 @@
 use anyhow::{Context, Result};
 use sahara_bench::report::{StatsReport, TreeStatsReport};
 use sahara_bench::runner::{build_timed, Pools};
-use sahara_kd::BuildParams;
 
 use crate::cli::StatsArgs;
 use crate::human;
@@ -11,23 +10,23 @@ use crate::input::load_mesh;
 
 /// `sahara stats MESH ...`.
 pub fn run(args: &StatsArgs) -> Result<()> {
-    let mesh = load_mesh(&args.mesh)?;
+    let mesh = args.tree.select(load_mesh(&args.mesh)?);
     let pools = Pools::new(Pools::available_threads()).context("cannot start the thread pool")?;
     eprintln!(
         "building the {} tree over {} triangles ({})...",
-        args.builder.name(),
+        args.tree.builder.name(),
         mesh.triangle_count(),
         human::count(args.runs, "build")
     );
     let (tree, build_ms) = build_timed(
         &mesh.triangles(),
-        &BuildParams::new(args.builder),
+        &args.tree.params(),
         args.runs,
         &pools.all,
     );
     let report = StatsReport {
         mesh: args.mesh.display().to_string(),
-        builder: args.builder.name(),
+        builder: args.tree.builder.name(),
         build_ms,
         build_runs: args.runs,
         tree: TreeStatsReport::from(&tree.stats()),

@@ -1,0 +1,100 @@
+//! Criterion benchmarks of the accelerator's hot paths on the Stanford bunny
+//! (read in place from the shared scenes, `$SAHARA_SCENES` to override):
+//! building each kind of tree, and tracing the protocol's ray sets on one
+//! thread (closest hit for primary / diffuse / random, any hit for shadow).
+//!
+//! `cargo bench -p sahara-bench --bench kdtree`
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize};
+use sahara_bench::{HitRecord, ProtocolCamera, SceneFrame};
+use sahara_kd::{BuildParams, Builder, KdTree, Ray};
+use sahara_render::mesh::Mesh;
+
+/// Rays per traced batch: enough to leave the caches' warm-up behind.
+const BATCH: usize = 1 << 16;
+
+fn bunny() -> Option<Mesh> {
+    let path = sahara_formats::scenes_dir().join("bunny/bunny.ply");
+    match sahara_formats::load_mesh(&path) {
+        Ok(m) => Some(m),
+        Err(e) => {
+            eprintln!("skipping the kd-tree benchmarks: {e}");
+            None
+        }
+    }
+}
+
+fn build(c: &mut Criterion) {
+    let Some(mesh) = bunny() else { return };
+    let tris = mesh.triangles();
+    let mut g = c.benchmark_group("build_bunny");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(tris.len() as u64));
+    for b in [
+        Builder::Sah,
+        Builder::Binned { bins: 16 },
+        Builder::parse("largest-middle").unwrap(),
+    ] {
+        g.bench_function(BenchmarkId::from_parameter(b.name()), |bench| {
+            bench.iter(|| KdTree::build(tris.clone(), &BuildParams::new(b)))
+        });
+    }
+    g.finish();
+}
+
+/// Every `step`-th ray, so that a batch samples the whole image.
+fn spread(rays: &[Ray], n: usize) -> Vec<Ray> {
+    let step = (rays.len() / n).max(1);
+    rays.iter().step_by(step).take(n).copied().collect()
+}
+
+fn trace(c: &mut Criterion) {
+    let Some(mesh) = bunny() else { return };
+    let frame = SceneFrame::from_mesh(&mesh).expect("bunny is a valid mesh");
+    let sidecar = sahara_formats::camera::read_sidecar(
+        &sahara_formats::scenes_dir().join("bunny/bunny.camera.json"),
+    );
+    let camera = match sidecar {
+        Ok(s) => ProtocolCamera {
+            eye: s.eye,
+            target: s.target,
+            up: s.up,
+            vfov_deg: s.vfov_deg,
+        },
+        Err(_) => ProtocolCamera::auto(&frame),
+    };
+    let tree = KdTree::build(mesh.triangles(), &BuildParams::new(Builder::Sah));
+    let primary = camera.primary_rays(ImageSize::PROTOCOL);
+    let hits: Vec<HitRecord> = primary
+        .iter()
+        .map(|r| HitRecord::from_closest(tree.closest_hit(r)))
+        .collect();
+    let secondary = secondary_rays(&mesh, &frame, &primary, &hits).expect("consistent hits");
+    let sets = [
+        ("primary", spread(&primary, BATCH), false),
+        ("shadow", spread(&secondary.shadow, BATCH), true),
+        ("diffuse", spread(&secondary.diffuse, BATCH), false),
+        ("random", spread(&random_rays(&frame, BATCH), BATCH), false),
+    ];
+    let mut g = c.benchmark_group("trace_bunny_1t");
+    g.sample_size(20);
+    for (name, rays, any) in &sets {
+        g.throughput(Throughput::Elements(rays.len() as u64));
+        g.bench_function(*name, |bench| {
+            bench.iter(|| {
+                if *any {
+                    rays.iter().filter(|r| tree.any_hit(r)).count()
+                } else {
+                    rays.iter()
+                        .filter(|r| tree.closest_hit(r).is_some())
+                        .count()
+                }
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, build, trace);
+criterion_main!(benches);
