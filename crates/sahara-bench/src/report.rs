@@ -123,6 +123,8 @@ pub struct SetReport {
     pub t_sum: f64,
     /// Best Mrays/s on one thread.
     pub mrays_1t: f64,
+    /// Best Mrays/s on one thread by the tracing thread's CPU time.
+    pub mrays_1t_cpu: f64,
     /// Best Mrays/s on all threads.
     pub mrays_all: f64,
     /// Traversal work, with `--counters`.

@@ -65,7 +65,7 @@ Comparing ray by ray with another tracer (e.g. embree_bench):
 Human-readable results go to stdout, progress to stderr; with --json stdout
 holds exactly one JSON object: mesh, triangles, builder, build_ms,
 memory_bytes, sah_cost, threads, runs, tree_depth, leaves, camera, and
-sets.<name>.{rays, hits, t_sum, mrays_1t, mrays_all[, counters]}.";
+sets.<name>.{rays, hits, t_sum, mrays_1t, mrays_1t_cpu, mrays_all[, counters]}.";
 
 /// Options of `sahara bench`.
 #[derive(Debug, Args)]

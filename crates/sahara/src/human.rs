@@ -82,19 +82,20 @@ pub fn bench_report(r: &BenchReport) -> String {
     let all = format!("Mrays/s {}T", r.threads);
     let _ = writeln!(
         s,
-        "{:<8} {:>11} {:>11} {:>22} {:>11} {:>11}",
-        "set", "rays", "hits", "t-sum", "Mrays/s 1T", all
+        "{:<8} {:>11} {:>11} {:>22} {:>11} {:>11} {:>11}",
+        "set", "rays", "hits", "t-sum", "Mrays/s 1T", "1T CPU", all
     );
     let entries = r.sets.entries();
     for (name, e) in &entries {
         let _ = writeln!(
             s,
-            "{:<8} {:>11} {:>11} {:>22.6} {:>11.3} {:>11.3}",
+            "{:<8} {:>11} {:>11} {:>22.6} {:>11.3} {:>11.3} {:>11.3}",
             name,
             thousands(e.rays as u64),
             thousands(e.hits),
             e.t_sum,
             e.mrays_1t,
+            e.mrays_1t_cpu,
             e.mrays_all
         );
     }

@@ -97,6 +97,7 @@ impl Bench {
             hits: m.hits,
             t_sum: m.t_sum,
             mrays_1t: m.mrays_1t,
+            mrays_1t_cpu: m.mrays_1t_cpu,
             mrays_all: m.mrays_all,
             counters,
         };
