@@ -165,6 +165,9 @@ pub struct StatsArgs {
     /// Builds to time; the best is reported.
     #[arg(long, default_value_t = 1, value_parser = parse_runs)]
     pub runs: usize,
+    /// Threads of the build [default: all hardware threads].
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    pub threads: Option<u16>,
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,

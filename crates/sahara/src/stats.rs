@@ -11,7 +11,10 @@ use crate::input::load_mesh;
 /// `sahara stats MESH ...`.
 pub fn run(args: &StatsArgs) -> Result<()> {
     let mesh = args.tree.select(load_mesh(&args.mesh)?);
-    let pools = Pools::new(Pools::available_threads()).context("cannot start the thread pool")?;
+    let threads = args
+        .threads
+        .map_or_else(Pools::available_threads, usize::from);
+    let pools = Pools::new(threads).context("cannot start the thread pool")?;
     eprintln!(
         "building the {} tree over {} triangles ({})...",
         args.tree.builder.name(),
