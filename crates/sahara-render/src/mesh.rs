@@ -31,3 +31,60 @@ impl Mesh {
             .fold(Aabb::EMPTY, |b, &i| b.grow(self.positions[i as usize]))
     }
 }
+
+/// A mesh with the optional attributes rendering uses beside positions.
+///
+/// Kept apart from [`Mesh`] so that the plain geometry type other crates
+/// build stays two arrays.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneMesh {
+    /// Positions and triangles.
+    pub mesh: Mesh,
+    /// Per-vertex shading normals (parallel to `mesh.positions`).
+    pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates (parallel to `mesh.positions`).
+    pub uvs: Option<Vec<glam::Vec2>>,
+    /// Per-triangle material ids (parallel to `mesh.indices`); an
+    /// instance's own material, when set, takes precedence.
+    pub material_ids: Option<Vec<u32>>,
+}
+
+impl From<Mesh> for SceneMesh {
+    fn from(mesh: Mesh) -> Self {
+        Self {
+            mesh,
+            ..Self::default()
+        }
+    }
+}
+
+impl SceneMesh {
+    /// Checks that the attribute arrays have the right lengths and indices
+    /// are in range; returns a description of the first problem.
+    pub fn validate(&self) -> Result<(), String> {
+        let nv = self.mesh.positions.len();
+        if let Some(i) = self
+            .mesh
+            .indices
+            .iter()
+            .flatten()
+            .find(|&&i| i as usize >= nv)
+        {
+            return Err(format!("vertex index {i} out of range ({nv} vertices)"));
+        }
+        if self.normals.as_ref().is_some_and(|n| n.len() != nv) {
+            return Err("normals: one per vertex expected".into());
+        }
+        if self.uvs.as_ref().is_some_and(|n| n.len() != nv) {
+            return Err("uvs: one per vertex expected".into());
+        }
+        if self
+            .material_ids
+            .as_ref()
+            .is_some_and(|m| m.len() != self.mesh.indices.len())
+        {
+            return Err("material_ids: one per triangle expected".into());
+        }
+        Ok(())
+    }
+}

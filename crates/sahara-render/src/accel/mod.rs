@@ -1,0 +1,158 @@
+//! Two-level acceleration: one kd-tree per distinct mesh, in object space,
+//! and a top level over the instances' world (swept) bounds. Rays are
+//! moved into an instance's object space at their time; ray parameters are
+//! preserved by the affine map, so hits of different instances compare
+//! directly.
+
+pub mod top_level;
+
+use glam::Affine3A;
+use sahara_kd::{Aabb, BuildParams, Counters, KdTree, Ray};
+
+use crate::instance::{Instance, Placement};
+use crate::mesh::SceneMesh;
+use top_level::InstanceList;
+
+/// A hit before shading: which instance and triangle, where.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RawHit {
+    /// World ray parameter.
+    pub t: f32,
+    /// Instance index.
+    pub instance: u32,
+    /// Triangle index in the instance's mesh.
+    pub tri: u32,
+    /// Barycentric weight of the triangle's second vertex.
+    pub u: f32,
+    /// Barycentric weight of the third vertex.
+    pub v: f32,
+}
+
+/// An instance ready for traversal.
+#[derive(Clone, Copy, Debug)]
+struct Placed {
+    mesh: u32,
+    placement: Placement,
+    /// World-to-object map of a static instance (None when moving).
+    to_object: Option<Affine3A>,
+}
+
+/// The scene's acceleration structure.
+#[derive(Debug)]
+pub struct Accel {
+    trees: Vec<KdTree>,
+    placed: Vec<Placed>,
+    top: InstanceList,
+    bounds: Aabb,
+}
+
+impl Accel {
+    /// Builds one tree per mesh (instances share them) and the top level.
+    pub fn build(meshes: &[SceneMesh], instances: &[Instance], params: &BuildParams) -> Self {
+        let trees: Vec<KdTree> = meshes
+            .iter()
+            .map(|m| KdTree::build(m.mesh.triangles(), params))
+            .collect();
+        let placed: Vec<Placed> = instances
+            .iter()
+            .map(|inst| Placed {
+                mesh: inst.mesh,
+                placement: inst.placement,
+                to_object: match inst.placement {
+                    Placement::Static(a) => Some(a.inverse()),
+                    Placement::Moving { .. } => None,
+                },
+            })
+            .collect();
+        let boxes: Vec<Aabb> = placed
+            .iter()
+            .map(|p| p.placement.world_bounds(trees[p.mesh as usize].bounds()))
+            .collect();
+        let bounds = boxes.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
+        Self {
+            trees,
+            placed,
+            top: InstanceList::build(&boxes),
+            bounds,
+        }
+    }
+
+    /// Number of kd-trees (one per distinct mesh, however many instances).
+    pub fn tree_count(&self) -> usize {
+        self.trees.len()
+    }
+
+    /// Bytes held by the kd-trees (nodes, leaf indices, triangles).
+    pub fn tree_bytes(&self) -> usize {
+        self.trees
+            .iter()
+            .map(|t| {
+                std::mem::size_of_val(t.nodes())
+                    + std::mem::size_of_val(t.indices())
+                    + std::mem::size_of_val(t.triangles())
+            })
+            .sum()
+    }
+
+    /// World bounds of everything.
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// The object-space ray of instance `p` at shutter fraction `s`.
+    #[inline]
+    fn object_ray(p: &Placed, ray: &Ray, s: f32, tmax: f32) -> Ray {
+        let inv = match p.to_object {
+            Some(a) => a,
+            None => p.placement.at(s).inverse(),
+        };
+        Ray::with_interval(
+            inv.transform_point3(ray.origin),
+            inv.transform_vector3(ray.dir),
+            ray.tmin,
+            tmax,
+        )
+    }
+
+    /// The closest hit along `ray` at shutter fraction `s`, counting the
+    /// work (top-level box tests count as inner-node visits).
+    pub fn closest<C: Counters>(&self, ray: &Ray, s: f32, counters: &mut C) -> Option<RawHit> {
+        let mut best: Option<RawHit> = None;
+        self.top.closest(ray, counters, |i, tmax, counters| {
+            let p = &self.placed[i as usize];
+            let r = Self::object_ray(p, ray, s, tmax);
+            let h = self.trees[p.mesh as usize].closest_hit_counted(&r, counters)?;
+            // Ties between instances go to the lower index (visited first).
+            if best.is_some_and(|b| b.t <= h.t) {
+                return None;
+            }
+            best = Some(RawHit {
+                t: h.t,
+                instance: i,
+                tri: h.tri,
+                u: h.u,
+                v: h.v,
+            });
+            Some(h.t)
+        });
+        best
+    }
+
+    /// True if anything but instance `ignore` lies along `ray` within its
+    /// interval.
+    pub fn occluded(&self, ray: &Ray, s: f32, ignore: Option<u32>) -> bool {
+        self.top.any(ray, |i| {
+            if Some(i) == ignore {
+                return false;
+            }
+            let p = &self.placed[i as usize];
+            let r = Self::object_ray(p, ray, s, ray.tmax);
+            self.trees[p.mesh as usize].any_hit(&r)
+        })
+    }
+
+    /// Object-to-world transform of instance `i` at shutter fraction `s`.
+    pub fn transform(&self, i: u32, s: f32) -> Affine3A {
+        self.placed[i as usize].placement.at(s)
+    }
+}

@@ -1,0 +1,234 @@
+//! Light transport: the distribution ray tracer, the path tracer, and
+//! debug views.
+
+pub mod debug;
+pub mod distribution;
+pub mod path;
+
+use glam::Vec3;
+use sahara_kd::{Ray, TraversalCounters};
+
+use crate::light::LightSample;
+use crate::material::Material;
+use crate::sampler::PixelSampler;
+use crate::sampling::Frame;
+use crate::world::{SurfaceHit, World};
+
+/// Which estimator computes a pixel sample's radiance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Integrator {
+    /// Unidirectional path tracing with next-event estimation, MIS (power
+    /// heuristic) and Russian roulette.
+    Path {
+        /// Largest number of scattering events (1: direct light only).
+        max_depth: u32,
+        /// Bounces before Russian roulette starts.
+        rr_depth: u32,
+    },
+    /// Cook's distribution ray tracing: direct light from every light with
+    /// `light_samples` samples each, recursion only through mirror, glossy
+    /// and refractive lobes (no diffuse interreflection).
+    Distribution {
+        /// Largest number of specular/glossy bounces.
+        max_depth: u32,
+        /// Samples per area light (and environment) at every hit.
+        light_samples: u32,
+    },
+    /// The shading normal, mapped to `n / 2 + 1/2`.
+    Normals,
+    /// Distance to the first hit (0 where nothing is hit).
+    Depth,
+    /// Ambient occlusion: fraction of cosine-weighted rays unblocked within
+    /// `distance` (0: a tenth of the scene's radius).
+    Ao {
+        /// Rays per pixel sample.
+        samples: u32,
+        /// Occlusion distance.
+        distance: f32,
+    },
+    /// A heat map of kd-tree work per pixel (traversal steps plus triangle
+    /// tests of the camera ray).
+    Cost,
+}
+
+impl Default for Integrator {
+    fn default() -> Self {
+        Integrator::Path {
+            max_depth: 8,
+            rr_depth: 3,
+        }
+    }
+}
+
+impl Integrator {
+    /// A short name (`path`, `distribution`, `normals`, `depth`, `ao`,
+    /// `cost`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Path { .. } => "path",
+            Integrator::Distribution { .. } => "distribution",
+            Integrator::Normals => "normals",
+            Integrator::Depth => "depth",
+            Integrator::Ao { .. } => "ao",
+            Integrator::Cost => "cost",
+        }
+    }
+
+    /// The integrator called `name` with default parameters.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Some(match name {
+            "path" => Integrator::default(),
+            "distribution" => Integrator::Distribution {
+                max_depth: 5,
+                light_samples: 4,
+            },
+            "normals" => Integrator::Normals,
+            "depth" => Integrator::Depth,
+            "ao" => Integrator::Ao {
+                samples: 4,
+                distance: 0.0,
+            },
+            "cost" => Integrator::Cost,
+            _ => return None,
+        })
+    }
+}
+
+/// Work counted while tracing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TraceStats {
+    /// Rays from the camera.
+    pub camera_rays: u64,
+    /// Rays after scattering.
+    pub bounce_rays: u64,
+    /// Occlusion rays.
+    pub shadow_rays: u64,
+    /// Kd-tree work of camera rays in the `cost` view.
+    pub traversal: TraversalCounters,
+}
+
+impl std::ops::AddAssign for TraceStats {
+    fn add_assign(&mut self, o: Self) {
+        self.camera_rays += o.camera_rays;
+        self.bounce_rays += o.bounce_rays;
+        self.shadow_rays += o.shadow_rays;
+        self.traversal += o.traversal;
+    }
+}
+
+/// What an integrator needs for one pixel sample.
+pub struct Context<'w, 'a> {
+    /// The scene.
+    pub world: &'w World<'a>,
+    /// Sample dimensions.
+    pub sampler: PixelSampler,
+    /// Counters.
+    pub stats: &'w mut TraceStats,
+}
+
+impl Integrator {
+    /// Radiance along a camera ray at `time`.
+    pub fn li(&self, ctx: &mut Context, ray: &Ray, time: f32) -> Vec3 {
+        ctx.stats.camera_rays += 1;
+        match *self {
+            Integrator::Path {
+                max_depth,
+                rr_depth,
+            } => path::li(ctx, ray, time, max_depth, rr_depth),
+            Integrator::Distribution {
+                max_depth,
+                light_samples,
+            } => distribution::li(ctx, ray, time, max_depth, light_samples.max(1)),
+            Integrator::Normals => debug::normals(ctx, ray, time),
+            Integrator::Depth => debug::depth(ctx, ray, time),
+            Integrator::Ao { samples, distance } => {
+                debug::ao(ctx, ray, time, samples.max(1), distance)
+            }
+            Integrator::Cost => debug::cost(ctx, ray, time),
+        }
+    }
+}
+
+/// The local shading setup at a hit: frame, outgoing direction, tint.
+pub(crate) struct Shading<'m> {
+    pub frame: Frame,
+    pub wo_world: Vec3,
+    pub wo: Vec3,
+    pub material: &'m Material,
+    pub tint: Vec3,
+}
+
+impl<'m> Shading<'m> {
+    /// Shading at `hit` for a ray travelling along `dir`.
+    #[inline]
+    pub fn new(world: &'m World, hit: &SurfaceHit, dir: Vec3) -> Self {
+        let material = world.material(hit.material);
+        let frame = hit.frame();
+        let wo_world = -dir;
+        Self {
+            frame,
+            wo_world,
+            wo: frame.to_local(wo_world),
+            material,
+            tint: material.tint(hit.uv),
+        }
+    }
+
+    /// True when `wi` leaves on a side the BSDF may scatter to: a reflector
+    /// must not send light through its geometric surface (shading normals
+    /// can suggest it; that would leak light).
+    #[inline]
+    pub fn side_ok(&self, hit: &SurfaceHit, wi: Vec3) -> bool {
+        !self.material.bsdf.is_reflective_only() || wi.dot(hit.ng) * self.wo_world.dot(hit.ng) > 0.0
+    }
+}
+
+impl Shading<'_> {
+    /// The world direction of a sampled `wi`, or `None` if the path must
+    /// end. A reflection that the shading normal sends below the geometric
+    /// surface (at silhouettes of smooth-shaded meshes) is, for a delta
+    /// lobe, folded back across the geometric plane, which keeps its energy
+    /// (mirror spheres would otherwise show dark rims); other lobes end the
+    /// path there, as their density for the folded direction is unknown.
+    #[inline]
+    pub fn scattered(&self, hit: &SurfaceHit, wi_local: Vec3, delta: bool) -> Option<Vec3> {
+        let wi = self.frame.to_world(wi_local);
+        if self.side_ok(hit, wi) {
+            return Some(wi);
+        }
+        if !delta {
+            return None;
+        }
+        let folded = (wi - 2.0 * wi.dot(hit.ng) * hit.ng).normalize();
+        self.side_ok(hit, folded).then_some(folded)
+    }
+}
+
+/// Unoccluded light from a light sample: `f |cos| Li` (not divided by the
+/// pdf) and the BSDF's density for the direction; `None` if blocked or
+/// zero.
+pub(crate) fn light_contribution(
+    ctx: &mut Context,
+    hit: &SurfaceHit,
+    sh: &Shading,
+    ls: &LightSample,
+    time: f32,
+) -> Option<(Vec3, f32)> {
+    if !sh.side_ok(hit, ls.wi) {
+        return None;
+    }
+    let wi = sh.frame.to_local(ls.wi);
+    let e = sh.material.bsdf.eval(sh.tint, sh.wo, wi);
+    let c = e.f * wi.z.abs() * ls.li;
+    if c.max_element() <= 0.0 {
+        return None;
+    }
+    ctx.stats.shadow_rays += 1;
+    if !ctx
+        .world
+        .unoccluded(hit.spawn_origin(ls.wi), ls.wi, ls.dist, time, ls.ignore)
+    {
+        return None;
+    }
+    Some((c, e.pdf))
+}

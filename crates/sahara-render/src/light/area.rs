@@ -1,0 +1,287 @@
+//! Area lights: emissive quads, discs and spheres sampled analytically,
+//! and emissive triangle meshes sampled by area.
+
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+use super::LightSample;
+use crate::distribution::Distribution1D;
+use crate::sampling::{concentric_disc, luminance, uniform_cone, uniform_triangle, Frame};
+
+/// The emitting surface.
+#[derive(Clone, Debug)]
+pub enum Emitter {
+    /// `corner + s u + t v`, front face towards `n`.
+    Quad {
+        /// Corner.
+        corner: Vec3,
+        /// First edge.
+        u: Vec3,
+        /// Second edge.
+        v: Vec3,
+        /// Unit front normal.
+        n: Vec3,
+    },
+    /// A disc.
+    Disc {
+        /// Centre.
+        center: Vec3,
+        /// Frame whose `n` is the front normal.
+        frame: Frame,
+        /// Radius.
+        radius: f32,
+    },
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius.
+        radius: f32,
+    },
+    /// Triangles in world space, chosen in proportion to their area.
+    Mesh {
+        /// Vertices.
+        tris: Vec<[Vec3; 3]>,
+        /// Emitted radiance per triangle.
+        radiance: Vec<Vec3>,
+        /// Two-sided emission per triangle.
+        two_sided: Vec<bool>,
+        /// Distribution over triangle areas.
+        dist: Distribution1D,
+    },
+}
+
+/// An emitting surface with its radiance.
+#[derive(Clone, Debug)]
+pub struct AreaLight {
+    /// Shape.
+    pub emitter: Emitter,
+    /// Radiance of an analytic shape (mesh lights carry theirs per triangle).
+    pub radiance: Vec3,
+    /// Emission from both faces (analytic shapes).
+    pub two_sided: bool,
+    /// Total area.
+    pub area: f32,
+    /// The instance of an analytic (convex) emitter, which never shadows
+    /// its own samples.
+    pub instance: Option<u32>,
+}
+
+/// Radiance leaving a surface point with front normal `n` towards `w`.
+#[inline]
+fn emitted(radiance: Vec3, two_sided: bool, n: Vec3, w: Vec3) -> Vec3 {
+    let c = n.dot(w);
+    if c > 0.0 || (two_sided && c < 0.0) {
+        radiance
+    } else {
+        Vec3::ZERO
+    }
+}
+
+impl AreaLight {
+    /// A light over an analytic emitter.
+    pub fn analytic(emitter: Emitter, radiance: Vec3, two_sided: bool, instance: u32) -> Self {
+        let area = match &emitter {
+            Emitter::Quad { u, v, .. } => u.cross(*v).length(),
+            Emitter::Disc { radius, .. } => PI * radius * radius,
+            Emitter::Sphere { radius, .. } => 4.0 * PI * radius * radius,
+            Emitter::Mesh { .. } => unreachable!("mesh lights use AreaLight::mesh"),
+        };
+        Self {
+            emitter,
+            radiance,
+            two_sided,
+            area,
+            instance: Some(instance),
+        }
+    }
+
+    /// A light over world-space triangles with per-triangle emission.
+    pub fn mesh(tris: Vec<[Vec3; 3]>, radiance: Vec<Vec3>, two_sided: Vec<bool>) -> Self {
+        let areas: Vec<f32> = tris
+            .iter()
+            .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
+            .collect();
+        let area = areas.iter().map(|&a| a as f64).sum::<f64>() as f32;
+        Self {
+            emitter: Emitter::Mesh {
+                tris,
+                radiance,
+                two_sided,
+                dist: Distribution1D::new(areas),
+            },
+            radiance: Vec3::ZERO,
+            two_sided: false,
+            area,
+            instance: None,
+        }
+    }
+
+    /// Emitted power (luminance) for light selection.
+    pub fn power(&self) -> f32 {
+        match &self.emitter {
+            Emitter::Mesh {
+                tris,
+                radiance,
+                two_sided,
+                ..
+            } => tris
+                .iter()
+                .zip(radiance)
+                .zip(two_sided)
+                .map(|((t, l), &two)| {
+                    let a = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+                    PI * a * luminance(*l) * if two { 2.0 } else { 1.0 }
+                })
+                .sum(),
+            _ => PI * self.area * luminance(self.radiance) * if self.two_sided { 2.0 } else { 1.0 },
+        }
+    }
+
+    /// A point on the light as seen from `p`: direction, distance, incident
+    /// radiance and solid-angle density.
+    pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let (q, n, pdf_area, le) = match &self.emitter {
+            Emitter::Quad {
+                corner,
+                u: eu,
+                v: ev,
+                n,
+            } => (*corner + *eu * u.x + *ev * u.y, *n, 1.0 / self.area, None),
+            Emitter::Disc {
+                center,
+                frame,
+                radius,
+            } => {
+                let d = concentric_disc(u) * *radius;
+                (
+                    *center + frame.s * d.x + frame.t * d.y,
+                    frame.n,
+                    1.0 / self.area,
+                    None,
+                )
+            }
+            Emitter::Sphere { center, radius } => {
+                return self.sample_sphere(*center, *radius, p, u)
+            }
+            Emitter::Mesh {
+                tris,
+                radiance,
+                two_sided,
+                dist,
+            } => {
+                let (x, _, i) = dist.sample_continuous(u.x);
+                // Reuse the position within the chosen cell as a fresh
+                // uniform number: it is uniform and independent of i.
+                let ux = (x * dist.len() as f32 - i as f32).clamp(0.0, 1.0);
+                let (b1, b2) = uniform_triangle(Vec2::new(ux, u.y));
+                let t = &tris[i];
+                let q = t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2;
+                let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+                (
+                    q,
+                    n,
+                    1.0 / self.area,
+                    Some(emitted(radiance[i], two_sided[i], n, p - q)),
+                )
+            }
+        };
+        let d = q - p;
+        let dist2 = d.length_squared();
+        if dist2 == 0.0 {
+            return None;
+        }
+        let dist = dist2.sqrt();
+        let wi = d / dist;
+        let cos = n.dot(-wi).abs();
+        if cos == 0.0 {
+            return None;
+        }
+        let li = le.unwrap_or_else(|| emitted(self.radiance, self.two_sided, n, -wi));
+        if li == Vec3::ZERO {
+            return None;
+        }
+        Some(LightSample {
+            wi,
+            dist,
+            li,
+            pdf: pdf_area * dist2 / cos,
+            delta: false,
+            ignore: self.instance,
+        })
+    }
+
+    /// Solid-angle sampling of the cone a sphere subtends from outside;
+    /// uniform area sampling from inside.
+    fn sample_sphere(&self, c: Vec3, r: f32, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let to_c = c - p;
+        let d2 = to_c.length_squared();
+        if d2 <= r * r {
+            // Inside: uniform on the surface.
+            let n = crate::sampling::uniform_sphere(u);
+            let q = c + r * n;
+            let d = q - p;
+            let dist2 = d.length_squared();
+            let dist = dist2.sqrt();
+            let wi = d / dist;
+            let cos = n.dot(-wi).abs();
+            let li = emitted(self.radiance, self.two_sided, n, -wi);
+            if cos == 0.0 || li == Vec3::ZERO {
+                return None;
+            }
+            return Some(LightSample {
+                wi,
+                dist,
+                li,
+                pdf: dist2 / (cos * self.area),
+                delta: false,
+                ignore: self.instance,
+            });
+        }
+        let d = d2.sqrt();
+        let sin2_max = r * r / d2;
+        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+        // 1 - cos_max without cancellation for small, distant spheres.
+        let one_minus = sin2_max / (1.0 + cos_max);
+        let frame = Frame::from_normal(to_c / d);
+        let local = uniform_cone(u, cos_max);
+        let wi = frame.to_world(local);
+        // Nearest intersection with the sphere, clamped to the tangent
+        // point when rounding puts the direction just outside the cone.
+        let b = wi.dot(to_c);
+        let disc = (r * r - (d2 - b * b)).max(0.0);
+        let dist = b - disc.sqrt();
+        let q = p + wi * dist;
+        let n = (q - c).normalize_or_zero();
+        let li = emitted(self.radiance, self.two_sided, n, -wi);
+        if li == Vec3::ZERO || dist <= 0.0 {
+            return None;
+        }
+        Some(LightSample {
+            wi,
+            dist,
+            li,
+            pdf: 1.0 / (2.0 * PI * one_minus),
+            delta: false,
+            ignore: self.instance,
+        })
+    }
+
+    /// Solid-angle density with which [`AreaLight::sample`] picks the point
+    /// `q` (front normal `n`) seen from `p` along unit `wi`.
+    pub fn pdf(&self, p: Vec3, q: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        if let Emitter::Sphere { center, radius } = self.emitter {
+            let d2 = (center - p).length_squared();
+            if d2 > radius * radius {
+                let sin2_max = radius * radius / d2;
+                let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+                return 1.0 / (2.0 * PI * sin2_max / (1.0 + cos_max));
+            }
+        }
+        let cos = n.dot(wi).abs();
+        if cos == 0.0 {
+            return 0.0;
+        }
+        (q - p).length_squared() / (cos * self.area)
+    }
+}

@@ -1,0 +1,25 @@
+//! The directional (distant) light.
+
+use glam::Vec3;
+use std::f32::consts::PI;
+
+use super::LightSample;
+use crate::sampling::luminance;
+
+/// Incident light from a distant source travelling along `direction`
+/// (unit), delivering `irradiance` on a surface facing it.
+pub fn sample(direction: Vec3, irradiance: Vec3) -> Option<LightSample> {
+    Some(LightSample {
+        wi: -direction,
+        dist: f32::INFINITY,
+        li: irradiance,
+        pdf: 1.0,
+        delta: true,
+        ignore: None,
+    })
+}
+
+/// Power through a disc of the scene's radius, for light selection.
+pub fn power(irradiance: Vec3, scene_radius: f32) -> f32 {
+    PI * scene_radius * scene_radius * luminance(irradiance)
+}

@@ -1,0 +1,31 @@
+//! The isotropic point light.
+
+use glam::Vec3;
+use std::f32::consts::PI;
+
+use super::LightSample;
+use crate::sampling::luminance;
+
+/// Incident radiance at `p` from a point light of `intensity` (W/sr) at
+/// `position`: `I / d^2` along the connecting direction.
+pub fn sample(position: Vec3, intensity: Vec3, p: Vec3) -> Option<LightSample> {
+    let d = position - p;
+    let d2 = d.length_squared();
+    if d2 == 0.0 {
+        return None;
+    }
+    let dist = d2.sqrt();
+    Some(LightSample {
+        wi: d / dist,
+        dist,
+        li: intensity / d2,
+        pdf: 1.0,
+        delta: true,
+        ignore: None,
+    })
+}
+
+/// Emitted power (luminance) for light selection.
+pub fn power(intensity: Vec3) -> f32 {
+    4.0 * PI * luminance(intensity)
+}

@@ -1,0 +1,77 @@
+//! Metals: the rough GGX conductor and the perfect mirror, both with a
+//! Schlick Fresnel term tinted by the base colour (the reflectance at
+//! normal incidence).
+
+use glam::{Vec2, Vec3};
+
+use super::fresnel::{reflect, schlick};
+use super::microfacet::Ggx;
+use super::{BsdfEval, BsdfSample};
+
+/// Mirror `w` into the upper hemisphere (reflection-only BSDFs are
+/// two-sided: they are evaluated as if seen from above).
+#[inline]
+fn upper(w: Vec3, flip: bool) -> Vec3 {
+    if flip {
+        Vec3::new(w.x, w.y, -w.z)
+    } else {
+        w
+    }
+}
+
+/// Value and density of the rough conductor.
+pub fn eval(color: Vec3, ggx: &Ggx, wo: Vec3, wi: Vec3) -> BsdfEval {
+    if wo.z * wi.z <= 0.0 {
+        return BsdfEval::ZERO;
+    }
+    let flip = wo.z < 0.0;
+    let (wo, wi) = (upper(wo, flip), upper(wi, flip));
+    let h = (wo + wi).normalize();
+    let oh = wo.dot(h);
+    if oh <= 0.0 {
+        return BsdfEval::ZERO;
+    }
+    let f = schlick(color, oh) * (ggx.d(h) * ggx.g(wo, wi) / (4.0 * wo.z * wi.z));
+    BsdfEval {
+        f,
+        pdf: ggx.pdf_visible(wo, h) / (4.0 * oh),
+    }
+}
+
+/// A direction reflected about a visible microfacet normal.
+pub fn sample(color: Vec3, ggx: &Ggx, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+    if wo.z == 0.0 {
+        return None;
+    }
+    let flip = wo.z < 0.0;
+    let wo = upper(wo, flip);
+    let m = ggx.sample_visible(wo, u);
+    let om = wo.dot(m);
+    let wi = reflect(wo, m);
+    if wi.z <= 0.0 || om <= 0.0 {
+        return None;
+    }
+    let pdf = ggx.pdf_visible(wo, m) / (4.0 * om);
+    // f cos / pdf = F D G / (4 wo.z) / (G1 D (wo.m) / wo.z / (4 wo.m))
+    //             = F G / G1: D and the Jacobian cancel.
+    let weight = schlick(color, om) * (ggx.g(wo, wi) / ggx.g1(wo));
+    Some(BsdfSample {
+        wi: upper(wi, flip),
+        weight,
+        pdf,
+        delta: false,
+    })
+}
+
+/// The perfect mirror direction (a delta lobe).
+pub fn sample_mirror(color: Vec3, wo: Vec3) -> Option<BsdfSample> {
+    if wo.z == 0.0 {
+        return None;
+    }
+    Some(BsdfSample {
+        wi: Vec3::new(-wo.x, -wo.y, wo.z),
+        weight: schlick(color, wo.z.abs()),
+        pdf: 1.0,
+        delta: true,
+    })
+}

@@ -1,0 +1,160 @@
+//! The scene description: plain values the caller fills in.
+
+use glam::{Affine3A, Vec3};
+
+use crate::camera::Camera;
+use crate::instance::Instance;
+use crate::light::{Environment, Light};
+use crate::material::Material;
+use crate::mesh::SceneMesh;
+use crate::shape::Shape;
+
+/// A built-in shape placed in the scene, remembered so that an emissive one
+/// is sampled analytically rather than as triangles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeInstance {
+    /// The instance holding the shape's tessellation.
+    pub instance: u32,
+    /// The exact shape (world coordinates).
+    pub shape: Shape,
+}
+
+/// Everything to render: camera, geometry, materials, lights.
+///
+/// Area lights are not listed: every triangle whose material emits is one
+/// (sampled analytically for quad, disc and sphere shapes added with
+/// [`Scene::add_shape`], by area for meshes). Emissive geometry on moving
+/// instances is seen but not sampled by next-event estimation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// Distinct meshes (each gets one kd-tree, shared by its instances).
+    pub meshes: Vec<SceneMesh>,
+    /// Placed meshes.
+    pub instances: Vec<Instance>,
+    /// Materials, indexed by instances and per-triangle ids.
+    pub materials: Vec<Material>,
+    /// Point, spot and directional lights.
+    pub lights: Vec<Light>,
+    /// Light from infinitely far (none: black).
+    pub environment: Option<Environment>,
+    /// Instances that are built-in shapes.
+    pub shapes: Vec<ShapeInstance>,
+}
+
+impl Scene {
+    /// An empty scene seen by `camera`.
+    pub fn new(camera: Camera) -> Self {
+        Self {
+            camera,
+            meshes: Vec::new(),
+            instances: Vec::new(),
+            materials: Vec::new(),
+            lights: Vec::new(),
+            environment: None,
+            shapes: Vec::new(),
+        }
+    }
+
+    /// Adds a material; returns its id.
+    pub fn add_material(&mut self, m: Material) -> u32 {
+        self.materials.push(m);
+        self.materials.len() as u32 - 1
+    }
+
+    /// Adds a mesh; returns its index.
+    pub fn add_mesh(&mut self, m: impl Into<SceneMesh>) -> u32 {
+        self.meshes.push(m.into());
+        self.meshes.len() as u32 - 1
+    }
+
+    /// Adds an instance; returns its index.
+    pub fn add_instance(&mut self, i: Instance) -> u32 {
+        self.instances.push(i);
+        self.instances.len() as u32 - 1
+    }
+
+    /// Adds a mesh with one static instance of it; returns the instance.
+    pub fn add_object(
+        &mut self,
+        m: impl Into<SceneMesh>,
+        transform: Affine3A,
+        material: u32,
+    ) -> u32 {
+        let mesh = self.add_mesh(m);
+        self.add_instance(Instance::new(mesh, transform, Some(material)))
+    }
+
+    /// Adds a built-in shape with a material; returns its instance. An
+    /// emissive quad, disc or sphere becomes an analytically sampled light.
+    pub fn add_shape(&mut self, shape: Shape, material: u32) -> u32 {
+        let instance = self.add_object(shape.to_mesh(), Affine3A::IDENTITY, material);
+        self.shapes.push(ShapeInstance { instance, shape });
+        instance
+    }
+
+    /// Adds an explicit light.
+    pub fn add_light(&mut self, l: Light) {
+        self.lights.push(l);
+    }
+
+    /// The material id of triangle `tri` of instance `instance`.
+    #[inline]
+    pub fn material_of(&self, instance: u32, tri: u32) -> u32 {
+        let inst = &self.instances[instance as usize];
+        inst.material.unwrap_or_else(|| {
+            self.meshes[inst.mesh as usize]
+                .material_ids
+                .as_ref()
+                .map_or(0, |ids| ids[tri as usize])
+        })
+    }
+
+    /// Checks every index and array length; returns the first problem.
+    pub fn validate(&self) -> Result<(), String> {
+        for (i, m) in self.meshes.iter().enumerate() {
+            m.validate().map_err(|e| format!("mesh {i}: {e}"))?;
+            if let Some(ids) = &m.material_ids {
+                if let Some(id) = ids.iter().find(|&&id| id as usize >= self.materials.len()) {
+                    return Err(format!("mesh {i}: material id {id} out of range"));
+                }
+            }
+        }
+        for (i, inst) in self.instances.iter().enumerate() {
+            if inst.mesh as usize >= self.meshes.len() {
+                return Err(format!("instance {i}: mesh {} out of range", inst.mesh));
+            }
+            let m = &self.meshes[inst.mesh as usize];
+            let mat = inst.material.unwrap_or(0);
+            if (inst.material.is_some() || m.material_ids.is_none())
+                && mat as usize >= self.materials.len()
+            {
+                return Err(format!("instance {i}: material {mat} out of range"));
+            }
+        }
+        for s in &self.shapes {
+            if s.instance as usize >= self.instances.len() {
+                return Err(format!("shape instance {} out of range", s.instance));
+            }
+        }
+        let c = &self.camera;
+        if !(c.vfov_deg > 0.0 && c.vfov_deg < 180.0 && c.aspect > 0.0 && c.eye.is_finite()) {
+            return Err("camera: field of view, aspect or position invalid".into());
+        }
+        Ok(())
+    }
+
+    /// Radiance emitted by the scene's brightest emitter (a quick check for
+    /// a scene with no light at all).
+    pub fn has_light(&self) -> bool {
+        !self.lights.is_empty()
+            || self.environment.is_some()
+            || self.materials.iter().any(|m| m.is_emissive())
+    }
+
+    /// A neutral grey diffuse material, for geometry without one.
+    pub fn default_material() -> Material {
+        Material::diffuse(Vec3::splat(0.8))
+    }
+}

@@ -1,0 +1,371 @@
+//! The scene prepared for rendering: acceleration structure, the lights
+//! the integrators sample and how one is chosen, and surface hits.
+
+use glam::{Vec2, Vec3};
+use sahara_kd::geometry::aabb::gamma;
+use sahara_kd::{BuildParams, Counters, NoCounters, Ray};
+
+use crate::accel::{Accel, RawHit};
+use crate::distribution::Distribution1D;
+use crate::light::area::Emitter;
+use crate::light::{AreaLight, EnvLight, LightSample, LightSource};
+use crate::material::Material;
+use crate::sampling::Frame;
+use crate::scene::Scene;
+use crate::shape::Shape;
+
+/// A ray's intersection with a surface, in world space.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    /// Ray parameter (distance for unit directions).
+    pub t: f32,
+    /// Hit point.
+    pub p: Vec3,
+    /// Unit geometric normal of the front face (winding order).
+    pub ng: Vec3,
+    /// Unit shading normal, on the same side as `ng`.
+    pub ns: Vec3,
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// Material id.
+    pub material: u32,
+    /// Instance index.
+    pub instance: u32,
+    /// Triangle index in the instance's mesh.
+    pub tri: u32,
+    /// Bound on the rounding error of `p` along `ng`.
+    pub err: f32,
+}
+
+impl SurfaceHit {
+    /// The origin of a ray leaving the surface along `w`: the hit point
+    /// pushed along the geometric normal, to `w`'s side, past the bound on
+    /// its rounding error, so the new ray cannot hit this surface again.
+    #[inline]
+    pub fn spawn_origin(&self, w: Vec3) -> Vec3 {
+        let off = self.ng * self.err;
+        if w.dot(self.ng) >= 0.0 {
+            self.p + off
+        } else {
+            self.p - off
+        }
+    }
+
+    /// The shading frame.
+    #[inline]
+    pub fn frame(&self) -> Frame {
+        Frame::from_normal(self.ns)
+    }
+}
+
+/// Safety factor on the pbrt-style error bound (it is a first-order bound;
+/// doubling it costs nothing visible).
+const ERR_SAFETY: f32 = 2.0;
+
+/// Smallest ray-origin offset, in units of the hit point's largest
+/// coordinate times the machine epsilon (about 8 ulps).
+const MIN_OFFSET_ULPS: f32 = 16.0;
+
+/// The prepared scene.
+pub struct World<'a> {
+    /// The description.
+    pub scene: &'a Scene,
+    /// Ray queries.
+    pub accel: Accel,
+    /// Every sampled light.
+    pub lights: Vec<LightSource>,
+    select: Distribution1D,
+    instance_light: Vec<Option<u32>>,
+    env: Option<u32>,
+    default_material: Material,
+    /// Centre of the scene's bounds.
+    pub center: Vec3,
+    /// Radius of the scene's bounding sphere.
+    pub radius: f32,
+}
+
+impl<'a> World<'a> {
+    /// Builds trees and lights.
+    pub fn new(scene: &'a Scene, params: &BuildParams) -> Self {
+        let accel = Accel::build(&scene.meshes, &scene.instances, params);
+        let b = accel.bounds();
+        let (center, radius) = if b.is_empty() {
+            (Vec3::ZERO, 1.0)
+        } else {
+            (b.center(), (0.5 * b.extent().length()).max(1e-3))
+        };
+        let mut lights: Vec<LightSource> = scene
+            .lights
+            .iter()
+            .map(|l| LightSource::Explicit(*l))
+            .collect();
+        let mut instance_light = vec![None; scene.instances.len()];
+        let material = |id: u32| scene.materials.get(id as usize);
+        // Analytic shapes first.
+        for s in &scene.shapes {
+            let inst = &scene.instances[s.instance as usize];
+            let Some(m) = material(scene.material_of(s.instance, 0)) else {
+                continue;
+            };
+            if !m.is_emissive() || !s.shape.has_analytic_sampling() || inst.placement.is_moving() {
+                continue;
+            }
+            let emitter = match s.shape {
+                Shape::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                } => Emitter::Quad {
+                    corner,
+                    u: edge_u,
+                    v: edge_v,
+                    n: edge_u.cross(edge_v).normalize(),
+                },
+                Shape::Disc {
+                    center,
+                    normal,
+                    radius,
+                } => Emitter::Disc {
+                    center,
+                    frame: Frame::from_normal(normal.normalize()),
+                    radius,
+                },
+                Shape::Sphere { center, radius } => Emitter::Sphere { center, radius },
+                Shape::Box { .. } => unreachable!(),
+            };
+            instance_light[s.instance as usize] = Some(lights.len() as u32);
+            lights.push(LightSource::Area(AreaLight::analytic(
+                emitter,
+                m.emission,
+                m.two_sided_emission,
+                s.instance,
+            )));
+        }
+        // Then every other static instance with emissive triangles.
+        for (i, inst) in scene.instances.iter().enumerate() {
+            if instance_light[i].is_some() || inst.placement.is_moving() {
+                continue;
+            }
+            let mesh = &scene.meshes[inst.mesh as usize];
+            let xf = inst.placement.at(0.0);
+            let (mut tris, mut radiance, mut two) = (Vec::new(), Vec::new(), Vec::new());
+            for (t, idx) in mesh.mesh.indices.iter().enumerate() {
+                let Some(m) = material(scene.material_of(i as u32, t as u32)) else {
+                    continue;
+                };
+                if !m.is_emissive() {
+                    continue;
+                }
+                tris.push(idx.map(|k| xf.transform_point3(mesh.mesh.positions[k as usize])));
+                radiance.push(m.emission);
+                two.push(m.two_sided_emission);
+            }
+            if !tris.is_empty() {
+                instance_light[i] = Some(lights.len() as u32);
+                lights.push(LightSource::Area(AreaLight::mesh(tris, radiance, two)));
+            }
+        }
+        let env = scene.environment.as_ref().map(|e| {
+            lights.push(LightSource::Environment(EnvLight::new(e)));
+            lights.len() as u32 - 1
+        });
+        let select = Distribution1D::new(lights.iter().map(|l| l.power(radius)).collect());
+        Self {
+            scene,
+            accel,
+            lights,
+            select,
+            instance_light,
+            env,
+            default_material: Scene::default_material(),
+            center,
+            radius,
+        }
+    }
+
+    /// The material with id `id` (a grey default when out of range).
+    #[inline]
+    pub fn material(&self, id: u32) -> &Material {
+        self.scene
+            .materials
+            .get(id as usize)
+            .unwrap_or(&self.default_material)
+    }
+
+    /// Shutter fraction of an absolute time.
+    #[inline]
+    pub fn shutter_fraction(&self, time: f32) -> f32 {
+        self.scene.camera.shutter_fraction(time)
+    }
+
+    /// The closest surface along `ray` at `time`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, time: f32) -> Option<SurfaceHit> {
+        self.intersect_counted(ray, time, &mut NoCounters)
+    }
+
+    /// [`World::intersect`], counting traversal work.
+    pub fn intersect_counted<C: Counters>(
+        &self,
+        ray: &Ray,
+        time: f32,
+        counters: &mut C,
+    ) -> Option<SurfaceHit> {
+        let s = self.shutter_fraction(time);
+        let h = self.accel.closest(ray, s, counters)?;
+        Some(self.surface(&h, s))
+    }
+
+    /// Shading data of a raw hit.
+    fn surface(&self, h: &RawHit, s: f32) -> SurfaceHit {
+        let inst = &self.scene.instances[h.instance as usize];
+        let mesh = &self.scene.meshes[inst.mesh as usize];
+        let idx = mesh.mesh.indices[h.tri as usize];
+        let [p0, p1, p2] = idx.map(|k| mesh.mesh.positions[k as usize]);
+        let (b1, b2) = (h.u, h.v);
+        let b0 = 1.0 - b1 - b2;
+        let xf = self.accel.transform(h.instance, s);
+        let p_obj = p0 * b0 + p1 * b1 + p2 * b2;
+        let p = xf.transform_point3(p_obj);
+        // Error bounds after pbrt (Pharr, Jakob, Humphreys, section 3.9):
+        // barycentric interpolation, then the affine transform.
+        let err_obj = gamma(7) * ((p0 * b0).abs() + (p1 * b1).abs() + (p2 * b2).abs());
+        let m = glam::Mat3::from(xf.matrix3);
+        let m_abs = glam::Mat3::from_cols(m.x_axis.abs(), m.y_axis.abs(), m.z_axis.abs());
+        let t_abs = Vec3::from(xf.translation).abs();
+        let err = m_abs * err_obj * (1.0 + gamma(3)) + gamma(3) * (m_abs * p_obj.abs() + t_abs);
+        // Normals transform by the inverse transpose.
+        let nm = m.inverse().transpose();
+        let ng = (nm * (p1 - p0).cross(p2 - p0)).normalize_or_zero();
+        let ns = match &mesh.normals {
+            Some(n) => {
+                let [n0, n1, n2] = idx.map(|k| n[k as usize]);
+                let ns = (nm * (n0 * b0 + n1 * b1 + n2 * b2)).normalize_or_zero();
+                if ns == Vec3::ZERO || !ns.is_finite() {
+                    ng
+                } else if ns.dot(ng) < 0.0 {
+                    -ns
+                } else {
+                    ns
+                }
+            }
+            None => ng,
+        };
+        let uv = match &mesh.uvs {
+            Some(t) => {
+                let [t0, t1, t2] = idx.map(|k| t[k as usize]);
+                t0 * b0 + t1 * b1 + t2 * b2
+            }
+            None => Vec2::new(b1, b2),
+        };
+        SurfaceHit {
+            t: h.t,
+            p,
+            ng,
+            ns,
+            uv,
+            material: self.scene.material_of(h.instance, h.tri),
+            instance: h.instance,
+            tri: h.tri,
+            // The bound is zero for a point computed exactly (a triangle in
+            // a coordinate plane), but the kd-tree's test accepts t = 0, and
+            // an offset below an ulp of the coordinates would round away:
+            // never offset by less than a few ulps of the point's magnitude.
+            err: (ERR_SAFETY * err.dot(ng.abs()))
+                .max(MIN_OFFSET_ULPS * f32::EPSILON * p.abs().max_element())
+                .max(f32::MIN_POSITIVE),
+        }
+    }
+
+    /// True if nothing blocks the segment from `origin` along unit `w` over
+    /// `dist` (infinite for distant lights). The segment stops short of its
+    /// end by [`SHADOW_EPS`] of its length, so the light's own surface does
+    /// not block it.
+    /// `ignore` names an instance that cannot block (see [`LightSample`]).
+    pub fn unoccluded(
+        &self,
+        origin: Vec3,
+        w: Vec3,
+        dist: f32,
+        time: f32,
+        ignore: Option<u32>,
+    ) -> bool {
+        let tmax = if dist.is_finite() {
+            dist * (1.0 - SHADOW_EPS)
+        } else {
+            f32::INFINITY
+        };
+        let ray = Ray::with_interval(origin, w, 0.0, tmax);
+        !self
+            .accel
+            .occluded(&ray, self.shutter_fraction(time), ignore)
+    }
+
+    /// True if the scene has any light to sample.
+    pub fn has_lights(&self) -> bool {
+        !self.lights.is_empty()
+    }
+
+    /// One light chosen by power (`u_pick`), sampled from `p` (`u`), with
+    /// the probability of the choice.
+    pub fn sample_light(&self, p: Vec3, u_pick: f32, u: Vec2) -> Option<(LightSample, f32)> {
+        if self.lights.is_empty() {
+            return None;
+        }
+        let (i, pmf) = self.select.sample_discrete(u_pick);
+        if pmf <= 0.0 {
+            return None;
+        }
+        let s = self.lights[i].sample(p, u)?;
+        Some((s, pmf))
+    }
+
+    /// Probability that [`World::sample_light`] picks light `i`.
+    pub fn light_pmf(&self, i: usize) -> f32 {
+        self.select.pmf(i)
+    }
+
+    /// Density (selection times solid angle) with which light sampling from
+    /// `p_ref` produces direction `wi` towards the emissive `hit`; 0 when the
+    /// hit surface is not a sampled light.
+    pub fn light_pdf(&self, p_ref: Vec3, hit: &SurfaceHit, wi: Vec3) -> f32 {
+        let Some(l) = self.instance_light[hit.instance as usize] else {
+            return 0.0;
+        };
+        match &self.lights[l as usize] {
+            LightSource::Area(a) => self.select.pmf(l as usize) * a.pdf(p_ref, hit.p, hit.ng, wi),
+            _ => 0.0,
+        }
+    }
+
+    /// Radiance of the environment along `w` (black without one).
+    pub fn env_radiance(&self, w: Vec3) -> Vec3 {
+        match self.env {
+            Some(i) => match &self.lights[i as usize] {
+                LightSource::Environment(e) => e.radiance(w),
+                _ => Vec3::ZERO,
+            },
+            None => Vec3::ZERO,
+        }
+    }
+
+    /// Density (selection times solid angle) of light sampling choosing
+    /// direction `w` on the environment.
+    pub fn env_pdf(&self, w: Vec3) -> f32 {
+        match self.env {
+            Some(i) => match &self.lights[i as usize] {
+                LightSource::Environment(e) => self.select.pmf(i as usize) * e.pdf(w),
+                _ => 0.0,
+            },
+            None => 0.0,
+        }
+    }
+
+    /// True if the scene has an environment.
+    pub fn has_environment(&self) -> bool {
+        self.env.is_some()
+    }
+}
+
+/// Relative shortening of shadow rays towards points on lights.
+pub const SHADOW_EPS: f32 = 1.0 / 4096.0;

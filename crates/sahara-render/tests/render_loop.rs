@@ -1,0 +1,291 @@
+//! The render loop and whole scenes: determinism, the Cornell box, no NaN
+//! anywhere, progressive passes and cancellation, instancing.
+
+mod common;
+
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::Duration;
+
+use common::{run, settings};
+use glam::{Affine3A, Quat, Vec3};
+use sahara_render::world::World;
+use sahara_render::{
+    builtin, render, Camera, Environment, Filter, Instance, Integrator, Light, Material,
+    SamplerKind, Scene, Shape, Srt, Texture,
+};
+
+fn render_in_pool(threads: usize, scene: &Scene, s: &sahara_render::RenderSettings) -> Vec<u32> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let r = pool.install(|| render(scene, s, &|_| {}));
+    r.film
+        .pixels
+        .iter()
+        .flat_map(|p| p.to_array().map(f32::to_bits))
+        .collect()
+}
+
+#[test]
+fn same_seed_same_bits_whatever_the_thread_count() {
+    let scene = builtin::cornell_box();
+    for sampler in [
+        SamplerKind::Sobol,
+        SamplerKind::Stratified,
+        SamplerKind::Independent,
+    ] {
+        let mut s = settings(24, 24, 4, Integrator::default());
+        s.sampler = sampler;
+        // A filter wider than a pixel and small tiles: samples cross tiles.
+        s.filter = Filter::mitchell();
+        s.tile_size = 5;
+        s.passes = 2;
+        let one = render_in_pool(1, &scene, &s);
+        let two = render_in_pool(2, &scene, &s);
+        assert!(
+            one == two,
+            "{sampler:?}: images differ between 1 and 2 threads"
+        );
+        s.seed += 1;
+        let other = render_in_pool(2, &scene, &s);
+        assert!(one != other, "{sampler:?}: the seed changes nothing");
+    }
+}
+
+#[test]
+fn cornell_box_has_red_left_and_green_right() {
+    let scene = builtin::cornell_box();
+    let r = run(&scene, &settings(32, 32, 16, Integrator::default()));
+    // Halves: more red on the left, more green on the right.
+    let left = r.film.mean(0, 0, 16, 32);
+    let right = r.film.mean(16, 0, 32, 32);
+    assert!(left.x > 1.1 * right.x, "red: left {left} right {right}");
+    assert!(right.y > 1.1 * left.y, "green: left {left} right {right}");
+    // The outer strips at mid height are the side walls themselves.
+    let red = r.film.mean(0, 10, 4, 22);
+    let green = r.film.mean(28, 10, 32, 22);
+    assert!(
+        red.x > 2.0 * red.y && red.x > 2.0 * red.z,
+        "left wall {red}"
+    );
+    assert!(
+        green.y > 1.5 * green.x && green.y > 1.5 * green.z,
+        "right wall {green}"
+    );
+    // The light, seen directly at the top centre, is the brightest thing.
+    let top = r.film.mean(14, 4, 18, 5);
+    assert!(top.x > 5.0, "ceiling light {top}");
+}
+
+/// Every feature at once, through every integrator: never NaN, never
+/// negative.
+#[test]
+fn no_nan_or_negative_anywhere() {
+    let cam = Camera::look_at(Vec3::new(0.0, 2.0, -6.0), Vec3::ZERO, Vec3::Y, 50.0, 1.5)
+        .with_thin_lens(0.05, 6.0)
+        .with_shutter(0.0, 1.0);
+    let mut scene = Scene::new(cam);
+    let checker: Vec<Vec3> = (0..64)
+        .map(|i| {
+            if (i % 8 + i / 8) % 2 == 0 {
+                Vec3::splat(0.9)
+            } else {
+                Vec3::splat(0.1)
+            }
+        })
+        .collect();
+    let tex = Arc::new(Texture::new(8, 8, checker));
+    let floor = scene.add_material(Material::diffuse(Vec3::ONE).with_texture(tex));
+    let glass = scene.add_material(Material::glass(1.5));
+    let rough_glass = scene.add_material(Material::rough_glass(1.33, 0.4));
+    let metal = scene.add_material(Material::conductor(Vec3::new(0.9, 0.6, 0.2), 0.2));
+    let mirror = scene.add_material(Material::mirror(Vec3::splat(0.9)));
+    let lamp = scene.add_material(Material::emitter(Vec3::new(5.0, 4.0, 3.0)));
+    let mut glow = Material::diffuse(Vec3::splat(0.5)).with_emission(Vec3::splat(2.0));
+    glow.two_sided_emission = true;
+    let glow = scene.add_material(glow);
+    scene.add_shape(
+        Shape::Quad {
+            corner: Vec3::new(-5.0, -1.0, -5.0),
+            edge_u: Vec3::new(0.0, 0.0, 10.0),
+            edge_v: Vec3::new(10.0, 0.0, 0.0),
+        },
+        floor,
+    );
+    scene.add_shape(
+        Shape::Sphere {
+            center: Vec3::new(-1.5, 0.0, 0.0),
+            radius: 1.0,
+        },
+        glass,
+    );
+    scene.add_shape(
+        Shape::Sphere {
+            center: Vec3::new(1.5, 0.0, 0.0),
+            radius: 1.0,
+        },
+        rough_glass,
+    );
+    scene.add_shape(
+        Shape::Box {
+            min: Vec3::new(-0.5, -1.0, 1.5),
+            max: Vec3::new(0.5, 0.5, 2.5),
+        },
+        metal,
+    );
+    scene.add_shape(
+        Shape::Disc {
+            center: Vec3::new(0.0, 3.0, 0.0),
+            normal: -Vec3::Y,
+            radius: 0.5,
+        },
+        lamp,
+    );
+    scene.add_shape(
+        Shape::Sphere {
+            center: Vec3::new(2.5, 2.0, 2.0),
+            radius: 0.3,
+        },
+        lamp,
+    );
+    scene.add_shape(
+        Shape::Box {
+            min: Vec3::new(-3.0, -1.0, 2.0),
+            max: Vec3::new(-2.5, 0.0, 2.5),
+        },
+        glow,
+    );
+    let ball = scene.add_mesh(
+        Shape::Sphere {
+            center: Vec3::ZERO,
+            radius: 0.4,
+        }
+        .to_mesh(),
+    );
+    scene.add_instance(Instance::moving(
+        ball,
+        Srt::translation(Vec3::new(0.0, 1.0, -1.0)),
+        Srt {
+            scale: Vec3::splat(1.5),
+            rotation: Quat::from_rotation_y(1.0),
+            translation: Vec3::new(0.8, 1.2, -1.0),
+        },
+        Some(mirror),
+    ));
+    scene.add_instance(Instance::moving(
+        ball,
+        Srt::translation(Vec3::new(-2.0, 2.0, 1.0)),
+        Srt::translation(Vec3::new(-1.0, 2.0, 1.0)),
+        Some(glow),
+    ));
+    scene.add_light(Light::point(Vec3::new(2.0, 3.0, -2.0), Vec3::splat(10.0)));
+    scene.add_light(Light::spot(
+        Vec3::new(-2.0, 3.0, -2.0),
+        Vec3::ZERO,
+        Vec3::splat(20.0),
+        15.0,
+        25.0,
+    ));
+    scene.add_light(Light::directional(
+        Vec3::new(-1.0, -2.0, 1.0),
+        Vec3::splat(0.5),
+    ));
+    let env: Vec<Vec3> = (0..32 * 16)
+        .map(|i| Vec3::splat(((i * 7919) % 13) as f32 / 4.0))
+        .collect();
+    scene.environment = Some(Environment::Map {
+        texture: Arc::new(Texture::new(32, 16, env)),
+        scale: 0.3,
+    });
+    scene.validate().unwrap();
+    for integrator in ["path", "distribution", "normals", "depth", "ao", "cost"] {
+        let integrator = Integrator::from_name(integrator).unwrap();
+        let mut s = settings(30, 20, 8, integrator);
+        s.filter = Filter::mitchell();
+        let r = run(&scene, &s);
+        let mean = r.film.mean(0, 0, 30, 20);
+        assert!(mean.max_element() > 0.0, "{integrator:?}: black image");
+        if integrator == Integrator::Cost {
+            let c = r.cost.as_ref().unwrap();
+            assert!(c
+                .steps
+                .iter()
+                .zip(&c.tests)
+                .all(|(a, b)| a.is_finite() && b.is_finite()));
+            assert!(c.tests.iter().any(|&t| t > 0.0));
+            assert!(r.stats.trace.traversal.triangles > 0);
+        }
+    }
+}
+
+#[test]
+fn passes_stop_on_cancel_and_time_limit() {
+    let scene = builtin::cornell_box();
+    let mut s = settings(16, 16, 1, Integrator::default());
+    s.passes = 1_000_000;
+    s.time_limit = Some(Duration::from_millis(150));
+    let r = render(&scene, &s, &|_| {});
+    assert!(r.stats.stopped_early && r.stats.passes >= 1 && r.stats.passes < 1_000_000);
+    assert_eq!(r.stats.spp, r.stats.passes);
+    assert!(r.film.mean(0, 0, 16, 16).x > 0.0);
+
+    let cancel = Arc::new(AtomicBool::new(true));
+    s.time_limit = None;
+    s.cancel = Some(cancel);
+    let r = render(&scene, &s, &|_| {});
+    assert_eq!(r.stats.passes, 0);
+    assert!(r.film.pixels.iter().all(|p| *p == Vec3::ZERO));
+
+    // Progress reports every tile of every pass.
+    let count = std::sync::atomic::AtomicU32::new(0);
+    let mut s = settings(16, 16, 1, Integrator::default());
+    s.passes = 3;
+    s.tile_size = 8;
+    render(&scene, &s, &|p| {
+        assert!(p.tiles_done <= p.tiles && p.pass < 3);
+        count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    });
+    assert_eq!(count.into_inner(), 12);
+}
+
+#[test]
+fn instances_share_one_tree() {
+    let mut scene = Scene::new(Camera::look_at(
+        Vec3::new(0.0, 0.0, -30.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        60.0,
+        1.0,
+    ));
+    let m = scene.add_material(Material::diffuse(Vec3::ONE));
+    let mesh = scene.add_mesh(
+        Shape::Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        }
+        .to_mesh(),
+    );
+    for i in 0..100 {
+        let t = Vec3::new(
+            (i % 10) as f32 * 3.0 - 13.5,
+            (i / 10) as f32 * 3.0 - 13.5,
+            0.0,
+        );
+        scene.add_instance(Instance::new(mesh, Affine3A::from_translation(t), Some(m)));
+    }
+    let world = World::new(&scene, &Default::default());
+    assert_eq!(world.accel.tree_count(), 1);
+    let one = {
+        let mut single = scene.clone();
+        single.instances.truncate(1);
+        World::new(&single, &Default::default()).accel.tree_bytes()
+    };
+    assert_eq!(world.accel.tree_bytes(), one);
+    // And all hundred are there: a lit render sees spheres everywhere.
+    scene.environment = Some(Environment::Constant(Vec3::ONE));
+    let r = run(&scene, &settings(40, 40, 1, Integrator::Normals));
+    let hit = r.film.pixels.iter().filter(|p| p.length() > 0.0).count();
+    assert!(hit > 300, "{hit} pixels see a sphere");
+}
