@@ -122,8 +122,10 @@ impl Accel {
             let p = &self.placed[i as usize];
             let r = Self::object_ray(p, ray, s, tmax);
             let h = self.trees[p.mesh as usize].closest_hit_counted(&r, counters)?;
-            // Ties between instances go to the lower index (visited first).
-            if best.is_some_and(|b| b.t <= h.t) {
+            // Ties between instances go to the lower index, whatever order
+            // the top level offers them in (an instance spanning several
+            // cells may also be offered again).
+            if best.is_some_and(|b| b.t < h.t || (b.t == h.t && b.instance <= i)) {
                 return None;
             }
             best = Some(RawHit {

@@ -1,31 +1,34 @@
-//! The top level of the two-level acceleration structure: a structure over
-//! instance bounds queried with closures.
-//!
-//! For now a plain loop over the boxes; the interface is that of the
-//! coming `sahara_kd::BoxTree` (`build(&[Aabb])`, closure-based `closest`
-//! and `any`), so it can be swapped in here without touching the callers.
+//! The top level of the two-level acceleration structure: a kd-tree over the
+//! instances' world bounds (`sahara_kd::BoxTree`), queried with closures that
+//! trace the instance's own mesh tree.
 
-use glam::Vec3;
-use sahara_kd::{Aabb, Counters, Ray};
+use sahara_kd::{Aabb, BoxTree, BuildParams, Builder, Counters, Ray};
 
-/// The instances' world bounds, traversed by testing each box.
-#[derive(Clone, Debug, Default)]
+/// The instances' world bounds in a kd-tree.
+#[derive(Clone, Debug)]
 pub struct InstanceList {
-    bounds: Vec<Aabb>,
+    tree: BoxTree,
+}
+
+impl Default for InstanceList {
+    fn default() -> Self {
+        Self::build(&[])
+    }
 }
 
 impl InstanceList {
     /// A top level over these boxes (index `i` is instance `i`).
     pub fn build(bounds: &[Aabb]) -> Self {
         Self {
-            bounds: bounds.to_vec(),
+            tree: BoxTree::build(bounds.to_vec(), &BuildParams::new(Builder::Sah)),
         }
     }
 
-    /// Calls `visit(i, tmax)` for every instance whose box the ray meets
-    /// before `tmax`; `visit` returns the new `tmax` when it found a closer
-    /// hit. Instances are visited in index order, so the result does not
-    /// depend on anything but the scene.
+    /// Calls `visit(i, tmax)` for the instances whose cells the ray passes
+    /// through, front to back; `visit` returns the hit distance when it found
+    /// a hit no farther than `tmax`. The traversal stops once no cell ahead
+    /// can hold a closer hit; among equally distant hits the smallest
+    /// instance index wins, so the result depends on nothing but the scene.
     #[inline]
     pub fn closest<C: Counters>(
         &self,
@@ -33,27 +36,16 @@ impl InstanceList {
         counters: &mut C,
         mut visit: impl FnMut(u32, f32, &mut C) -> Option<f32>,
     ) {
-        let inv = Vec3::ONE / ray.dir;
-        let mut tmax = ray.tmax;
-        for (i, b) in self.bounds.iter().enumerate() {
+        self.tree.closest_with(ray, |i, tmax| {
             counters.inner();
-            if b.intersect_ray(ray.origin, inv, ray.tmin, tmax).is_some() {
-                if let Some(t) = visit(i as u32, tmax, counters) {
-                    tmax = t;
-                }
-            }
-        }
+            visit(i, tmax, counters)
+        });
     }
 
-    /// True as soon as `visit(i)` returns true for an instance whose box the
-    /// ray meets.
+    /// True as soon as `visit(i)` returns true for an instance whose cell
+    /// the ray passes through.
     #[inline]
-    pub fn any(&self, ray: &Ray, mut visit: impl FnMut(u32) -> bool) -> bool {
-        let inv = Vec3::ONE / ray.dir;
-        self.bounds.iter().enumerate().any(|(i, b)| {
-            b.intersect_ray(ray.origin, inv, ray.tmin, ray.tmax)
-                .is_some()
-                && visit(i as u32)
-        })
+    pub fn any(&self, ray: &Ray, visit: impl FnMut(u32) -> bool) -> bool {
+        self.tree.any_with(ray, visit)
     }
 }
