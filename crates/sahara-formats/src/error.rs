@@ -18,6 +18,15 @@ pub enum FormatError {
         #[source]
         source: io::Error,
     },
+    /// The file could not be written (or a temporary file beside it could not be made).
+    #[error("{path}: cannot write the file: {source}")]
+    Write {
+        /// The file, as given by the caller.
+        path: String,
+        /// What the operating system said.
+        #[source]
+        source: io::Error,
+    },
     /// A problem at a 1-based line of a text file (or of a PLY header).
     #[error("{path}: line {line}: {message}")]
     AtLine {
@@ -60,6 +69,14 @@ impl FormatError {
     /// An I/O error while reading `path`.
     pub fn io(path: &Path, source: io::Error) -> Self {
         FormatError::Io {
+            path: path.display().to_string(),
+            source,
+        }
+    }
+
+    /// An I/O error while writing `path`.
+    pub fn write(path: &Path, source: io::Error) -> Self {
+        FormatError::Write {
             path: path.display().to_string(),
             source,
         }

@@ -1,4 +1,9 @@
-//! `sahara-formats`: files in, plain arrays out.
+//! `sahara-formats`: files in, plain arrays out; images out, atomically.
+//!
+//! - meshes: [`obj`] (with [`mtl`] materials), [`ply`], [`gltf`] (meshes plus instances);
+//! - scenes: [`scene_file`] (TOML, documented in `SCENE_FORMAT.md`), [`camera`] sidecars;
+//! - images: [`image_out`] (PNG/EXR via [`atomic`] replacement), [`image_in`] (textures);
+//! - every error is a [`FormatError`]: one line naming the file and the place.
 //!
 //! Meshes come out as [`sahara_render::mesh::Mesh`]: one merged triangle list
 //! in file order, polygons fan-triangulated as `(v0, vi, vi+1)`, so triangle
@@ -6,11 +11,18 @@
 
 #![warn(missing_docs)]
 
+pub mod atomic;
 pub mod camera;
 pub mod error;
 mod fan;
+pub mod gltf;
+pub mod image_in;
+pub mod image_out;
+pub mod mtl;
 pub mod obj;
 pub mod ply;
+pub mod scene_file;
+pub mod srgb;
 
 use std::path::{Path, PathBuf};
 

@@ -4,7 +4,8 @@
 //! order. Polygons are fan-triangulated here as `(v0, vi, vi+1)` (tobj is asked
 //! not to triangulate, so the order is ours, not tobj's). Relative (negative)
 //! indices work. Points (`p`, and `f` with fewer than three corners) and
-//! polylines (`l`) give no triangles. Materials (`mtllib`) are not read.
+//! polylines (`l`) give no triangles. Materials (`mtllib`) are not read here;
+//! [`load_obj_with_materials`] reads them, with normals and uvs.
 //!
 //! `positions` are not the file's `v` list verbatim: tobj compacts them per
 //! object in first-use order, so unreferenced vertices are dropped and vertices
@@ -12,6 +13,7 @@
 //! the file's.
 
 mod locate;
+mod with_materials;
 
 use std::borrow::Cow;
 use std::fs;
@@ -23,6 +25,8 @@ use sahara_render::mesh::Mesh;
 use crate::error::FormatError;
 use crate::fan::fan_triangulate;
 
+pub use with_materials::{load_obj_with_materials, ObjScene};
+
 /// Loads an OBJ file; errors name the file and, when it can be found, the line.
 pub fn load_obj(path: &Path) -> Result<Mesh, FormatError> {
     let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
@@ -31,22 +35,26 @@ pub fn load_obj(path: &Path) -> Result<Mesh, FormatError> {
 
 /// Parses an OBJ file held in memory; `name` is used in error messages.
 pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, FormatError> {
+    let source = without_polylines(bytes);
+    let (models, _materials) = tobj::load_obj_buf(&mut &source[..], &obj_load_options(), |_| {
+        Ok((Vec::new(), Default::default()))
+    })
+    .map_err(|e| locate::describe(bytes, name, e))?;
+    merge(&models, name)
+}
+
+/// How tobj is asked to read OBJ: separate index streams, no triangulation, no points or lines.
+fn obj_load_options() -> tobj::LoadOptions {
     // Another crate enabling tobj's `merging`/`reordering` features adds
     // fields to LoadOptions; the struct update keeps them at their defaults.
     #[allow(clippy::needless_update)]
-    let options = tobj::LoadOptions {
+    tobj::LoadOptions {
         single_index: false,
         triangulate: false,
         ignore_points: true,
         ignore_lines: true,
         ..Default::default()
-    };
-    let source = without_polylines(bytes);
-    let (models, _materials) = tobj::load_obj_buf(&mut &source[..], &options, |_| {
-        Ok((Vec::new(), Default::default()))
-    })
-    .map_err(|e| locate::describe(bytes, name, e))?;
-    merge(&models, name)
+    }
 }
 
 /// `bytes` with every `l` (polyline) statement turned into a comment.

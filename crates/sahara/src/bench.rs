@@ -22,27 +22,25 @@ const FILE_SET: &str = "file";
 
 /// `sahara bench MESH ...`.
 pub fn run_file(args: &BenchArgs) -> Result<()> {
-    let mesh = args.opts.tree.select(load_mesh(&args.mesh)?);
-    run(
-        &args.mesh.display().to_string(),
-        Some(&args.mesh),
-        &mesh,
-        &args.opts,
-    )
+    let Some(path) = &args.mesh else {
+        return run_builtin(&args.opts);
+    };
+    let mesh = args.opts.tree.select(load_mesh(path)?);
+    run(&path.display().to_string(), Some(path), &mesh, &args.opts)
 }
 
-/// `sahara` with no subcommand: the benchmark on the built-in scene.
-pub fn run_builtin() -> Result<()> {
-    let mesh = demo_scene();
+/// `sahara bench` without a mesh: the benchmark on the built-in scene.
+fn run_builtin(opts: &BenchOptions) -> Result<()> {
+    let mesh = opts.tree.select(demo_scene());
     eprintln!(
-        "no subcommand: benchmarking the built-in scene ({} triangles); see `sahara --help`",
+        "no mesh: benchmarking the built-in scene ({} triangles)",
         mesh.triangle_count()
     );
     run(
         "built-in: sphere and torus on a ground plane",
         None,
         &mesh,
-        &BenchOptions::default(),
+        opts,
     )
 }
 

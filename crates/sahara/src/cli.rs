@@ -12,8 +12,8 @@ pub const DEFAULT_RUNS: usize = 3;
 
 /// Sahara: a ray tracer built around an SAH kd-tree.
 ///
-/// With no subcommand, benchmarks a built-in procedural scene (as `sahara
-/// bench` would, with default options).
+/// With no subcommand, renders the built-in Cornell box to
+/// `cornell_box.png` in the working folder (as `sahara render` would).
 #[derive(Debug, Parser)]
 #[command(name = "sahara", version, propagate_version = true)]
 pub struct Cli {
@@ -30,6 +30,79 @@ pub enum Command {
     Bench(BenchArgs),
     /// Build a kd-tree over a mesh and print its statistics and build time.
     Stats(StatsArgs),
+    /// Render a scene (built-in Cornell box, a mesh file, or a scene file) to PNG or EXR.
+    Render(RenderArgs),
+}
+
+/// Options of `sahara render`.
+#[derive(Debug, Args, Clone, PartialEq)]
+pub struct RenderArgs {
+    /// What to render: a mesh (.obj, .ply) framed by its camera sidecar or
+    /// automatically and lit by a default sky and sun; none for the built-in
+    /// Cornell box.
+    pub scene: Option<PathBuf>,
+    /// Output image; the format follows the extension (.png, .exr)
+    /// [default: <scene name>.png in the working folder].
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Samples per pixel in all (or per pass with --time-limit).
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
+    pub spp: u32,
+    /// Samples per pixel in each progressive pass [default: min(spp, 8)].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
+    pub pass_spp: Option<u32>,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub height: u32,
+    /// Light transport: path, distribution, normals, depth, ao, cost.
+    #[arg(long, default_value = "path")]
+    pub integrator: String,
+    /// Sample generator: independent, stratified, sobol.
+    #[arg(long, default_value = "sobol")]
+    pub sampler: String,
+    /// Reconstruction filter: box, tent, gaussian, mitchell.
+    #[arg(long, default_value = "gaussian")]
+    pub filter: String,
+    /// Rendering threads [default: all hardware threads].
+    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    pub threads: Option<u16>,
+    /// Seed of every random decision (same seed, same image, bit for bit).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Render progressive passes until this many seconds have passed (for
+    /// equal-time comparisons); --spp is then the samples of each pass.
+    #[arg(long, value_name = "SECS")]
+    pub time_limit: Option<f64>,
+    /// Exposure in stops, for PNG output.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Tone map for PNG output: clamp or filmic.
+    #[arg(long, default_value = "clamp")]
+    pub tonemap: String,
+}
+
+impl Default for RenderArgs {
+    fn default() -> Self {
+        Self {
+            scene: None,
+            output: None,
+            spp: 64,
+            pass_spp: None,
+            width: 512,
+            height: 512,
+            integrator: "path".into(),
+            sampler: "sobol".into(),
+            filter: "gaussian".into(),
+            threads: None,
+            seed: 0,
+            time_limit: None,
+            exposure: 0.0,
+            tonemap: "clamp".into(),
+        }
+    }
 }
 
 const BENCH_ABOUT: &str = "\
@@ -70,8 +143,8 @@ sets.<name>.{rays, hits, t_sum, mrays_1t, mrays_1t_cpu, mrays_all[, counters]}."
 /// Options of `sahara bench`.
 #[derive(Debug, Args)]
 pub struct BenchArgs {
-    /// The mesh (.obj or .ply).
-    pub mesh: PathBuf,
+    /// The mesh (.obj or .ply); none for a built-in procedural scene.
+    pub mesh: Option<PathBuf>,
     /// How to run.
     #[command(flatten)]
     pub opts: BenchOptions,

@@ -9,20 +9,22 @@ mod cli;
 mod demo_scene;
 mod human;
 mod input;
+mod render;
 mod stats;
 
 use std::process::ExitCode;
 
 use clap::Parser;
 
-use cli::{Cli, Command};
+use cli::{Cli, Command, RenderArgs};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Some(Command::Bench(args)) => bench::run_file(args),
         Some(Command::Stats(args)) => stats::run(args),
-        None => bench::run_builtin(),
+        Some(Command::Render(args)) => render::run(args),
+        None => render::run(&RenderArgs::default()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

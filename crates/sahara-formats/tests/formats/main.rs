@@ -1,7 +1,12 @@
-//! Tests for `sahara-formats`: PLY, OBJ, camera sidecars and the shared scenes.
+//! Tests for `sahara-formats`: meshes, materials, glTF, scene files, images, camera sidecars and the shared scenes.
 
 mod camera;
 mod common;
+mod gltf;
+mod image_in;
+mod image_out;
 mod obj;
+mod obj_materials;
 mod ply;
+mod scene_file;
 mod scenes;

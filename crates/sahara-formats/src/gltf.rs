@@ -1,0 +1,525 @@
+//! glTF 2.0 scenes (`.gltf` with external or embedded buffers, and `.glb`).
+//!
+//! What is read: the default scene (else the first; else every root node),
+//! each node's world transform (parent * local, `matrix` or TRS), and every
+//! triangle primitive (`TRIANGLES`, `TRIANGLE_STRIP`, `TRIANGLE_FAN`) of
+//! the meshes those nodes use: `POSITION`, `NORMAL`, `TEXCOORD_0`,
+//! indices, and the metallic-roughness material with its base colour
+//! texture and emission. Points and lines are skipped with a warning.
+//!
+//! A glTF mesh (all its primitives merged, with per-triangle material ids)
+//! becomes one [`GltfMesh`], stored once however many nodes use it; each use
+//! is a [`GltfInstance`]. Buffers and images are only read from local files
+//! or `data:` URIs, never from the network. Every error names the file.
+
+mod accessor;
+mod uri;
+
+use std::collections::HashMap;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use ::gltf::mesh::Mode;
+use glam::{Mat4, Quat, Vec2, Vec3};
+use sahara_render::mesh::Mesh;
+
+use crate::error::FormatError;
+use uri::UriTarget;
+
+/// Everything read from a glTF file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GltfScene {
+    /// The meshes used by the scene's nodes, each stored once.
+    pub meshes: Vec<GltfMesh>,
+    /// One entry per node that uses a mesh: which mesh, and where.
+    pub instances: Vec<GltfInstance>,
+    /// The materials the meshes' `material_ids` refer to (a default is appended if needed).
+    pub materials: Vec<GltfMaterial>,
+    /// Problems that did not stop loading, one line each.
+    pub warnings: Vec<String>,
+}
+
+/// One glTF mesh: its triangle primitives merged into one triangle list.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GltfMesh {
+    /// The mesh's name in the file, if any.
+    pub name: Option<String>,
+    /// Positions and triangles (primitives in file order).
+    pub mesh: Mesh,
+    /// Per-vertex normals, parallel to `mesh.positions`, if every primitive has them.
+    pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex `TEXCOORD_0`, parallel to `mesh.positions`, if any primitive has them (others get 0, 0).
+    pub uvs: Option<Vec<Vec2>>,
+    /// Per-triangle index into [`GltfScene::materials`], parallel to `mesh.indices`.
+    pub material_ids: Vec<u32>,
+}
+
+/// A use of a mesh by a node.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GltfInstance {
+    /// Index into [`GltfScene::meshes`].
+    pub mesh: usize,
+    /// Object-to-world transform (the product of the node's ancestors' transforms and its own).
+    pub transform: Mat4,
+}
+
+/// A glTF metallic-roughness material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GltfMaterial {
+    /// The material's name in the file, if any.
+    pub name: Option<String>,
+    /// Linear base colour factor (RGBA).
+    pub base_color: [f32; 4],
+    /// Base colour texture (sRGB), multiplied by `base_color`.
+    pub base_color_texture: Option<GltfTexture>,
+    /// Metalness factor in `[0, 1]`.
+    pub metallic: f32,
+    /// Perceptual roughness factor in `[0, 1]`.
+    pub roughness: f32,
+    /// Emitted radiance: `emissiveFactor` times `KHR_materials_emissive_strength`.
+    pub emissive: [f32; 3],
+    /// Whether back faces are visible.
+    pub double_sided: bool,
+}
+
+impl GltfMaterial {
+    /// The glTF default material: white, fully metallic, fully rough, no emission.
+    pub fn default_material() -> GltfMaterial {
+        GltfMaterial {
+            name: None,
+            base_color: [1.0; 4],
+            base_color_texture: None,
+            metallic: 1.0,
+            roughness: 1.0,
+            emissive: [0.0; 3],
+            double_sided: false,
+        }
+    }
+}
+
+/// A texture reference: the image and which uv set it uses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GltfTexture {
+    /// Where the image is.
+    pub image: GltfImage,
+    /// Which `TEXCOORD_n` set (only 0 is loaded into [`GltfMesh::uvs`]).
+    pub tex_coord: u32,
+}
+
+/// Where a texture's image is: a file, or bytes inside the glTF.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GltfImage {
+    /// An image file, resolved relative to the glTF file (it exists).
+    File(PathBuf),
+    /// An encoded image embedded in a buffer view or a `data:` URI.
+    Embedded {
+        /// The MIME type given in the file (`image/png`, `image/jpeg`), if any.
+        mime_type: Option<String>,
+        /// The encoded image file's bytes.
+        bytes: Vec<u8>,
+    },
+}
+
+/// Loads a `.gltf` or `.glb` file (the format is recognised by content).
+pub fn load_gltf(path: &Path) -> Result<GltfScene, FormatError> {
+    let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
+    let name = path.display().to_string();
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let ::gltf::Gltf { document, blob } = parse(&bytes, &name)?;
+    let buffers = load_buffers(&document, blob, folder, &name)?;
+    let mut loader = Loader {
+        name: &name,
+        folder,
+        buffers: &buffers,
+        scene: GltfScene::default(),
+        mesh_slot: HashMap::new(),
+        material_slot: HashMap::new(),
+        default_material: None,
+    };
+    for (node, transform) in scene_nodes(&document, &name)? {
+        if let Some(mesh) = node.mesh() {
+            let slot = loader.mesh(&mesh)?;
+            loader.scene.instances.push(GltfInstance {
+                mesh: slot,
+                transform,
+            });
+        }
+    }
+    Ok(loader.scene)
+}
+
+/// Parses and validates the JSON (and GLB container), tolerating only
+/// missing `POSITION` bounds (`min`/`max`), which many exporters leave out.
+fn parse(bytes: &[u8], name: &str) -> Result<::gltf::Gltf, FormatError> {
+    match ::gltf::Gltf::from_slice(bytes) {
+        Err(::gltf::Error::Validation(problems))
+            if problems.iter().all(|(path, e)| {
+                let path = path.as_str();
+                matches!(e, ::gltf::json::validation::Error::Missing)
+                    && (path.ends_with(".min") || path.ends_with(".max"))
+            }) =>
+        {
+            ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| describe_error(name, e))
+        }
+        other => other.map_err(|e| describe_error(name, e)),
+    }
+}
+
+/// One line for an error of the `gltf` crate (JSON errors get their line and column).
+fn describe_error(name: &str, error: ::gltf::Error) -> FormatError {
+    match error {
+        ::gltf::Error::Deserialize(e) => FormatError::at_line(
+            name,
+            e.line().max(1),
+            format!("column {}: invalid glTF JSON: {e}", e.column()),
+        ),
+        ::gltf::Error::Validation(problems) => {
+            let shown: Vec<String> = problems
+                .iter()
+                .take(3)
+                .map(|(path, e)| format!("{}: {e}", path.as_str()))
+                .collect();
+            let more = problems.len().saturating_sub(3);
+            FormatError::in_file(
+                name,
+                format!(
+                    "invalid glTF: {}{}",
+                    shown.join("; "),
+                    if more > 0 {
+                        format!(" (and {more} more)")
+                    } else {
+                        String::new()
+                    }
+                ),
+            )
+        }
+        other => FormatError::in_file(name, format!("invalid glTF: {other}")),
+    }
+}
+
+/// Reads every buffer: the GLB binary chunk, a `data:` URI, or a file next to the glTF.
+fn load_buffers(
+    document: &::gltf::Document,
+    mut blob: Option<Vec<u8>>,
+    folder: &Path,
+    name: &str,
+) -> Result<Vec<Vec<u8>>, FormatError> {
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let i = buffer.index();
+        let (data, what) = match buffer.source() {
+            ::gltf::buffer::Source::Bin => (
+                blob.take().ok_or_else(|| {
+                    FormatError::in_file(
+                        name,
+                        format!("buffer {i} refers to the GLB binary chunk, which is missing"),
+                    )
+                })?,
+                "the GLB binary chunk".to_owned(),
+            ),
+            ::gltf::buffer::Source::Uri(uri) => match uri::resolve(uri, folder)
+                .map_err(|e| FormatError::in_file(name, format!("buffer {i}: {e}")))?
+            {
+                UriTarget::Data(data) => (data, "its data URI".to_owned()),
+                UriTarget::File(file) => {
+                    let data = fs::read(&file).map_err(|e| {
+                        FormatError::in_file(
+                            name,
+                            format!("buffer {i}: cannot read {}: {e}", file.display()),
+                        )
+                    })?;
+                    (data, file.display().to_string())
+                }
+            },
+        };
+        if data.len() < buffer.length() {
+            return Err(FormatError::in_file(
+                name,
+                format!(
+                    "buffer {i} should have {} bytes but {what} has {}",
+                    buffer.length(),
+                    data.len()
+                ),
+            ));
+        }
+        buffers.push(data);
+    }
+    Ok(buffers)
+}
+
+/// The nodes of the default scene (else the first, else all roots) with their world transforms.
+fn scene_nodes<'a>(
+    document: &'a ::gltf::Document,
+    name: &str,
+) -> Result<Vec<(::gltf::Node<'a>, Mat4)>, FormatError> {
+    let roots: Vec<::gltf::Node> = match document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+    {
+        Some(scene) => scene.nodes().collect(),
+        None => {
+            let mut is_child = vec![false; document.nodes().len()];
+            for node in document.nodes() {
+                for child in node.children() {
+                    is_child[child.index()] = true;
+                }
+            }
+            document.nodes().filter(|n| !is_child[n.index()]).collect()
+        }
+    };
+    let mut visited = vec![false; document.nodes().len()];
+    let mut out = Vec::new();
+    let mut stack: Vec<(::gltf::Node, Mat4)> = roots
+        .into_iter()
+        .rev()
+        .map(|n| (n, Mat4::IDENTITY))
+        .collect();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut visited[node.index()], true) {
+            return Err(FormatError::in_file(
+                name,
+                format!(
+                    "node {} is reached twice from the scene (a cycle, or two parents); glTF nodes must form a tree",
+                    node.index()
+                ),
+            ));
+        }
+        let world = parent * local_transform(&node);
+        let children: Vec<_> = node.children().collect();
+        stack.extend(children.into_iter().rev().map(|c| (c, world)));
+        out.push((node, world));
+    }
+    Ok(out)
+}
+
+/// A node's own transform: its `matrix`, or translation * rotation * scale.
+fn local_transform(node: &::gltf::Node) -> Mat4 {
+    match node.transform() {
+        ::gltf::scene::Transform::Matrix { matrix } => Mat4::from_cols_array_2d(&matrix),
+        ::gltf::scene::Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => Mat4::from_scale_rotation_translation(
+            Vec3::from_array(scale),
+            Quat::from_array(rotation),
+            Vec3::from_array(translation),
+        ),
+    }
+}
+
+/// State while converting meshes and materials, each once.
+struct Loader<'a> {
+    name: &'a str,
+    folder: &'a Path,
+    buffers: &'a [Vec<u8>],
+    scene: GltfScene,
+    mesh_slot: HashMap<usize, usize>,
+    material_slot: HashMap<usize, u32>,
+    default_material: Option<u32>,
+}
+
+impl Loader<'_> {
+    /// The index in `scene.meshes` of glTF mesh `mesh`, converting it on first use.
+    fn mesh(&mut self, mesh: &::gltf::Mesh) -> Result<usize, FormatError> {
+        if let Some(&slot) = self.mesh_slot.get(&mesh.index()) {
+            return Ok(slot);
+        }
+        let mut out = GltfMesh {
+            name: mesh.name().map(str::to_owned),
+            ..GltfMesh::default()
+        };
+        let mut all_normals = true;
+        let mut normals = Vec::new();
+        let mut uvs: Option<Vec<Vec2>> = None;
+        for primitive in mesh.primitives() {
+            let fail = |e: String| {
+                FormatError::in_file(
+                    self.name,
+                    format!("mesh {} primitive {}: {e}", mesh.index(), primitive.index()),
+                )
+            };
+            let mode = primitive.mode();
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                self.scene.warnings.push(format!(
+                    "{}: mesh {} primitive {}: {mode:?} primitives are skipped (only triangles are rendered)",
+                    self.name,
+                    mesh.index(),
+                    primitive.index()
+                ));
+                continue;
+            }
+            let positions = primitive
+                .get(&::gltf::Semantic::Positions)
+                .ok_or_else(|| fail("no POSITION attribute".to_owned()))?;
+            let positions =
+                accessor::read_floats(&positions, self.buffers, 3, false).map_err(fail)?;
+            let count = positions.len() / 3;
+            let base = out.mesh.positions.len();
+            if base + count > u32::MAX as usize {
+                return Err(fail("more than 2^32 vertices in one mesh".to_owned()));
+            }
+            out.mesh
+                .positions
+                .extend(positions.chunks_exact(3).map(Vec3::from_slice));
+            match primitive.get(&::gltf::Semantic::Normals) {
+                Some(a) if all_normals => {
+                    let n = accessor::read_floats(&a, self.buffers, 3, false).map_err(fail)?;
+                    if n.len() != positions.len() {
+                        return Err(fail(format!(
+                            "{} normals for {count} positions",
+                            n.len() / 3
+                        )));
+                    }
+                    normals.extend(n.chunks_exact(3).map(Vec3::from_slice));
+                }
+                _ => all_normals = false,
+            }
+            if let Some(a) = primitive.get(&::gltf::Semantic::TexCoords(0)) {
+                let t = accessor::read_floats(&a, self.buffers, 2, true).map_err(fail)?;
+                if t.len() / 2 != count {
+                    return Err(fail(format!("{} uvs for {count} positions", t.len() / 2)));
+                }
+                let uvs = uvs.get_or_insert_with(|| vec![Vec2::ZERO; base]);
+                uvs.extend(t.chunks_exact(2).map(Vec2::from_slice));
+            } else if let Some(uvs) = &mut uvs {
+                uvs.resize(base + count, Vec2::ZERO);
+            }
+            let indices = match primitive.indices() {
+                Some(a) => accessor::read_indices(&a, self.buffers).map_err(fail)?,
+                None => (0..count as u32).collect(),
+            };
+            if let Some(bad) = indices.iter().find(|&&i| i as usize >= count) {
+                return Err(fail(format!("index {bad} but only {count} vertices")));
+            }
+            let before = out.mesh.indices.len();
+            let b = base as u32;
+            match mode {
+                Mode::Triangles => out.mesh.indices.extend(
+                    indices
+                        .chunks_exact(3)
+                        .map(|t| [b + t[0], b + t[1], b + t[2]]),
+                ),
+                // Every other strip triangle is flipped to keep one winding.
+                Mode::TriangleStrip => {
+                    out.mesh
+                        .indices
+                        .extend(indices.windows(3).enumerate().map(|(k, t)| {
+                            if k % 2 == 0 {
+                                [b + t[0], b + t[1], b + t[2]]
+                            } else {
+                                [b + t[1], b + t[0], b + t[2]]
+                            }
+                        }))
+                }
+                _ => {
+                    if let Some((&first, rest)) = indices.split_first() {
+                        out.mesh
+                            .indices
+                            .extend(rest.windows(2).map(|w| [b + first, b + w[0], b + w[1]]));
+                    }
+                }
+            }
+            let material = self.material(&primitive.material())?;
+            let added = out.mesh.indices.len() - before;
+            out.material_ids
+                .extend(std::iter::repeat_n(material, added));
+        }
+        if let Some(uvs) = &mut uvs {
+            uvs.resize(out.mesh.positions.len(), Vec2::ZERO);
+        }
+        out.normals = (all_normals && !out.mesh.positions.is_empty()).then_some(normals);
+        out.uvs = uvs;
+        let slot = self.scene.meshes.len();
+        self.scene.meshes.push(out);
+        self.mesh_slot.insert(mesh.index(), slot);
+        Ok(slot)
+    }
+
+    /// The index in `scene.materials` of a primitive's material, converting it on first use.
+    fn material(&mut self, material: &::gltf::Material) -> Result<u32, FormatError> {
+        let Some(index) = material.index() else {
+            let next = self.scene.materials.len() as u32;
+            let id = *self.default_material.get_or_insert(next);
+            if id == next {
+                self.scene.materials.push(GltfMaterial::default_material());
+            }
+            return Ok(id);
+        };
+        if let Some(&id) = self.material_slot.get(&index) {
+            return Ok(id);
+        }
+        let pbr = material.pbr_metallic_roughness();
+        let strength = material.emissive_strength().unwrap_or(1.0);
+        let texture = match pbr.base_color_texture() {
+            Some(info) => self
+                .image(&info.texture().source(), index)?
+                .map(|image| GltfTexture {
+                    image,
+                    tex_coord: info.tex_coord(),
+                }),
+            None => None,
+        };
+        let converted = GltfMaterial {
+            name: material.name().map(str::to_owned),
+            base_color: pbr.base_color_factor(),
+            base_color_texture: texture,
+            metallic: pbr.metallic_factor(),
+            roughness: pbr.roughness_factor(),
+            emissive: material.emissive_factor().map(|e| e * strength),
+            double_sided: material.double_sided(),
+        };
+        let id = self.scene.materials.len() as u32;
+        self.scene.materials.push(converted);
+        self.material_slot.insert(index, id);
+        Ok(id)
+    }
+
+    /// Where an image is; a missing file is a warning (the material is then untextured).
+    fn image(
+        &mut self,
+        image: &::gltf::Image,
+        material: usize,
+    ) -> Result<Option<GltfImage>, FormatError> {
+        let fail =
+            |e: String| FormatError::in_file(self.name, format!("image {}: {e}", image.index()));
+        match image.source() {
+            ::gltf::image::Source::View { view, mime_type } => {
+                let bytes = self
+                    .buffers
+                    .get(view.buffer().index())
+                    .and_then(|b| b.get(view.offset()..view.offset().checked_add(view.length())?))
+                    .ok_or_else(|| {
+                        fail(format!(
+                            "buffer view {} lies outside its buffer",
+                            view.index()
+                        ))
+                    })?;
+                Ok(Some(GltfImage::Embedded {
+                    mime_type: Some(mime_type.to_owned()),
+                    bytes: bytes.to_vec(),
+                }))
+            }
+            ::gltf::image::Source::Uri { uri, mime_type } => {
+                match uri::resolve(uri, self.folder).map_err(fail)? {
+                    UriTarget::Data(bytes) => Ok(Some(GltfImage::Embedded {
+                        mime_type: mime_type.map(str::to_owned),
+                        bytes,
+                    })),
+                    UriTarget::File(file) if file.is_file() => Ok(Some(GltfImage::File(file))),
+                    UriTarget::File(file) => {
+                        self.scene.warnings.push(format!(
+                            "{}: material {material}: base colour texture {} not found; the material is untextured",
+                            self.name,
+                            file.display()
+                        ));
+                        Ok(None)
+                    }
+                }
+            }
+        }
+    }
+}

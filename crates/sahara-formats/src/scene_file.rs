@@ -1,0 +1,437 @@
+//! Scene files: TOML describing camera, materials, objects, lights and render settings.
+//!
+//! The format is documented in `SCENE_FORMAT.md` beside this crate's
+//! `Cargo.toml`; in short:
+//!
+//! ```toml
+//! [camera]                       # required
+//! eye = [0, 1, 5]                # required
+//! target = [0, 1, 0]             # required
+//! up = [0, 1, 0]                 # default [0, 1, 0]
+//! vfov = 40                      # vertical field of view, degrees; default 45
+//! aperture_radius = 0.05         # lens radius; default 0 (pinhole)
+//! focus_distance = 5             # default: |target - eye|
+//! shutter_open = 0               # default 0
+//! shutter_close = 1              # default 0 (no motion blur)
+//!
+//! [[material]]                   # named; objects refer to them by name
+//! name = "red"
+//! type = "diffuse"               # diffuse | conductor (alias glossy) | mirror | dielectric | rough_dielectric | emission
+//! albedo = [0.6, 0.1, 0.1]
+//!
+//! [[object]]
+//! type = "mesh"                  # mesh | quad | disc | sphere | box
+//! file = "bunny.obj"             # relative to this scene file
+//! material = "red"               # optional: overrides the mesh's own materials
+//! transform = { translate = [0, 0, 0], rotate = { axis = [0, 1, 0], degrees = 30 }, scale = 2 }
+//!
+//! [[light]]
+//! type = "point"                 # point | spot | directional | area | environment
+//! position = [0, 5, 0]
+//! intensity = [10, 10, 10]
+//!
+//! [integrator]
+//! name = "path"                  # distribution | path | normals | depth | ao | cost
+//! max_depth = 8
+//!
+//! [sampler]
+//! name = "sobol"                 # independent | stratified | sobol
+//! spp = 64
+//! seed = 0
+//!
+//! [filter]
+//! name = "gaussian"              # box | tent | gaussian | mitchell
+//! radius = 1.5
+//!
+//! [film]                         # required
+//! width = 640
+//! height = 480
+//! exposure = 0                   # stops: pixels are scaled by 2^exposure
+//! tonemap = "clamp"              # clamp | filmic
+//! output = "out.png"             # .png or .exr, relative to this scene file
+//! ```
+//!
+//! Unknown keys, keys that do not apply to an entry's `type`, and values
+//! out of range are errors; every error names the file, the line and column.
+//! All file paths are resolved relative to the scene file's folder.
+
+mod raw;
+mod resolve;
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Quat, Vec3};
+
+use crate::error::FormatError;
+
+/// A parsed and checked scene file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneFile {
+    /// The camera.
+    pub camera: CameraSpec,
+    /// Named materials, in file order.
+    pub materials: Vec<MaterialSpec>,
+    /// Objects, in file order.
+    pub objects: Vec<ObjectSpec>,
+    /// Lights, in file order (at most one environment).
+    pub lights: Vec<LightSpec>,
+    /// How radiance is estimated.
+    pub integrator: IntegratorSpec,
+    /// How pixel samples are placed.
+    pub sampler: SamplerSpec,
+    /// The pixel reconstruction filter.
+    pub filter: FilterSpec,
+    /// Image size, exposure, tone mapping and output file.
+    pub film: FilmSpec,
+}
+
+/// `[camera]`: a thin-lens camera with a shutter interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraSpec {
+    /// Position of the lens centre.
+    pub eye: Vec3,
+    /// Point looked at.
+    pub target: Vec3,
+    /// Up direction (not parallel to `target - eye`).
+    pub up: Vec3,
+    /// Vertical field of view in degrees, in (0, 180).
+    pub vfov_deg: f32,
+    /// Lens radius (0: pinhole).
+    pub aperture_radius: f32,
+    /// Distance from the eye to the plane in focus (> 0).
+    pub focus_distance: f32,
+    /// Time the shutter opens.
+    pub shutter_open: f32,
+    /// Time the shutter closes (>= `shutter_open`).
+    pub shutter_close: f32,
+}
+
+/// `[[material]]`: a named material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialSpec {
+    /// The name objects use to refer to it (unique in the file).
+    pub name: String,
+    /// What kind of material, with its parameters.
+    pub kind: MaterialKind,
+}
+
+/// The kinds of material and their parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MaterialKind {
+    /// Lambertian: `albedo` in [0, 1] (default 0.5 grey), optionally times an sRGB texture.
+    Diffuse {
+        /// Reflectance.
+        albedo: Vec3,
+        /// Texture file multiplying `albedo` (resolved; exists).
+        texture: Option<PathBuf>,
+    },
+    /// Rough metal (`type = "conductor"` or `"glossy"`): GGX with Schlick Fresnel.
+    Conductor {
+        /// Reflectance at normal incidence, in [0, 1].
+        color: Vec3,
+        /// Perceptual roughness in [0, 1].
+        roughness: f32,
+    },
+    /// A perfect mirror.
+    Mirror {
+        /// Reflectance at normal incidence, in [0, 1] (default 1).
+        color: Vec3,
+    },
+    /// Smooth glass.
+    Dielectric {
+        /// Index of refraction (> 0, default 1.5).
+        ior: f32,
+    },
+    /// Rough glass.
+    RoughDielectric {
+        /// Index of refraction (> 0, default 1.5).
+        ior: f32,
+        /// Perceptual roughness in [0, 1].
+        roughness: f32,
+    },
+    /// A light-emitting surface (black otherwise).
+    Emission {
+        /// Emitted radiance (>= 0).
+        radiance: Vec3,
+        /// Emit from both faces (default: only the front).
+        two_sided: bool,
+    },
+}
+
+/// `[[object]]`: a shape, its material and where it is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectSpec {
+    /// The geometry.
+    pub shape: ShapeSpec,
+    /// Name of a `[[material]]` (checked to exist); `None`: the mesh's own materials, or a default.
+    pub material: Option<String>,
+    /// Object-to-world placement.
+    pub placement: Placement,
+}
+
+/// Geometry: a mesh file or a built-in shape.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeSpec {
+    /// A mesh file (`.obj`, `.ply`, `.gltf`, `.glb`), resolved relative to the scene file (exists).
+    Mesh {
+        /// The resolved path.
+        path: PathBuf,
+    },
+    /// The parallelogram `corner + s * edge_u + t * edge_v`, `s, t` in [0, 1]; front face along `edge_u x edge_v`.
+    Quad {
+        /// One corner.
+        corner: Vec3,
+        /// First edge from the corner.
+        edge_u: Vec3,
+        /// Second edge from the corner (not parallel to `edge_u`).
+        edge_v: Vec3,
+    },
+    /// A disc facing along `normal`.
+    Disc {
+        /// Centre.
+        center: Vec3,
+        /// Facing direction (non-zero; not necessarily unit).
+        normal: Vec3,
+        /// Radius (> 0).
+        radius: f32,
+    },
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius (> 0).
+        radius: f32,
+    },
+    /// An axis-aligned box.
+    Box {
+        /// Smallest corner.
+        min: Vec3,
+        /// Largest corner (> `min` on every axis).
+        max: Vec3,
+    },
+}
+
+/// Where an object is: fixed, or moving linearly over the shutter interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Placement {
+    /// One transform (identity when the object has no `transform`).
+    Static(TransformSpec),
+    /// `motion`: the transform at shutter open and at shutter close.
+    Motion {
+        /// Transform when the shutter opens.
+        open: TransformSpec,
+        /// Transform when the shutter closes.
+        close: TransformSpec,
+    },
+}
+
+/// Scale, then rotate about an axis through the origin, then translate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TransformSpec {
+    /// Translation.
+    pub translate: Vec3,
+    /// Unit rotation axis.
+    pub rotate_axis: Vec3,
+    /// Rotation angle in degrees (right-handed about `rotate_axis`).
+    pub rotate_deg: f32,
+    /// Per-axis scale (no component zero).
+    pub scale: Vec3,
+}
+
+impl TransformSpec {
+    /// The identity transform.
+    pub const IDENTITY: TransformSpec = TransformSpec {
+        translate: Vec3::ZERO,
+        rotate_axis: Vec3::Y,
+        rotate_deg: 0.0,
+        scale: Vec3::ONE,
+    };
+
+    /// The matrix `T * R * S`.
+    pub fn matrix(&self) -> Mat4 {
+        Mat4::from_scale_rotation_translation(
+            self.scale,
+            Quat::from_axis_angle(self.rotate_axis, self.rotate_deg.to_radians()),
+            self.translate,
+        )
+    }
+}
+
+/// `[[light]]`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LightSpec {
+    /// An isotropic point light.
+    Point {
+        /// Position.
+        position: Vec3,
+        /// Radiant intensity (>= 0).
+        intensity: Vec3,
+    },
+    /// A spot light aimed at `target`, full inside `inner_deg`, dark beyond `outer_deg`.
+    Spot {
+        /// Position.
+        position: Vec3,
+        /// Point the cone's axis passes through (not `position`).
+        target: Vec3,
+        /// Radiant intensity on the axis (>= 0).
+        intensity: Vec3,
+        /// Half-angle where the falloff starts, degrees (default `outer_deg`).
+        inner_deg: f32,
+        /// Half-angle where the light ends, degrees, in (0, 180].
+        outer_deg: f32,
+    },
+    /// A distant light.
+    Directional {
+        /// Direction the light travels (non-zero).
+        direction: Vec3,
+        /// Irradiance on a surface facing the light (>= 0).
+        irradiance: Vec3,
+    },
+    /// An emitting quad, disc or sphere.
+    Area {
+        /// The shape (never a mesh or box).
+        shape: ShapeSpec,
+        /// Emitted radiance (>= 0).
+        radiance: Vec3,
+        /// Emit from both faces.
+        two_sided: bool,
+    },
+    /// Light from infinitely far away in every direction.
+    Environment(EnvironmentSpec),
+}
+
+/// The environment: one colour, or an equirectangular map.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EnvironmentSpec {
+    /// The same radiance everywhere.
+    Constant(Vec3),
+    /// A lat-long image (`.hdr`, `.exr`, `.png`, `.jpg`), resolved and existing, scaled by `scale`.
+    Map {
+        /// The image file.
+        path: PathBuf,
+        /// Radiance multiplier (> 0, default 1).
+        scale: f32,
+    },
+}
+
+/// `[integrator]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum IntegratorSpec {
+    /// Cook's distribution ray tracing.
+    Distribution {
+        /// Largest number of specular/glossy bounces (>= 1, default 8).
+        max_depth: u32,
+        /// Samples per area light at every hit (>= 1, default 1).
+        light_samples: u32,
+    },
+    /// Path tracing with next-event estimation.
+    Path {
+        /// Largest number of bounces (>= 1, default 8).
+        max_depth: u32,
+        /// Bounces before Russian roulette (default 3).
+        rr_depth: u32,
+    },
+    /// Shading normals as colours.
+    Normals,
+    /// Distance to the first hit.
+    Depth,
+    /// Ambient occlusion.
+    Ao {
+        /// Rays per pixel sample (>= 1, default 1).
+        samples: u32,
+        /// Occlusion distance (>= 0; 0: a tenth of the scene's size).
+        distance: f32,
+    },
+    /// A heat map of kd-tree work.
+    Cost,
+}
+
+/// Sampler kinds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplerKind {
+    /// Independent uniform random numbers.
+    Independent,
+    /// Jittered strata.
+    Stratified,
+    /// Owen-scrambled Sobol points.
+    Sobol,
+}
+
+/// `[sampler]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SamplerSpec {
+    /// Which sampler (default sobol).
+    pub kind: SamplerKind,
+    /// Samples per pixel (>= 1, default 16).
+    pub spp: u32,
+    /// Seed (>= 0, default 0).
+    pub seed: u64,
+}
+
+/// `[filter]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FilterSpec {
+    /// A box of half-width `radius` (default 0.5).
+    Box {
+        /// Half width in pixels (> 0).
+        radius: f32,
+    },
+    /// A tent of half-width `radius` (default 1).
+    Tent {
+        /// Half width in pixels (> 0).
+        radius: f32,
+    },
+    /// A truncated Gaussian (defaults: radius 1.5, sigma 0.5).
+    Gaussian {
+        /// Half width in pixels (> 0).
+        radius: f32,
+        /// Standard deviation in pixels (> 0).
+        sigma: f32,
+    },
+    /// Mitchell-Netravali (defaults: radius 2, b = c = 1/3).
+    Mitchell {
+        /// Half width in pixels (> 0).
+        radius: f32,
+        /// The B parameter.
+        b: f32,
+        /// The C parameter.
+        c: f32,
+    },
+}
+
+/// Tone mapping curves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToneMapSpec {
+    /// Clamp to [0, 1].
+    Clamp,
+    /// A filmic curve.
+    Filmic,
+}
+
+/// `[film]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FilmSpec {
+    /// Width in pixels (1..=65536).
+    pub width: u32,
+    /// Height in pixels (1..=65536).
+    pub height: u32,
+    /// Exposure in stops (pixels scaled by `2^exposure`; default 0).
+    pub exposure: f32,
+    /// Tone mapping for 8-bit output (default clamp).
+    pub tonemap: ToneMapSpec,
+    /// Output image (`.png` or `.exr`), resolved; `None` if not given.
+    pub output: Option<PathBuf>,
+}
+
+/// Reads and checks a scene file; paths in it are resolved relative to its folder.
+pub fn load_scene_file(path: &Path) -> Result<SceneFile, FormatError> {
+    let text = fs::read_to_string(path).map_err(|e| FormatError::io(path, e))?;
+    let folder = path.parent().unwrap_or(Path::new(""));
+    parse_scene_file(&text, &path.display().to_string(), folder)
+}
+
+/// Parses and checks scene TOML held in memory; `name` is used in errors, paths resolve against `folder`.
+pub fn parse_scene_file(text: &str, name: &str, folder: &Path) -> Result<SceneFile, FormatError> {
+    resolve::resolve(text, name, folder)
+}

@@ -1,0 +1,895 @@
+//! From the raw TOML shape to checked [`SceneFile`] values, with positioned errors.
+
+use std::collections::HashSet;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use toml::Spanned;
+
+use super::raw::*;
+use super::*;
+use crate::image_out::ImageFormat;
+
+/// Largest film width or height.
+const MAX_FILM_SIDE: i64 = 65536;
+
+/// Parses `text` and checks every value.
+pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile, FormatError> {
+    let ctx = Ctx { text, name, folder };
+    let raw: RawScene = toml::from_str(text).map_err(|e| match e.span() {
+        Some(span) => ctx.at(span, e.message().trim_end()),
+        None => FormatError::in_file(name, e.message().trim_end()),
+    })?;
+    let camera = raw
+        .camera
+        .as_ref()
+        .ok_or_else(|| FormatError::in_file(name, "no [camera] table; a scene needs one"))?;
+    let film = raw.film.as_ref().ok_or_else(|| {
+        FormatError::in_file(
+            name,
+            "no [film] table; a scene needs one (width and height)",
+        )
+    })?;
+    let materials = raw
+        .material
+        .iter()
+        .map(|m| ctx.material(m.get_ref()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut seen = HashSet::new();
+    for (m, raw_m) in materials.iter().zip(&raw.material) {
+        if !seen.insert(m.name.as_str()) {
+            return Err(ctx.at(
+                raw_m.get_ref().name.span(),
+                format!("a material named '{}' is already defined", m.name),
+            ));
+        }
+    }
+    let objects = raw
+        .object
+        .iter()
+        .map(|o| ctx.object(o, &seen))
+        .collect::<Result<Vec<_>, _>>()?;
+    let lights = raw
+        .light
+        .iter()
+        .map(|l| ctx.light(l))
+        .collect::<Result<Vec<_>, _>>()?;
+    let environments: Vec<_> = raw
+        .light
+        .iter()
+        .filter(|l| *l.get_ref().kind.get_ref() == LightType::Environment)
+        .collect();
+    if let Some(second) = environments.get(1) {
+        return Err(ctx.at(second.span(), "a scene has at most one environment light"));
+    }
+    Ok(SceneFile {
+        camera: ctx.camera(camera)?,
+        materials,
+        objects,
+        lights,
+        integrator: match &raw.integrator {
+            Some(i) => ctx.integrator(i.get_ref())?,
+            None => IntegratorSpec::Path {
+                max_depth: 8,
+                rr_depth: 3,
+            },
+        },
+        sampler: match &raw.sampler {
+            Some(s) => ctx.sampler(s.get_ref())?,
+            None => SamplerSpec {
+                kind: SamplerKind::Sobol,
+                spp: 16,
+                seed: 0,
+            },
+        },
+        filter: match &raw.filter {
+            Some(f) => ctx.filter(f.get_ref())?,
+            None => FilterSpec::Gaussian {
+                radius: 1.5,
+                sigma: 0.5,
+            },
+        },
+        film: ctx.film(film.get_ref())?,
+    })
+}
+
+/// 1-based line and column (in characters) of byte `offset` of `text`.
+pub(super) fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let mut offset = offset.min(text.len());
+    while !text.is_char_boundary(offset) {
+        offset -= 1;
+    }
+    let before = &text[..offset];
+    let line = 1 + before.matches('\n').count();
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    (line, 1 + before[line_start..].chars().count())
+}
+
+/// The span of an optional value, if present.
+fn span<T>(value: &Opt<T>) -> Option<Range<usize>> {
+    value.as_ref().map(Spanned::span)
+}
+
+/// The file being read, for positioned errors and path resolution.
+struct Ctx<'a> {
+    text: &'a str,
+    name: &'a str,
+    folder: &'a Path,
+}
+
+impl Ctx<'_> {
+    /// An error at the start of `span`.
+    fn at(&self, span: Range<usize>, message: impl Into<String>) -> FormatError {
+        let (line, column) = line_column(self.text, span.start);
+        FormatError::at_line(
+            self.name,
+            line,
+            format!("column {column}: {}", message.into()),
+        )
+    }
+
+    /// A required key of an entry, or an error at the entry.
+    fn required<'r, T>(
+        &self,
+        value: &'r Opt<T>,
+        key: &str,
+        entry: &Range<usize>,
+        what: &str,
+    ) -> Result<&'r Spanned<T>, FormatError> {
+        value
+            .as_ref()
+            .ok_or_else(|| self.at(entry.clone(), format!("{what} needs the key `{key}`")))
+    }
+
+    /// Rejects present keys that do not apply (`allowed` lists those that do).
+    fn only(
+        &self,
+        present: &[(&str, Option<Range<usize>>)],
+        allowed: &[&str],
+        what: &str,
+    ) -> Result<(), FormatError> {
+        for (key, at) in present {
+            if let Some(at) = at {
+                if !allowed.contains(key) {
+                    return Err(self.at(
+                        at.clone(),
+                        format!(
+                            "the key `{key}` does not apply to {what} (its keys: {})",
+                            allowed.join(", ")
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A finite vector.
+    fn vec(&self, value: &Spanned<V3>, key: &str) -> Result<Vec3, FormatError> {
+        let v = Vec3::from_array(*value.get_ref());
+        if !v.is_finite() {
+            return Err(self.at(value.span(), format!("`{key}` must be finite, not {v}")));
+        }
+        Ok(v)
+    }
+
+    /// A finite vector, or `default` if absent.
+    fn vec_or(&self, value: &Opt<V3>, key: &str, default: Vec3) -> Result<Vec3, FormatError> {
+        value.as_ref().map_or(Ok(default), |v| self.vec(v, key))
+    }
+
+    /// A non-zero finite vector.
+    fn direction(&self, value: &Spanned<V3>, key: &str) -> Result<Vec3, FormatError> {
+        let v = self.vec(value, key)?;
+        if v.length_squared() == 0.0 || !v.length_squared().is_finite() {
+            return Err(self.at(
+                value.span(),
+                format!("`{key}` must be a non-zero direction"),
+            ));
+        }
+        Ok(v)
+    }
+
+    /// A colour with every component in `[0, 1]`, or `default`.
+    fn reflectance(&self, value: &Opt<V3>, key: &str, default: Vec3) -> Result<Vec3, FormatError> {
+        let v = self.vec_or(value, key, default)?;
+        if v.min_element() < 0.0 || v.max_element() > 1.0 {
+            return Err(self.at(
+                span(value).unwrap_or(0..0),
+                format!("`{key}` {v} must have every component between 0 and 1"),
+            ));
+        }
+        Ok(v)
+    }
+
+    /// A colour with every component `>= 0`.
+    fn power(&self, value: &Spanned<V3>, key: &str) -> Result<Vec3, FormatError> {
+        let v = self.vec(value, key)?;
+        if v.min_element() < 0.0 {
+            return Err(self.at(value.span(), format!("`{key}` {v} must not be negative")));
+        }
+        Ok(v)
+    }
+
+    /// A finite number satisfying `ok` (described by `rule`), or `default` if absent.
+    fn number(
+        &self,
+        value: &Opt<f32>,
+        key: &str,
+        default: f32,
+        ok: impl Fn(f32) -> bool,
+        rule: &str,
+    ) -> Result<f32, FormatError> {
+        match value {
+            None => Ok(default),
+            Some(v) => {
+                let x = *v.get_ref();
+                if x.is_finite() && ok(x) {
+                    Ok(x)
+                } else {
+                    Err(self.at(v.span(), format!("`{key}` is {x} but must be {rule}")))
+                }
+            }
+        }
+    }
+
+    /// A whole number `>= min` that fits in 32 bits, or `default` if absent.
+    fn count(
+        &self,
+        value: &Opt<i64>,
+        key: &str,
+        default: u32,
+        min: i64,
+    ) -> Result<u32, FormatError> {
+        match value {
+            None => Ok(default),
+            Some(v) => {
+                let x = *v.get_ref();
+                if x < min {
+                    return Err(self.at(
+                        v.span(),
+                        format!("`{key}` is {x} but must be at least {min}"),
+                    ));
+                }
+                u32::try_from(x)
+                    .map_err(|_| self.at(v.span(), format!("`{key}` is {x}, too large")))
+            }
+        }
+    }
+
+    /// An existing file named relative to the scene file.
+    fn file(&self, value: &Spanned<String>, what: &str) -> Result<PathBuf, FormatError> {
+        let path = self.folder.join(value.get_ref());
+        if !path.is_file() {
+            return Err(self.at(
+                value.span(),
+                format!(
+                    "{what} '{}' not found (looked for {})",
+                    value.get_ref(),
+                    path.display()
+                ),
+            ));
+        }
+        Ok(path)
+    }
+
+    /// `[camera]`.
+    fn camera(&self, raw: &Spanned<RawCamera>) -> Result<CameraSpec, FormatError> {
+        let c = raw.get_ref();
+        let eye = self.vec(&c.eye, "eye")?;
+        let target = self.vec(&c.target, "target")?;
+        let up = self.vec_or(&c.up, "up", Vec3::Y)?;
+        let view = target - eye;
+        if view.length_squared() == 0.0 {
+            return Err(self.at(
+                c.target.span(),
+                format!("eye and target are the same point {eye}"),
+            ));
+        }
+        if up.length_squared() == 0.0 || view.normalize().cross(up.normalize()).length() < 1e-6 {
+            return Err(self.at(
+                span(&c.up).unwrap_or(raw.span()),
+                format!("up {up} is zero or parallel to the view direction {view}"),
+            ));
+        }
+        let shutter_open = self.number(&c.shutter_open, "shutter_open", 0.0, |_| true, "finite")?;
+        let shutter_close = self.number(
+            &c.shutter_close,
+            "shutter_close",
+            shutter_open,
+            |t| t >= shutter_open,
+            "at least shutter_open",
+        )?;
+        Ok(CameraSpec {
+            eye,
+            target,
+            up,
+            vfov_deg: self.number(
+                &c.vfov,
+                "vfov",
+                45.0,
+                |v| v > 0.0 && v < 180.0,
+                "between 0 and 180 degrees (exclusive)",
+            )?,
+            aperture_radius: self.number(
+                &c.aperture_radius,
+                "aperture_radius",
+                0.0,
+                |r| r >= 0.0,
+                "at least 0",
+            )?,
+            focus_distance: self.number(
+                &c.focus_distance,
+                "focus_distance",
+                view.length(),
+                |d| d > 0.0,
+                "greater than 0",
+            )?,
+            shutter_open,
+            shutter_close,
+        })
+    }
+
+    /// `[[material]]`.
+    fn material(&self, m: &RawMaterial) -> Result<MaterialSpec, FormatError> {
+        let kind = *m.kind.get_ref();
+        let what = format!("a {} material", type_name(&m.kind));
+        let present = [
+            ("albedo", span(&m.albedo)),
+            ("texture", span(&m.texture)),
+            ("color", span(&m.color)),
+            ("roughness", span(&m.roughness)),
+            ("ior", span(&m.ior)),
+            ("radiance", span(&m.radiance)),
+            ("two_sided", span(&m.two_sided)),
+        ];
+        let allowed: &[&str] = match kind {
+            MaterialType::Diffuse => &["albedo", "texture"],
+            MaterialType::Conductor => &["color", "roughness"],
+            MaterialType::Mirror => &["color"],
+            MaterialType::Dielectric => &["ior"],
+            MaterialType::RoughDielectric => &["ior", "roughness"],
+            MaterialType::Emission => &["radiance", "two_sided"],
+        };
+        self.only(&present, allowed, &what)?;
+        if m.name.get_ref().is_empty() {
+            return Err(self.at(m.name.span(), "a material name must not be empty"));
+        }
+        let roughness = |default| {
+            self.number(
+                &m.roughness,
+                "roughness",
+                default,
+                |r| (0.0..=1.0).contains(&r),
+                "between 0 and 1",
+            )
+        };
+        let ior = || self.number(&m.ior, "ior", 1.5, |n| n > 0.0, "greater than 0");
+        let kind = match kind {
+            MaterialType::Diffuse => MaterialKind::Diffuse {
+                albedo: self.reflectance(&m.albedo, "albedo", Vec3::splat(0.5))?,
+                texture: m
+                    .texture
+                    .as_ref()
+                    .map(|t| self.file(t, "texture"))
+                    .transpose()?,
+            },
+            MaterialType::Conductor => MaterialKind::Conductor {
+                color: self.reflectance(&m.color, "color", Vec3::splat(0.9))?,
+                roughness: roughness(0.2)?,
+            },
+            MaterialType::Mirror => MaterialKind::Mirror {
+                color: self.reflectance(&m.color, "color", Vec3::ONE)?,
+            },
+            MaterialType::Dielectric => MaterialKind::Dielectric { ior: ior()? },
+            MaterialType::RoughDielectric => MaterialKind::RoughDielectric {
+                ior: ior()?,
+                roughness: roughness(0.2)?,
+            },
+            MaterialType::Emission => MaterialKind::Emission {
+                radiance: self.power(
+                    self.required(&m.radiance, "radiance", &m.kind.span(), &what)?,
+                    "radiance",
+                )?,
+                two_sided: m.two_sided.as_ref().is_some_and(|b| *b.get_ref()),
+            },
+        };
+        Ok(MaterialSpec {
+            name: m.name.get_ref().clone(),
+            kind,
+        })
+    }
+
+    /// `[[object]]`.
+    fn object(
+        &self,
+        raw: &Spanned<RawObject>,
+        materials: &HashSet<&str>,
+    ) -> Result<ObjectSpec, FormatError> {
+        let o = raw.get_ref();
+        let keys = ShapeKeys {
+            file: &o.file,
+            corner: &o.corner,
+            edge_u: &o.edge_u,
+            edge_v: &o.edge_v,
+            center: &o.center,
+            normal: &o.normal,
+            radius: &o.radius,
+            min: &o.min,
+            max: &o.max,
+        };
+        let shape = self.shape(
+            *o.kind.get_ref(),
+            &raw.span(),
+            &keys,
+            &format!("a {} object", type_name(&o.kind)),
+        )?;
+        if let Some(m) = &o.material {
+            if !materials.contains(m.get_ref().as_str()) {
+                return Err(self.at(
+                    m.span(),
+                    format!("no [[material]] is named '{}'", m.get_ref()),
+                ));
+            }
+        }
+        let placement = match (&o.transform, &o.motion) {
+            (Some(_), Some(m)) => {
+                return Err(self.at(
+                    m.span(),
+                    "an object has either `transform` or `motion`, not both",
+                ))
+            }
+            (Some(t), None) => Placement::Static(self.transform(t)?),
+            (None, Some(m)) => Placement::Motion {
+                open: self.transform(&m.get_ref().open)?,
+                close: self.transform(&m.get_ref().close)?,
+            },
+            (None, None) => Placement::Static(TransformSpec::IDENTITY),
+        };
+        Ok(ObjectSpec {
+            shape,
+            material: o.material.as_ref().map(|m| m.get_ref().clone()),
+            placement,
+        })
+    }
+
+    /// A shape of type `kind` from an entry's keys; `what` names the entry in errors.
+    fn shape(
+        &self,
+        kind: ShapeType,
+        entry: &Range<usize>,
+        k: &ShapeKeys,
+        what: &str,
+    ) -> Result<ShapeSpec, FormatError> {
+        let allowed: &[&str] = match kind {
+            ShapeType::Mesh => &["file"],
+            ShapeType::Quad => &["corner", "edge_u", "edge_v"],
+            ShapeType::Disc => &["center", "normal", "radius"],
+            ShapeType::Sphere => &["center", "radius"],
+            ShapeType::Box => &["min", "max"],
+        };
+        let present = [
+            ("file", span(k.file)),
+            ("corner", span(k.corner)),
+            ("edge_u", span(k.edge_u)),
+            ("edge_v", span(k.edge_v)),
+            ("center", span(k.center)),
+            ("normal", span(k.normal)),
+            ("radius", span(k.radius)),
+            ("min", span(k.min)),
+            ("max", span(k.max)),
+        ];
+        self.only(&present, allowed, what)?;
+        let radius = || {
+            let r = self.required(k.radius, "radius", entry, what)?;
+            self.number(k.radius, "radius", 0.0, |r| r > 0.0, "greater than 0")
+                .map_err(|_| {
+                    self.at(
+                        r.span(),
+                        format!("`radius` is {} but must be greater than 0", r.get_ref()),
+                    )
+                })
+        };
+        Ok(match kind {
+            ShapeType::Mesh => {
+                let file = self.required(k.file, "file", entry, what)?;
+                let path = self.file(file, "mesh file")?;
+                let extension = path
+                    .extension()
+                    .map(|e| e.to_string_lossy().to_ascii_lowercase())
+                    .unwrap_or_default();
+                if !["obj", "ply", "gltf", "glb"].contains(&extension.as_str()) {
+                    return Err(self.at(
+                        file.span(),
+                        format!(
+                            "mesh file '{}' is not .obj, .ply, .gltf or .glb",
+                            file.get_ref()
+                        ),
+                    ));
+                }
+                ShapeSpec::Mesh { path }
+            }
+            ShapeType::Quad => {
+                let corner = self.vec(self.required(k.corner, "corner", entry, what)?, "corner")?;
+                let edge_u =
+                    self.direction(self.required(k.edge_u, "edge_u", entry, what)?, "edge_u")?;
+                let v = self.required(k.edge_v, "edge_v", entry, what)?;
+                let edge_v = self.direction(v, "edge_v")?;
+                if edge_u.normalize().cross(edge_v.normalize()).length() < 1e-6 {
+                    return Err(self.at(
+                        v.span(),
+                        "`edge_v` is parallel to `edge_u`: the quad has no area",
+                    ));
+                }
+                ShapeSpec::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                }
+            }
+            ShapeType::Disc => ShapeSpec::Disc {
+                center: self.vec(self.required(k.center, "center", entry, what)?, "center")?,
+                normal: self
+                    .direction(self.required(k.normal, "normal", entry, what)?, "normal")?,
+                radius: radius()?,
+            },
+            ShapeType::Sphere => ShapeSpec::Sphere {
+                center: self.vec(self.required(k.center, "center", entry, what)?, "center")?,
+                radius: radius()?,
+            },
+            ShapeType::Box => {
+                let min = self.vec(self.required(k.min, "min", entry, what)?, "min")?;
+                let max_raw = self.required(k.max, "max", entry, what)?;
+                let max = self.vec(max_raw, "max")?;
+                if !min.cmplt(max).all() {
+                    return Err(self.at(
+                        max_raw.span(),
+                        format!("box max {max} must exceed min {min} on every axis"),
+                    ));
+                }
+                ShapeSpec::Box { min, max }
+            }
+        })
+    }
+
+    /// `transform = { ... }`.
+    fn transform(&self, raw: &Spanned<RawTransform>) -> Result<TransformSpec, FormatError> {
+        let t = raw.get_ref();
+        let translate = self.vec_or(&t.translate, "translate", Vec3::ZERO)?;
+        let (rotate_axis, rotate_deg) = match &t.rotate {
+            None => (Vec3::Y, 0.0),
+            Some(r) => {
+                let axis = Vec3::from_array(r.get_ref().axis);
+                let degrees = r.get_ref().degrees;
+                if !axis.is_finite() || axis.length_squared() == 0.0 || !degrees.is_finite() {
+                    return Err(self.at(
+                        r.span(),
+                        "`rotate` needs a non-zero finite `axis` and finite `degrees`",
+                    ));
+                }
+                (axis.normalize(), degrees)
+            }
+        };
+        let scale = match &t.scale {
+            None => Vec3::ONE,
+            Some(s) => {
+                let v = match *s.get_ref() {
+                    RawScale::Uniform(k) => Vec3::splat(k),
+                    RawScale::PerAxis(v) => Vec3::from_array(v),
+                };
+                if !v.is_finite() || v.cmpeq(Vec3::ZERO).any() {
+                    return Err(self.at(
+                        s.span(),
+                        format!("`scale` {v} must be finite with no zero component"),
+                    ));
+                }
+                v
+            }
+        };
+        Ok(TransformSpec {
+            translate,
+            rotate_axis,
+            rotate_deg,
+            scale,
+        })
+    }
+
+    /// `[[light]]`.
+    fn light(&self, raw: &Spanned<RawLight>) -> Result<LightSpec, FormatError> {
+        let l = raw.get_ref();
+        let entry = raw.span();
+        let what = format!("a {} light", type_name(&l.kind));
+        let present = [
+            ("position", span(&l.position)),
+            ("target", span(&l.target)),
+            ("direction", span(&l.direction)),
+            ("intensity", span(&l.intensity)),
+            ("irradiance", span(&l.irradiance)),
+            ("inner_angle", span(&l.inner_angle)),
+            ("outer_angle", span(&l.outer_angle)),
+            ("radiance", span(&l.radiance)),
+            ("two_sided", span(&l.two_sided)),
+            ("shape", span(&l.shape)),
+            ("map", span(&l.map)),
+            ("scale", span(&l.scale)),
+        ];
+        let allowed: &[&str] = match l.kind.get_ref() {
+            LightType::Point => &["position", "intensity"],
+            LightType::Spot => &[
+                "position",
+                "target",
+                "intensity",
+                "inner_angle",
+                "outer_angle",
+            ],
+            LightType::Directional => &["direction", "irradiance"],
+            LightType::Area => &[
+                "shape",
+                "radiance",
+                "two_sided",
+                "corner",
+                "edge_u",
+                "edge_v",
+                "center",
+                "normal",
+                "radius",
+            ],
+            LightType::Environment => &["radiance", "map", "scale"],
+        };
+        self.only(&present, allowed, &what)?;
+        if *l.kind.get_ref() != LightType::Area {
+            let shape_keys = [
+                ("corner", span(&l.corner)),
+                ("edge_u", span(&l.edge_u)),
+                ("edge_v", span(&l.edge_v)),
+                ("center", span(&l.center)),
+                ("normal", span(&l.normal)),
+                ("radius", span(&l.radius)),
+            ];
+            self.only(&shape_keys, allowed, &what)?;
+        }
+        let need = |value: &'_ Opt<V3>, key: &str| -> Result<Vec3, FormatError> {
+            self.vec(self.required(value, key, &entry, &what)?, key)
+        };
+        let need_power = |value: &'_ Opt<V3>, key: &str| -> Result<Vec3, FormatError> {
+            self.power(self.required(value, key, &entry, &what)?, key)
+        };
+        Ok(match l.kind.get_ref() {
+            LightType::Point => LightSpec::Point {
+                position: need(&l.position, "position")?,
+                intensity: need_power(&l.intensity, "intensity")?,
+            },
+            LightType::Spot => {
+                let position = need(&l.position, "position")?;
+                let target_raw = self.required(&l.target, "target", &entry, &what)?;
+                let target = self.vec(target_raw, "target")?;
+                if target == position {
+                    return Err(self.at(target_raw.span(), "a spot light's target must differ from its position"));
+                }
+                let outer = self.required(&l.outer_angle, "outer_angle", &entry, &what)?;
+                let outer_deg = self.number(&l.outer_angle, "outer_angle", 0.0, |a| a > 0.0 && a <= 180.0, "in (0, 180] degrees")
+                    .map_err(|_| self.at(outer.span(), format!("`outer_angle` is {} but must be in (0, 180] degrees", outer.get_ref())))?;
+                LightSpec::Spot {
+                    position,
+                    target,
+                    intensity: need_power(&l.intensity, "intensity")?,
+                    inner_deg: self.number(&l.inner_angle, "inner_angle", outer_deg, |a| (0.0..=outer_deg).contains(&a), "between 0 and outer_angle")?,
+                    outer_deg,
+                }
+            }
+            LightType::Directional => LightSpec::Directional {
+                direction: self.direction(self.required(&l.direction, "direction", &entry, &what)?, "direction")?,
+                irradiance: need_power(&l.irradiance, "irradiance")?,
+            },
+            LightType::Area => {
+                let kind = self.required(&l.shape, "shape", &entry, &what)?;
+                if matches!(kind.get_ref(), ShapeType::Mesh | ShapeType::Box) {
+                    return Err(self.at(kind.span(), "an area light's shape is quad, disc or sphere (for an emitting mesh, give the object an emission material)"));
+                }
+                let keys = ShapeKeys {
+                    file: &None,
+                    corner: &l.corner,
+                    edge_u: &l.edge_u,
+                    edge_v: &l.edge_v,
+                    center: &l.center,
+                    normal: &l.normal,
+                    radius: &l.radius,
+                    min: &None,
+                    max: &None,
+                };
+                LightSpec::Area {
+                    shape: self.shape(*kind.get_ref(), &entry, &keys, &format!("{what} ({})", type_name(kind)))?,
+                    radiance: need_power(&l.radiance, "radiance")?,
+                    two_sided: l.two_sided.as_ref().is_some_and(|b| *b.get_ref()),
+                }
+            }
+            LightType::Environment => match (&l.radiance, &l.map) {
+                (Some(r), None) => {
+                    if l.scale.is_some() {
+                        return Err(self.at(span(&l.scale).unwrap_or(entry), "`scale` applies only to an environment `map`"));
+                    }
+                    LightSpec::Environment(EnvironmentSpec::Constant(self.power(r, "radiance")?))
+                }
+                (None, Some(m)) => {
+                    let path = self.file(m, "environment map")?;
+                    let extension = path
+                        .extension()
+                        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+                        .unwrap_or_default();
+                    if !["hdr", "exr", "png", "jpg", "jpeg"].contains(&extension.as_str()) {
+                        return Err(self.at(m.span(), format!("environment map '{}' is not .hdr, .exr, .png or .jpg", m.get_ref())));
+                    }
+                    LightSpec::Environment(EnvironmentSpec::Map {
+                        path,
+                        scale: self.number(&l.scale, "scale", 1.0, |s| s > 0.0, "greater than 0")?,
+                    })
+                }
+                _ => return Err(self.at(entry, "an environment light needs exactly one of `radiance` (a constant colour) or `map` (an image file)")),
+            },
+        })
+    }
+
+    /// `[integrator]`.
+    fn integrator(&self, i: &RawIntegrator) -> Result<IntegratorSpec, FormatError> {
+        let what = format!("the {} integrator", type_name(&i.name));
+        let present = [
+            ("max_depth", span(&i.max_depth)),
+            ("rr_depth", span(&i.rr_depth)),
+            ("light_samples", span(&i.light_samples)),
+            ("samples", span(&i.samples)),
+            ("distance", span(&i.distance)),
+        ];
+        let allowed: &[&str] = match i.name.get_ref() {
+            IntegratorName::Distribution => &["max_depth", "light_samples"],
+            IntegratorName::Path => &["max_depth", "rr_depth"],
+            IntegratorName::Ao => &["samples", "distance"],
+            _ => &[],
+        };
+        self.only(&present, allowed, &what)?;
+        Ok(match i.name.get_ref() {
+            IntegratorName::Distribution => IntegratorSpec::Distribution {
+                max_depth: self.count(&i.max_depth, "max_depth", 8, 1)?,
+                light_samples: self.count(&i.light_samples, "light_samples", 1, 1)?,
+            },
+            IntegratorName::Path => IntegratorSpec::Path {
+                max_depth: self.count(&i.max_depth, "max_depth", 8, 1)?,
+                rr_depth: self.count(&i.rr_depth, "rr_depth", 3, 0)?,
+            },
+            IntegratorName::Normals => IntegratorSpec::Normals,
+            IntegratorName::Depth => IntegratorSpec::Depth,
+            IntegratorName::Ao => IntegratorSpec::Ao {
+                samples: self.count(&i.samples, "samples", 1, 1)?,
+                distance: self.number(&i.distance, "distance", 0.0, |d| d >= 0.0, "at least 0")?,
+            },
+            IntegratorName::Cost => IntegratorSpec::Cost,
+        })
+    }
+
+    /// `[sampler]`.
+    fn sampler(&self, s: &RawSampler) -> Result<SamplerSpec, FormatError> {
+        let seed = match &s.seed {
+            None => 0,
+            Some(v) if *v.get_ref() >= 0 => *v.get_ref() as u64,
+            Some(v) => {
+                return Err(self.at(
+                    v.span(),
+                    format!("`seed` is {} but must be at least 0", v.get_ref()),
+                ))
+            }
+        };
+        Ok(SamplerSpec {
+            kind: match s.name.as_ref().map(|n| *n.get_ref()) {
+                None | Some(SamplerName::Sobol) => SamplerKind::Sobol,
+                Some(SamplerName::Independent) => SamplerKind::Independent,
+                Some(SamplerName::Stratified) => SamplerKind::Stratified,
+            },
+            spp: self.count(&s.spp, "spp", 16, 1)?,
+            seed,
+        })
+    }
+
+    /// `[filter]`.
+    fn filter(&self, f: &RawFilter) -> Result<FilterSpec, FormatError> {
+        let what = format!("the {} filter", type_name(&f.name));
+        let present = [
+            ("radius", span(&f.radius)),
+            ("sigma", span(&f.sigma)),
+            ("b", span(&f.b)),
+            ("c", span(&f.c)),
+        ];
+        let allowed: &[&str] = match f.name.get_ref() {
+            FilterName::Box | FilterName::Tent => &["radius"],
+            FilterName::Gaussian => &["radius", "sigma"],
+            FilterName::Mitchell => &["radius", "b", "c"],
+        };
+        self.only(&present, allowed, &what)?;
+        let radius =
+            |default| self.number(&f.radius, "radius", default, |r| r > 0.0, "greater than 0");
+        Ok(match f.name.get_ref() {
+            FilterName::Box => FilterSpec::Box {
+                radius: radius(0.5)?,
+            },
+            FilterName::Tent => FilterSpec::Tent {
+                radius: radius(1.0)?,
+            },
+            FilterName::Gaussian => FilterSpec::Gaussian {
+                radius: radius(1.5)?,
+                sigma: self.number(&f.sigma, "sigma", 0.5, |s| s > 0.0, "greater than 0")?,
+            },
+            FilterName::Mitchell => FilterSpec::Mitchell {
+                radius: radius(2.0)?,
+                b: self.number(&f.b, "b", 1.0 / 3.0, |_| true, "finite")?,
+                c: self.number(&f.c, "c", 1.0 / 3.0, |_| true, "finite")?,
+            },
+        })
+    }
+
+    /// `[film]`.
+    fn film(&self, f: &RawFilm) -> Result<FilmSpec, FormatError> {
+        let side = |v: &Spanned<i64>, key: &str| {
+            let x = *v.get_ref();
+            if (1..=MAX_FILM_SIDE).contains(&x) {
+                Ok(x as u32)
+            } else {
+                Err(self.at(
+                    v.span(),
+                    format!("`{key}` is {x} but must be between 1 and {MAX_FILM_SIDE} pixels"),
+                ))
+            }
+        };
+        let output = match &f.output {
+            None => None,
+            Some(o) => {
+                let path = self.folder.join(o.get_ref());
+                ImageFormat::from_path(&path).map_err(|_| {
+                    self.at(
+                        o.span(),
+                        format!("output '{}' must end in .png or .exr", o.get_ref()),
+                    )
+                })?;
+                Some(path)
+            }
+        };
+        Ok(FilmSpec {
+            width: side(&f.width, "width")?,
+            height: side(&f.height, "height")?,
+            exposure: self.number(&f.exposure, "exposure", 0.0, |_| true, "finite")?,
+            tonemap: match f.tonemap.as_ref().map(|t| *t.get_ref()) {
+                None | Some(ToneMapName::Clamp) => ToneMapSpec::Clamp,
+                Some(ToneMapName::Filmic) => ToneMapSpec::Filmic,
+            },
+            output,
+        })
+    }
+}
+
+/// The keys a shape may use, borrowed from an object or area light entry.
+struct ShapeKeys<'r> {
+    file: &'r Opt<String>,
+    corner: &'r Opt<V3>,
+    edge_u: &'r Opt<V3>,
+    edge_v: &'r Opt<V3>,
+    center: &'r Opt<V3>,
+    normal: &'r Opt<V3>,
+    radius: &'r Opt<f32>,
+    min: &'r Opt<V3>,
+    max: &'r Opt<V3>,
+}
+
+/// The snake_case name of a `type`/`name` value, as written in the file.
+fn type_name<T: std::fmt::Debug>(value: &Spanned<T>) -> String {
+    let debug = format!("{:?}", value.get_ref());
+    let mut out = String::new();
+    for (i, c) in debug.chars().enumerate() {
+        if c.is_ascii_uppercase() {
+            if i > 0 {
+                out.push('_');
+            }
+            out.push(c.to_ascii_lowercase());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}

@@ -1,0 +1,617 @@
+//! Scene files: a complete example, defaults, every error class, the shipped examples.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Quat, Vec3};
+use sahara_formats::scene_file::*;
+
+use crate::common::TempDir;
+
+/// A folder with a mesh, a texture and an environment map for scenes to name.
+fn assets() -> TempDir {
+    let dir = TempDir::new("scene");
+    std::fs::create_dir(dir.0.join("meshes")).unwrap();
+    dir.write("meshes/tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    dir.write("wood.png", "exists");
+    dir.write("sky.hdr", "exists");
+    dir
+}
+
+const COMPLETE: &str = r#"
+[camera]
+eye = [0, 1, 5]
+target = [0, 1, 0]
+up = [0, 1, 0]
+vfov = 40
+aperture_radius = 0.05
+focus_distance = 4.5
+shutter_open = 0.25
+shutter_close = 0.75
+
+[[material]]
+name = "wood"
+type = "diffuse"
+albedo = [0.6, 0.4, 0.2]
+texture = "wood.png"
+
+[[material]]
+name = "gold"
+type = "glossy"
+color = [1.0, 0.8, 0.3]
+roughness = 0.1
+
+[[material]]
+name = "mirror"
+type = "mirror"
+
+[[material]]
+name = "glass"
+type = "dielectric"
+ior = 1.33
+
+[[material]]
+name = "frosted"
+type = "rough_dielectric"
+roughness = 0.4
+
+[[material]]
+name = "lamp"
+type = "emission"
+radiance = [5, 5, 4]
+two_sided = true
+
+[[object]]
+type = "mesh"
+file = "meshes/tri.obj"
+material = "wood"
+transform = { translate = [1, 2, 3], rotate = { axis = [0, 2, 0], degrees = 90 }, scale = [2, 2, 2] }
+
+[[object]]
+type = "sphere"
+center = [0, 1, 0]
+radius = 0.5
+material = "glass"
+motion = { open = { translate = [0, 0, 0] }, close = { translate = [1, 0, 0], scale = 2 } }
+
+[[object]]
+type = "quad"
+corner = [-1, 0, -1]
+edge_u = [2, 0, 0]
+edge_v = [0, 0, 2]
+
+[[object]]
+type = "disc"
+center = [0, 3, 0]
+normal = [0, -1, 0]
+radius = 0.3
+material = "lamp"
+
+[[object]]
+type = "box"
+min = [-1, -1, -1]
+max = [1, 0, 1]
+material = "gold"
+
+[[light]]
+type = "point"
+position = [0, 4, 0]
+intensity = [10, 10, 10]
+
+[[light]]
+type = "spot"
+position = [0, 4, 0]
+target = [0, 0, 0]
+intensity = [20, 20, 20]
+inner_angle = 20
+outer_angle = 30
+
+[[light]]
+type = "directional"
+direction = [0, -1, 0]
+irradiance = [1, 1, 1]
+
+[[light]]
+type = "area"
+shape = "quad"
+corner = [-0.5, 3.9, -0.5]
+edge_u = [1, 0, 0]
+edge_v = [0, 0, 1]
+radiance = [8, 8, 8]
+
+[[light]]
+type = "environment"
+map = "sky.hdr"
+scale = 0.5
+
+[integrator]
+name = "distribution"
+max_depth = 6
+light_samples = 4
+
+[sampler]
+name = "stratified"
+spp = 64
+seed = 42
+
+[filter]
+name = "mitchell"
+radius = 2
+b = 0.5
+c = 0.25
+
+[film]
+width = 320
+height = 240
+exposure = -1
+tonemap = "filmic"
+output = "renders/out.EXR"
+"#;
+
+#[test]
+fn a_complete_scene_parses_into_the_expected_values() {
+    let dir = assets();
+    let path = dir.write("scene.toml", COMPLETE);
+    let s = load_scene_file(&path).unwrap();
+    let at = |p: &str| dir.0.join(p);
+
+    assert_eq!(
+        s.camera,
+        CameraSpec {
+            eye: Vec3::new(0., 1., 5.),
+            target: Vec3::new(0., 1., 0.),
+            up: Vec3::Y,
+            vfov_deg: 40.0,
+            aperture_radius: 0.05,
+            focus_distance: 4.5,
+            shutter_open: 0.25,
+            shutter_close: 0.75,
+        }
+    );
+    assert_eq!(
+        s.materials,
+        vec![
+            MaterialSpec {
+                name: "wood".into(),
+                kind: MaterialKind::Diffuse {
+                    albedo: Vec3::new(0.6, 0.4, 0.2),
+                    texture: Some(at("wood.png"))
+                }
+            },
+            MaterialSpec {
+                name: "gold".into(),
+                kind: MaterialKind::Conductor {
+                    color: Vec3::new(1.0, 0.8, 0.3),
+                    roughness: 0.1
+                }
+            },
+            MaterialSpec {
+                name: "mirror".into(),
+                kind: MaterialKind::Mirror { color: Vec3::ONE }
+            },
+            MaterialSpec {
+                name: "glass".into(),
+                kind: MaterialKind::Dielectric { ior: 1.33 }
+            },
+            MaterialSpec {
+                name: "frosted".into(),
+                kind: MaterialKind::RoughDielectric {
+                    ior: 1.5,
+                    roughness: 0.4
+                }
+            },
+            MaterialSpec {
+                name: "lamp".into(),
+                kind: MaterialKind::Emission {
+                    radiance: Vec3::new(5., 5., 4.),
+                    two_sided: true
+                }
+            },
+        ]
+    );
+
+    assert_eq!(s.objects.len(), 5);
+    let mesh = &s.objects[0];
+    assert_eq!(
+        mesh.shape,
+        ShapeSpec::Mesh {
+            path: at("meshes/tri.obj")
+        }
+    );
+    assert_eq!(mesh.material.as_deref(), Some("wood"));
+    let Placement::Static(t) = mesh.placement else {
+        panic!("{:?}", mesh.placement)
+    };
+    assert_eq!(t.rotate_axis, Vec3::Y, "the axis is normalised");
+    // By hand: scale 2, then 90 degrees about y (x -> -z), then move by (1, 2, 3):
+    // the point (1, 0, 0) goes to (2, 0, 0), (0, 0, -2), (1, 2, 1).
+    let p = t.matrix().transform_point3(Vec3::X);
+    assert!(p.abs_diff_eq(Vec3::new(1., 2., 1.), 1e-5), "{p}");
+    let expected = Mat4::from_translation(Vec3::new(1., 2., 3.))
+        * Mat4::from_quat(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2))
+        * Mat4::from_scale(Vec3::splat(2.));
+    assert!(t.matrix().abs_diff_eq(expected, 1e-5));
+
+    assert_eq!(
+        s.objects[1].placement,
+        Placement::Motion {
+            open: TransformSpec::IDENTITY,
+            close: TransformSpec {
+                translate: Vec3::X,
+                scale: Vec3::splat(2.0),
+                ..TransformSpec::IDENTITY
+            }
+        }
+    );
+    assert_eq!(
+        s.objects[2],
+        ObjectSpec {
+            shape: ShapeSpec::Quad {
+                corner: Vec3::new(-1., 0., -1.),
+                edge_u: Vec3::new(2., 0., 0.),
+                edge_v: Vec3::new(0., 0., 2.)
+            },
+            material: None,
+            placement: Placement::Static(TransformSpec::IDENTITY)
+        }
+    );
+    assert_eq!(
+        s.objects[3].shape,
+        ShapeSpec::Disc {
+            center: Vec3::new(0., 3., 0.),
+            normal: Vec3::NEG_Y,
+            radius: 0.3
+        }
+    );
+    assert_eq!(
+        s.objects[4].shape,
+        ShapeSpec::Box {
+            min: Vec3::splat(-1.),
+            max: Vec3::new(1., 0., 1.)
+        }
+    );
+
+    assert_eq!(s.lights.len(), 5);
+    assert_eq!(
+        s.lights[1],
+        LightSpec::Spot {
+            position: Vec3::new(0., 4., 0.),
+            target: Vec3::ZERO,
+            intensity: Vec3::splat(20.),
+            inner_deg: 20.,
+            outer_deg: 30.
+        }
+    );
+    assert!(matches!(
+        &s.lights[3],
+        LightSpec::Area { shape: ShapeSpec::Quad { .. }, radiance, two_sided: false } if *radiance == Vec3::splat(8.)
+    ));
+    assert_eq!(
+        s.lights[4],
+        LightSpec::Environment(EnvironmentSpec::Map {
+            path: at("sky.hdr"),
+            scale: 0.5
+        })
+    );
+    assert_eq!(
+        s.integrator,
+        IntegratorSpec::Distribution {
+            max_depth: 6,
+            light_samples: 4
+        }
+    );
+    assert_eq!(
+        s.sampler,
+        SamplerSpec {
+            kind: SamplerKind::Stratified,
+            spp: 64,
+            seed: 42
+        }
+    );
+    assert_eq!(
+        s.filter,
+        FilterSpec::Mitchell {
+            radius: 2.,
+            b: 0.5,
+            c: 0.25
+        }
+    );
+    assert_eq!(
+        s.film,
+        FilmSpec {
+            width: 320,
+            height: 240,
+            exposure: -1.,
+            tonemap: ToneMapSpec::Filmic,
+            output: Some(at("renders/out.EXR"))
+        }
+    );
+}
+
+#[test]
+fn a_minimal_scene_gets_the_documented_defaults() {
+    let text = "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 8\nheight = 4\n";
+    let s = parse_scene_file(text, "min.toml", Path::new("")).unwrap();
+    assert_eq!(s.camera.up, Vec3::Y);
+    assert_eq!(s.camera.vfov_deg, 45.0);
+    assert_eq!(s.camera.aperture_radius, 0.0);
+    assert_eq!(s.camera.focus_distance, 3.0, "|target - eye|");
+    assert_eq!((s.camera.shutter_open, s.camera.shutter_close), (0.0, 0.0));
+    assert_eq!(
+        s.integrator,
+        IntegratorSpec::Path {
+            max_depth: 8,
+            rr_depth: 3
+        }
+    );
+    assert_eq!(
+        s.sampler,
+        SamplerSpec {
+            kind: SamplerKind::Sobol,
+            spp: 16,
+            seed: 0
+        }
+    );
+    assert_eq!(
+        s.filter,
+        FilterSpec::Gaussian {
+            radius: 1.5,
+            sigma: 0.5
+        }
+    );
+    assert_eq!(s.film.tonemap, ToneMapSpec::Clamp);
+    assert_eq!(s.film.exposure, 0.0);
+    assert_eq!(s.film.output, None);
+    assert!(s.objects.is_empty() && s.lights.is_empty() && s.materials.is_empty());
+}
+
+/// The error for `text` (a scene in the assets folder); checks it is one line naming the file.
+fn error_of(text: &str) -> String {
+    let dir = assets();
+    let path = dir.write("bad.toml", text);
+    let message = load_scene_file(&path).unwrap_err().to_string();
+    assert!(message.contains("bad.toml"), "{message}");
+    assert!(!message.contains('\n'), "{message}");
+    message
+}
+
+const HEAD: &str = "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 8\nheight = 4\n";
+
+/// `HEAD` (6 lines) followed by `rest`, so `rest`'s first line is line 7.
+fn with_head(rest: &str) -> String {
+    format!("{HEAD}{rest}")
+}
+
+#[test]
+fn syntax_errors_and_unknown_keys_give_line_and_column() {
+    let m = error_of("[camera]\neye = [0, 0, 3\ntarget = [0, 0, 0]\n");
+    assert!(m.contains("line 2:") || m.contains("line 3:"), "{m}");
+
+    let m = error_of(&with_head("[sampler]\nspp = 4\nsed = 1\n"));
+    assert!(m.contains("line 9: column 1:") && m.contains("sed"), "{m}");
+
+    let m = error_of(&with_head(
+        "[[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ncolour = \"red\"\n",
+    ));
+    assert!(
+        m.contains("line 11: column 1:") && m.contains("colour"),
+        "{m}"
+    );
+
+    let m = error_of(
+        "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nfov = 30\n[film]\nwidth = 8\nheight = 4\n",
+    );
+    assert!(m.contains("line 4:") && m.contains("fov"), "{m}");
+
+    let m = error_of(&with_head("[bogus]\nx = 1\n"));
+    assert!(m.contains("line 7:") && m.contains("bogus"), "{m}");
+
+    // A key that exists, but for another type.
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"diffuse\"\nior = 1.5\n",
+    ));
+    assert!(
+        m.contains("line 10: column 7:") && m.contains("`ior`") && m.contains("diffuse"),
+        "{m}"
+    );
+    let m = error_of(&with_head(
+        "[integrator]\nname = \"normals\"\nmax_depth = 3\n",
+    ));
+    assert!(
+        m.contains("line 9:") && m.contains("max_depth") && m.contains("normals"),
+        "{m}"
+    );
+
+    // Wrong value types.
+    let m = error_of(&with_head("[sampler]\nspp = \"many\"\n"));
+    assert!(m.contains("line 8: column 7:"), "{m}");
+    let m = error_of(&with_head(
+        "[[light]]\ntype = \"point\"\nposition = [0, 1]\nintensity = [1, 1, 1]\n",
+    ));
+    assert!(m.contains("line 9:") && m.contains("3"), "{m}");
+}
+
+#[test]
+fn unknown_names_are_errors_at_the_value() {
+    let m = error_of(&with_head("[integrator]\nname = \"photon_mapping\"\n"));
+    assert!(
+        m.contains("line 8: column 8:") && m.contains("photon_mapping") && m.contains("path"),
+        "{m}"
+    );
+    let m = error_of(&with_head("[sampler]\nname = \"halton\"\n"));
+    assert!(
+        m.contains("line 8:") && m.contains("halton") && m.contains("sobol"),
+        "{m}"
+    );
+    let m = error_of(&with_head("[filter]\nname = \"lanczos\"\n"));
+    assert!(m.contains("line 8:") && m.contains("lanczos"), "{m}");
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"velvet\"\n",
+    ));
+    assert!(m.contains("line 9:") && m.contains("velvet"), "{m}");
+    let m = error_of(&with_head("[[object]]\ntype = \"torus\"\n"));
+    assert!(m.contains("line 8:") && m.contains("torus"), "{m}");
+    let m = error_of(&with_head(
+        "[[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"nope\"\n",
+    ));
+    assert!(m.contains("line 11:") && m.contains("'nope'"), "{m}");
+    let m = error_of(&with_head("[film2]\n"));
+    assert!(m.contains("film2"), "{m}");
+}
+
+#[test]
+fn bad_values_are_errors_with_their_position() {
+    let cases: &[(&str, &[&str])] = &[
+        ("[sampler]\nspp = -4\n", &["line 8: column 7:", "spp", "-4", "at least 1"]),
+        ("[sampler]\nspp = 0\n", &["line 8:", "spp"]),
+        ("[sampler]\nseed = -1\n", &["line 8:", "seed"]),
+        ("[integrator]\nname = \"path\"\nmax_depth = 0\n", &["line 9:", "max_depth"]),
+        ("[integrator]\nname = \"ao\"\ndistance = -1\n", &["line 9:", "distance"]),
+        ("[filter]\nname = \"box\"\nradius = 0\n", &["line 9:", "radius"]),
+        ("[[material]]\nname = \"m\"\ntype = \"diffuse\"\nalbedo = [0.5, 1.5, 0]\n", &["line 10:", "albedo", "between 0 and 1"]),
+        ("[[material]]\nname = \"m\"\ntype = \"dielectric\"\nior = -1\n", &["line 10:", "ior"]),
+        ("[[material]]\nname = \"m\"\ntype = \"conductor\"\nroughness = 2\n", &["line 10:", "roughness"]),
+        ("[[material]]\nname = \"m\"\ntype = \"emission\"\n", &["line 9:", "radiance"]),
+        ("[[material]]\nname = \"m\"\ntype = \"mirror\"\n[[material]]\nname = \"m\"\ntype = \"mirror\"\n", &["line 11:", "already defined"]),
+        ("[[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = -1\n", &["line 10:", "radius"]),
+        ("[[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\n", &["line 7:", "radius"]),
+        ("[[object]]\ntype = \"box\"\nmin = [0, 0, 0]\nmax = [1, 0, 1]\n", &["line 10:", "max"]),
+        ("[[object]]\ntype = \"quad\"\ncorner = [0, 0, 0]\nedge_u = [1, 0, 0]\nedge_v = [2, 0, 0]\n", &["line 11:", "parallel"]),
+        ("[[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = { scale = [1, 0, 1] }\n", &["line 11:", "scale"]),
+        ("[[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = {}\nmotion = { open = {}, close = {} }\n", &["line 12:", "not both"]),
+        ("[[light]]\ntype = \"spot\"\nposition = [0, 0, 0]\ntarget = [0, 0, -1]\nintensity = [1, 1, 1]\nouter_angle = 30\ninner_angle = 40\n", &["line 13:", "inner_angle"]),
+        ("[[light]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = [-1, 1, 1]\n", &["line 10:", "intensity", "negative"]),
+        ("[[light]]\ntype = \"environment\"\n", &["line 7:", "radiance", "map"]),
+        ("[[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n[[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n", &["line 10:", "at most one"]),
+        ("[[light]]\ntype = \"area\"\nshape = \"box\"\nradiance = [1, 1, 1]\n", &["line 9:", "quad, disc or sphere"]),
+        ("[[light]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = [1, 1, 1]\nradius = 2\n", &["line 11:", "radius", "point"]),
+        ("[[light]]\ntype = \"directional\"\ndirection = [0, 0, 0]\nirradiance = [1, 1, 1]\n", &["line 9:", "direction"]),
+    ];
+    for (rest, expected) in cases {
+        let m = error_of(&with_head(rest));
+        for e in *expected {
+            assert!(m.contains(e), "{rest:?}: expected {e:?} in {m}");
+        }
+    }
+    // Film and camera values.
+    let m =
+        error_of("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 0\nheight = 4\n");
+    assert!(
+        m.contains("line 5: column 9:") && m.contains("width") && m.contains("between 1"),
+        "{m}"
+    );
+    let m =
+        error_of("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 8\nheight = -2\n");
+    assert!(m.contains("line 6:") && m.contains("height"), "{m}");
+    let m = error_of("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 8\nheight = 4\noutput = \"x.jpg\"\n");
+    assert!(m.contains("line 7:") && m.contains(".png or .exr"), "{m}");
+    let m =
+        error_of("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 3]\n[film]\nwidth = 8\nheight = 4\n");
+    assert!(m.contains("line 3:") && m.contains("same point"), "{m}");
+    let m = error_of("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nup = [0, 0, 1]\n[film]\nwidth = 8\nheight = 4\n");
+    assert!(m.contains("line 4:") && m.contains("parallel"), "{m}");
+    let m = error_of("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nvfov = 180\n[film]\nwidth = 8\nheight = 4\n");
+    assert!(m.contains("line 4:") && m.contains("vfov"), "{m}");
+    let m = error_of("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nshutter_open = 1\nshutter_close = 0.5\n[film]\nwidth = 8\nheight = 4\n");
+    assert!(m.contains("line 5:") && m.contains("shutter_close"), "{m}");
+    let m = error_of("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\naperture_radius = -0.1\n[film]\nwidth = 8\nheight = 4\n");
+    assert!(
+        m.contains("line 4:") && m.contains("aperture_radius"),
+        "{m}"
+    );
+    let m = error_of("[film]\nwidth = 8\nheight = 4\n");
+    assert!(m.contains("[camera]"), "{m}");
+    let m = error_of("[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n");
+    assert!(m.contains("[film]"), "{m}");
+}
+
+#[test]
+fn missing_files_are_errors_naming_the_resolved_path() {
+    let m = error_of(&with_head(
+        "[[object]]\ntype = \"mesh\"\nfile = \"meshes/gone.obj\"\n",
+    ));
+    assert!(
+        m.contains("line 9: column 8:") && m.contains("meshes/gone.obj") && m.contains("not found"),
+        "{m}"
+    );
+    let m = error_of(&with_head("[[object]]\ntype = \"mesh\"\n"));
+    assert!(m.contains("line 7:") && m.contains("`file`"), "{m}");
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"diffuse\"\ntexture = \"nope.png\"\n",
+    ));
+    assert!(m.contains("line 10:") && m.contains("nope.png"), "{m}");
+    let m = error_of(&with_head(
+        "[[light]]\ntype = \"environment\"\nmap = \"nope.exr\"\n",
+    ));
+    assert!(m.contains("line 9:") && m.contains("nope.exr"), "{m}");
+    // The mesh exists but is not a mesh format.
+    let m = error_of(&with_head(
+        "[[object]]\ntype = \"mesh\"\nfile = \"wood.png\"\n",
+    ));
+    assert!(m.contains("line 9:") && m.contains(".obj"), "{m}");
+    let missing = load_scene_file(Path::new("/no/such/scene.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(missing.contains("/no/such/scene.toml"), "{missing}");
+}
+
+#[test]
+fn columns_count_characters_not_bytes() {
+    // "é" is two bytes; the bad key starts at character 1 of line 8 either way,
+    // and the value after a two-byte name is at column 8, not 9.
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"é\"\ntype = \"mirror\"\n[sampler]\nspp = -1\n",
+    ));
+    assert!(m.contains("line 11: column 7:"), "{m}");
+}
+
+/// The workspace's `scenes/` folder.
+fn example_scenes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+#[test]
+fn every_example_scene_loads() {
+    if !sahara_formats::scenes_dir().exists() {
+        println!("note: shared scenes not found; skipping");
+        return;
+    }
+    let mut found = 0;
+    for entry in std::fs::read_dir(example_scenes()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+            assert!(!scene.objects.is_empty(), "{}", path.display());
+            for object in &scene.objects {
+                if let ShapeSpec::Mesh { path } = &object.shape {
+                    assert!(path.is_file());
+                }
+            }
+            found += 1;
+        }
+    }
+    assert!(found >= 3, "{found} example scenes");
+
+    // Each example shows what it is for.
+    let load = |name: &str| load_scene_file(&example_scenes().join(name)).unwrap();
+    let cornell = load("cornell_glossy_glass.toml");
+    assert!(cornell
+        .materials
+        .iter()
+        .any(|m| matches!(m.kind, MaterialKind::Conductor { roughness, .. } if roughness > 0.0)));
+    assert!(cornell
+        .materials
+        .iter()
+        .any(|m| matches!(m.kind, MaterialKind::Dielectric { .. })));
+    assert!(matches!(
+        cornell.integrator,
+        IntegratorSpec::Distribution { .. }
+    ));
+    let dof = load("bunny_dof.toml");
+    assert!(dof.camera.aperture_radius > 0.0);
+    let blur = load("motion_blur.toml");
+    assert!(blur.camera.shutter_close > blur.camera.shutter_open);
+    assert!(blur
+        .objects
+        .iter()
+        .any(|o| matches!(o.placement, Placement::Motion { .. })));
+}
