@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use super::cost::{SahModel, Split};
-use super::partition::{partition, root_refs, Ref};
+use super::partition::{count_straddlers, partition, root_refs, Ref};
 use super::subtree::Subtree;
 use super::BuildParams;
 use crate::geometry::{Aabb, Primitive};
@@ -16,6 +16,7 @@ const PARALLEL_MIN: usize = 2048;
 
 struct Ctx<'a, P> {
     triangles: &'a [P],
+    budget: super::budget::RefBudget,
     params: &'a BuildParams,
     bins: usize,
     max_depth: u32,
@@ -31,6 +32,7 @@ pub fn build<P: Primitive>(
 ) -> Subtree {
     let ctx = Ctx {
         triangles,
+        budget: params.reference_budget(live.len()),
         params,
         bins: bins.max(2),
         max_depth: params.depth_limit(live.len()),
@@ -54,6 +56,12 @@ fn recurse<P: Primitive>(ctx: &Ctx<P>, refs: Vec<Ref>, cell: Aabb, depth: u32) -
     else {
         return leaf(refs);
     };
+    if !ctx
+        .budget
+        .try_take(count_straddlers(&refs, split.axis, split.pos))
+    {
+        return leaf(refs);
+    }
     let (lcell, rcell) = cell.split(split.axis, split.pos);
     let (lrefs, rrefs) = partition(
         ctx.triangles,
@@ -158,6 +166,7 @@ fn best_split<P: Primitive>(
                         pos,
                         planar: super::cost::PlanarSide::Left,
                         cost,
+                        refs: nl + nr,
                     });
                 }
             }

@@ -23,6 +23,8 @@ pub struct Split {
     pub planar: PlanarSide,
     /// Expected cost, in the same units as `K_I * n` for a leaf.
     pub cost: f64,
+    /// References in both children together (straddlers count twice).
+    pub refs: usize,
 }
 
 /// The SAH cost model of one node (Wald & Havran 2006, section 4).
@@ -94,6 +96,7 @@ impl SahModel {
             pos,
             planar,
             cost,
+            refs: nl + np + nr,
         })
     }
 }

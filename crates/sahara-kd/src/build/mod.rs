@@ -2,6 +2,7 @@
 //! algorithm.
 
 pub mod binned;
+pub mod budget;
 pub mod cost;
 pub mod naive;
 pub mod params;

@@ -3,13 +3,14 @@
 //! position rule (middle of the cell or median of the geometry), stopping at
 //! a leaf size or a depth. They exist to be measured against.
 
-use super::partition::{partition, root_refs, Ref};
+use super::partition::{count_straddlers, partition, root_refs, Ref};
 use super::subtree::Subtree;
 use super::{AxisRule, BuildParams, PositionRule};
 use crate::geometry::{Aabb, Primitive};
 
 struct Ctx<'a, P> {
     triangles: &'a [P],
+    budget: super::budget::RefBudget,
     params: &'a BuildParams,
     axis: AxisRule,
     position: PositionRule,
@@ -30,6 +31,7 @@ pub fn build<P: Primitive>(
 ) -> Subtree {
     let ctx = Ctx {
         triangles,
+        budget: params.reference_budget(live.len()),
         params,
         axis,
         position,
@@ -65,6 +67,9 @@ fn recurse<P: Primitive>(ctx: &Ctx<P>, mut refs: Vec<Ref>, cell: Aabb, depth: u3
     }
     if !(pos > lo && pos < hi) {
         return leaf(refs); // the cell is flat along the axis
+    }
+    if !ctx.budget.try_take(count_straddlers(&refs, axis, pos)) {
+        return leaf(refs);
     }
     let (lcell, rcell) = cell.split(axis, pos);
     let parallel = p.parallel && n >= PARALLEL_MIN;

@@ -122,6 +122,12 @@ pub struct BuildParams {
     pub max_leaf_size: u32,
     /// Build subtrees in parallel on rayon's pool.
     pub parallel: bool,
+    /// Most triangle references the tree may hold, as a multiple of the
+    /// triangle count (split clipping duplicates straddlers). A split that
+    /// would pass it becomes a leaf, so no input can make the build's memory
+    /// explode. When the cap is reached in a parallel build, which subtree
+    /// meets it first may vary from run to run.
+    pub max_duplication: f32,
 }
 
 impl Default for BuildParams {
@@ -148,7 +154,14 @@ impl BuildParams {
             max_depth: None,
             max_leaf_size,
             parallel: true,
+            max_duplication: 64.0,
         }
+    }
+
+    /// The reference budget for `n` triangles.
+    pub fn reference_budget(&self, n: usize) -> super::budget::RefBudget {
+        let limit = (n as f64 * self.max_duplication.max(1.0) as f64) as usize;
+        super::budget::RefBudget::new(n, limit.max(n))
     }
 
     /// The depth cap for `n` triangles, clamped to the traversal stack.

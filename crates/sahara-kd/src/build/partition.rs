@@ -24,6 +24,19 @@ pub fn root_refs<P: Primitive>(triangles: &[P], live: &[u32]) -> Vec<Ref> {
         .collect()
 }
 
+/// True if `r` crosses the plane `axis = pos` and so goes to both sides
+/// (the rule [`partition`] follows).
+#[inline]
+fn straddles(r: &Ref, axis: usize, pos: f32) -> bool {
+    let (lo, hi) = (r.bounds.min[axis], r.bounds.max[axis]);
+    lo < pos && hi > pos
+}
+
+/// How many references a split at `axis = pos` would duplicate.
+pub fn count_straddlers(refs: &[Ref], axis: usize, pos: f32) -> usize {
+    refs.iter().filter(|r| straddles(r, axis, pos)).count()
+}
+
 /// Below this many references a partition runs on the current thread.
 const PARALLEL_MIN: usize = 1 << 14;
 

@@ -92,6 +92,7 @@ const PARALLEL_MIN: usize = 2048;
 
 struct Ctx<'a, P> {
     triangles: &'a [P],
+    budget: super::budget::RefBudget,
     params: &'a BuildParams,
     max_depth: u32,
 }
@@ -106,6 +107,7 @@ pub fn build<P: Primitive>(
 ) -> Subtree {
     let ctx = Ctx {
         triangles,
+        budget: params.reference_budget(live.len()),
         params,
         max_depth: params.depth_limit(live.len()),
     };
@@ -144,6 +146,9 @@ fn recurse<P: Primitive>(ctx: &Ctx<P>, w: Work) -> Subtree {
     let Some(split) = split.filter(|s| s.cost < model.leaf_cost(n)) else {
         return Subtree::leaf(w.tris, &w.cell, p);
     };
+    if !ctx.budget.try_take(split.refs.saturating_sub(n)) {
+        return Subtree::leaf(w.tris, &w.cell, p);
+    }
     let cell = w.cell;
     let (left, right) = split_work(ctx, w, &split);
     let (below, above) = if p.parallel && n >= PARALLEL_MIN {
