@@ -2,6 +2,9 @@
 //!
 //! - meshes: [`obj`] (with [`mtl`] materials), [`ply`], [`gltf`] (meshes plus instances);
 //! - scenes: [`scene_file`] (TOML, documented in `SCENE_FORMAT.md`), [`camera`] sidecars;
+//! - to the renderer: [`scene_load`] (a scene file as a `sahara_render::Scene`),
+//!   [`mesh_scene`] (a bare mesh file as one), sharing [`mesh_library`] (each
+//!   mesh file loaded once) and [`material_map`] (MTL / glTF materials);
 //! - images: [`image_out`] (PNG/EXR via [`atomic`] replacement), [`image_in`] (textures);
 //! - every error is a [`FormatError`]: one line naming the file and the place.
 //!
@@ -18,10 +21,14 @@ mod fan;
 pub mod gltf;
 pub mod image_in;
 pub mod image_out;
+pub mod material_map;
+pub mod mesh_library;
+pub mod mesh_scene;
 pub mod mtl;
 pub mod obj;
 pub mod ply;
 pub mod scene_file;
+pub mod scene_load;
 pub mod srgb;
 
 use std::path::{Path, PathBuf};

@@ -35,74 +35,67 @@ pub enum Command {
 }
 
 /// Options of `sahara render`.
-#[derive(Debug, Args, Clone, PartialEq)]
+///
+/// Options a scene file can also set (`--spp`, `--width`, `--height`,
+/// `--integrator`, `--sampler`, `--filter`, `--seed`, `--exposure`,
+/// `--tonemap`, `--output`) are `None` unless given, so that the file's
+/// values hold unless overridden on the command line; the defaults in
+/// brackets apply when neither gives one.
+#[derive(Debug, Args, Clone, PartialEq, Default)]
 pub struct RenderArgs {
-    /// What to render: a mesh (.obj, .ply) framed by its camera sidecar or
-    /// automatically and lit by a default sky and sun; none for the built-in
-    /// Cornell box.
+    /// What to render: a scene file (.toml), or a mesh (.obj, .ply, .gltf,
+    /// .glb) with its own materials, framed by its camera sidecar or
+    /// automatically and lit by a default sky and sun unless it emits
+    /// light; none for the built-in Cornell box.
     pub scene: Option<PathBuf>,
     /// Output image; the format follows the extension (.png, .exr)
-    /// [default: <scene name>.png in the working folder].
+    /// [default: the scene file's output, else <scene name>.png in the
+    /// working folder].
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
-    /// Samples per pixel in all (or per pass with --time-limit).
-    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
-    pub spp: u32,
+    /// Samples per pixel in all (or per pass with --time-limit) [default:
+    /// the scene file's, else 64].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
+    pub spp: Option<u32>,
     /// Samples per pixel in each progressive pass [default: min(spp, 8)].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
     pub pass_spp: Option<u32>,
-    /// Image width in pixels.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub width: u32,
-    /// Image height in pixels.
-    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub height: u32,
-    /// Light transport: path, distribution, normals, depth, ao, cost.
-    #[arg(long, default_value = "path")]
-    pub integrator: String,
-    /// Sample generator: independent, stratified, sobol.
-    #[arg(long, default_value = "sobol")]
-    pub sampler: String,
-    /// Reconstruction filter: box, tent, gaussian, mitchell.
-    #[arg(long, default_value = "gaussian")]
-    pub filter: String,
+    /// Image width in pixels [default: the scene file's, else 512].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub width: Option<u32>,
+    /// Image height in pixels [default: the scene file's, else 512].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub height: Option<u32>,
+    /// Light transport: path, distribution, normals, depth, ao, cost
+    /// [default: the scene file's, else path].
+    #[arg(long, value_name = "NAME")]
+    pub integrator: Option<String>,
+    /// Sample generator: independent, stratified, sobol [default: the scene
+    /// file's, else sobol].
+    #[arg(long, value_name = "NAME")]
+    pub sampler: Option<String>,
+    /// Reconstruction filter: box, tent, gaussian, mitchell [default: the
+    /// scene file's, else gaussian].
+    #[arg(long, value_name = "NAME")]
+    pub filter: Option<String>,
     /// Rendering threads [default: all hardware threads].
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
     pub threads: Option<u16>,
-    /// Seed of every random decision (same seed, same image, bit for bit).
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    /// Seed of every random decision (same seed, same image, bit for bit)
+    /// [default: the scene file's, else 0].
+    #[arg(long)]
+    pub seed: Option<u64>,
     /// Render progressive passes until this many seconds have passed (for
     /// equal-time comparisons); --spp is then the samples of each pass.
     #[arg(long, value_name = "SECS")]
     pub time_limit: Option<f64>,
-    /// Exposure in stops, for PNG output.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub exposure: f32,
-    /// Tone map for PNG output: clamp or filmic.
-    #[arg(long, default_value = "clamp")]
-    pub tonemap: String,
-}
-
-impl Default for RenderArgs {
-    fn default() -> Self {
-        Self {
-            scene: None,
-            output: None,
-            spp: 64,
-            pass_spp: None,
-            width: 512,
-            height: 512,
-            integrator: "path".into(),
-            sampler: "sobol".into(),
-            filter: "gaussian".into(),
-            threads: None,
-            seed: 0,
-            time_limit: None,
-            exposure: 0.0,
-            tonemap: "clamp".into(),
-        }
-    }
+    /// Exposure in stops, for PNG output [default: the scene file's, else 0].
+    #[arg(long, allow_negative_numbers = true)]
+    pub exposure: Option<f32>,
+    /// Tone map for PNG output: clamp or filmic [default: the scene file's,
+    /// else clamp].
+    #[arg(long, value_name = "NAME")]
+    pub tonemap: Option<String>,
 }
 
 const BENCH_ABOUT: &str = "\

@@ -10,6 +10,7 @@ mod demo_scene;
 mod human;
 mod input;
 mod render;
+mod render_options;
 mod stats;
 
 use std::process::ExitCode;

@@ -1,46 +1,59 @@
 //! `sahara render`: a scene to a PNG or EXR, with a progress bar, Ctrl-C
 //! handling and a summary.
 
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::path::Path;
+use std::sync::atomic::Ordering;
 use std::time::Duration;
 
 use anyhow::{anyhow, bail, Context, Result};
-use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
-use sahara_formats::camera::{read_sidecar, sidecar_path};
 use sahara_formats::image_out::{write_image, Pixels};
-use sahara_render::{
-    builtin, render, Camera, Environment, Filter, Integrator, Light, Material, Progress,
-    RenderSettings, SamplerKind, Scene, ToneMap,
-};
+use sahara_formats::mesh_scene::load_mesh_scene;
+use sahara_formats::scene_load::{load_scene, FileSettings};
+use sahara_render::{builtin, render, Progress, RenderSettings, Scene};
 
 use crate::cli::RenderArgs;
-use crate::input::load_mesh;
+use crate::render_options::{resolve, RenderOptions};
+
+/// Most warnings printed one by one; the rest are counted.
+const MAX_WARNINGS_SHOWN: usize = 20;
+
+/// A scene to render, with what its file says about rendering it.
+struct Input {
+    scene: Scene,
+    file: Option<FileSettings>,
+    name: String,
+    description: String,
+    warnings: Vec<String>,
+}
 
 /// `sahara render ...` (and `sahara` with no subcommand).
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let (scene, name) = match &args.scene {
-        None => (builtin::cornell_box(), "cornell_box".to_string()),
-        Some(path) => (scene_from_file(path, args)?, stem(path)),
-    };
-    let output = args
-        .output
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("{name}.png")));
+    let Input {
+        mut scene,
+        file,
+        name,
+        description,
+        warnings,
+    } = load_input(args.scene.as_deref())?;
+    print_warnings(&warnings);
+    let RenderOptions {
+        settings,
+        sampler_name,
+        exposure,
+        tonemap,
+        output,
+    } = resolve(args, file.as_ref(), &name)?;
     // Refuse an unwritable output now, not after the render.
     sahara_formats::atomic::check_writable(&output)
         .map_err(|e| anyhow!("{e}"))
         .context("cannot write the output image")?;
-    let mut scene = scene;
     // Any aspect ratio: the vertical field of view is kept.
-    scene.camera.aspect = args.width as f32 / args.height as f32;
+    scene.camera.aspect = settings.width as f32 / settings.height as f32;
     scene
         .validate()
         .map_err(|e| anyhow!("invalid scene: {e}"))?;
 
-    let settings = settings(args)?;
     let cancel = settings.cancel.clone().expect("settings set a cancel flag");
     ctrlc::set_handler(move || {
         // A second Ctrl-C leaves the default way.
@@ -57,16 +70,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .build()
         .context("cannot start the render threads")?;
     eprintln!(
-        "rendering {} at {}x{}, {} ({}), {} spp in passes of {}, {} threads",
-        args.scene
-            .as_deref()
-            .map_or("the built-in Cornell box".into(), |p| p
-                .display()
-                .to_string()),
-        args.width,
-        args.height,
+        "rendering {description} at {}x{}, {} ({sampler_name}), {} spp in passes of {}, {} threads",
+        settings.width,
+        settings.height,
         settings.integrator.name(),
-        args.sampler,
         if args.time_limit.is_some() {
             "unlimited".to_string()
         } else {
@@ -95,14 +102,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bail!("stopped before the first pass completed: no image written");
     }
     let rgb = result.film.to_rgb_f32();
-    let tone = match args.tonemap.as_str() {
-        "filmic" => ToneMap::Filmic,
-        _ => ToneMap::Clamp,
-    };
     let rgb8 = if is_exr(&output) {
         Vec::new()
     } else {
-        result.film.to_srgb8(args.exposure, tone)
+        result.film.to_srgb8(exposure, tonemap)
     };
     let pixels = if is_exr(&output) {
         Pixels::LinearRgbF32(&rgb)
@@ -118,7 +121,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ("sahara:seed".to_string(), settings.seed.to_string()),
         ("sahara:partial".to_string(), partial.to_string()),
     ];
-    write_image(&output, args.width, args.height, pixels, &metadata)
+    write_image(&output, settings.width, settings.height, pixels, &metadata)
         .map_err(|e| anyhow!("{e}"))
         .context("cannot write the output image")?;
     let secs = s.render_time.as_secs_f64();
@@ -141,62 +144,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// Render settings from the command line.
-fn settings(args: &RenderArgs) -> Result<RenderSettings> {
-    let integrator = Integrator::from_name(&args.integrator).ok_or_else(|| {
-        anyhow!(
-            "unknown integrator '{}'; expected path, distribution, normals, depth, ao or cost",
-            args.integrator
-        )
-    })?;
-    let sampler = match args.sampler.as_str() {
-        "independent" => SamplerKind::Independent,
-        "stratified" => SamplerKind::Stratified,
-        "sobol" => SamplerKind::Sobol,
-        s => bail!("unknown sampler '{s}'; expected independent, stratified or sobol"),
-    };
-    let filter = match args.filter.as_str() {
-        "box" => Filter::Box { radius: 0.5 },
-        "tent" => Filter::Tent { radius: 1.0 },
-        "gaussian" => Filter::default(),
-        "mitchell" => Filter::Mitchell {
-            radius: 2.0,
-            b: 1.0 / 3.0,
-            c: 1.0 / 3.0,
-        },
-        f => bail!("unknown filter '{f}'; expected box, tent, gaussian or mitchell"),
-    };
-    if !matches!(args.tonemap.as_str(), "clamp" | "filmic") {
-        bail!(
-            "unknown tone map '{}'; expected clamp or filmic",
-            args.tonemap
-        );
-    }
-    let (spp, passes, time_limit) = match args.time_limit {
-        Some(t) if !(t > 0.0 && t.is_finite()) => {
-            bail!("--time-limit must be a positive number of seconds")
-        }
-        Some(t) => (args.spp, u32::MAX, Some(Duration::from_secs_f64(t))),
-        None => {
-            let per_pass = args.pass_spp.unwrap_or(args.spp.min(8)).min(args.spp);
-            (per_pass, args.spp.div_ceil(per_pass), None)
-        }
-    };
-    Ok(RenderSettings {
-        width: args.width,
-        height: args.height,
-        spp,
-        passes,
-        time_limit,
-        cancel: Some(Arc::new(AtomicBool::new(false))),
-        seed: args.seed,
-        sampler,
-        filter,
-        integrator,
-        ..Default::default()
-    })
-}
-
 fn progress_bar(settings: &RenderSettings) -> ProgressBar {
     let bar = ProgressBar::new(0);
     let template = if settings.time_limit.is_some() {
@@ -211,43 +158,70 @@ fn progress_bar(settings: &RenderSettings) -> ProgressBar {
     bar
 }
 
-/// A scene from a file: a mesh (OBJ, PLY) with its camera sidecar or an
-/// automatic camera, a grey diffuse material, a sky and a sun.
-fn scene_from_file(path: &Path, args: &RenderArgs) -> Result<Scene> {
+/// The scene to render: the built-in Cornell box, a scene file or a mesh file.
+fn load_input(path: Option<&Path>) -> Result<Input> {
+    let Some(path) = path else {
+        return Ok(Input {
+            scene: builtin::cornell_box(),
+            file: None,
+            name: "cornell_box".into(),
+            description: "the built-in Cornell box".into(),
+            warnings: Vec::new(),
+        });
+    };
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    if !matches!(ext.as_str(), "obj" | "ply") {
-        bail!(
-            "{}: cannot render .{ext} files; expected a mesh (.obj, .ply)",
+    // A `FormatError`'s message already names the file and place.
+    let flat = |e: sahara_formats::FormatError| anyhow!("{e}");
+    let (scene, file, warnings) = match ext.as_str() {
+        "toml" => {
+            let l = load_scene(path).map_err(flat)?;
+            (l.scene, Some(l.settings), l.warnings)
+        }
+        "obj" | "ply" | "gltf" | "glb" => {
+            let m = load_mesh_scene(path).map_err(flat)?;
+            eprintln!(
+                "camera: {}; light: {}",
+                m.camera_source,
+                if m.default_light {
+                    "default sky and sun"
+                } else {
+                    "the mesh's emitters"
+                }
+            );
+            (m.scene, None, m.warnings)
+        }
+        _ => bail!(
+            "{}: cannot render .{ext} files; expected a scene file (.toml) or a mesh (.obj, .ply, .gltf, .glb)",
             path.display()
+        ),
+    };
+    Ok(Input {
+        scene,
+        file,
+        name: stem(path),
+        description: path.display().to_string(),
+        warnings,
+    })
+}
+
+/// Prints warnings (the first [`MAX_WARNINGS_SHOWN`]) and their count.
+fn print_warnings(warnings: &[String]) {
+    for w in warnings.iter().take(MAX_WARNINGS_SHOWN) {
+        eprintln!("warning: {w}");
+    }
+    if warnings.len() > MAX_WARNINGS_SHOWN {
+        eprintln!("... and {} more", warnings.len() - MAX_WARNINGS_SHOWN);
+    }
+    if !warnings.is_empty() {
+        eprintln!(
+            "{} warning{} while loading",
+            warnings.len(),
+            if warnings.len() == 1 { "" } else { "s" }
         );
     }
-    let mesh = load_mesh(path)?;
-    let bounds = mesh.bounds();
-    let aspect = args.width as f32 / args.height as f32;
-    let sidecar = sidecar_path(path);
-    let camera = if sidecar.exists() {
-        let c = read_sidecar(&sidecar).map_err(|e| anyhow!("{e}"))?;
-        Camera::look_at(c.eye, c.target, c.up, c.vfov_deg, aspect)
-    } else {
-        // Framed like the benchmark protocol's automatic camera.
-        let c = bounds.center();
-        let r = 0.5 * bounds.extent().length();
-        let vfov: f32 = 45.0;
-        let eye = c + Vec3::new(0.3, 0.5, 1.0).normalize() * (r / (0.5 * vfov.to_radians()).sin());
-        Camera::look_at(eye, c, Vec3::Y, vfov, aspect)
-    };
-    let mut scene = Scene::new(camera);
-    let grey = scene.add_material(Material::diffuse(Vec3::splat(0.7)));
-    scene.add_object(mesh, glam::Affine3A::IDENTITY, grey);
-    scene.environment = Some(Environment::Constant(Vec3::new(0.55, 0.6, 0.7)));
-    scene.add_light(Light::directional(
-        Vec3::new(-0.4, -1.0, -0.3),
-        Vec3::splat(2.5),
-    ));
-    Ok(scene)
 }
 
 fn stem(path: &Path) -> String {

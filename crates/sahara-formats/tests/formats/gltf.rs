@@ -6,19 +6,19 @@ use sahara_formats::gltf::{load_gltf, GltfImage, GltfMaterial};
 use crate::common::TempDir;
 
 /// Little-endian bytes of floats.
-fn f32s(values: &[f32]) -> Vec<u8> {
+pub(crate) fn f32s(values: &[f32]) -> Vec<u8> {
     values.iter().flat_map(|v| v.to_le_bytes()).collect()
 }
 
 /// Little-endian bytes of u16s, padded to a multiple of 4 bytes.
-fn u16s(values: &[u16]) -> Vec<u8> {
+pub(crate) fn u16s(values: &[u16]) -> Vec<u8> {
     let mut out: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
     out.resize(out.len().div_ceil(4) * 4, 0);
     out
 }
 
 /// Standard base64 with padding (written here so the loader's decoder is checked independently).
-fn base64(bytes: &[u8]) -> String {
+pub(crate) fn base64(bytes: &[u8]) -> String {
     const A: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::new();
     for chunk in bytes.chunks(3) {
@@ -40,7 +40,7 @@ fn base64(bytes: &[u8]) -> String {
 }
 
 /// One triangle: positions, normals, uvs, u16 indices; returns the buffer and the byte offsets.
-fn triangle_buffer() -> Vec<u8> {
+pub(crate) fn triangle_buffer() -> Vec<u8> {
     let mut bin = f32s(&[0., 0., 0., 1., 0., 0., 0., 1., 0.]); // 0..36
     bin.extend(f32s(&[0., 0., 1., 0., 0., 1., 0., 0., 1.])); // 36..72
     bin.extend(f32s(&[0., 0., 1., 0., 0., 1.])); // 72..96
@@ -49,7 +49,7 @@ fn triangle_buffer() -> Vec<u8> {
 }
 
 /// The JSON for [`triangle_buffer`] given the buffer's `uri` entry (or none for GLB) and extra top-level JSON.
-fn triangle_json(buffer: &str, length: usize, extra: &str) -> String {
+pub(crate) fn triangle_json(buffer: &str, length: usize, extra: &str) -> String {
     format!(
         r#"{{
   "asset": {{"version": "2.0"}},

@@ -1,4 +1,4 @@
-//! Tests for `sahara-formats`: meshes, materials, glTF, scene files, images, camera sidecars and the shared scenes.
+//! Tests for `sahara-formats`: meshes, materials, glTF, scene files and their conversion to renderer scenes, images, camera sidecars and the shared scenes.
 
 mod camera;
 mod common;
@@ -9,4 +9,5 @@ mod obj;
 mod obj_materials;
 mod ply;
 mod scene_file;
+mod scene_load;
 mod scenes;

@@ -1,0 +1,247 @@
+//! Scene files as renderer scenes: a [`SceneFile`] becomes a
+//! [`sahara_render::Scene`] plus the file's render settings.
+//!
+//! - Mesh files are loaded once each by a [`MeshLibrary`], however many
+//!   objects use them: objects only add instances (glTF nodes add one
+//!   instance per node, placed by the object's transform times the node's).
+//! - An object with `material = "name"` overrides a mesh's own materials;
+//!   without it a mesh keeps its MTL / glTF materials (mapped as
+//!   [`crate::material_map`] describes) and a PLY or a built-in shape gets
+//!   the grey default.
+//! - `motion` gives a moving instance (`Placement::Moving`) interpolated
+//!   over the shutter interval.
+//! - Built-in shapes and area lights go through [`Scene::add_shape`] where
+//!   possible, so emissive quads, discs and spheres are sampled
+//!   analytically (see [`shapes`]).
+//! - Problems that still allow rendering (a missing MTL file or texture)
+//!   are warnings in [`LoadedScene::warnings`].
+
+mod placement;
+pub mod settings;
+pub mod shapes;
+
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
+use sahara_render::{Camera, Environment, Instance, Light, Material, Scene, Texture};
+
+use crate::error::FormatError;
+use crate::image_in::load_rgb_f32;
+use crate::mesh_library::{file_key, MeshLibrary};
+use crate::scene_file::{
+    load_scene_file, CameraSpec, EnvironmentSpec, LightSpec, MaterialKind, MaterialSpec,
+    Placement as PlacementSpec, SceneFile, ShapeSpec,
+};
+
+pub use placement::{placement, srt};
+pub use settings::FileSettings;
+
+/// A scene ready to render, with how its file asks for it to be rendered.
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    /// The scene (camera aspect from the film size).
+    pub scene: Scene,
+    /// Integrator, sampler, filter and film of the file.
+    pub settings: FileSettings,
+    /// Problems that did not stop loading, one line each, naming the file.
+    pub warnings: Vec<String>,
+}
+
+/// Reads a scene file and builds its scene (meshes, textures and maps read relative to it).
+pub fn load_scene(path: &Path) -> Result<LoadedScene, FormatError> {
+    let file = load_scene_file(path)?;
+    build_scene(&file, &path.display().to_string())
+}
+
+/// Builds the scene of a parsed scene file; `name` (the scene file) is used in messages.
+pub fn build_scene(file: &SceneFile, name: &str) -> Result<LoadedScene, FormatError> {
+    let settings =
+        FileSettings::from_specs(&file.integrator, &file.sampler, &file.filter, &file.film);
+    let aspect = settings.width as f32 / settings.height as f32;
+    let mut scene = Scene::new(camera_of(&file.camera, aspect));
+    let mut library = MeshLibrary::new();
+
+    let mut named = HashMap::new();
+    for m in &file.materials {
+        let id = scene.add_material(material_of(m, &mut library.warnings, name));
+        named.insert(m.name.as_str(), id);
+    }
+    // Files some object shows with their own materials.
+    let own: HashSet<_> = file
+        .objects
+        .iter()
+        .filter(|o| o.material.is_none())
+        .filter_map(|o| match &o.shape {
+            ShapeSpec::Mesh { path } => Some(file_key(path)),
+            _ => None,
+        })
+        .collect();
+    let mut moving_emitters = 0;
+    for (k, o) in file.objects.iter().enumerate() {
+        // The resolver checked that the name exists.
+        let material = o.material.as_deref().and_then(|n| named.get(n).copied());
+        match &o.shape {
+            ShapeSpec::Mesh { path } => {
+                let f = library
+                    .load(&mut scene, path, own.contains(&file_key(path)))
+                    .map_err(|e| FormatError::in_file(name, format!("object {}: {e}", k + 1)))?;
+                for part in &f.parts {
+                    scene.add_instance(Instance {
+                        mesh: part.mesh,
+                        placement: placement(&o.placement, part.transform),
+                        material: material.or(f.material),
+                    });
+                }
+                if matches!(o.placement, PlacementSpec::Motion { .. })
+                    && material.map_or(f.emissive, |m| is_emissive(&scene, m))
+                {
+                    moving_emitters += 1;
+                }
+            }
+            spec => {
+                let shape = shapes::shape_of(spec).expect("not a mesh");
+                let material = match material {
+                    Some(m) => m,
+                    None => library.default_material(&mut scene),
+                };
+                if matches!(o.placement, PlacementSpec::Motion { .. })
+                    && is_emissive(&scene, material)
+                {
+                    moving_emitters += 1;
+                }
+                shapes::add_placed_shape(
+                    &mut scene,
+                    shape,
+                    placement(&o.placement, Mat4::IDENTITY),
+                    material,
+                );
+            }
+        }
+    }
+    if moving_emitters > 0 {
+        library.warnings.push(format!(
+            "{name}: {moving_emitters} moving object(s) emit light: they are seen, but not sampled as lights"
+        ));
+    }
+    for l in &file.lights {
+        add_light(&mut scene, l, name)?;
+    }
+    let mut warnings = std::mem::take(&mut library.warnings);
+    if !scene.has_light() {
+        warnings.push(format!(
+            "{name}: the scene has no light (no [[light]], emissive material or environment); the image will be black"
+        ));
+    }
+    Ok(LoadedScene {
+        scene,
+        settings,
+        warnings,
+    })
+}
+
+/// True if material `id` of `scene` emits.
+fn is_emissive(scene: &Scene, id: u32) -> bool {
+    scene.materials[id as usize].is_emissive()
+}
+
+/// The thin-lens camera of `[camera]`.
+pub fn camera_of(c: &CameraSpec, aspect: f32) -> Camera {
+    Camera::look_at(c.eye, c.target, c.up, c.vfov_deg, aspect)
+        .with_thin_lens(c.aperture_radius, c.focus_distance)
+        .with_shutter(c.shutter_open, c.shutter_close)
+}
+
+/// The renderer material of a `[[material]]` (a texture that cannot be read is a warning).
+fn material_of(m: &MaterialSpec, warnings: &mut Vec<String>, name: &str) -> Material {
+    match &m.kind {
+        MaterialKind::Diffuse { albedo, texture } => {
+            let mut out = Material::diffuse(*albedo);
+            if let Some(path) = texture {
+                match load_rgb_f32(path) {
+                    Ok((w, h, rgb)) if w > 0 && h > 0 => {
+                        let texels = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
+                        out.texture = Some(Arc::new(Texture::new(w, h, texels)));
+                    }
+                    Ok(_) => warnings.push(format!(
+                        "{name}: material '{}': texture {} is empty; the material is untextured",
+                        m.name,
+                        path.display()
+                    )),
+                    Err(e) => warnings.push(format!(
+                        "{name}: material '{}': {e}; the material is untextured",
+                        m.name
+                    )),
+                }
+            }
+            out
+        }
+        MaterialKind::Conductor { color, roughness } => Material::conductor(*color, *roughness),
+        MaterialKind::Mirror { color } => Material::mirror(*color),
+        MaterialKind::Dielectric { ior } => Material::glass(*ior),
+        MaterialKind::RoughDielectric { ior, roughness } => Material::rough_glass(*ior, *roughness),
+        MaterialKind::Emission {
+            radiance,
+            two_sided,
+        } => {
+            let mut out = Material::emitter(*radiance);
+            out.two_sided_emission = *two_sided;
+            out
+        }
+    }
+}
+
+/// Adds a `[[light]]`: explicit lights, emissive shapes, or the environment.
+fn add_light(scene: &mut Scene, l: &LightSpec, name: &str) -> Result<(), FormatError> {
+    match l {
+        LightSpec::Point {
+            position,
+            intensity,
+        } => scene.add_light(Light::point(*position, *intensity)),
+        LightSpec::Spot {
+            position,
+            target,
+            intensity,
+            inner_deg,
+            outer_deg,
+        } => scene.add_light(Light::spot(
+            *position, *target, *intensity, *inner_deg, *outer_deg,
+        )),
+        LightSpec::Directional {
+            direction,
+            irradiance,
+        } => scene.add_light(Light::directional(*direction, *irradiance)),
+        LightSpec::Area {
+            shape,
+            radiance,
+            two_sided,
+        } => {
+            let mut m = Material::emitter(*radiance);
+            m.two_sided_emission = *two_sided;
+            let m = scene.add_material(m);
+            let shape = shapes::shape_of(shape).ok_or_else(|| {
+                FormatError::in_file(name, "an area light's shape is quad, disc or sphere")
+            })?;
+            scene.add_shape(shape, m);
+        }
+        LightSpec::Environment(EnvironmentSpec::Constant(c)) => {
+            scene.environment = Some(Environment::Constant(*c));
+        }
+        LightSpec::Environment(EnvironmentSpec::Map { path, scale }) => {
+            let (w, h, rgb) = load_rgb_f32(path)?;
+            if w == 0 || h == 0 {
+                return Err(FormatError::in_file(
+                    &path.display().to_string(),
+                    "the environment map is empty",
+                ));
+            }
+            let texels = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
+            scene.environment = Some(Environment::Map {
+                texture: Arc::new(Texture::new(w, h, texels)),
+                scale: *scale,
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,228 @@
+//! End-to-end tests of `sahara render`: every example scene, mesh files,
+//! and the errors a user meets first.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use sahara_formats::image_in::load_rgb_f32;
+
+const SAHARA: &str = env!("CARGO_BIN_EXE_sahara");
+
+/// A fresh directory for one test.
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sahara-render-{}-{name}", std::process::id()));
+    let _ = fs::remove_dir_all(&d);
+    fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Run `sahara` with `args`.
+fn sahara(args: &[&str]) -> Output {
+    Command::new(SAHARA)
+        .args(args)
+        .output()
+        .expect("run sahara")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// The workspace's example scenes.
+fn example_scenes() -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut scenes: Vec<_> = fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    scenes.sort();
+    scenes
+}
+
+/// Mean of the image's linear RGB values, after checking they are finite.
+fn checked_mean(path: &Path, width: u32, height: u32) -> f32 {
+    let (w, h, rgb) = load_rgb_f32(path).unwrap();
+    assert_eq!((w, h), (width, height), "{}", path.display());
+    assert!(rgb.iter().all(|v| v.is_finite()), "{}", path.display());
+    rgb.iter().sum::<f32>() / rgb.len() as f32
+}
+
+#[test]
+fn every_example_scene_renders() {
+    let scenes = example_scenes();
+    assert!(scenes.len() >= 3, "{scenes:?}");
+    let shared = sahara_formats::scenes_dir();
+    if !shared.join("bunny/bunny.obj").exists() {
+        println!("note: {} not found; skipping", shared.display());
+        return;
+    }
+    let dir = temp_dir("examples");
+    for scene in scenes {
+        let stem = scene.file_stem().unwrap().to_string_lossy().into_owned();
+        let png = dir.join(format!("{stem}.png"));
+        let out = sahara(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--width",
+            "48",
+            "--height",
+            "48",
+            "--spp",
+            "2",
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        let err = stderr(&out);
+        assert!(out.status.success(), "{stem}: {err}");
+        assert!(!err.contains("NaN"), "{stem}: {err}");
+        assert!(!err.contains("warning"), "{stem}: {err}");
+        let mean = checked_mean(&png, 48, 48);
+        assert!(
+            (0.02..0.9).contains(&mean),
+            "{stem}: implausible mean {mean}"
+        );
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A one-quad OBJ facing +z with an MTL naming a missing texture, and a
+/// sidecar camera looking at it.
+fn write_quad(dir: &Path, mtl: &str) -> PathBuf {
+    fs::write(dir.join("quad.mtl"), format!("newmtl m\n{mtl}\n")).unwrap();
+    fs::write(
+        dir.join("quad.camera.json"),
+        r#"{"eye":[0,0,3],"target":[0,0,0],"vfov_deg":60}"#,
+    )
+    .unwrap();
+    let obj = dir.join("quad.obj");
+    fs::write(
+        &obj,
+        "mtllib quad.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nusemtl m\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    obj
+}
+
+#[test]
+fn a_mesh_renders_with_its_mtl_and_warnings_are_counted() {
+    let dir = temp_dir("mesh");
+    let obj = write_quad(&dir, "Kd 0.2 0.9 0.2\nmap_Kd missing.png");
+    let exr = dir.join("quad.exr");
+    let out = sahara(&[
+        "render",
+        obj.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        "2",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("missing.png") && err.contains("1 warning"),
+        "{err}"
+    );
+    assert!(err.contains("quad.camera.json"), "{err}");
+    // The quad fills the centre: lit by the default sun and sky, green.
+    let (w, _, rgb) = load_rgb_f32(&exr).unwrap();
+    let c = ((8 * w + 8) * 3) as usize;
+    let (r, g, b) = (rgb[c], rgb[c + 1], rgb[c + 2]);
+    assert!(g > 2.0 * r && g > 2.0 * b && g > 0.1, "{r} {g} {b}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_emissive_mesh_gets_no_default_light() {
+    let dir = temp_dir("emitter");
+    let obj = write_quad(&dir, "Kd 0 0 0\nKe 0.5 0.25 0.125");
+    let exr = dir.join("quad.exr");
+    let out = sahara(&[
+        "render",
+        obj.to_str().unwrap(),
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        "1",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (w, _, rgb) = load_rgb_f32(&exr).unwrap();
+    // The quad shows exactly its emission; the background is black (no sky).
+    let c = ((8 * w + 8) * 3) as usize;
+    assert!((rgb[c] - 0.5).abs() < 1e-3 && (rgb[c + 2] - 0.125).abs() < 1e-3);
+    assert_eq!(&rgb[..3], &[0.0, 0.0, 0.0]);
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn command_line_options_override_the_scene_file() {
+    let dir = temp_dir("override");
+    write_quad(&dir, "Kd 0.5 0.5 0.5");
+    let scene = dir.join("s.toml");
+    fs::write(
+        &scene,
+        "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n\n[[object]]\ntype = \"mesh\"\nfile = \"quad.obj\"\n\n\
+         [[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n\n\
+         [film]\nwidth = 12\nheight = 6\noutput = \"from_file.png\"\n",
+    )
+    .unwrap();
+    let out = sahara(&["render", scene.to_str().unwrap(), "--spp", "1"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    // The file's size and output (relative to the scene file) hold...
+    let (w, h, _) = load_rgb_f32(&dir.join("from_file.png")).unwrap();
+    assert_eq!((w, h), (12, 6));
+    // ...unless given on the command line.
+    let png = dir.join("cli.png");
+    let out = sahara(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        "1",
+        "--width",
+        "5",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (w, h, _) = load_rgb_f32(&png).unwrap();
+    assert_eq!((w, h), (5, 6));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_unknown_integrator_is_a_clear_error() {
+    let out = sahara(&["render", "--integrator", "whitted", "--width", "4"]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(
+        err.contains("unknown integrator 'whitted'") && err.contains("path, distribution"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_scene_with_a_missing_mesh_names_the_line_and_the_path() {
+    let dir = temp_dir("missing");
+    let scene = dir.join("s.toml");
+    fs::write(
+        &scene,
+        "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n\n[film]\nwidth = 4\nheight = 4\n\n\
+         [[object]]\ntype = \"mesh\"\nfile = \"gone/bunny.obj\"\n",
+    )
+    .unwrap();
+    let out = sahara(&["render", scene.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("s.toml: line 11"), "{err}");
+    assert!(err.contains("gone/bunny.obj"), "{err}");
+    let _ = fs::remove_dir_all(&dir);
+}
