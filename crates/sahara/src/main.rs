@@ -9,6 +9,7 @@ mod cli;
 mod demo_scene;
 mod human;
 mod input;
+mod memory;
 mod render;
 mod render_options;
 mod stats;

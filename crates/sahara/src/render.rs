@@ -13,6 +13,7 @@ use sahara_formats::scene_load::{load_scene, FileSettings};
 use sahara_render::{builtin, render, Progress, RenderSettings, Scene};
 
 use crate::cli::RenderArgs;
+use crate::memory;
 use crate::render_options::{resolve, RenderOptions};
 
 /// Most warnings printed one by one; the rest are counted.
@@ -48,6 +49,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     sahara_formats::atomic::check_writable(&output)
         .map_err(|e| anyhow!("{e}"))
         .context("cannot write the output image")?;
+    // Refuse a render that would not fit, with what it would need.
+    let triangles: u64 = scene
+        .meshes
+        .iter()
+        .map(|m| m.mesh.indices.len() as u64)
+        .sum();
+    memory::check_fits(
+        triangles,
+        settings.width,
+        settings.height,
+        memory::available_bytes(),
+    )?;
     // Any aspect ratio: the vertical field of view is kept.
     scene.camera.aspect = settings.width as f32 / settings.height as f32;
     scene
