@@ -90,6 +90,9 @@ pub struct Progress {
     pub tiles: u32,
     /// Time since the render began.
     pub elapsed: Duration,
+    /// Rays traced so far (camera, bounce and shadow rays), for a live
+    /// Mrays/s figure.
+    pub rays: u64,
 }
 
 /// Counts and times of a render.
@@ -202,6 +205,7 @@ pub fn render(
     };
     let out_of_time = || settings.time_limit.is_some_and(|t| start.elapsed() >= t);
     let passes = settings.passes.max(1);
+    let rays_so_far = std::sync::atomic::AtomicU64::new(0);
     for pass in 0..passes {
         if cancelled() || (pass > 0 && out_of_time()) {
             stats.stopped_early = true;
@@ -218,12 +222,20 @@ pub fn render(
                 }
                 let out = render_tile(&world, settings, *tile, pass, w, h);
                 let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                let t = &out.stats;
+                let rays = rays_so_far.fetch_add(
+                    t.camera_rays + t.bounce_rays + t.shadow_rays,
+                    Ordering::Relaxed,
+                ) + t.camera_rays
+                    + t.bounce_rays
+                    + t.shadow_rays;
                 progress(Progress {
                     pass,
                     passes,
                     tiles_done: d,
                     tiles: tiles.len() as u32,
                     elapsed: start.elapsed(),
+                    rays,
                 });
                 Some(out)
             })

@@ -99,8 +99,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         bar.set_position((p.pass as u64) * p.tiles as u64 + p.tiles_done as u64);
         if p.tiles_done == 1 {
             bar.set_length(p.passes as u64 * p.tiles as u64);
-            bar.set_message(format!("pass {}/{}", p.pass + 1, p.passes));
         }
+        let mrays = p.rays as f64 / p.elapsed.as_secs_f64().max(1e-9) / 1e6;
+        let of = if p.passes == u32::MAX {
+            String::new()
+        } else {
+            format!("/{}", p.passes)
+        };
+        bar.set_message(format!("pass {}{of} {mrays:.1} Mrays/s", p.pass + 1));
     };
     let result = pool.install(|| render(&scene, &settings, &on_progress));
     bar.finish_and_clear();
