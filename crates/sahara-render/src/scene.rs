@@ -153,6 +153,37 @@ impl Scene {
             || self.materials.iter().any(|m| m.is_emissive())
     }
 
+    /// Problems that do not stop a render, one line each: triangles no ray
+    /// can hit (non-finite coordinates or zero area; the kd-trees leave them
+    /// out) and a scene without any light (it renders black but for what
+    /// emits).
+    pub fn diagnostics(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for (i, m) in self.meshes.iter().enumerate() {
+            let skipped = m.mesh.indices.iter().filter(|t| {
+                let v = t.map(|k| {
+                    m.mesh
+                        .positions
+                        .get(k as usize)
+                        .copied()
+                        .unwrap_or(glam::Vec3::NAN)
+                });
+                !sahara_kd::Triangle::new(v[0], v[1], v[2]).is_hittable()
+            });
+            let n = skipped.count();
+            if n > 0 {
+                out.push(format!(
+                    "mesh {i}: {n} of {} triangles skipped (non-finite coordinates or zero area)",
+                    m.mesh.indices.len()
+                ));
+            }
+        }
+        if !self.has_light() {
+            out.push("the scene has no light: the image will be black".to_string());
+        }
+        out
+    }
+
     /// A neutral grey diffuse material, for geometry without one.
     pub fn default_material() -> Material {
         Material::diffuse(Vec3::splat(0.8))

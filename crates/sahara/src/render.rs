@@ -37,6 +37,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         description,
         warnings,
     } = load_input(args.scene.as_deref())?;
+    let mut warnings = warnings;
+    warnings.extend(scene.diagnostics());
     print_warnings(&warnings);
     let RenderOptions {
         settings,
