@@ -4,6 +4,7 @@ use crate::tree::KdTree;
 
 /// Shape, size and cost of a tree.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct TreeStats {
     /// Triangles given to the build.
     pub triangles: usize,

@@ -1,7 +1,7 @@
 //! `sahara stats`: a tree's statistics and build time.
 
 use anyhow::{Context, Result};
-use sahara_bench::report::{StatsReport, TreeStatsReport};
+use sahara_bench::report::StatsReport;
 use sahara_bench::runner::{build_timed, Pools};
 
 use crate::cli::StatsArgs;
@@ -32,7 +32,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         builder: args.tree.builder.name(),
         build_ms,
         build_runs: args.runs,
-        tree: TreeStatsReport::from(&tree.stats()),
+        tree: tree.stats(),
     };
     if args.json {
         println!(

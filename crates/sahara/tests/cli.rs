@@ -2,27 +2,13 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 
-const SAHARA: &str = env!("CARGO_BIN_EXE_sahara");
+mod common;
 
-/// A fresh directory for one test.
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("sahara-cli-{}-{name}", std::process::id()));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Run `sahara` with `args`.
-fn sahara(args: &[&str]) -> Output {
-    Command::new(SAHARA)
-        .args(args)
-        .output()
-        .expect("run sahara")
-}
+use common::{sahara, temp_dir};
 
 fn stdout_json(out: &Output) -> Value {
     assert!(

@@ -3,27 +3,13 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use sahara_formats::image_in::load_rgb_f32;
 
-const SAHARA: &str = env!("CARGO_BIN_EXE_sahara");
+mod common;
 
-/// A fresh directory for one test.
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("sahara-render-{}-{name}", std::process::id()));
-    let _ = fs::remove_dir_all(&d);
-    fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Run `sahara` with `args`.
-fn sahara(args: &[&str]) -> Output {
-    Command::new(SAHARA)
-        .args(args)
-        .output()
-        .expect("run sahara")
-}
+use common::{sahara, temp_dir};
 
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
