@@ -238,13 +238,11 @@ fn invalid_rays_never_hit() {
 /// below): a ray 1.9e38 away from a triangle in the plane x = 0
 /// gets a "hit" from the watertight test at t = 3e-18 with NaN barycentrics:
 /// shearing vertices ~1e38 away overflows f32, and NaN edge functions pass
-/// the sign tests. Brute force reports that false hit; the tree, whose
-/// bounding boxes cull the ray, does not, so the two disagree. Ignored until
-/// the ray/triangle test rejects non-finite edge functions (or coordinates
-/// are limited); the `kdtree` fuzz target clamps finite values to +-1e18
-/// meanwhile.
+/// the sign tests. Brute force reported that false hit; the tree, whose
+/// bounding boxes cull the ray, did not. Fixed: the test decides overflowed
+/// edge functions in f64 and rejects non-finite ones.
 #[test]
-#[ignore = "known bug: false hit with NaN barycentrics at ~1e38 (see comment)"]
+
 fn ray_far_from_a_triangle_never_hits_it() {
     let t = tri(
         [0.0, 1.05e9, 9.5e8],
@@ -263,12 +261,11 @@ fn ray_far_from_a_triangle_never_hits_it() {
 /// Found by fuzzing (target `kdtree`, coordinates then clamped to +-1e18):
 /// with one triangle reaching 1e18 among others of size 1e9, the rr-median
 /// builder makes a leaf (a slab 0.37 thick in y) that `validate` says misses
-/// triangle 2, which overlaps it: f32 clipping of a 1e18 triangle is off by
-/// far more than the cell. Either a triangle can be lost (rays through that
-/// leaf would miss it) or the validator is too strict at such ratios; not
-/// classified yet. The fuzz target now clamps finite values to +-1e9.
+/// triangle 2, which overlaps it: the f64 clipping of a 1e18 triangle was off
+/// by far more than the cell. Fixed: clipped bounds are padded by a bound on
+/// that rounding, so they stay conservative.
 #[test]
-#[ignore = "known issue: leaf misses a 1e18-sized triangle (see comment)"]
+
 fn one_huge_triangle_among_small_ones_is_in_every_leaf_it_overlaps() {
     let tris = [
         tri(

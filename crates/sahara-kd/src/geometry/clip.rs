@@ -49,6 +49,20 @@ pub fn clipped_bounds(tri: &Triangle, cell: &Aabb) -> Option<Aabb> {
         lo = lo.min(*p);
         hi = hi.max(*p);
     }
+    // The clipped vertices carry f64 rounding relative to the largest
+    // coordinate involved; pad by a bound on it so the bounds stay
+    // conservative even for a 1e18-sized triangle cut by a 0.1-wide cell
+    // (negligible, and below f32 resolution, at ordinary ratios).
+    let scale = tri
+        .v
+        .iter()
+        .fold(0.0f64, |m, v| m.max(v.abs().max_element() as f64));
+    let scale = scale
+        .max(cell.min.abs().max_element() as f64)
+        .max(cell.max.abs().max_element() as f64);
+    let pad = 16.0 * f64::EPSILON * scale;
+    lo -= DVec3::splat(pad);
+    hi += DVec3::splat(pad);
     let mut out = Aabb::EMPTY;
     for a in 0..3 {
         out.min[a] = round_down(lo[a]);
@@ -140,8 +154,47 @@ mod tests {
         );
         let cell = Aabb::new(Vec3::new(1.0, -5.0, -5.0), Vec3::splat(5.0));
         let b = clipped_bounds(&t, &cell).unwrap();
-        assert_eq!(b.min, Vec3::new(1.0, 0.0, 0.0));
-        assert_eq!(b.max, Vec3::new(2.0, 1.0, 0.0));
+        // Exact up to the conservative outward rounding (at most 1 ulp).
+        let exact = Aabb::new(Vec3::new(1.0, 0.0, 0.0), Vec3::new(2.0, 1.0, 0.0));
+        assert!(
+            b.min.cmple(exact.min).all() && b.max.cmpge(exact.max).all(),
+            "{b:?} must contain {exact:?}"
+        );
+        assert!(
+            (b.max - exact.max).abs().max_element() <= 2.0 * f32::EPSILON,
+            "{b:?}"
+        );
+        assert!(
+            (b.min - exact.min).abs().max_element() <= 2.0 * f32::EPSILON,
+            "{b:?}"
+        );
+    }
+
+    #[test]
+    fn clipping_a_huge_triangle_to_a_thin_cell_stays_conservative() {
+        // A 1e18 triangle cut by a slab 0.37 thick: f64 rounding of the
+        // clipped vertices (~256 units) dwarfs the cell, so without padding
+        // the bounds could miss part of the true clip.
+        let t = Triangle::new(
+            Vec3::new(-1e18, -1e18, 3.0),
+            Vec3::new(1e18, 0.0, -5.0),
+            Vec3::new(0.0, 1e18, 7.0),
+        );
+        let cell = Aabb::new(Vec3::new(-10.0, 0.1, -10.0), Vec3::new(10.0, 0.47, 10.0));
+        let b = clipped_bounds(&t, &cell).expect("the triangle crosses the slab");
+        // The true clip spans the whole x and z range of the cell inside the
+        // triangle; check a point of the triangle inside the cell is covered.
+        let p = glam::DVec3::new(0.0, 0.3, 0.0);
+        let v = t.v.map(|q| q.as_dvec3());
+        // Barycentric point of the triangle near p (solve in x, y): the
+        // plane's z at (0, 0.3).
+        let n = (v[1] - v[0]).cross(v[2] - v[0]);
+        let z = v[0].z - (n.x * (p.x - v[0].x) + n.y * (p.y - v[0].y)) / n.z;
+        assert!(
+            (b.min.z as f64) <= z && z <= b.max.z as f64,
+            "{b:?} misses z = {z}"
+        );
+        assert!(b.min.y >= 0.1 && b.max.y <= 0.47);
     }
 
     #[test]

@@ -151,36 +151,46 @@ impl RayShear {
         let cx = c[kx] - self.s.x * c[kz];
         let cy = c[ky] - self.s.y * c[kz];
 
-        let mut u = cx * by - cy * bx;
-        let mut v = ax * cy - ay * cx;
-        let mut w = bx * ay - by * ax;
-        if u == 0.0 || v == 0.0 || w == 0.0 {
-            // Edge hit: decide it in double precision (paper, section 3).
+        let u = cx * by - cy * bx;
+        let v = ax * cy - ay * cx;
+        let w = bx * ay - by * ax;
+        let det = u + v + w;
+        let (bu, bv) = if u != 0.0 && v != 0.0 && w != 0.0 && det.is_finite() {
+            if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+                return None;
+            }
+            let rcp = 1.0 / det;
+            (v * rcp, w * rcp)
+        } else {
+            // An edge function exactly zero (a ray through an edge or a
+            // vertex) is decided in double precision (paper, section 3); so is
+            // one that overflowed f32 (vertices ~1e19 apart, whose products
+            // pass f32::MAX). NaN or infinite sheared coordinates (vertices
+            // ~1e38 away) fail the finiteness test.
             let (ax, ay, bx, by, cx, cy) = (
                 ax as f64, ay as f64, bx as f64, by as f64, cx as f64, cy as f64,
             );
-            u = (cx * by - cy * bx) as f32;
-            v = (ax * cy - ay * cx) as f32;
-            w = (bx * ay - by * ax) as f32;
-        }
-        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
-            return None;
-        }
-        let det = u + v + w;
-        if det == 0.0 {
-            return None;
-        }
+            let u = cx * by - cy * bx;
+            let v = ax * cy - ay * cx;
+            let w = bx * ay - by * ax;
+            if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+                return None;
+            }
+            let det = u + v + w;
+            if det == 0.0 || !det.is_finite() {
+                return None;
+            }
+            ((v / det) as f32, (w / det) as f32)
+        };
         let t = plane_distance(tri, self.origin, self.dir);
         // Written so that NaN fails the test; `+ 0.0` turns -0 into +0.
         if !(t >= tmin && t <= tmax) {
             return None;
         }
-        let rcp = 1.0 / det;
-        let t = t + 0.0;
         Some(TriangleHit {
-            t,
-            u: v * rcp,
-            v: w * rcp,
+            t: t + 0.0,
+            u: bu,
+            v: bv,
         })
     }
 }
