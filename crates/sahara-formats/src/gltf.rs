@@ -122,6 +122,10 @@ pub enum GltfImage {
 
 /// Loads a `.gltf` or `.glb` file (the format is recognised by content).
 pub fn load_gltf(path: &Path) -> Result<GltfScene, FormatError> {
+    load(path).map_err(crate::scene_file::one_line)
+}
+
+fn load(path: &Path) -> Result<GltfScene, FormatError> {
     let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
     let name = path.display().to_string();
     let folder = path.parent().unwrap_or(Path::new(""));
@@ -151,6 +155,28 @@ pub fn load_gltf(path: &Path) -> Result<GltfScene, FormatError> {
 /// Parses and validates the JSON (and GLB container), tolerating only
 /// missing `POSITION` bounds (`min`/`max`), which many exporters leave out.
 fn parse(bytes: &[u8], name: &str) -> Result<::gltf::Gltf, FormatError> {
+    // The gltf crate computes `length - 12` unchecked: a GLB header whose
+    // total length is below its own 12 bytes overflowed (a panic where
+    // overflow is checked; found by fuzzing).
+    if let Some(length) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .map(|l| u32::from_le_bytes([l[0], l[1], l[2], l[3]]))
+    {
+        if length < 12 {
+            return Err(FormatError::at_byte(
+                name,
+                8,
+                format!("invalid GLB header: total length {length} is less than the header's own 12 bytes"),
+            ));
+        }
+    }
+    // gltf-json's validation indexes `accessors[POSITION]` unchecked: a
+    // POSITION naming a missing accessor panicked, in every build (found by
+    // fuzzing). Read without validation first and check those indices here.
+    if let Ok(unchecked) = ::gltf::Gltf::from_slice_without_validation(bytes) {
+        check_position_accessors(unchecked.document.as_json(), name)?;
+    }
     match ::gltf::Gltf::from_slice(bytes) {
         Err(::gltf::Error::Validation(problems))
             if problems.iter().all(|(path, e)| {
@@ -163,6 +189,29 @@ fn parse(bytes: &[u8], name: &str) -> Result<::gltf::Gltf, FormatError> {
         }
         other => other.map_err(|e| describe_error(name, e)),
     }
+}
+
+/// An error for the first mesh primitive whose `POSITION` attribute names an
+/// accessor that does not exist.
+fn check_position_accessors(root: &::gltf::json::Root, name: &str) -> Result<(), FormatError> {
+    let position = ::gltf::json::validation::Checked::Valid(::gltf::Semantic::Positions);
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(index) = primitive.attributes.get(&position) {
+                if index.value() >= root.accessors.len() {
+                    return Err(FormatError::in_file(
+                        name,
+                        format!(
+                            "invalid glTF: meshes[{m}].primitives[{p}].attributes.POSITION: accessor {} does not exist ({} accessors)",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// One line for an error of the `gltf` crate (JSON errors get their line and column).

@@ -30,6 +30,10 @@ pub fn load_rgb_f32(path: &Path) -> Result<RgbF32Image, FormatError> {
 
 /// Decodes an image held in memory as linear float RGB; `name` is used in error messages.
 pub fn decode_rgb_f32(bytes: &[u8], name: &str) -> Result<RgbF32Image, FormatError> {
+    decode(bytes, name).map_err(crate::scene_file::one_line)
+}
+
+fn decode(bytes: &[u8], name: &str) -> Result<RgbF32Image, FormatError> {
     if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
         return decode_exr(bytes, name);
     }

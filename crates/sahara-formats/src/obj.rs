@@ -35,7 +35,7 @@ pub fn load_obj(path: &Path) -> Result<Mesh, FormatError> {
 
 /// Parses an OBJ file held in memory; `name` is used in error messages.
 pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, FormatError> {
-    let source = without_polylines(bytes);
+    let source = tobj_source(bytes);
     let (models, _materials) = tobj::load_obj_buf(&mut &source[..], &obj_load_options(), |_| {
         Ok((Vec::new(), Default::default()))
     })
@@ -57,6 +57,17 @@ fn obj_load_options() -> tobj::LoadOptions {
     }
 }
 
+/// The text handed to tobj: `bytes` with polylines commented out and
+/// overflowing texture/normal indices defused (see the two functions below).
+/// Line structure is kept, so tobj's errors are found on the same lines.
+fn tobj_source(bytes: &[u8]) -> Cow<'_, [u8]> {
+    let source = without_polylines(bytes);
+    match without_overflowing_indices(&source) {
+        Some(fixed) => Cow::Owned(fixed),
+        None => source,
+    }
+}
+
 /// `bytes` with every `l` (polyline) statement turned into a comment.
 ///
 /// tobj parses `l` like `f`, so a polyline with three or more points would
@@ -75,6 +86,99 @@ fn without_polylines(bytes: &[u8]) -> Cow<'_, [u8]> {
         start += line.len() + 1;
     }
     out.map_or(Cow::Borrowed(bytes), Cow::Owned)
+}
+
+/// A `vt` or `vn` index that tobj can multiply without overflow, and that
+/// no file can reach (2^61 texture coordinates would take exabytes).
+const DEFUSED_INDEX: &str = "2305843009213693951";
+
+/// `bytes` with every texture and normal index of a face that would make
+/// tobj overflow replaced by [`DEFUSED_INDEX`], or `None` if there is none.
+///
+/// tobj turns a corner's `vt` and `vn` indices into `usize` unchecked and
+/// then computes `vt * 2 + 1` and `vn * 3 + 2`: a relative index reaching
+/// more than one before the first `vt`/`vn` line, or a huge one, overflows
+/// (0, or a relative index landing just before the first line, becomes
+/// `usize::MAX`, which tobj takes for "no index" and leaves alone), which panics where overflow is checked (debug
+/// builds, fuzzing) and is at best an accident elsewhere. Replaced by an
+/// index that is merely out of range, the corner gets tobj's ordinary
+/// out-of-bounds error, on the same line, in the same order among other
+/// errors (or, as before, nothing when the file has no `vt`/`vn` lines, which
+/// tobj then never looks up). Vertex indices need no help: tobj saturates
+/// those.
+fn without_overflowing_indices(bytes: &[u8]) -> Option<Vec<u8>> {
+    // Largest 0-based index that tobj can use safely: DEFUSED_INDEX.
+    const LIMIT: i128 = 2305843009213693951;
+    let mut out: Option<Vec<u8>> = None;
+    let mut start = 0;
+    // `vt` and `vn` lines so far: tobj's base for relative indices.
+    let (mut texcoords, mut normals) = (0i128, 0i128);
+    for line in bytes.split(|&b| b == b'\n') {
+        let line_start = start;
+        start += line.len() + 1;
+        let Ok(text) = std::str::from_utf8(line) else {
+            // tobj stops at a line that is not UTF-8: the rest is copied as it is.
+            start = line_start;
+            break;
+        };
+        let mut words = text.split_whitespace();
+        match words.next() {
+            Some("vt") => texcoords += 1,
+            Some("vn") => normals += 1,
+            Some("f") => {
+                // Offsets in `line` of the index texts to replace.
+                let mut defuse: Vec<(usize, usize)> = Vec::new();
+                for word in words {
+                    let word_at = word.as_ptr() as usize - text.as_ptr() as usize;
+                    let mut part_at = word_at;
+                    for (slot, part) in word.split('/').enumerate() {
+                        let base = match slot {
+                            1 => Some(texcoords),
+                            2 => Some(normals),
+                            _ => None,
+                        };
+                        if let Some(base) = base {
+                            // What tobj cannot parse (as isize) is its FaceParseError.
+                            if let Ok(x) = part.parse::<isize>() {
+                                // tobj's 0-based index: relative from the end, else x - 1.
+                                let x = x as i128;
+                                let index = if x < 0 { base + x } else { x - 1 };
+                                // -1 is tobj's "no index" (usize::MAX): never multiplied.
+                                if index != -1 && !(0..=LIMIT).contains(&index) {
+                                    defuse.push((part_at, part_at + part.len()));
+                                }
+                            }
+                        }
+                        part_at += part.len() + 1;
+                    }
+                }
+                if !defuse.is_empty() {
+                    let out = out.get_or_insert_with(|| bytes[..line_start].to_vec());
+                    let mut at = 0;
+                    for (from, to) in defuse {
+                        out.extend_from_slice(&line[at..from]);
+                        out.extend_from_slice(DEFUSED_INDEX.as_bytes());
+                        at = to;
+                    }
+                    out.extend_from_slice(&line[at..]);
+                    if start <= bytes.len() {
+                        out.push(b'\n');
+                    }
+                    continue;
+                }
+            }
+            _ => {}
+        }
+        if let Some(out) = out.as_mut() {
+            out.extend_from_slice(&bytes[line_start..start.min(bytes.len())]);
+        }
+    }
+    if let Some(out) = out.as_mut() {
+        if start < bytes.len() {
+            out.extend_from_slice(&bytes[start..]);
+        }
+    }
+    out
 }
 
 /// Concatenates tobj's models into one fan-triangulated mesh, checking every index.

@@ -294,3 +294,49 @@ fn one_huge_triangle_among_small_ones_is_in_every_leaf_it_overlaps() {
     let tree = KdTree::build(tris.to_vec(), &params);
     validate(&tree).unwrap();
 }
+
+/// Found by fuzzing (target `kdtree`, coordinates clamped to +-1e9): a ray
+/// starting 1e-27 outside the scene's bounds, at a triangle's vertex (0, 0, 0)
+/// of a scene 1e9 across, and pointing away: brute force (the watertight
+/// test) reports a hit at t = 0 on that vertex; the tree, whose root box the
+/// ray never enters, reports none. The fuzz target now keeps finite values
+/// within 1e-3..1e4 times its grid scale (or 0).
+#[test]
+#[ignore = "known issue: t = 0 vertex hit just outside the root box (see comment)"]
+fn ray_starting_on_a_vertex_just_outside_the_bounds() {
+    let tris = [
+        tri(
+            [1.05e9, 1.05e9, 2.575e9],
+            [2.575e9, 0.0, 2.55e9],
+            [0.0, 2.55e9, -3.2e9],
+        ),
+        tri([2.55e9, 7e8, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, -2.5e7]),
+    ];
+    let p = Vec3::splat(-9.250_028e-28);
+    check_all(&tris, &[Ray::new(p, p)]);
+}
+
+/// Found by fuzzing (target `kdtree`, grid coordinates only): a ray along
+/// the x axis, which is an edge of the scene's bounding box (y = z = 0 are
+/// its minima), aimed exactly at a vertex on that edge: brute force hits the
+/// vertex at t = 1; the SAH tree reports no hit.
+#[test]
+#[ignore = "known issue: a vertex hit on the bounding box's edge is missed (see comment)"]
+fn ray_along_a_bounding_box_edge_hits_the_vertex_on_it() {
+    let tris = [
+        tri(
+            [7.25e8, 0.0, 0.0],
+            [0.0, 0.0, 3.125e9],
+            [-2.5e7, 2.575e9, 2.575e9],
+        ),
+        tri(
+            [0.0, 2.575e9, 0.0],
+            [2.375e9, 2.375e9, 0.0],
+            [2.25e8, 0.0, 0.0],
+        ),
+    ];
+    let ray = Ray::new(Vec3::new(1.2e9, 0.0, 0.0), Vec3::new(-4.75e8, 0.0, -0.0));
+    let hit = brute::closest_hit(&tris, &ray).unwrap();
+    assert_eq!((hit.t, hit.tri), (1.0, 0));
+    check_all(&tris, &[ray]);
+}

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use glam::{Vec2, Vec3};
 use sahara_render::mesh::Mesh;
 
-use super::{locate, obj_load_options, without_polylines};
+use super::{locate, obj_load_options, tobj_source};
 use crate::error::FormatError;
 use crate::fan::fan_triangulate;
 use crate::mtl::MtlMaterial;
@@ -52,7 +52,7 @@ pub fn load_obj_with_materials(path: &Path) -> Result<ObjScene, FormatError> {
     let warnings = RefCell::new(Vec::new());
     let mtl_error = RefCell::new(None);
     let loader = |mtl: &Path| load_mtl(&folder.join(mtl), &name, &warnings, &mtl_error);
-    let source = without_polylines(&bytes);
+    let source = tobj_source(&bytes);
     let (models, materials) = tobj::load_obj_buf(&mut &source[..], &obj_load_options(), loader)
         .map_err(|e| locate::describe(&bytes, &name, e))?;
     if let Some(error) = mtl_error.into_inner() {
