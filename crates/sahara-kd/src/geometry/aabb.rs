@@ -117,8 +117,8 @@ impl Aabb {
     ///
     /// Robust in the sense of pbrt-v3 (Pharr, Jakob, Humphreys, section 3.9.2):
     /// the far distance is enlarged by `1 + 2 gamma(3)` so that rounding never
-    /// rejects a ray that grazes the box, and NaN slab distances (a ray lying
-    /// in a slab plane) are ignored by the comparison order.
+    /// rejects a ray that grazes the box; a ray parallel to a slab is tested
+    /// against it by its origin alone.
     pub fn intersect_ray(
         &self,
         origin: Vec3,
@@ -130,6 +130,15 @@ impl Aabb {
         let mut t0 = tmin;
         let mut t1 = tmax;
         for a in 0..3 {
+            if inv_dir[a].is_infinite() {
+                // Parallel to the slab (d = +-0): inside it for every t, or
+                // never. Computed instead, 0 * inf on the slab's face would be
+                // NaN on one side and -inf on the other, and cut the interval.
+                if origin[a] < self.min[a] || origin[a] > self.max[a] {
+                    return None;
+                }
+                continue;
+            }
             let mut near = (self.min[a] - origin[a]) * inv_dir[a];
             let mut far = (self.max[a] - origin[a]) * inv_dir[a];
             if near > far {
