@@ -66,6 +66,36 @@ pub enum FormatError {
 }
 
 impl FormatError {
+    /// The same error with its message rewritten by `f` (the file and its
+    /// line or byte offset are kept; errors without a message are unchanged).
+    pub fn map_message(self, f: impl FnOnce(String) -> String) -> FormatError {
+        match self {
+            FormatError::AtLine {
+                path,
+                line,
+                message,
+            } => FormatError::AtLine {
+                path,
+                line,
+                message: f(message),
+            },
+            FormatError::AtByte {
+                path,
+                offset,
+                message,
+            } => FormatError::AtByte {
+                path,
+                offset,
+                message: f(message),
+            },
+            FormatError::InFile { path, message } => FormatError::InFile {
+                path,
+                message: f(message),
+            },
+            other => other,
+        }
+    }
+
     /// An I/O error while reading `path`.
     pub fn io(path: &Path, source: io::Error) -> Self {
         FormatError::Io {

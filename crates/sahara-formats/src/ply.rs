@@ -220,28 +220,7 @@ fn list_len<R: Reader>(
 
 /// Prefixes a reader error's message with the record and property being read.
 fn with_context(e: FormatError, element: &Element, record: u64, property: &str) -> FormatError {
-    let prefix = |m: String| format!("{} {record}, property '{property}': {m}", element.name);
-    match e {
-        FormatError::AtLine {
-            path,
-            line,
-            message,
-        } => FormatError::AtLine {
-            path,
-            line,
-            message: prefix(message),
-        },
-        FormatError::AtByte {
-            path,
-            offset,
-            message,
-        } => FormatError::AtByte {
-            path,
-            offset,
-            message: prefix(message),
-        },
-        other => other,
-    }
+    e.map_message(|m| format!("{} {record}, property '{property}': {m}", element.name))
 }
 
 fn read_vertices<R: Reader>(

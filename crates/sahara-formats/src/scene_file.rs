@@ -458,29 +458,5 @@ pub(crate) fn one_line(error: FormatError) -> FormatError {
             message
         }
     };
-    match error {
-        FormatError::AtLine {
-            path,
-            line,
-            message,
-        } => FormatError::AtLine {
-            path,
-            line,
-            message: fix(message),
-        },
-        FormatError::AtByte {
-            path,
-            offset,
-            message,
-        } => FormatError::AtByte {
-            path,
-            offset,
-            message: fix(message),
-        },
-        FormatError::InFile { path, message } => FormatError::InFile {
-            path,
-            message: fix(message),
-        },
-        other => other,
-    }
+    error.map_message(fix)
 }
