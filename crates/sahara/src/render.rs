@@ -70,13 +70,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .map_err(|e| anyhow!("invalid scene: {e}"))?;
 
     let cancel = settings.cancel.clone().expect("settings set a cancel flag");
+    // SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature): a batch
+    // system's kill is handled like Ctrl-C.
     ctrlc::set_handler(move || {
-        // A second Ctrl-C leaves the default way.
+        // A second signal leaves at once.
         if cancel.swap(true, Ordering::SeqCst) {
             std::process::exit(130);
         }
     })
-    .context("cannot install the Ctrl-C handler")?;
+    .context("cannot install the SIGINT/SIGTERM handler")?;
 
     let bar = progress_bar(&settings);
     let threads = args.threads.map_or(0, usize::from);

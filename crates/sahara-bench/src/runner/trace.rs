@@ -14,7 +14,7 @@ pub const CHUNK: usize = 4096;
 pub enum Query {
     /// The nearest hit (`t`, triangle).
     ClosestHit,
-    /// Occlusion: is anything hit in `[tmin, tmax]`?
+    /// Occlusion: is anything hit in `(tmin, tmax]`?
     AnyHit,
 }
 

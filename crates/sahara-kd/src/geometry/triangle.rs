@@ -130,7 +130,7 @@ impl RayShear {
         Self::new(ray.origin, ray.dir)
     }
 
-    /// The watertight test: the hit with `t` in `[tmin, tmax]`, or `None`.
+    /// The watertight test: the hit with `t` in `(tmin, tmax]`, or `None`.
     ///
     /// This is the reference test: every query of the crate and the
     /// brute-force oracle call it, so a kd-tree and brute force compute the
@@ -183,8 +183,15 @@ impl RayShear {
             ((v / det) as f32, (w / det) as f32)
         };
         let t = plane_distance(tri, self.origin, self.dir);
-        // Written so that NaN fails the test; `+ 0.0` turns -0 into +0.
-        if !(t >= tmin && t <= tmax) {
+        // `tmin` is exclusive, as Embree's `tnear`: a hit at the origin itself
+        // is not a hit. Besides sparing a ray leaving a surface its own
+        // triangle, this settles hits that exist only by rounding: a ray
+        // starting 1e-27 outside a 1e9-wide scene at a vertex, pointing
+        // away, computes t = 0 there (the origin vanishes in `v0 - o`), and no
+        // cell of a tree holds that point (fuzz regression in
+        // `tests/bad_input.rs`). Written so that NaN fails the test; `+ 0.0`
+        // turns -0 into +0 for a negative `tmin`.
+        if !(t > tmin && t <= tmax) {
             return None;
         }
         Some(TriangleHit {
@@ -203,6 +210,8 @@ impl RayShear {
 /// (a ground plane 5 km wide hit 0.3 m away loses three digits in f32). The
 /// plane equation in f64 keeps about 1e-12 relative accuracy there; it is
 /// evaluated only for rays that passed the edge test, so it costs little.
+/// Its absolute error grows with the vertices' distance from the origin
+/// (~1e-16 of it): a triangle 1e30 away cannot place a hit 3 units away.
 #[inline(always)]
 fn plane_distance(tri: &Triangle, o: Vec3, d: Vec3) -> f32 {
     let v0 = tri.v[0].as_dvec3();
@@ -246,6 +255,27 @@ mod tests {
         assert!(intersect_ray_triangle(&r, &tri).is_some());
         let r = Ray::with_interval(ray.origin, ray.dir, 0.0, 3.999);
         assert!(intersect_ray_triangle(&r, &tri).is_none());
+    }
+
+    #[test]
+    fn tmin_is_exclusive_and_tmax_inclusive() {
+        let tri = Triangle::new(
+            Vec3::new(0.0, 0.0, 2.0),
+            Vec3::new(4.0, 0.0, 2.0),
+            Vec3::new(0.0, 4.0, 2.0),
+        );
+        let o = Vec3::new(1.0, 1.0, 0.0);
+        let d = Vec3::new(0.0, 0.0, 1.0); // hits at t = 2 exactly
+        let hit = |tmin, tmax| intersect_ray_triangle(&Ray::with_interval(o, d, tmin, tmax), &tri);
+        assert!(hit(2.0, 3.0).is_none(), "t == tmin is not a hit");
+        assert_eq!(hit(1.999_999_9, 3.0).unwrap().t, 2.0);
+        assert_eq!(hit(0.0, 2.0).unwrap().t, 2.0, "t == tmax is a hit");
+        assert!(hit(0.0, 1.999_999_9).is_none());
+        // A ray starting on the triangle (t = 0) does not hit it.
+        let on = Ray::new(Vec3::new(1.0, 1.0, 2.0), Vec3::new(0.0, 0.0, 1.0));
+        assert!(intersect_ray_triangle(&on, &tri).is_none());
+        let on_back = Ray::new(Vec3::new(1.0, 1.0, 2.0), Vec3::new(0.0, 0.0, -1.0));
+        assert!(intersect_ray_triangle(&on_back, &tri).is_none());
     }
 
     #[test]
