@@ -1,5 +1,6 @@
 //! Statistics of a finished tree, including its true SAH cost.
 
+use crate::geometry::Primitive;
 use crate::tree::KdTree;
 
 /// Shape, size and cost of a tree.
@@ -30,8 +31,8 @@ pub struct TreeStats {
     pub duplication: f64,
     /// Bytes of nodes + index array + triangle data.
     pub memory_bytes: usize,
-    /// The tree's SAH cost with its build's K_T and K_I:
-    /// `sum_inner SA/SA_root K_T + sum_leaves SA/SA_root K_I n`.
+    /// The tree's SAH cost with its build's K_T, K_I and leaf width W:
+    /// `sum_inner SA/SA_root K_T + sum_leaves SA/SA_root K_I ceil(n / W)`.
     pub sah_cost: f64,
     /// What the SAH predicts a ray meeting the root visits (no early exit):
     /// inner nodes `sum_inner SA/SA_root`.
@@ -40,9 +41,11 @@ pub struct TreeStats {
     pub expected_leaves: f64,
     /// Triangle tests: `sum_leaves SA/SA_root n`.
     pub expected_triangles: f64,
+    /// Leaf tests as the SAH counts them: `sum_leaves SA/SA_root ceil(n / W)`.
+    pub expected_leaf_tests: f64,
 }
 
-impl<P> KdTree<P> {
+impl<P: Primitive> KdTree<P> {
     /// Compute the statistics (one pass over the nodes).
     pub fn stats(&self) -> TreeStats {
         let mut s = TreeStats {
@@ -74,6 +77,7 @@ impl<P> KdTree<P> {
                 s.references += c;
                 s.expected_leaves += p;
                 s.expected_triangles += p * c as f64;
+                s.expected_leaf_tests += p * self.params.leaf_tests(c);
                 for &t in self.leaf_primitives(n) {
                     referenced[t as usize] = true;
                 }
@@ -87,8 +91,9 @@ impl<P> KdTree<P> {
             // every ray that reaches it.
             s.expected_leaves = 1.0;
             s.expected_triangles = s.references as f64;
+            s.expected_leaf_tests = self.params.leaf_tests(s.references);
         }
-        s.sah_cost = s.expected_inner * k_t + s.expected_triangles * k_i;
+        s.sah_cost = s.expected_inner * k_t + s.expected_leaf_tests * k_i;
         s.mean_leaf_depth = depth_sum as f64 / s.leaves.max(1) as f64;
         let non_empty = s.leaves - s.empty_leaves;
         s.mean_leaf_triangles = s.references as f64 / non_empty.max(1) as f64;
@@ -96,7 +101,43 @@ impl<P> KdTree<P> {
         s.duplication = s.references as f64 / distinct.max(1) as f64;
         s.memory_bytes = std::mem::size_of_val(self.nodes.as_slice())
             + std::mem::size_of_val(self.indices.as_slice())
-            + std::mem::size_of_val(self.prims.as_slice());
+            + std::mem::size_of_val(self.prims.as_slice())
+            + P::leaf_data_bytes(&self.leaf_data);
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use crate::build::{BuildParams, Builder};
+    use crate::geometry::Triangle;
+    use crate::tree::KdTree;
+
+    /// A single leaf of ten triangles costs K_I per block of W: two blocks
+    /// at W = 8, ten tests at W = 1.
+    #[test]
+    fn a_leaf_costs_k_i_per_block_of_the_leaf_width() {
+        let tris: Vec<Triangle> = (0..10)
+            .map(|i| {
+                let z = i as f32;
+                Triangle::new(
+                    Vec3::new(0.0, 0.0, z),
+                    Vec3::new(1.0, 0.0, z),
+                    Vec3::new(0.0, 1.0, z),
+                )
+            })
+            .collect();
+        for (width, tests) in [(8, 2.0), (1, 10.0), (4, 3.0)] {
+            let mut p = BuildParams::new(Builder::Sah);
+            p.max_leaf_size = 10; // one leaf, no split evaluated
+            p.leaf_width = width;
+            let s = KdTree::build(tris.clone(), &p).stats();
+            assert_eq!((s.leaves, s.references), (1, 10));
+            assert_eq!(s.expected_triangles, 10.0);
+            assert_eq!(s.expected_leaf_tests, tests);
+            assert_eq!(s.sah_cost, tests * p.intersection_cost as f64);
+        }
     }
 }

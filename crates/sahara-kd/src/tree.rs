@@ -1,7 +1,7 @@
 //! The finished tree: 8-byte nodes and the flat triangle-index array.
 
 use crate::build::BuildParams;
-use crate::geometry::{Aabb, Triangle};
+use crate::geometry::{Aabb, Primitive, Triangle};
 
 /// One kd-tree node in 8 bytes (the layout of pbrt-v3's `KdAccelNode`,
 /// itself after Havran's thesis).
@@ -105,21 +105,26 @@ impl Node {
 /// [`KdTree::closest_hit`] and [`KdTree::any_hit`], a [`BoxTree`] with
 /// closures (see `traverse`).
 #[derive(Clone, Debug)]
-pub struct KdTree<P = Triangle> {
+pub struct KdTree<P: Primitive = Triangle> {
     pub(crate) nodes: Vec<Node>,
+    /// Leaf runs, each starting at a multiple of `P::LEAF_WIDTH` and padded
+    /// to one with `u32::MAX`.
     pub(crate) indices: Vec<u32>,
     pub(crate) prims: Vec<P>,
+    /// Leaf-ordered copies for fast tests (triangles: blocks of eight).
+    pub(crate) leaf_data: P::LeafData,
     pub(crate) bounds: Aabb,
     pub(crate) params: BuildParams,
 }
 
-impl<P> KdTree<P> {
+impl<P: Primitive> KdTree<P> {
     /// The nodes, root first, in depth-first order.
     pub fn nodes(&self) -> &[Node] {
         &self.nodes
     }
 
-    /// The leaves' triangle indices, one run per leaf.
+    /// The leaves' triangle indices, one run per leaf; runs are padded with
+    /// `u32::MAX` to a multiple of the primitive's leaf width.
     pub fn indices(&self) -> &[u32] {
         &self.indices
     }

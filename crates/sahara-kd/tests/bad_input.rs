@@ -61,7 +61,12 @@ fn check_all(tris: &[Triangle], rays: &[Ray]) -> Vec<KdTree> {
 
 /// The triangles a tree references anywhere.
 fn stored(tree: &KdTree) -> Vec<u32> {
-    let mut out = tree.indices().to_vec();
+    let mut out: Vec<u32> = tree
+        .indices()
+        .iter()
+        .copied()
+        .filter(|&i| i != u32::MAX)
+        .collect();
     out.sort_unstable();
     out.dedup();
     out

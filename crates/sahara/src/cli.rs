@@ -249,7 +249,7 @@ pub struct TreeOptions {
     /// SAH cost of a traversal step, K_T [default: the builder's].
     #[arg(long, value_parser = parse_positive)]
     pub traversal_cost: Option<f32>,
-    /// SAH cost of a ray/triangle test, K_I [default: the builder's].
+    /// SAH cost of one leaf test (a block of --leaf-width triangles), K_I [default: 40].
     #[arg(long, value_parser = parse_positive)]
     pub intersection_cost: Option<f32>,
     /// Fraction of the SAH cost forgiven for cutting off empty space, in
@@ -262,6 +262,11 @@ pub struct TreeOptions {
     /// Leaf size at which the naive builders stop [default: 4].
     #[arg(long)]
     pub max_leaf_size: Option<u32>,
+    /// Triangles the SAH assumes a leaf tests at once: a leaf of n costs
+    /// K_I ceil(n / W) [default: 8, the leaf block width; 1 is the classic
+    /// SAH].
+    #[arg(long, value_name = "W", value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub leaf_width: Option<u32>,
     /// Use only the first FRACTION of the triangles, in file order (0 < F
     /// <= 1; for build-scaling measurements).
     #[arg(long, value_name = "FRACTION", value_parser = parse_subset)]
@@ -277,6 +282,7 @@ impl Default for TreeOptions {
             empty_bonus: None,
             max_depth: None,
             max_leaf_size: None,
+            leaf_width: None,
             subset: None,
         }
     }
@@ -291,6 +297,7 @@ impl TreeOptions {
         p.empty_bonus = self.empty_bonus.unwrap_or(p.empty_bonus);
         p.max_depth = self.max_depth.or(p.max_depth);
         p.max_leaf_size = self.max_leaf_size.unwrap_or(p.max_leaf_size);
+        p.leaf_width = self.leaf_width.unwrap_or(p.leaf_width);
         p
     }
 

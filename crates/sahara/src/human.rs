@@ -181,8 +181,8 @@ pub fn stats_report(r: &StatsReport) -> String {
         (
             "expected",
             format!(
-                "{:.2} inner nodes, {:.2} leaves, {:.2} triangle tests per ray meeting the root",
-                t.expected_inner, t.expected_leaves, t.expected_triangles
+                "{:.2} inner nodes, {:.2} leaves, {:.2} triangles in {:.2} leaf tests per ray meeting the root",
+                t.expected_inner, t.expected_leaves, t.expected_triangles, t.expected_leaf_tests
             ),
         ),
     ];

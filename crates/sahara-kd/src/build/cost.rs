@@ -34,6 +34,7 @@ pub struct SahModel {
     k_t: f64,
     k_i: f64,
     lambda: f64,
+    width: u32,
 }
 
 impl SahModel {
@@ -46,12 +47,19 @@ impl SahModel {
             k_t: p.traversal_cost as f64,
             k_i: p.intersection_cost as f64,
             lambda: 1.0 - p.empty_bonus as f64,
+            width: p.leaf_width,
         })
+    }
+
+    /// Tests a leaf of `n` triangles takes: `ceil(n / leaf_width)`.
+    #[inline(always)]
+    fn tests(&self, n: usize) -> f64 {
+        super::params::leaf_tests(n, self.width)
     }
 
     /// Cost of a leaf with `n` triangles.
     pub fn leaf_cost(&self, n: usize) -> f64 {
-        self.k_i * n as f64
+        self.k_i * self.tests(n)
     }
 
     /// Cost of splitting at `axis = pos` with `nl`, `nr` triangles on each
@@ -67,7 +75,7 @@ impl SahModel {
         let (l, r) = self.cell.split(axis, pos);
         let pl = l.surface_area() * self.inv_area;
         let pr = r.surface_area() * self.inv_area;
-        let c = self.k_t + self.k_i * (pl * nl as f64 + pr * nr as f64);
+        let c = self.k_t + self.k_i * (pl * self.tests(nl) + pr * self.tests(nr));
         // Bonus for cutting off empty space, but not for a flat empty side.
         let bonus = (nl == 0 || nr == 0) && !at_min && !at_max;
         Some(if bonus { self.lambda * c } else { c })

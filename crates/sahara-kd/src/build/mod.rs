@@ -13,7 +13,7 @@ pub mod subtree;
 pub use params::{AxisRule, BuildParams, Builder, PositionRule};
 
 use crate::geometry::{Aabb, Primitive};
-use crate::tree::KdTree;
+use crate::tree::{KdTree, Node};
 
 impl<P: Primitive> KdTree<P> {
     /// Build a tree over `triangles` (their indices are the ones hits report).
@@ -40,12 +40,29 @@ impl<P: Primitive> KdTree<P> {
                 }
             }
         };
+        let (nodes, indices) = pad_leaf_runs(sub.nodes, &sub.indices, P::LEAF_WIDTH);
+        let leaf_data = P::leaf_data(&triangles, &indices);
         KdTree {
-            nodes: sub.nodes,
-            indices: sub.indices,
+            nodes,
+            indices,
             prims: triangles,
+            leaf_data,
             bounds,
             params: *params,
         }
     }
+}
+
+/// Moves every leaf's index run to a multiple of `width` and pads it to one
+/// with `u32::MAX`, so that run `k` of a triangle leaf is block `k / width`.
+fn pad_leaf_runs(mut nodes: Vec<Node>, indices: &[u32], width: usize) -> (Vec<Node>, Vec<u32>) {
+    let mut padded = Vec::with_capacity(indices.len() + indices.len() / 2);
+    for n in nodes.iter_mut().filter(|n| n.is_leaf()) {
+        let (o, c) = (n.leaf_offset() as usize, n.leaf_count() as usize);
+        let at = padded.len() as u32;
+        padded.extend_from_slice(&indices[o..o + c]);
+        padded.resize(padded.len().next_multiple_of(width), u32::MAX);
+        *n = Node::leaf(at, c as u32);
+    }
+    (nodes, padded)
 }

@@ -128,6 +128,10 @@ pub struct BuildParams {
     /// explode. When the cap is reached in a parallel build, which subtree
     /// meets it first may vary from run to run.
     pub max_duplication: f32,
+    /// Primitives a leaf tests at once: the SAH prices a leaf of `n` at
+    /// `K_I ceil(n / leaf_width)` (triangle trees test [`crate::geometry::triangle_block::BLOCK_WIDTH`]
+    /// = 8 at a time, so a leaf of 8 costs one test); 1 is the classic model.
+    pub leaf_width: u32,
 }
 
 impl Default for BuildParams {
@@ -139,8 +143,14 @@ impl Default for BuildParams {
 impl BuildParams {
     /// Default parameters for a builder.
     ///
-    /// K_T = 15, K_I = 20 and an empty bonus of 0.2 are Wald & Havran's
-    /// (2006, section 5) values.
+    /// K_T = 15 and an empty bonus of 0.2 are Wald & Havran's (2006,
+    /// section 5) values. Their K_I = 20 prices one scalar triangle test;
+    /// here K_I prices one eight-wide block test (`leaf_width`) and is 40,
+    /// measured: with K_I = 20, 30, 40 (`sahara bench --intersection-cost`,
+    /// 1-thread Mrays/s, primary/shadow/diffuse/random) teapot_stadium gave
+    /// 4.8/9.7/4.7/14.9, 5.2/10.2/4.8/15.1, 6.3/14.8/5.7/15.2; sponza
+    /// 4.6/7.6/2.1/2.6, 5.2/8.3/2.1/2.8, 5.3/8.8/2.2/2.8; bunny equal within
+    /// 3%; only the dragon preferred 20 (by 9%).
     pub fn new(builder: Builder) -> Self {
         let max_leaf_size = match builder {
             Builder::Naive { .. } => 4,
@@ -149,13 +159,21 @@ impl BuildParams {
         Self {
             builder,
             traversal_cost: 15.0,
-            intersection_cost: 20.0,
+            intersection_cost: 40.0,
             empty_bonus: 0.2,
             max_depth: None,
             max_leaf_size,
             parallel: true,
             max_duplication: 64.0,
+            leaf_width: crate::geometry::triangle_block::BLOCK_WIDTH as u32,
         }
+    }
+
+    /// Tests the SAH charges for a leaf of `n` primitives:
+    /// `ceil(n / leaf_width)`.
+    #[inline(always)]
+    pub fn leaf_tests(&self, n: usize) -> f64 {
+        leaf_tests(n, self.leaf_width)
     }
 
     /// The reference budget for `n` triangles.
@@ -171,4 +189,10 @@ impl BuildParams {
             .unwrap_or_else(|| (8.0 + 1.3 * (n.max(1) as f64).log2()).round() as u32);
         d.min(crate::traverse::MAX_DEPTH as u32 - 1)
     }
+}
+
+/// `ceil(n / width)` as f64 (a width of 0 counts as 1).
+#[inline(always)]
+pub fn leaf_tests(n: usize, width: u32) -> f64 {
+    n.div_ceil(width.max(1) as usize) as f64
 }

@@ -15,14 +15,14 @@ pub struct Subtree {
     pub nodes: Vec<Node>,
     /// Leaf triangle indices; offsets relative to this array.
     pub indices: Vec<u32>,
-    /// Area-weighted cost: `sum SA(inner) K_T + sum SA(leaf) K_I n`.
+    /// Area-weighted cost: `sum SA(inner) K_T + sum SA(leaf) K_I tests(n)`.
     pub cost: f64,
 }
 
 impl Subtree {
     /// A single leaf holding `tris`.
     pub fn leaf(tris: Vec<u32>, cell: &Aabb, p: &BuildParams) -> Self {
-        let cost = cell.surface_area() * p.intersection_cost as f64 * tris.len() as f64;
+        let cost = cell.surface_area() * p.intersection_cost as f64 * p.leaf_tests(tris.len());
         Self {
             nodes: vec![Node::leaf(0, tris.len() as u32)],
             indices: tris,
@@ -49,7 +49,7 @@ impl Subtree {
     ) -> Self {
         let area = cell.surface_area();
         let cost = area * p.traversal_cost as f64 + below.cost + above.cost;
-        if retract && area * p.intersection_cost as f64 * n as f64 <= cost {
+        if retract && area * p.intersection_cost as f64 * p.leaf_tests(n) <= cost {
             let mut tris: Vec<u32> = below
                 .indices
                 .iter()
@@ -58,7 +58,7 @@ impl Subtree {
                 .collect();
             tris.sort_unstable();
             tris.dedup();
-            let leaf_cost = area * p.intersection_cost as f64 * tris.len() as f64;
+            let leaf_cost = area * p.intersection_cost as f64 * p.leaf_tests(tris.len());
             if leaf_cost <= cost {
                 return Self::leaf(tris, cell, p);
             }

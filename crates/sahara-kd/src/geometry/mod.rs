@@ -5,8 +5,10 @@ pub mod clip;
 pub mod primitive;
 pub mod ray;
 pub mod triangle;
+pub mod triangle_block;
 
 pub use aabb::Aabb;
 pub use primitive::Primitive;
 pub use ray::Ray;
 pub use triangle::{Triangle, TriangleHit};
+pub use triangle_block::TriangleBlock;

@@ -1,17 +1,27 @@
 //! What a kd-tree can be built over.
 
 use super::clip::clipped_bounds;
+use super::triangle_block::{TriangleBlock, BLOCK_WIDTH};
 use super::{Aabb, Triangle};
 
 /// A primitive a kd-tree can hold: it has bounds, and bounds of its part
 /// inside a cell (for split clipping).
-pub trait Primitive: Send + Sync {
+pub trait Primitive: Send + Sync + Sized {
     /// Bounds of the whole primitive.
     fn bounds(&self) -> Aabb;
     /// Bounds of the primitive clipped to `cell`, `None` if they do not meet.
     fn clipped_bounds(&self, cell: &Aabb) -> Option<Aabb>;
     /// False for primitives no ray can hit; the tree leaves them out.
     fn is_hittable(&self) -> bool;
+
+    /// What a tree keeps beside its primitives for fast leaf tests.
+    type LeafData: Clone + std::fmt::Debug + Default + Send + Sync;
+    /// Leaf index runs start at and are padded to a multiple of this.
+    const LEAF_WIDTH: usize;
+    /// The leaf data for a padded index array (`u32::MAX` marks padding).
+    fn leaf_data(prims: &[Self], padded_indices: &[u32]) -> Self::LeafData;
+    /// Heap bytes of the leaf data.
+    fn leaf_data_bytes(data: &Self::LeafData) -> usize;
 }
 
 impl Primitive for Triangle {
@@ -23,6 +33,26 @@ impl Primitive for Triangle {
     }
     fn is_hittable(&self) -> bool {
         Triangle::is_hittable(self)
+    }
+
+    /// Copies of the leaves' triangles in leaf order, eight to a block.
+    type LeafData = Vec<TriangleBlock>;
+    const LEAF_WIDTH: usize = BLOCK_WIDTH;
+    fn leaf_data(prims: &[Self], padded_indices: &[u32]) -> Vec<TriangleBlock> {
+        padded_indices
+            .chunks(BLOCK_WIDTH)
+            .map(|run| {
+                let tris: Vec<Triangle> = run
+                    .iter()
+                    .filter(|&&i| i != u32::MAX)
+                    .map(|&i| prims[i as usize])
+                    .collect();
+                TriangleBlock::pack(&tris)
+            })
+            .collect()
+    }
+    fn leaf_data_bytes(data: &Vec<TriangleBlock>) -> usize {
+        std::mem::size_of_val(data.as_slice())
     }
 }
 
@@ -38,5 +68,13 @@ impl Primitive for Aabb {
     }
     fn is_hittable(&self) -> bool {
         !self.is_empty() && self.min.is_finite() && self.max.is_finite()
+    }
+
+    /// Box trees hand indices to the caller's closures: nothing extra.
+    type LeafData = ();
+    const LEAF_WIDTH: usize = 1;
+    fn leaf_data(_: &[Self], _: &[u32]) {}
+    fn leaf_data_bytes(_: &()) -> usize {
+        0
     }
 }

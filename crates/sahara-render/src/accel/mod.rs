@@ -82,16 +82,10 @@ impl Accel {
         self.trees.len()
     }
 
-    /// Bytes held by the kd-trees (nodes, leaf indices, triangles).
+    /// Bytes held by the kd-trees (nodes, leaf indices, triangles, leaf
+    /// blocks).
     pub fn tree_bytes(&self) -> usize {
-        self.trees
-            .iter()
-            .map(|t| {
-                std::mem::size_of_val(t.nodes())
-                    + std::mem::size_of_val(t.indices())
-                    + std::mem::size_of_val(t.triangles())
-            })
-            .sum()
+        self.trees.iter().map(|t| t.stats().memory_bytes).sum()
     }
 
     /// World bounds of everything.

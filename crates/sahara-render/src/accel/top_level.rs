@@ -20,7 +20,12 @@ impl InstanceList {
     /// A top level over these boxes (index `i` is instance `i`).
     pub fn build(bounds: &[Aabb]) -> Self {
         Self {
-            tree: BoxTree::build(bounds.to_vec(), &BuildParams::new(Builder::Sah)),
+            tree: BoxTree::build(bounds.to_vec(), &{
+                // Instances are tested one at a time: the classic SAH.
+                let mut p = BuildParams::new(Builder::Sah);
+                p.leaf_width = 1;
+                p
+            }),
         }
     }
 
