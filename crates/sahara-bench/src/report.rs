@@ -127,6 +127,13 @@ pub struct SetReport {
     pub mrays_1t_cpu: f64,
     /// Best Mrays/s on all threads.
     pub mrays_all: f64,
+    /// `primary` only: best Mrays/s on one thread of the packet path (8 rays
+    /// per packet, 4x2 pixel tiles).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mrays_packet_1t: Option<f64>,
+    /// The same by the tracing thread's CPU time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mrays_packet_1t_cpu: Option<f64>,
     /// Traversal work, with `--counters`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub counters: Option<CounterReport>,

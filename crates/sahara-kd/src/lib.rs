@@ -19,6 +19,7 @@
 pub mod brute;
 pub mod build;
 pub mod geometry;
+pub mod packet;
 pub mod stats;
 pub mod traverse;
 pub mod tree;

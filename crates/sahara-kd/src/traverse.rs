@@ -18,7 +18,7 @@ use crate::tree::KdTree;
 /// Run-time CPU feature selection: the release binary targets baseline
 /// x86-64 (SSE2) and picks the AVX2 build of the traversal where it exists.
 #[cfg(target_arch = "x86_64")]
-mod simd {
+pub(crate) mod simd {
     /// True when the CPU has AVX2 (std caches the CPUID query).
     #[inline(always)]
     pub fn avx2() -> bool {
@@ -49,7 +49,7 @@ pub struct Hit {
 /// (what the brute-force oracle does); the price is an occasional extra leaf
 /// visit at a boundary. 2^-12 is ~500 ulps: far above the rounding of the
 /// watertight test on the test suite's scales, far below any cell size.
-const MARGIN: f32 = 1.0 / 4096.0;
+pub(crate) const MARGIN: f32 = 1.0 / 4096.0;
 
 /// Depth bound of the traversal stack; builders never exceed it.
 pub const MAX_DEPTH: usize = 64;
@@ -160,30 +160,17 @@ impl KdTree<Triangle> {
         };
         self.walk(ray, counters, |offset, count, counters, best_t_out| {
             // SAFETY: `offset`, `count` describe a leaf of this tree.
-            let (blocks, indices) = unsafe { self.leaf_blocks(offset, count) };
-            for (b, block) in blocks.iter().enumerate() {
-                let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
-                (0..lanes).for_each(|_| counters.triangle());
-                // Eight edge tests at once; the scalar test decides the few
-                // lanes left (see `triangle_block`).
-                let mut m = shear.block_candidates(block, lanes);
-                while m != 0 {
-                    let l = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    let i = indices[b * BLOCK_WIDTH + l];
-                    if let Some(h) = shear.intersect(&block.triangle(l), ray.tmin, best_t) {
-                        if h.t < best_t || i < best.tri {
-                            best_t = h.t;
-                            best = Hit {
-                                t: h.t,
-                                tri: i,
-                                u: h.u,
-                                v: h.v,
-                            };
-                        }
-                    }
-                }
-            }
+            unsafe {
+                self.leaf_closest(
+                    &shear,
+                    ray.tmin,
+                    offset,
+                    count,
+                    &mut best_t,
+                    &mut best,
+                    counters,
+                )
+            };
             *best_t_out = if best.tri == u32::MAX {
                 f32::INFINITY
             } else {
@@ -244,6 +231,51 @@ impl KdTree<Triangle> {
             LeafResult::Continue
         });
         found
+    }
+
+    /// The closest-hit test of one leaf: updates `best_t` and `best` (whose
+    /// `tri` is `u32::MAX` while there is no hit) with the leaf's triangles;
+    /// among equally distant hits the smallest index wins.
+    ///
+    /// # Safety
+    /// `offset` and `count` must be those of a leaf of this tree.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) unsafe fn leaf_closest<C: Counters>(
+        &self,
+        shear: &RayShear,
+        tmin: f32,
+        offset: usize,
+        count: usize,
+        best_t: &mut f32,
+        best: &mut Hit,
+        counters: &mut C,
+    ) {
+        // SAFETY: passed on from the caller.
+        let (blocks, indices) = unsafe { self.leaf_blocks(offset, count) };
+        for (b, block) in blocks.iter().enumerate() {
+            let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
+            (0..lanes).for_each(|_| counters.triangle());
+            // Eight edge tests at once; the scalar test decides the few
+            // lanes left (see `triangle_block`).
+            let mut m = shear.block_candidates(block, lanes);
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let i = indices[b * BLOCK_WIDTH + l];
+                if let Some(h) = shear.intersect(&block.triangle(l), tmin, *best_t) {
+                    if h.t < *best_t || i < best.tri {
+                        *best_t = h.t;
+                        *best = Hit {
+                            t: h.t,
+                            tri: i,
+                            u: h.u,
+                            v: h.v,
+                        };
+                    }
+                }
+            }
+        }
     }
 
     /// The blocks of the leaf whose run starts at `offset` and holds `count`

@@ -215,8 +215,15 @@ fn protocol_sets(
         let primary = camera.primary_rays(ImageSize::PROTOCOL);
         dump_rays(ray_dumps, "primary", &primary)?;
         let own_hits = if opts.sets.contains(&SetKind::Primary) {
-            let (report, records) =
+            let (mut report, records) =
                 measure_records(bench, "primary", &primary, Query::ClosestHit, opts);
+            eprintln!("tracing primary in packets of 8 (4x2 tiles) on 1 thread...");
+            let p = bench.measure_packets(&primary, ImageSize::PROTOCOL, &records);
+            if !p.agrees {
+                bail!("primary: the packet path's hits differ from the single-ray path's (a bug)");
+            }
+            report.mrays_packet_1t = Some(p.mrays_1t);
+            report.mrays_packet_1t_cpu = Some(p.mrays_1t_cpu);
             dump_hits(hit_dumps, "primary", &records)?;
             sets.primary = Some(report);
             Some(records)

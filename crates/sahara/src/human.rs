@@ -98,6 +98,13 @@ pub fn bench_report(r: &BenchReport) -> String {
             e.mrays_1t_cpu,
             e.mrays_all
         );
+        if let (Some(p), Some(c)) = (e.mrays_packet_1t, e.mrays_packet_1t_cpu) {
+            let _ = writeln!(
+                s,
+                "{:<8} {:>11} {:>11} {:>22} {:>11.3} {:>11.3} {:>11}",
+                "  packets", "(8 rays,", "4x2 tiles)", "same hits", p, c, "-"
+            );
+        }
     }
     if entries.iter().any(|(_, e)| e.counters.is_some()) {
         let _ = writeln!(s);

@@ -99,9 +99,24 @@ impl Bench {
             mrays_1t: m.mrays_1t,
             mrays_1t_cpu: m.mrays_1t_cpu,
             mrays_all: m.mrays_all,
+            mrays_packet_1t: None,
+            mrays_packet_1t_cpu: None,
             counters,
         };
         (report, m)
+    }
+
+    /// Time the packet path on one thread over the row-major rays of
+    /// `image` (checked against `reference`, the single-ray records).
+    pub fn measure_packets(
+        &self,
+        rays: &[Ray],
+        image: crate::protocol::camera::ImageSize,
+        reference: &[HitRecord],
+    ) -> super::PacketMeasurement {
+        self.pools
+            .one
+            .install(|| super::measure_packets(&self.tree, rays, image, self.runs, reference))
     }
 
     /// The full report, from the mesh's name, the camera and the sets.

@@ -7,6 +7,7 @@
 pub mod bench;
 pub mod build;
 pub mod counters;
+pub mod packets;
 pub mod pools;
 pub mod throughput;
 pub mod trace;
@@ -14,6 +15,7 @@ pub mod trace;
 pub use bench::Bench;
 pub use build::{build_timed, BUILD_RUNS};
 pub use counters::{count_set, CountTotals};
+pub use packets::{measure_packets, PacketMeasurement};
 pub use pools::Pools;
 pub use throughput::{measure, Measurement};
 pub use trace::{trace_into, Query, CHUNK};
