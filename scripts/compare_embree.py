@@ -90,7 +90,7 @@ def best(a, b):
     if a is None:
         return b
     for s, v in b["sets"].items():
-        for k in ("mrays_1t", "mrays_all", "mrays_1t_cpu"):
+        for k in ("mrays_1t", "mrays_all", "mrays_1t_cpu", "mrays_packet_1t", "mrays_packet_1t_cpu"):
             if k in v:
                 a["sets"][s][k] = max(a["sets"][s][k], v[k])
     for k in ("build_ms", "build_medium_ms"):
@@ -157,11 +157,12 @@ def main():
                 print(f"| {name} | {k}, from Embree's primary hits | {sv['rays']:,} | "
                       f"{sv['hits']:,} / {ev['hits']:,} | {sv['t_sum']:.6f} / {ev['t_sum']:.6f} | "
                       f"{'yes' if agree(sv, ev) else '**no**'} | | |")
-        if e and "prim_p16" in e["sets"]:
-            p = s["sets"]["primary"].get("mrays_packet_1t")
-            ev = e["sets"]["prim_p16"]["mrays_1t_cpu"]
-            print(f"| {name} | primary, 16-ray packets | | | | | "
-                  f"{p if p is not None else '-'} / {ev:.2f} | |")
+        p = s["sets"]["primary"].get("mrays_packet_1t_cpu")
+        for ek, label in (("prim_p8", "8"), ("prim_p16", "16")):
+            if e and ek in e["sets"] and p is not None:
+                ev = e["sets"][ek]["mrays_1t_cpu"]
+                print(f"| {name} | primary packets: Sahara 8 (4x2) / Embree {label} | | | | | "
+                      f"{p:.2f} / {ev:.2f} ({p / ev:.2f}) | |")
     print("\n| mesh | triangles | Sahara build ms | Embree HIGH / MEDIUM build ms | "
           "Sahara tree + triangles MB | Embree BVH MB (+ vertex/index buffers) | Sahara SAH cost |")
     print("|---|---|---|---|---|---|---|")

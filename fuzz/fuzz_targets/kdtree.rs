@@ -154,7 +154,7 @@ fuzz_target!(|input: Input| {
         params.max_leaf_size = 1 + u32::from(input.max_leaf_size % 8);
         params.empty_bonus = f32::from(input.empty_bonus) / 255.0;
         let tree = KdTree::build(triangles.clone(), &params);
-        if let Err(e) = validate(&tree) {
+        if let Err(e) = validate(&tree, &triangles) {
             panic!("{}: invalid tree: {e}", builder.name());
         }
         for (ray, &(closest, any)) in rays.iter().zip(&expected) {

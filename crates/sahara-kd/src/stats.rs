@@ -29,7 +29,8 @@ pub struct TreeStats {
     pub references: usize,
     /// References per referenced triangle (1 = no duplication).
     pub duplication: f64,
-    /// Bytes of nodes + index array + triangle data.
+    /// Bytes of nodes + index array + leaf data (a triangle tree's leaf
+    /// blocks hold its triangles; it keeps no other copy).
     pub memory_bytes: usize,
     /// The tree's SAH cost with its build's K_T, K_I and leaf width W:
     /// `sum_inner SA/SA_root K_T + sum_leaves SA/SA_root K_I ceil(n / W)`.
@@ -49,7 +50,7 @@ impl<P: Primitive> KdTree<P> {
     /// Compute the statistics (one pass over the nodes).
     pub fn stats(&self) -> TreeStats {
         let mut s = TreeStats {
-            triangles: self.prims.len(),
+            triangles: self.prim_count,
             ..Default::default()
         };
         let root_area = self.bounds.surface_area();
@@ -63,7 +64,7 @@ impl<P: Primitive> KdTree<P> {
             self.params.intersection_cost as f64,
         );
         let mut depth_sum = 0u64;
-        let mut referenced = vec![false; self.prims.len()];
+        let mut referenced = vec![false; self.prim_count];
         self.visit(|_, n, cell, depth| {
             s.nodes += 1;
             let p = cell.surface_area() * inv_root;
@@ -101,7 +102,6 @@ impl<P: Primitive> KdTree<P> {
         s.duplication = s.references as f64 / distinct.max(1) as f64;
         s.memory_bytes = std::mem::size_of_val(self.nodes.as_slice())
             + std::mem::size_of_val(self.indices.as_slice())
-            + std::mem::size_of_val(self.prims.as_slice())
             + P::leaf_data_bytes(&self.leaf_data);
         s
     }

@@ -110,7 +110,8 @@ pub struct KdTree<P: Primitive = Triangle> {
     /// Leaf runs, each starting at a multiple of `P::LEAF_WIDTH` and padded
     /// to one with `u32::MAX`.
     pub(crate) indices: Vec<u32>,
-    pub(crate) prims: Vec<P>,
+    /// Primitives given to the build (hittable or not).
+    pub(crate) prim_count: usize,
     /// Leaf-ordered copies for fast tests (triangles: blocks of eight).
     pub(crate) leaf_data: P::LeafData,
     pub(crate) bounds: Aabb,
@@ -129,9 +130,17 @@ impl<P: Primitive> KdTree<P> {
         &self.indices
     }
 
-    /// The primitives, indexed as given to the build.
-    pub fn primitives(&self) -> &[P] {
-        &self.prims
+    /// Number of primitives given to the build (hit indices range over them).
+    /// The tree keeps no copy of them beyond its leaf data: a triangle tree
+    /// stores each referenced triangle in its leaf blocks, a box tree only
+    /// indices.
+    pub fn primitive_count(&self) -> usize {
+        self.prim_count
+    }
+
+    /// The leaf data (for a triangle tree, the leaf blocks in leaf order).
+    pub fn leaf_data(&self) -> &P::LeafData {
+        &self.leaf_data
     }
 
     /// The root cell: the bounds of all hittable triangles.
@@ -174,11 +183,6 @@ impl<P: Primitive> KdTree<P> {
 pub type BoxTree = KdTree<Aabb>;
 
 impl KdTree<Triangle> {
-    /// The triangles, indexed as given to the build.
-    pub fn triangles(&self) -> &[Triangle] {
-        &self.prims
-    }
-
     /// The triangle indices of leaf `node`.
     #[inline(always)]
     pub fn leaf_triangles(&self, node: &Node) -> &[u32] {

@@ -2,8 +2,9 @@
 
 use glam::DVec3;
 
+use crate::geometry::triangle_block::BLOCK_WIDTH;
 use crate::geometry::{Aabb, Triangle};
-use crate::tree::KdTree;
+use crate::tree::{KdTree, Node};
 
 /// Check a tree's structure and coverage; the first problem found is
 /// returned as a message.
@@ -16,10 +17,22 @@ use crate::tree::KdTree;
 ///   the cell. ("Interior" shrinks the cell by 1e-5 of its extent on each
 ///   axis that has one; a flat cell's interior is the inside of its plane
 ///   rectangle, which only triangles lying in that plane overlap in area.)
-pub fn validate(tree: &KdTree) -> Result<(), String> {
+/// - Leaf blocks: every leaf's run starts at a multiple of the block width,
+///   its block lanes hold exactly the triangles its indices name (bit for
+///   bit), and the padding lanes' indices are `u32::MAX`.
+///
+/// `triangles` are the triangles the tree was built from.
+pub fn validate(tree: &KdTree, triangles: &[Triangle]) -> Result<(), String> {
     let nodes = tree.nodes();
     if nodes.is_empty() {
         return Err("no root node".into());
+    }
+    if tree.primitive_count() != triangles.len() {
+        return Err(format!(
+            "built from {} triangles, validated against {}",
+            tree.primitive_count(),
+            triangles.len()
+        ));
     }
     let mut seen = vec![false; nodes.len()];
     let mut err = None;
@@ -39,12 +52,14 @@ pub fn validate(tree: &KdTree) -> Result<(), String> {
             } else if let Some(&t) = tree
                 .leaf_triangles(n)
                 .iter()
-                .find(|&&t| t as usize >= tree.triangles().len())
+                .find(|&&t| t as usize >= triangles.len())
             {
                 err = Some(format!(
                     "leaf {i} references triangle {t} of {}",
-                    tree.triangles().len()
+                    triangles.len()
                 ));
+            } else if let Err(e) = check_blocks(tree, triangles, n) {
+                err = Some(format!("leaf {i}: {e}"));
             } else {
                 leaves.push((i, *n, *cell));
             }
@@ -73,7 +88,7 @@ pub fn validate(tree: &KdTree) -> Result<(), String> {
         let refs = tree.leaf_triangles(&n);
         let interior = shrink(&cell, 1e-5);
         let outside = shrink(&cell, -1e-5);
-        for (t, tri) in tree.triangles().iter().enumerate() {
+        for (t, tri) in triangles.iter().enumerate() {
             if !tri.is_hittable() {
                 continue;
             }
@@ -93,6 +108,44 @@ pub fn validate(tree: &KdTree) -> Result<(), String> {
                     "leaf {i} (cell {cell:?}) references triangle {t}, which does not touch it"
                 ));
             }
+        }
+    }
+    Ok(())
+}
+
+/// A leaf's blocks against its index run (see [`validate`]).
+fn check_blocks(tree: &KdTree, triangles: &[Triangle], leaf: &Node) -> Result<(), String> {
+    let (offset, count) = (leaf.leaf_offset() as usize, leaf.leaf_count() as usize);
+    if count == 0 {
+        return Ok(());
+    }
+    if offset % BLOCK_WIDTH != 0 {
+        return Err(format!("run at {offset} is not block aligned"));
+    }
+    let padded = count.next_multiple_of(BLOCK_WIDTH);
+    let Some(run) = tree.indices().get(offset..offset + padded) else {
+        return Err("padded run past the index array".into());
+    };
+    let Some(blocks) = tree
+        .leaf_data()
+        .get(offset / BLOCK_WIDTH..(offset + padded) / BLOCK_WIDTH)
+    else {
+        return Err("blocks past the block array".into());
+    };
+    for (k, &t) in run.iter().enumerate() {
+        let (block, lane) = (&blocks[k / BLOCK_WIDTH], k % BLOCK_WIDTH);
+        if k >= count {
+            if t != u32::MAX {
+                return Err(format!("padding entry {k} holds {t}"));
+            }
+            continue;
+        }
+        let (got, want) = (block.triangle(lane), triangles[t as usize]);
+        let bits = |tri: &Triangle| tri.v.map(|p| p.to_array().map(f32::to_bits));
+        if bits(&got) != bits(&want) {
+            return Err(format!(
+                "block lane {k} holds {got:?}, not triangle {t} {want:?}"
+            ));
         }
     }
     Ok(())
@@ -176,4 +229,33 @@ fn overlaps(tri: &Triangle, (lo, hi): &(DVec3, DVec3), certainty: Certainty) -> 
         }
     }
     true
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::build::BuildParams;
+
+    /// The block check fails on a block that no longer matches its indices.
+    #[test]
+    fn a_corrupted_leaf_block_is_reported() {
+        let tris: Vec<Triangle> = (0..20)
+            .map(|i| {
+                let x = i as f32;
+                Triangle::new(
+                    Vec3::new(x, 0.0, 1.0),
+                    Vec3::new(x + 0.5, 0.0, 1.0),
+                    Vec3::new(x, 1.0, 1.0),
+                )
+            })
+            .collect();
+        let mut tree = KdTree::build(tris.clone(), &BuildParams::default());
+        validate(&tree, &tris).unwrap();
+        tree.leaf_data[0].v[1][2][0] += 1.0;
+        let e = validate(&tree, &tris).unwrap_err();
+        assert!(e.contains("block lane"), "{e}");
+        assert!(validate(&tree, &tris[1..]).is_err(), "wrong triangle count");
+    }
 }

@@ -41,7 +41,7 @@ fn check_all(tris: &[Triangle], rays: &[Ray]) -> Vec<KdTree> {
         .map(|params| {
             let tree = KdTree::build(tris.to_vec(), &params);
             let name = params.builder.name();
-            validate(&tree).unwrap_or_else(|e| panic!("{name}: {e}"));
+            validate(&tree, tris).unwrap_or_else(|e| panic!("{name}: {e}"));
             for ray in rays {
                 let (got, want) = (tree.closest_hit(ray), brute::closest_hit(tris, ray));
                 let bits = |h: Option<sahara_kd::Hit>| {
@@ -310,7 +310,7 @@ fn one_huge_triangle_among_small_ones_is_in_every_leaf_it_overlaps() {
     params.max_leaf_size = 1;
     params.empty_bonus = 0.0;
     let tree = KdTree::build(tris.to_vec(), &params);
-    validate(&tree).unwrap();
+    validate(&tree, &tris).unwrap();
 }
 
 /// Found by fuzzing (target `kdtree`, coordinates clamped to +-1e9): a ray

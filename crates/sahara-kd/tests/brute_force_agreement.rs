@@ -216,7 +216,7 @@ fn builders() -> Vec<BuildParams> {
 fn check(tris: Vec<Triangle>, rays: &[RaySpec]) -> Result<(), TestCaseError> {
     for params in builders() {
         let tree = KdTree::build(tris.clone(), &params);
-        if let Err(e) = validate(&tree) {
+        if let Err(e) = validate(&tree, &tris) {
             return Err(TestCaseError::fail(format!(
                 "{}: invalid tree: {e}",
                 params.builder.name()
@@ -321,8 +321,8 @@ fn empty_and_non_finite_scenes() {
                 Vec3::new(0.0, 1.0, 2.0),
             ),
         ];
-        let tree = KdTree::build(tris, &params);
-        validate(&tree).unwrap();
+        let tree = KdTree::build(tris.clone(), &params);
+        validate(&tree, &tris).unwrap();
         let hit = tree.closest_hit(&ray).unwrap();
         assert_eq!((hit.t, hit.tri), (2.0, 1));
     }

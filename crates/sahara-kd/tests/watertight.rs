@@ -12,7 +12,7 @@ fn trees(tris: &[Triangle]) -> Vec<(String, KdTree)> {
         .iter()
         .map(|&b| {
             let tree = KdTree::build(tris.to_vec(), &BuildParams::new(b));
-            validate(&tree).unwrap_or_else(|e| panic!("{}: {e}", b.name()));
+            validate(&tree, tris).unwrap_or_else(|e| panic!("{}: {e}", b.name()));
             (b.name(), tree)
         })
         .collect()

@@ -45,7 +45,7 @@ impl<P: Primitive> KdTree<P> {
         KdTree {
             nodes,
             indices,
-            prims: triangles,
+            prim_count: triangles.len(),
             leaf_data,
             bounds,
             params: *params,
