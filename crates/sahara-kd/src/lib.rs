@@ -26,7 +26,7 @@ pub mod tree;
 pub mod validate;
 
 pub use build::{AxisRule, BuildParams, Builder, PositionRule};
-pub use geometry::{Aabb, Primitive, Ray, Triangle, TriangleHit};
+pub use geometry::{Aabb, Primitive, Ray, Triangle, TriangleBlock, TriangleHit};
 pub use stats::TreeStats;
 pub use traverse::{Counters, Hit, NoCounters, TraversalCounters};
 pub use tree::{BoxTree, KdTree, Node};

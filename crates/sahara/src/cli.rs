@@ -267,6 +267,10 @@ pub struct TreeOptions {
     /// SAH].
     #[arg(long, value_name = "W", value_parser = clap::value_parser!(u32).range(1..=64))]
     pub leaf_width: Option<u32>,
+    /// Extra SAH cost of each triangle in a leaf, in leaf tests: a leaf of n
+    /// costs K_I (ceil(n / W) + C n) [default: the builder's].
+    #[arg(long, value_name = "C", value_parser = parse_non_negative)]
+    pub lane_cost: Option<f32>,
     /// Use only the first FRACTION of the triangles, in file order (0 < F
     /// <= 1; for build-scaling measurements).
     #[arg(long, value_name = "FRACTION", value_parser = parse_subset)]
@@ -283,6 +287,7 @@ impl Default for TreeOptions {
             max_depth: None,
             max_leaf_size: None,
             leaf_width: None,
+            lane_cost: None,
             subset: None,
         }
     }
@@ -298,6 +303,7 @@ impl TreeOptions {
         p.max_depth = self.max_depth.or(p.max_depth);
         p.max_leaf_size = self.max_leaf_size.unwrap_or(p.max_leaf_size);
         p.leaf_width = self.leaf_width.unwrap_or(p.leaf_width);
+        p.lane_cost = self.lane_cost.unwrap_or(p.lane_cost);
         p
     }
 
@@ -315,6 +321,13 @@ fn parse_positive(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
         _ => Err(format!("'{s}' is not a positive number")),
+    }
+}
+
+fn parse_non_negative(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v >= 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("'{s}' is not a number >= 0")),
     }
 }
 

@@ -35,6 +35,7 @@ pub struct SahModel {
     k_i: f64,
     lambda: f64,
     width: u32,
+    lane_cost: f32,
 }
 
 impl SahModel {
@@ -48,13 +49,14 @@ impl SahModel {
             k_i: p.intersection_cost as f64,
             lambda: 1.0 - p.empty_bonus as f64,
             width: p.leaf_width,
+            lane_cost: p.lane_cost,
         })
     }
 
     /// Tests a leaf of `n` triangles takes: `ceil(n / leaf_width)`.
     #[inline(always)]
     fn tests(&self, n: usize) -> f64 {
-        super::params::leaf_tests(n, self.width)
+        super::params::leaf_tests(n, self.width, self.lane_cost)
     }
 
     /// Cost of a leaf with `n` triangles.

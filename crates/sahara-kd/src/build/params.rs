@@ -132,6 +132,17 @@ pub struct BuildParams {
     /// `K_I ceil(n / leaf_width)` (triangle trees test [`crate::geometry::triangle_block::BLOCK_WIDTH`]
     /// = 8 at a time, so a leaf of 8 costs one test); 1 is the classic model.
     pub leaf_width: u32,
+    /// Extra cost of each triangle in a leaf, in leaf tests: the SAH prices
+    /// a leaf of `n` at `K_I (ceil(n / leaf_width) + lane_cost n)`. It stands
+    /// for the work a block test does per triangle that the block does not
+    /// amortise (reading 36 bytes, and the exact scalar test of each
+    /// triangle the ray's line passes through). Default 0, measured
+    /// (`--lane-cost`, 1-thread Mrays/s primary/shadow/diffuse/random): 0.25
+    /// helped the Cornell box's primary rays (12.3 -> 16.3) but cost its
+    /// shadow rays (20.6 -> 14.6) and, with 0.5 and 1, doubled to
+    /// quadrupled the memory of bunny and sponza (small leaves padded to
+    /// blocks of eight) while slowing them by up to 40%.
+    pub lane_cost: f32,
 }
 
 impl Default for BuildParams {
@@ -166,6 +177,7 @@ impl BuildParams {
             parallel: true,
             max_duplication: 64.0,
             leaf_width: crate::geometry::triangle_block::BLOCK_WIDTH as u32,
+            lane_cost: 0.0,
         }
     }
 
@@ -173,7 +185,7 @@ impl BuildParams {
     /// `ceil(n / leaf_width)`.
     #[inline(always)]
     pub fn leaf_tests(&self, n: usize) -> f64 {
-        leaf_tests(n, self.leaf_width)
+        leaf_tests(n, self.leaf_width, self.lane_cost)
     }
 
     /// The reference budget for `n` triangles.
@@ -191,8 +203,8 @@ impl BuildParams {
     }
 }
 
-/// `ceil(n / width)` as f64 (a width of 0 counts as 1).
+/// `ceil(n / width) + lane_cost n` as f64 (a width of 0 counts as 1).
 #[inline(always)]
-pub fn leaf_tests(n: usize, width: u32) -> f64 {
-    n.div_ceil(width.max(1) as usize) as f64
+pub fn leaf_tests(n: usize, width: u32, lane_cost: f32) -> f64 {
+    n.div_ceil(width.max(1) as usize) as f64 + lane_cost as f64 * n as f64
 }
