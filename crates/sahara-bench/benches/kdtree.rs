@@ -1,14 +1,19 @@
 //! Criterion benchmarks of the accelerator's hot paths on the Stanford bunny
 //! (read in place from the shared scenes, `$SAHARA_SCENES` to override):
-//! building each kind of tree, and tracing the protocol's ray sets on one
-//! thread (closest hit for primary / diffuse / random, any hit for shadow).
+//! building each kind of tree, tracing the protocol's ray sets on one
+//! thread (closest hit for primary / diffuse / random, any hit for shadow),
+//! primary rays in 4x2 tiles as single rays and as packets, and the leaf
+//! block filter alone.
 //!
 //! `cargo bench -p sahara-bench --bench kdtree`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize};
 use sahara_bench::{HitRecord, ProtocolCamera, SceneFrame};
-use sahara_kd::{BuildParams, Builder, KdTree, Ray};
+use sahara_kd::geometry::triangle::RayShear;
+use sahara_kd::geometry::triangle_block::BLOCK_WIDTH;
+use sahara_kd::packet::PACKET;
+use sahara_kd::{BuildParams, Builder, KdTree, Ray, TriangleBlock};
 use sahara_render::mesh::Mesh;
 
 /// Rays per traced batch: enough to leave the caches' warm-up behind.
@@ -93,6 +98,61 @@ fn trace(c: &mut Criterion) {
             })
         });
     }
+    // The packet path on primary rays: whole 4x2 tiles spread over the image.
+    let order = sahara_bench::runner::packets::tile_order(ImageSize::PROTOCOL);
+    let tiles: Vec<&[u32]> = order.chunks(PACKET).collect();
+    let step = (tiles.len() / (BATCH / PACKET)).max(1);
+    let tiled: Vec<Ray> = tiles
+        .iter()
+        .step_by(step)
+        .take(BATCH / PACKET)
+        .flat_map(|t| t.iter().map(|&i| primary[i as usize]))
+        .collect();
+    let mut out = vec![None; tiled.len()];
+    g.throughput(Throughput::Elements(tiled.len() as u64));
+    g.bench_function("primary_tiles_single", |bench| {
+        bench.iter(|| {
+            tiled
+                .iter()
+                .filter(|r| tree.closest_hit(r).is_some())
+                .count()
+        })
+    });
+    g.bench_function("primary_tiles_packets", |bench| {
+        bench.iter(|| {
+            tree.closest_hits_packets(&tiled, &mut out);
+            out.iter().filter(|h| h.is_some()).count()
+        })
+    });
+    g.finish();
+
+    // The leaf block filter alone: eight bunny triangles against rays aimed
+    // at them (the hot loop of every leaf visit).
+    let tris = mesh.triangles();
+    let block = TriangleBlock::pack(&tris[..BLOCK_WIDTH]);
+    let centre = tris[0].v[0];
+    let shears: Vec<RayShear> = spread(&primary, 1024)
+        .iter()
+        .map(|r| {
+            RayShear::new(
+                r.origin,
+                centre - r.origin + (r.dir - r.dir.normalize()) * 0.01,
+            )
+        })
+        .collect();
+    let mut g = c.benchmark_group("leaf_block");
+    g.throughput(Throughput::Elements((shears.len() * BLOCK_WIDTH) as u64));
+    g.bench_function("block_candidates_8", |bench| {
+        bench.iter(|| {
+            shears
+                .iter()
+                .map(|s| {
+                    s.block_candidates(std::hint::black_box(&block), BLOCK_WIDTH)
+                        .count_ones()
+                })
+                .sum::<u32>()
+        })
+    });
     g.finish();
 }
 
