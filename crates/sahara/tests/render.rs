@@ -212,3 +212,51 @@ fn a_scene_with_a_missing_mesh_names_the_line_and_the_path() {
     assert!(err.contains("gone/bunny.obj"), "{err}");
     let _ = fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_zero_size_image_is_refused() {
+    for (w, h) in [("0", "16"), ("16", "0")] {
+        let out = sahara(&["render", "--width", w, "--height", h, "-o", "never.png"]);
+        assert!(!out.status.success());
+        let err = stderr(&out);
+        assert!(err.contains("--width") || err.contains("--height"), "{err}");
+        assert!(!Path::new("never.png").exists());
+    }
+}
+
+#[test]
+fn an_unwritable_output_is_refused_before_rendering() {
+    let dir = temp_dir("unwritable");
+    let target = dir.join("no-such-folder").join("out.png");
+    let start = std::time::Instant::now();
+    // 4096 spp would take minutes: the refusal must come first.
+    let out = sahara(&["render", "--spp", "4096", "-o", target.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(err.contains("cannot write the output image"), "{err}");
+    assert!(err.contains("no-such-folder"), "{err}");
+    assert!(!err.contains("rendering "), "refused after starting: {err}");
+    assert!(start.elapsed().as_secs() < 30);
+}
+
+#[test]
+fn a_render_that_cannot_fit_in_memory_is_refused_with_an_estimate() {
+    let dir = temp_dir("huge");
+    let out_png = dir.join("huge.png");
+    let out = sahara(&[
+        "render",
+        "--width",
+        "65536",
+        "--height",
+        "65536",
+        "-o",
+        out_png.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(
+        err.contains("needs about") && err.contains("available"),
+        "{err}"
+    );
+    assert!(!out_png.exists());
+}
