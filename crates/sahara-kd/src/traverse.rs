@@ -215,12 +215,13 @@ impl KdTree<Triangle> {
             for (b, block) in blocks.iter().enumerate() {
                 let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
                 (0..lanes).for_each(|_| counters.triangle());
-                let mut m = shear.block_candidates(block, lanes);
+                let (mut m, e) = shear.block_edges(block, lanes);
                 while m != 0 {
                     let l = m.trailing_zeros() as usize;
                     m &= m - 1;
+                    let uvw = [e[0][l], e[1][l], e[2][l]];
                     if shear
-                        .intersect(&block.triangle(l), ray.tmin, ray.tmax)
+                        .decide(&block.triangle(l), uvw, ray.tmin, ray.tmax)
                         .is_some()
                     {
                         found = true;
@@ -258,12 +259,13 @@ impl KdTree<Triangle> {
             (0..lanes).for_each(|_| counters.triangle());
             // Eight edge tests at once; the scalar test decides the few
             // lanes left (see `triangle_block`).
-            let mut m = shear.block_candidates(block, lanes);
+            let (mut m, e) = shear.block_edges(block, lanes);
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
                 let i = indices[b * BLOCK_WIDTH + l];
-                if let Some(h) = shear.intersect(&block.triangle(l), tmin, *best_t) {
+                let uvw = [e[0][l], e[1][l], e[2][l]];
+                if let Some(h) = shear.decide(&block.triangle(l), uvw, tmin, *best_t) {
                     if h.t < *best_t || i < best.tri {
                         *best_t = h.t;
                         *best = Hit {

@@ -202,6 +202,41 @@ impl RayShear {
     }
 }
 
+impl RayShear {
+    /// The watertight test of `tri` finished from its f32 edge functions
+    /// `u, v, w` as [`RayShear::block_edges`] computed them (the same bits
+    /// [`RayShear::intersect`] computes): a lane the block kept. Spares
+    /// recomputing the edge functions; an exact zero or an overflow still
+    /// goes through the whole scalar test (its f64 path).
+    #[inline(always)]
+    pub fn decide(
+        &self,
+        tri: &Triangle,
+        [u, v, w]: [f32; 3],
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<TriangleHit> {
+        let det = u + v + w;
+        if !(u != 0.0 && v != 0.0 && w != 0.0 && det.is_finite()) {
+            return self.intersect(tri, tmin, tmax);
+        }
+        if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
+            return None;
+        }
+        let rcp = 1.0 / det;
+        let t = plane_distance(tri, self.origin, self.dir);
+        // As in `intersect`.
+        if !(t > tmin && t <= tmax) {
+            return None;
+        }
+        Some(TriangleHit {
+            t: t + 0.0,
+            u: v * rcp,
+            v: w * rcp,
+        })
+    }
+}
+
 /// The distance along `o + t d` to the triangle's plane, computed in f64
 /// from the plane equation `t = ((v0 - o) . n) / (d . n)`.
 ///

@@ -84,15 +84,28 @@ impl RayShear {
     /// early rejection, computed with the same operations.
     #[inline(always)]
     pub fn block_candidates(&self, block: &TriangleBlock, lanes: usize) -> u32 {
+        self.block_edges(block, lanes).0
+    }
+
+    /// [`RayShear::block_candidates`] and the lanes' edge functions
+    /// `[u, v, w]`, for [`RayShear::decide`].
+    #[inline(always)]
+    pub fn block_edges(
+        &self,
+        block: &TriangleBlock,
+        lanes: usize,
+    ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
         let v = &block.v;
         let (ax, ay) = self.sheared(&v[0]);
         let (bx, by) = self.sheared(&v[1]);
         let (cx, cy) = self.sheared(&v[2]);
         let mut keep = [false; BLOCK_WIDTH];
+        let mut e = [[0.0f32; BLOCK_WIDTH]; 3];
         for l in 0..BLOCK_WIDTH {
             let u = cx[l] * by[l] - cy[l] * bx[l];
             let v = ax[l] * cy[l] - ay[l] * cx[l];
             let w = bx[l] * ay[l] - by[l] * ax[l];
+            (e[0][l], e[1][l], e[2][l]) = (u, v, w);
             let det = u + v + w;
             let nonzero = u != 0.0 && v != 0.0 && w != 0.0;
             let mixed = (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
@@ -102,7 +115,7 @@ impl RayShear {
         for (l, &k) in keep.iter().enumerate() {
             mask |= (k as u32) << l;
         }
-        mask & ((1u32 << lanes) - 1)
+        (mask & ((1u32 << lanes) - 1), e)
     }
 }
 
@@ -163,10 +176,17 @@ mod tests {
             );
             let shear = RayShear::from_ray(&ray);
             for lanes in [1, 5, BLOCK_WIDTH] {
-                let m = shear.block_candidates(&block, lanes);
+                let (m, e) = shear.block_edges(&block, lanes);
+                assert_eq!(m, shear.block_candidates(&block, lanes));
                 assert_eq!(m >> lanes, 0, "lanes past the count are masked");
                 for (l, t) in tris.iter().enumerate().take(lanes) {
                     let hit = shear.intersect(t, ray.tmin, ray.tmax);
+                    if m & (1 << l) != 0 {
+                        // Finishing from the block's edge functions gives
+                        // the scalar test's answer, bit for bit.
+                        let uvw = [e[0][l], e[1][l], e[2][l]];
+                        assert_eq!(shear.decide(t, uvw, ray.tmin, ray.tmax), hit);
+                    }
                     if hit.is_some() {
                         hits += 1;
                         assert!(m & (1 << l) != 0, "lane {l} hit but was dropped");
