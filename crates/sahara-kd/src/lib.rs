@@ -21,6 +21,8 @@ pub mod build;
 pub mod geometry;
 pub mod packet;
 pub mod stats;
+#[cfg(test)]
+mod test_support;
 pub mod traverse;
 pub mod tree;
 pub mod validate;

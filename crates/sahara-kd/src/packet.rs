@@ -241,30 +241,7 @@ mod tests {
     use super::*;
     use crate::brute;
     use crate::build::{BuildParams, Builder};
-
-    /// A deterministic xorshift stream of floats in [-1, 1).
-    fn floats(seed: u64) -> impl FnMut() -> f32 {
-        let mut s = seed;
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 23) as f32 - 1.0
-        }
-    }
-
-    fn soup(f: &mut impl FnMut() -> f32, n: usize) -> Vec<Triangle> {
-        (0..n)
-            .map(|_| {
-                let c = Vec3::new(f(), f(), f()) * 4.0;
-                Triangle::new(
-                    c,
-                    c + Vec3::new(f(), f(), f()) * 0.5,
-                    c + Vec3::new(f(), f(), f()) * 0.5,
-                )
-            })
-            .collect()
-    }
+    use crate::test_support::{floats, soup};
 
     /// Camera-like packets (a common origin, nearby directions), packets
     /// with mixed direction signs, short ones and invalid rays: every
@@ -272,7 +249,7 @@ mod tests {
     #[test]
     fn packets_agree_with_brute_force() {
         let mut f = floats(2024);
-        let tris = soup(&mut f, 2000);
+        let tris = soup(&mut f, 2000, 0.5);
         for builder in [Builder::Sah, Builder::Binned { bins: 16 }] {
             let tree = KdTree::build(tris.clone(), &BuildParams::new(builder));
             for p in 0..400 {
@@ -303,7 +280,7 @@ mod tests {
     #[test]
     fn batches_answer_every_ray() {
         let mut f = floats(5);
-        let tris = soup(&mut f, 500);
+        let tris = soup(&mut f, 500, 0.5);
         let tree = KdTree::build(tris.clone(), &BuildParams::default());
         let rays: Vec<Ray> = (0..1003)
             .map(|_| {

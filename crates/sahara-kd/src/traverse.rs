@@ -486,17 +486,7 @@ mod tests {
     use super::*;
     use crate::brute;
     use crate::build::BuildParams;
-
-    /// A deterministic xorshift stream of floats in [-1, 1).
-    fn floats(seed: u64) -> impl FnMut() -> f32 {
-        let mut s = seed;
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 23) as f32 - 1.0
-        }
-    }
+    use crate::test_support::{floats, soup};
 
     /// The portable build of the traversal (what a CPU without AVX2 runs)
     /// agrees with brute force bit for bit, like the dispatched one that the
@@ -504,16 +494,7 @@ mod tests {
     #[test]
     fn portable_and_dispatched_traversals_agree_with_brute_force() {
         let mut f = floats(99);
-        let tris: Vec<Triangle> = (0..3000)
-            .map(|_| {
-                let c = Vec3::new(f(), f(), f()) * 4.0;
-                Triangle::new(
-                    c,
-                    c + Vec3::new(f(), f(), f()) * 0.4,
-                    c + Vec3::new(f(), f(), f()) * 0.4,
-                )
-            })
-            .collect();
+        let tris = soup(&mut f, 3000, 0.4);
         let tree = KdTree::build(tris.clone(), &BuildParams::default());
         for _ in 0..3000 {
             let ray = Ray::new(Vec3::new(f(), f(), f()) * 5.0, Vec3::new(f(), f(), f()));

@@ -123,17 +123,7 @@ impl RayShear {
 mod tests {
     use super::*;
     use crate::geometry::Ray;
-
-    /// A deterministic xorshift stream of floats in [-1, 1).
-    fn floats(seed: u64) -> impl FnMut() -> f32 {
-        let mut s = seed;
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 23) as f32 - 1.0
-        }
-    }
+    use crate::test_support::floats;
 
     #[test]
     fn pack_round_trips() {
