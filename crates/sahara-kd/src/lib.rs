@@ -3,8 +3,9 @@
 //! Kd-trees over triangle soups, built by the surface area heuristic (an
 //! exact O(N log N) event sweep with split clipping, or binned) or by the
 //! naive baselines; front-to-back traversal with early exit for closest-hit
-//! and any-hit queries; tree statistics; and the brute-force oracle the tests
-//! hold the tree to. No I/O, no rendering.
+//! and any-hit queries, single rays or packets of eight, over leaves whose
+//! triangles sit in 8-wide blocks; tree statistics; and the brute-force
+//! oracle the tests hold the tree to. No I/O, no rendering.
 //!
 //! ```
 //! use glam::Vec3;
