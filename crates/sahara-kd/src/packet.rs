@@ -2,7 +2,7 @@
 //! traced down the tree together.
 //!
 //! Wald's coherent kd-tree traversal (Wald 2004, "Realtime Ray Tracing and
-//! Interactive Global Illumination", section 7.2): rays whose directions
+//! Interactive Global Illumination", PhD thesis): rays whose directions
 //! share their signs meet the two children of every node in the same order,
 //! so the packet walks one path, fetching each node once for all its rays.
 //! Each ray keeps its own parametric interval; a child is entered when at
