@@ -52,18 +52,12 @@ pub fn li(ctx: &mut Context, ray: &Ray, time: f32, max_depth: u32, light_samples
         if depth >= max_depth || mat.bsdf.is_diffuse() {
             break;
         }
-        let u_lobe = ctx.sampler.get_1d(dims::bounce(depth, dims::BSDF_LOBE));
-        let u = ctx.sampler.get_2d(dims::bounce(depth, dims::BSDF_DIR));
-        let Some(s) = mat.bsdf.sample(sh.tint, sh.wo, u_lobe, u) else {
-            break;
-        };
-        let Some(wi) = sh.scattered(&hit, s.wi, s.delta) else {
+        let Some((s, next)) = sh.sample_bounce(ctx, &hit, depth) else {
             break;
         };
         beta *= s.weight;
         count_emission = s.delta;
-        ray = Ray::new(hit.spawn_origin(wi), wi);
-        ctx.stats.bounce_rays += 1;
+        ray = next;
         depth += 1;
         if beta == Vec3::ZERO {
             break;

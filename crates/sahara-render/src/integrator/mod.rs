@@ -9,7 +9,8 @@ use glam::Vec3;
 use sahara_kd::{Ray, TraversalCounters};
 
 use crate::light::LightSample;
-use crate::material::Material;
+use crate::material::{BsdfSample, Material};
+use crate::sampler::dims;
 use crate::sampler::PixelSampler;
 use crate::sampling::Frame;
 use crate::world::{SurfaceHit, World};
@@ -201,6 +202,24 @@ impl Shading<'_> {
         }
         let folded = (wi - 2.0 * wi.dot(hit.ng) * hit.ng).normalize();
         self.side_ok(hit, folded).then_some(folded)
+    }
+
+    /// The next bounce of a path at `hit`: the BSDF sampled with the
+    /// sampler's dimensions of bounce `depth`, and the ray leaving along
+    /// the sampled direction (counted as a bounce ray); `None` if the path
+    /// ends there.
+    pub fn sample_bounce(
+        &self,
+        ctx: &mut Context,
+        hit: &SurfaceHit,
+        depth: u32,
+    ) -> Option<(BsdfSample, Ray)> {
+        let u_lobe = ctx.sampler.get_1d(dims::bounce(depth, dims::BSDF_LOBE));
+        let u = ctx.sampler.get_2d(dims::bounce(depth, dims::BSDF_DIR));
+        let s = self.material.bsdf.sample(self.tint, self.wo, u_lobe, u)?;
+        let wi = self.scattered(hit, s.wi, s.delta)?;
+        ctx.stats.bounce_rays += 1;
+        Some((s, Ray::new(hit.spawn_origin(wi), wi)))
     }
 }
 
