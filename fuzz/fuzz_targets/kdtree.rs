@@ -6,13 +6,16 @@
 //! infinities included, finite ones kept within 1e-3..1e4 times the scale) and arbitrary rays
 //! (sometimes aimed at a vertex, an edge or an inside point of a triangle). For each builder, with arbitrary
 //! depth and leaf limits: `validate` passes, closest hit equals
-//! `sahara_kd::brute::closest_hit` bit for bit (t, triangle, u, v), and any
-//! hit equals `sahara_kd::brute::any_hit` and "closest hit exists".
+//! `sahara_kd::brute::closest_hit` bit for bit (t, triangle, u, v), any
+//! hit equals `sahara_kd::brute::any_hit` and "closest hit exists", and the
+//! rays traced in packets of eight (grouped by direction signs) give the
+//! closest hits too.
 #![no_main]
 
 use arbitrary::Arbitrary;
 use glam::Vec3;
 use libfuzzer_sys::fuzz_target;
+use sahara_kd::packet::PACKET;
 use sahara_kd::validate::validate;
 use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
 
@@ -171,6 +174,30 @@ fuzz_target!(|input: Input| {
                 "{}: any hit {got_any} but brute force gives {any} for {ray:?}",
                 builder.name()
             );
+        }
+        // Packets: the rays grouped by direction signs (so that most packets
+        // take the packet path; mixed ones fall back to single rays), eight
+        // at a time.
+        let sign = |r: &Ray| {
+            usize::from(r.dir.x.is_sign_negative())
+                | usize::from(r.dir.y.is_sign_negative()) << 1
+                | usize::from(r.dir.z.is_sign_negative()) << 2
+        };
+        let mut order: Vec<usize> = (0..rays.len()).collect();
+        order.sort_by_key(|&i| sign(&rays[i]));
+        for idx in order.chunks(PACKET) {
+            let packet: Vec<Ray> = idx.iter().map(|&i| rays[i]).collect();
+            let mut got = vec![None; packet.len()];
+            tree.closest_hit_packet(&packet, &mut got);
+            for (&i, g) in idx.iter().zip(&got) {
+                assert!(
+                    same(*g, expected[i].0),
+                    "{}: packet hit {g:?} but brute force gives {:?} for {:?}",
+                    builder.name(),
+                    expected[i].0,
+                    rays[i]
+                );
+            }
         }
     }
 });
