@@ -139,9 +139,9 @@ pub struct BuildParams {
     /// triangle the ray's line passes through). Default 0, measured
     /// (`--lane-cost`, 1-thread Mrays/s primary/shadow/diffuse/random): 0.25
     /// helped the Cornell box's primary rays (12.3 -> 16.3) but cost its
-    /// shadow rays (20.6 -> 14.6) and, with 0.5 and 1, doubled to
-    /// quadrupled the memory of bunny and sponza (small leaves padded to
-    /// blocks of eight) while slowing them by up to 40%.
+    /// shadow rays (20.6 -> 14.6), and multiplied the memory of bunny and
+    /// sponza by 1.8 (0.25) to 9 (1) (small leaves padded to blocks of
+    /// eight) while slowing them by up to 40%.
     pub lane_cost: f32,
 }
 
