@@ -25,7 +25,11 @@ fn builders() -> Vec<BuildParams> {
     let mut serial = BuildParams::new(Builder::Binned { bins: 3 });
     serial.parallel = false;
     serial.traversal_cost = 0.01;
+    serial.exact_below = 0;
     out.push(serial);
+    let mut hybrid = serial;
+    hybrid.exact_below = 6;
+    out.push(hybrid);
     out
 }
 

@@ -204,9 +204,15 @@ fn builders() -> Vec<BuildParams> {
     deep.traversal_cost = 0.01;
     deep.empty_bonus = 0.9;
     out.push(deep);
+    // Binned all the way down, and binned cells handed to the exact sweep
+    // (the default hands over only cells larger than these scenes).
     let mut deep_binned = BuildParams::new(Builder::Binned { bins: 7 });
     deep_binned.traversal_cost = 0.01;
+    deep_binned.exact_below = 0;
     out.push(deep_binned);
+    let mut hybrid = deep_binned;
+    hybrid.exact_below = 12;
+    out.push(hybrid);
     let mut serial = BuildParams::new(Builder::Sah);
     serial.parallel = false;
     out.push(serial);

@@ -271,6 +271,10 @@ pub struct TreeOptions {
     /// costs K_I (ceil(n / W) + C n) [default: the builder's].
     #[arg(long, value_name = "C", value_parser = parse_non_negative)]
     pub lane_cost: Option<f32>,
+    /// Binned builder: cells of at most N references are built by the
+    /// exact sweep (0: bins all the way down) [default: the builder's].
+    #[arg(long, value_name = "N")]
+    pub exact_below: Option<u32>,
     /// Use only the first FRACTION of the triangles, in file order (0 < F
     /// <= 1; for build-scaling measurements).
     #[arg(long, value_name = "FRACTION", value_parser = parse_subset)]
@@ -288,6 +292,7 @@ impl Default for TreeOptions {
             max_leaf_size: None,
             leaf_width: None,
             lane_cost: None,
+            exact_below: None,
             subset: None,
         }
     }
@@ -304,6 +309,7 @@ impl TreeOptions {
         p.max_leaf_size = self.max_leaf_size.unwrap_or(p.max_leaf_size);
         p.leaf_width = self.leaf_width.unwrap_or(p.leaf_width);
         p.lane_cost = self.lane_cost.unwrap_or(p.lane_cost);
+        p.exact_below = self.exact_below.unwrap_or(p.exact_below);
         p
     }
 

@@ -50,6 +50,10 @@ fn recurse<P: Primitive>(ctx: &Ctx<P>, refs: Vec<Ref>, cell: Aabb, depth: u32) -
     if n == 0 || n <= p.max_leaf_size as usize || depth >= ctx.max_depth {
         return leaf(refs);
     }
+    if n <= p.exact_below as usize {
+        let (t, b, m) = (ctx.triangles, &ctx.budget, ctx.max_depth);
+        return super::sah_sweep::build_cell(t, &refs, cell, depth, m, b, p);
+    }
     let parallel = p.parallel && n >= PARALLEL_MIN;
     let Some(split) =
         best_split(ctx, &model, &refs, &cell, parallel).filter(|s| s.cost < model.leaf_cost(n))
