@@ -286,7 +286,11 @@ impl KdTree<Triangle> {
     /// # Safety
     /// `offset` and `count` must be those of a leaf of this tree.
     #[inline(always)]
-    unsafe fn leaf_blocks(&self, offset: usize, count: usize) -> (&[TriangleBlock], &[u32]) {
+    pub(crate) unsafe fn leaf_blocks(
+        &self,
+        offset: usize,
+        count: usize,
+    ) -> (&[TriangleBlock], &[u32]) {
         let first = offset / BLOCK_WIDTH;
         let n = count.div_ceil(BLOCK_WIDTH);
         debug_assert!(offset % BLOCK_WIDTH == 0 && first + n <= self.leaf_data.len());

@@ -6,6 +6,7 @@ pub mod primitive;
 pub mod ray;
 pub mod triangle;
 pub mod triangle_block;
+pub mod triangle_packet;
 
 pub use aabb::Aabb;
 pub use primitive::Primitive;
