@@ -121,6 +121,94 @@ enum LeafResult {
     Stop,
 }
 
+/// What the walk does at a non-empty leaf: test it, lower `closest` (the
+/// distance beyond which no cell can hold a closer hit) and say whether to
+/// go on.
+trait LeafVisit<C> {
+    /// Visit the leaf whose index run starts at `offset` with `count` entries.
+    fn visit(
+        &mut self,
+        offset: usize,
+        count: usize,
+        counters: &mut C,
+        closest: &mut f32,
+    ) -> LeafResult;
+}
+
+impl<C, F: FnMut(usize, usize, &mut C, &mut f32) -> LeafResult> LeafVisit<C> for F {
+    #[inline(always)]
+    fn visit(&mut self, offset: usize, count: usize, c: &mut C, closest: &mut f32) -> LeafResult {
+        self(offset, count, c, closest)
+    }
+}
+
+/// The closest-hit leaf visit of one ray, a named type rather than a
+/// closure so that `#[inline(always)]` can put it into the walk's loop
+/// (LLVM kept the closure out of line: a call per leaf).
+struct ClosestLeaf<'a> {
+    tree: &'a KdTree<Triangle>,
+    shear: &'a RayShear,
+    tmin: f32,
+    best_t: f32,
+    best: Hit,
+}
+
+impl<C: Counters> LeafVisit<C> for ClosestLeaf<'_> {
+    #[inline(always)]
+    fn visit(&mut self, offset: usize, count: usize, c: &mut C, closest: &mut f32) -> LeafResult {
+        // SAFETY: the walk passes the `offset`, `count` of a leaf.
+        unsafe {
+            self.tree.leaf_closest(
+                self.shear,
+                self.tmin,
+                offset,
+                count,
+                &mut self.best_t,
+                &mut self.best,
+                c,
+            )
+        };
+        if self.best.tri != u32::MAX {
+            *closest = self.best_t;
+        }
+        LeafResult::Continue
+    }
+}
+
+/// The any-hit leaf visit of one ray (a named type for the reason given at
+/// [`ClosestLeaf`]).
+struct AnyLeaf<'a> {
+    tree: &'a KdTree<Triangle>,
+    shear: &'a RayShear,
+    tmin: f32,
+    tmax: f32,
+    found: bool,
+}
+
+impl<C: Counters> LeafVisit<C> for AnyLeaf<'_> {
+    #[inline(always)]
+    fn visit(&mut self, offset: usize, count: usize, c: &mut C, _: &mut f32) -> LeafResult {
+        // SAFETY: the walk passes the `offset`, `count` of a leaf.
+        let (blocks, _) = unsafe { self.tree.leaf_blocks(offset, count) };
+        for (b, block) in blocks.iter().enumerate() {
+            let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
+            (0..lanes).for_each(|_| c.triangle());
+            let (mut m, e) = self.shear.block_edges(block, lanes);
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let uvw = [e[0][l], e[1][l], e[2][l]];
+                let tri = block.triangle(l);
+                if self.shear.decide(&tri, uvw, self.tmin, self.tmax).is_some() {
+                    self.found = true;
+                    return LeafResult::Stop;
+                }
+            }
+        }
+        LeafResult::Continue
+    }
+}
+
 impl KdTree<Triangle> {
     /// The closest hit with `t` in `(ray.tmin, ray.tmax]`; among hits at the
     /// same `t`, the one with the smallest triangle index.
@@ -151,33 +239,20 @@ impl KdTree<Triangle> {
     #[inline(always)]
     fn closest_hit_portable<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
         let shear = RayShear::from_ray(ray);
-        let mut best_t = ray.tmax;
-        let mut best = Hit {
-            t: f32::INFINITY,
-            tri: u32::MAX,
-            u: 0.0,
-            v: 0.0,
+        let mut leaf = ClosestLeaf {
+            tree: self,
+            shear: &shear,
+            tmin: ray.tmin,
+            best_t: ray.tmax,
+            best: Hit {
+                t: f32::INFINITY,
+                tri: u32::MAX,
+                u: 0.0,
+                v: 0.0,
+            },
         };
-        self.walk(ray, counters, |offset, count, counters, best_t_out| {
-            // SAFETY: `offset`, `count` describe a leaf of this tree.
-            unsafe {
-                self.leaf_closest(
-                    &shear,
-                    ray.tmin,
-                    offset,
-                    count,
-                    &mut best_t,
-                    &mut best,
-                    counters,
-                )
-            };
-            *best_t_out = if best.tri == u32::MAX {
-                f32::INFINITY
-            } else {
-                best_t
-            };
-            LeafResult::Continue
-        });
+        self.walk(ray, counters, &mut leaf);
+        let best = leaf.best;
         (best.tri != u32::MAX).then_some(best)
     }
 
@@ -208,30 +283,15 @@ impl KdTree<Triangle> {
     #[inline(always)]
     fn any_hit_portable<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
         let shear = RayShear::from_ray(ray);
-        let mut found = false;
-        self.walk(ray, counters, |offset, count, counters, _| {
-            // SAFETY: `offset`, `count` describe a leaf of this tree.
-            let (blocks, _) = unsafe { self.leaf_blocks(offset, count) };
-            for (b, block) in blocks.iter().enumerate() {
-                let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
-                (0..lanes).for_each(|_| counters.triangle());
-                let (mut m, e) = shear.block_edges(block, lanes);
-                while m != 0 {
-                    let l = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    let uvw = [e[0][l], e[1][l], e[2][l]];
-                    if shear
-                        .decide(&block.triangle(l), uvw, ray.tmin, ray.tmax)
-                        .is_some()
-                    {
-                        found = true;
-                        return LeafResult::Stop;
-                    }
-                }
-            }
-            LeafResult::Continue
-        });
-        found
+        let mut leaf = AnyLeaf {
+            tree: self,
+            shear: &shear,
+            tmin: ray.tmin,
+            tmax: ray.tmax,
+            found: false,
+        };
+        self.walk(ray, counters, &mut leaf);
+        leaf.found
     }
 
     /// The closest-hit test of one leaf: updates `best_t` and `best` (whose
@@ -338,24 +398,29 @@ impl KdTree<Aabb> {
     ) -> Option<(u32, f32)> {
         let mut best: Option<(u32, f32)> = None;
         let mut best_t = ray.tmax;
-        self.walk(ray, &mut NoCounters, |offset, count, _, closest| {
-            // SAFETY: `offset`, `count` describe a leaf of this tree.
-            let items = unsafe { self.indices.get_unchecked(offset..offset + count) };
-            for &i in items {
-                if let Some(t) = hit(i, best_t) {
-                    if t <= best_t && best.is_none_or(|(bi, bt)| t < bt || (t == bt && i < bi)) {
-                        best_t = t;
-                        best = Some((i, t));
+        self.walk(
+            ray,
+            &mut NoCounters,
+            &mut |offset, count, _: &mut NoCounters, closest: &mut f32| {
+                // SAFETY: `offset`, `count` describe a leaf of this tree.
+                let items = unsafe { self.indices.get_unchecked(offset..offset + count) };
+                for &i in items {
+                    if let Some(t) = hit(i, best_t) {
+                        if t <= best_t && best.is_none_or(|(bi, bt)| t < bt || (t == bt && i < bi))
+                        {
+                            best_t = t;
+                            best = Some((i, t));
+                        }
                     }
                 }
-            }
-            *closest = if best.is_some() {
-                best_t
-            } else {
-                f32::INFINITY
-            };
-            LeafResult::Continue
-        });
+                *closest = if best.is_some() {
+                    best_t
+                } else {
+                    f32::INFINITY
+                };
+                LeafResult::Continue
+            },
+        );
         best
     }
 
@@ -363,16 +428,20 @@ impl KdTree<Aabb> {
     /// through; stops at the first.
     pub fn any_with(&self, ray: &Ray, mut hit: impl FnMut(u32) -> bool) -> bool {
         let mut found = false;
-        self.walk(ray, &mut NoCounters, |offset, count, _, _| {
-            // SAFETY: `offset`, `count` describe a leaf of this tree.
-            let items = unsafe { self.indices.get_unchecked(offset..offset + count) };
-            if items.iter().any(|&i| hit(i)) {
-                found = true;
-                LeafResult::Stop
-            } else {
-                LeafResult::Continue
-            }
-        });
+        self.walk(
+            ray,
+            &mut NoCounters,
+            &mut |offset, count, _: &mut NoCounters, _: &mut f32| {
+                // SAFETY: `offset`, `count` describe a leaf of this tree.
+                let items = unsafe { self.indices.get_unchecked(offset..offset + count) };
+                if items.iter().any(|&i| hit(i)) {
+                    found = true;
+                    LeafResult::Stop
+                } else {
+                    LeafResult::Continue
+                }
+            },
+        );
         found
     }
 }
@@ -386,12 +455,7 @@ impl<P: Primitive> KdTree<P> {
     /// argument (infinity while there is none); cells entered beyond it are
     /// skipped.
     #[inline(always)]
-    fn walk<C: Counters>(
-        &self,
-        ray: &Ray,
-        counters: &mut C,
-        mut leaf: impl FnMut(usize, usize, &mut C, &mut f32) -> LeafResult,
-    ) {
+    fn walk<C: Counters>(&self, ray: &Ray, counters: &mut C, leaf: &mut impl LeafVisit<C>) {
         // `is_valid` rules out NaN bounds, so `>` is the whole test.
         if self.nodes.is_empty() || !ray.is_valid() || ray.tmin > ray.tmax {
             return;
@@ -462,7 +526,7 @@ impl<P: Primitive> KdTree<P> {
             let count = n.leaf_count() as usize;
             if count != 0 {
                 let offset = n.leaf_offset() as usize;
-                if let LeafResult::Stop = leaf(offset, count, counters, &mut closest) {
+                if let LeafResult::Stop = leaf.visit(offset, count, counters, &mut closest) {
                     return;
                 }
             }
