@@ -323,9 +323,12 @@ impl KdTree<Triangle> {
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
-                let i = indices[b * BLOCK_WIDTH + l];
                 let uvw = [e[0][l], e[1][l], e[2][l]];
                 if let Some(h) = shear.decide(&block.triangle(l), uvw, tmin, *best_t) {
+                    // The index only now: its load missed the cache on
+                    // most kept lanes (perf, random rays), and most kept
+                    // lanes are not hits within the interval.
+                    let i = indices[b * BLOCK_WIDTH + l];
                     if h.t < *best_t || i < best.tri {
                         *best_t = h.t;
                         *best = Hit {
