@@ -51,6 +51,9 @@ pub struct Hit {
 /// watertight test on the test suite's scales, far below any cell size.
 pub(crate) const MARGIN: f32 = 1.0 / 4096.0;
 
+/// Rays per work item of [`KdTree::closest_hits`] and [`KdTree::any_hits`].
+const BATCH: usize = 256;
+
 /// Depth bound of the traversal stack; builders never exceed it.
 pub const MAX_DEPTH: usize = 64;
 
@@ -371,19 +374,32 @@ impl KdTree<Triangle> {
     /// Closest hits of many rays, in parallel; `out[i]` answers `rays[i]`.
     pub fn closest_hits(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
-        rays.par_iter()
-            .zip(out.par_iter_mut())
-            .with_min_len(256)
-            .for_each(|(r, o)| *o = self.closest_hit(r));
+        // Work items of 256 rays, and every one its own job
+        // (`with_max_len(1)`): rayon otherwise splits a range only a few
+        // times unless a thief steals, so a costly quarter of an image can
+        // hold one thread while the other idles (teapot_stadium's camera
+        // rays scaled 1.30x on two threads that way).
+        rays.par_chunks(BATCH)
+            .zip(out.par_chunks_mut(BATCH))
+            .with_max_len(1)
+            .for_each(|(rs, os)| {
+                for (r, o) in rs.iter().zip(os) {
+                    *o = self.closest_hit(r);
+                }
+            });
     }
 
     /// Occlusion of many rays, in parallel; `out[i]` answers `rays[i]`.
     pub fn any_hits(&self, rays: &[Ray], out: &mut [bool]) {
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
-        rays.par_iter()
-            .zip(out.par_iter_mut())
-            .with_min_len(256)
-            .for_each(|(r, o)| *o = self.any_hit(r));
+        rays.par_chunks(BATCH)
+            .zip(out.par_chunks_mut(BATCH))
+            .with_max_len(1)
+            .for_each(|(rs, os)| {
+                for (r, o) in rs.iter().zip(os) {
+                    *o = self.any_hit(r);
+                }
+            });
     }
 }
 

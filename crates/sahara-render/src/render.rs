@@ -215,6 +215,9 @@ pub fn render(
         let abandon = AtomicBool::new(false);
         let outs: Vec<Option<TileOut>> = tiles
             .par_iter()
+            // One job per tile: rayon otherwise hands out a few large runs
+            // of tiles, and one costly run can leave the other cores idle.
+            .with_max_len(1)
             .map(|tile| {
                 if abandon.load(Ordering::Relaxed) || cancelled() || (pass > 0 && out_of_time()) {
                     abandon.store(true, Ordering::Relaxed);

@@ -41,6 +41,7 @@ fn meets_root(tree: &KdTree, ray: &Ray) -> bool {
 /// Count the traversal work of `rays` on the current rayon pool.
 pub fn count_set(tree: &KdTree, rays: &[Ray], query: Query) -> CountTotals {
     rays.par_chunks(CHUNK)
+        .with_max_len(1) // one job per chunk, as in `trace_into`
         .map(|chunk| {
             let mut t = CountTotals {
                 rays: chunk.len() as u64,

@@ -34,8 +34,13 @@ pub fn trace_one(tree: &KdTree, ray: &Ray, query: Query) -> HitRecord {
 /// If `out` and `rays` differ in length.
 pub fn trace_into(tree: &KdTree, rays: &[Ray], query: Query, out: &mut [HitRecord]) {
     assert_eq!(rays.len(), out.len(), "one record per ray");
+    // Every chunk its own job (`with_max_len(1)`): rayon otherwise splits
+    // the range only a few times unless a thief steals, and a costly
+    // quarter of the image held one thread while the other idled
+    // (teapot_stadium's camera rays: 1.30x on two threads, now 1.9x+).
     rays.par_chunks(CHUNK)
         .zip(out.par_chunks_mut(CHUNK))
+        .with_max_len(1)
         .for_each(|(rs, os)| match query {
             Query::ClosestHit => {
                 for (r, o) in rs.iter().zip(os) {
