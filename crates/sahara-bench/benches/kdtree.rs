@@ -2,8 +2,9 @@
 //! (read in place from the shared scenes, `$SAHARA_SCENES` to override):
 //! building each kind of tree, tracing the protocol's ray sets on one
 //! thread (closest hit for primary / diffuse / random, any hit for shadow),
-//! primary rays in 4x2 tiles as single rays and as packets, and the leaf
-//! block filter alone.
+//! primary rays in 4x2 tiles as single rays and as packets, and the two
+//! leaf tests alone (eight triangles against one ray, one triangle against
+//! eight rays; portable builds, as the benchmark binary is compiled).
 //!
 //! `cargo bench -p sahara-bench --bench kdtree`
 
@@ -12,6 +13,7 @@ use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize};
 use sahara_bench::{HitRecord, ProtocolCamera, SceneFrame};
 use sahara_kd::geometry::triangle::RayShear;
 use sahara_kd::geometry::triangle_block::BLOCK_WIDTH;
+use sahara_kd::geometry::triangle_packet::PacketShear;
 use sahara_kd::packet::PACKET;
 use sahara_kd::{BuildParams, Builder, KdTree, Ray, TriangleBlock};
 use sahara_render::mesh::Mesh;
@@ -149,6 +151,27 @@ fn trace(c: &mut Criterion) {
                 .map(|s| {
                     s.block_candidates(std::hint::black_box(&block), BLOCK_WIDTH)
                         .count_ones()
+                })
+                .sum::<u32>()
+        })
+    });
+    // The packet leaf test: the same rays eight at a time against each
+    // triangle of the block (the ray-parallel form of the filter above).
+    let packets: Vec<PacketShear> = shears.chunks(8).filter_map(PacketShear::new).collect();
+    assert_eq!(
+        packets.len() * 8,
+        shears.len(),
+        "rays aimed alike share a permutation"
+    );
+    g.bench_function("triangle_packet_8", |bench| {
+        bench.iter(|| {
+            let block = std::hint::black_box(&block);
+            packets
+                .iter()
+                .map(|p| {
+                    (0..BLOCK_WIDTH)
+                        .map(|j| p.triangle_edges(block, j).0.count_ones())
+                        .sum::<u32>()
                 })
                 .sum::<u32>()
         })
