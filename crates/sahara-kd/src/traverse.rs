@@ -513,13 +513,7 @@ impl<P: Primitive> KdTree<P> {
             if !n.is_leaf() {
                 counters.inner();
                 let axis = n.axis();
-                let below = node + 1;
-                let above = n.above_child();
-                let (near, far) = if neg[axis] {
-                    (above, below)
-                } else {
-                    (below, above)
-                };
+                let (near, far) = n.near_far(node, &neg);
                 // NaN when the ray lies in the plane (o = split, d = 0): then
                 // no comparison holds and both children get the whole
                 // interval, as they must.

@@ -69,6 +69,21 @@ impl Node {
         self.word1 >> 2
     }
 
+    /// The children of inner node `index` in the order a ray meets them:
+    /// `(near, far)`. A ray moving towards -axis (`neg[axis]`, the
+    /// direction's sign bit, so that d = -0 orders like `1/d = -inf`) meets
+    /// the cell above the plane first (Wald 2004).
+    #[inline(always)]
+    pub fn near_far(&self, index: u32, neg: &[bool; 3]) -> (u32, u32) {
+        let (below, above) = (index + 1, self.above_child());
+        debug_assert!(!self.is_leaf());
+        if neg[self.axis()] {
+            (above, below)
+        } else {
+            (below, above)
+        }
+    }
+
     /// Offset into the index array (leaves).
     #[inline(always)]
     pub fn leaf_offset(&self) -> u32 {

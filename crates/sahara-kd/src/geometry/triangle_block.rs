@@ -96,27 +96,46 @@ impl RayShear {
         lanes: usize,
     ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
         let v = &block.v;
-        let (ax, ay) = self.sheared(&v[0]);
-        let (bx, by) = self.sheared(&v[1]);
-        let (cx, cy) = self.sheared(&v[2]);
-        let mut keep = [false; BLOCK_WIDTH];
-        let mut e = [[0.0f32; BLOCK_WIDTH]; 3];
-        for l in 0..BLOCK_WIDTH {
-            let u = cx[l] * by[l] - cy[l] * bx[l];
-            let v = ax[l] * cy[l] - ay[l] * cx[l];
-            let w = bx[l] * ay[l] - by[l] * ax[l];
-            (e[0][l], e[1][l], e[2][l]) = (u, v, w);
-            let det = u + v + w;
-            let nonzero = u != 0.0 && v != 0.0 && w != 0.0;
-            let mixed = (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
-            keep[l] = !(nonzero && det.is_finite() && mixed);
-        }
-        let mut mask = 0u32;
-        for (l, &k) in keep.iter().enumerate() {
-            mask |= (k as u32) << l;
-        }
+        let (mask, e) = edge_lanes(
+            self.sheared(&v[0]),
+            self.sheared(&v[1]),
+            self.sheared(&v[2]),
+        );
         (mask & ((1u32 << lanes) - 1), e)
     }
+}
+
+/// Eight lanes of the watertight test's edge step: from the sheared
+/// vertices `a`, `b`, `c` (x and y lanes), the edge functions `[u, v, w]`
+/// and the mask of lanes the test may accept (bit `l` = lane `l`).
+///
+/// The expressions and their order are `RayShear::intersect`'s, so a lane
+/// left out is one the scalar test rejects early: its edge functions are
+/// non-zero with mixed signs and their sum is finite. Shared by the block
+/// test (lanes = triangles) and the packet test (lanes = rays).
+#[inline(always)]
+pub(crate) fn edge_lanes(
+    (ax, ay): ([f32; BLOCK_WIDTH], [f32; BLOCK_WIDTH]),
+    (bx, by): ([f32; BLOCK_WIDTH], [f32; BLOCK_WIDTH]),
+    (cx, cy): ([f32; BLOCK_WIDTH], [f32; BLOCK_WIDTH]),
+) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
+    let mut keep = [false; BLOCK_WIDTH];
+    let mut e = [[0.0f32; BLOCK_WIDTH]; 3];
+    for l in 0..BLOCK_WIDTH {
+        let u = cx[l] * by[l] - cy[l] * bx[l];
+        let v = ax[l] * cy[l] - ay[l] * cx[l];
+        let w = bx[l] * ay[l] - by[l] * ax[l];
+        (e[0][l], e[1][l], e[2][l]) = (u, v, w);
+        let det = u + v + w;
+        let nonzero = u != 0.0 && v != 0.0 && w != 0.0;
+        let mixed = (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
+        keep[l] = !(nonzero && det.is_finite() && mixed);
+    }
+    let mut mask = 0u32;
+    for (l, &k) in keep.iter().enumerate() {
+        mask |= (k as u32) << l;
+    }
+    (mask, e)
 }
 
 #[cfg(test)]

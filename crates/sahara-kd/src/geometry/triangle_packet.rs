@@ -16,7 +16,12 @@
 //! --counters`), where the packet test does a half to a quarter of the work.
 
 use super::triangle::RayShear;
-use super::triangle_block::{TriangleBlock, BLOCK_WIDTH};
+use super::triangle_block::{edge_lanes, TriangleBlock, BLOCK_WIDTH};
+
+const _: () = assert!(
+    RAYS == BLOCK_WIDTH,
+    "the packet test reuses the block's 8-lane edge step"
+);
 
 /// Rays per packet test.
 pub const RAYS: usize = 8;
@@ -88,27 +93,12 @@ impl PacketShear {
             let v = &block.v[k];
             [v[0][lane], v[1][lane], v[2][lane]]
         };
-        let (ax, ay) = self.sheared(vertex(0));
-        let (bx, by) = self.sheared(vertex(1));
-        let (cx, cy) = self.sheared(vertex(2));
-        let mut keep = [false; RAYS];
-        let mut e = [[0.0f32; RAYS]; 3];
-        for l in 0..RAYS {
-            // The expressions of `RayShear::block_edges`, lane for lane.
-            let u = cx[l] * by[l] - cy[l] * bx[l];
-            let v = ax[l] * cy[l] - ay[l] * cx[l];
-            let w = bx[l] * ay[l] - by[l] * ax[l];
-            (e[0][l], e[1][l], e[2][l]) = (u, v, w);
-            let det = u + v + w;
-            let nonzero = u != 0.0 && v != 0.0 && w != 0.0;
-            let mixed = (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
-            keep[l] = !(nonzero && det.is_finite() && mixed);
-        }
-        let mut mask = 0u32;
-        for (l, &k) in keep.iter().enumerate() {
-            mask |= (k as u32) << l;
-        }
-        (mask, e)
+        // Lanes are rays here; the step is the block test's, lane for lane.
+        edge_lanes(
+            self.sheared(vertex(0)),
+            self.sheared(vertex(1)),
+            self.sheared(vertex(2)),
+        )
     }
 }
 

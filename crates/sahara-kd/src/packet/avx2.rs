@@ -54,13 +54,7 @@ impl KdTree<Triangle> {
             let nd = unsafe { *self.nodes.get_unchecked(node as usize) };
             if !nd.is_leaf() {
                 let axis = nd.axis();
-                let below = node + 1;
-                let above = nd.above_child();
-                let (near, far) = if p.neg[axis] {
-                    (above, below)
-                } else {
-                    (below, above)
-                };
+                let (near, far) = nd.near_far(node, &p.neg);
                 // SAFETY: `axis` < 3 for an inner node.
                 let (o, iv) = unsafe { (*org.get_unchecked(axis), *inv.get_unchecked(axis)) };
                 let tp = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(nd.split()), o), iv);

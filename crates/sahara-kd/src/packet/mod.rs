@@ -186,13 +186,7 @@ impl KdTree<Triangle> {
             if !nd.is_leaf() {
                 let axis = nd.axis();
                 let split = nd.split();
-                let below = node + 1;
-                let above = nd.above_child();
-                let (near, far) = if p.neg[axis] {
-                    (above, below)
-                } else {
-                    (below, above)
-                };
+                let (near, far) = nd.near_far(node, &p.neg);
                 // Each lane decides as `walk` does (same expressions, so the
                 // same rounding): near only, far only, or both with the
                 // interval cut at the plane.
