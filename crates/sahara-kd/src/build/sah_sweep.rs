@@ -108,15 +108,17 @@ pub fn build<P: Primitive>(
     params: &BuildParams,
 ) -> Subtree {
     let budget = params.reference_budget(live.len());
-    let bounds_of = |t: &u32| triangles[*t as usize].bounds();
-    let refs: Vec<Aabb> = live.iter().map(bounds_of).collect();
+    let tri_bounds: Vec<Aabb> = live
+        .iter()
+        .map(|&t| triangles[t as usize].bounds())
+        .collect();
     let ctx = Ctx {
         triangles,
         budget: &budget,
         params,
         max_depth: params.depth_limit(live.len()),
     };
-    recurse(&ctx, initial_work(live, &refs, bounds, 0, params))
+    recurse(&ctx, initial_work(live, &tri_bounds, bounds, 0, params))
 }
 
 /// Build the subtree of one cell of another build (the binned builder's
@@ -333,8 +335,9 @@ fn child<P: Primitive>(
 /// scratch list, whose write position advances only for kept ones): the
 /// branchy filter-and-merge it replaces was a quarter of the exact build's
 /// profile, most of it mispredicted "kept?" branches. The result is then
-/// allocated at its exact size, so the build's peak memory stays what it
-/// was (an in-place merge in a parent-sized list raised it by half).
+/// allocated at its exact size: the dragon build's peak memory went from
+/// 217 to 236–246 MB this way, where an in-place merge in a parent-sized
+/// list took 315 MB.
 fn filter_merge(parent: &[Event], remap: &[u32], fresh: &[Event]) -> Vec<Event> {
     thread_local! {
         static SCRATCH: std::cell::RefCell<Vec<Event>> = const { std::cell::RefCell::new(Vec::new()) };

@@ -45,6 +45,7 @@ struct Entry {
 /// The empty interval that masks a lane off.
 const OFF: (f32, f32) = (f32::INFINITY, f32::NEG_INFINITY);
 
+/// The best hit of a ray that has none yet.
 const NO_HIT: Hit = Hit {
     t: f32::INFINITY,
     tri: u32::MAX,
