@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 use crate::geometry::triangle::RayShear;
 use crate::geometry::triangle_block::BLOCK_WIDTH;
-use crate::geometry::{Aabb, Primitive, Ray, Triangle, TriangleBlock};
+use crate::geometry::{Aabb, Primitive, Ray, Triangle, TriangleBlock, TriangleHit};
 use crate::tree::KdTree;
 
 /// Run-time CPU feature selection: the release binary targets baseline
@@ -38,6 +38,22 @@ pub struct Hit {
     pub u: f32,
     /// Barycentric weight of `v2`.
     pub v: f32,
+}
+
+/// Make `h`, a hit on triangle `i` with `h.t <= *best_t`, the best hit if
+/// it is closer, or as close with a smaller index (the tie rule every query
+/// and the brute-force oracle share).
+#[inline(always)]
+pub(crate) fn keep_closer(best_t: &mut f32, best: &mut Hit, h: TriangleHit, i: u32) {
+    if h.t < *best_t || i < best.tri {
+        *best_t = h.t;
+        *best = Hit {
+            t: h.t,
+            tri: i,
+            u: h.u,
+            v: h.v,
+        };
+    }
 }
 
 /// Relative slack on the traversal's distance comparisons.
@@ -332,15 +348,7 @@ impl KdTree<Triangle> {
                     // most kept lanes (perf, random rays), and most kept
                     // lanes are not hits within the interval.
                     let i = indices[b * BLOCK_WIDTH + l];
-                    if h.t < *best_t || i < best.tri {
-                        *best_t = h.t;
-                        *best = Hit {
-                            t: h.t,
-                            tri: i,
-                            u: h.u,
-                            v: h.v,
-                        };
-                    }
+                    keep_closer(best_t, best, h, i);
                 }
             }
         }

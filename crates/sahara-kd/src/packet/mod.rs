@@ -26,7 +26,7 @@ use crate::geometry::triangle::RayShear;
 use crate::geometry::triangle_block::BLOCK_WIDTH;
 use crate::geometry::triangle_packet::PacketShear;
 use crate::geometry::{Ray, Triangle};
-use crate::traverse::{Hit, NoCounters, MARGIN, MAX_DEPTH};
+use crate::traverse::{keep_closer, Hit, NoCounters, MARGIN, MAX_DEPTH};
 use crate::tree::KdTree;
 
 /// Rays per packet.
@@ -345,15 +345,7 @@ impl KdTree<Triangle> {
                     m &= m - 1;
                     let uvw = [e[0][l], e[1][l], e[2][l]];
                     if let Some(h) = p.shear[l].decide(&tri, uvw, p.tmin[l], p.best_t[l]) {
-                        if h.t < p.best_t[l] || i < p.best[l].tri {
-                            p.best_t[l] = h.t;
-                            p.best[l] = Hit {
-                                t: h.t,
-                                tri: i,
-                                u: h.u,
-                                v: h.v,
-                            };
-                        }
+                        keep_closer(&mut p.best_t[l], &mut p.best[l], h, i);
                     }
                 }
             }
