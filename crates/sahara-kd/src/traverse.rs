@@ -559,16 +559,12 @@ impl<P: Primitive> KdTree<P> {
                 sp -= 1;
                 // SAFETY: entries below `sp` were written by the push above.
                 let e = unsafe { stack[sp].assume_init() };
-                // Entries lie front to back from the top down (a cell pushed
-                // later lies inside the near part of one pushed earlier), so
-                // once the top one lies beyond the closest hit, all do.
-                if e.t0 > closest * (1.0 + MARGIN) {
-                    return;
+                if e.t0 <= closest * (1.0 + MARGIN) {
+                    node = e.node;
+                    t0 = e.t0;
+                    t1 = e.t1;
+                    break;
                 }
-                node = e.node;
-                t0 = e.t0;
-                t1 = e.t1;
-                break;
             }
         }
     }
