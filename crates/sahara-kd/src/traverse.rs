@@ -551,7 +551,11 @@ impl<P: Primitive> KdTree<P> {
                     return;
                 }
             }
-            // Pop the next cell that may still hold a closer hit.
+            // Pop the next cell that may still hold a closer hit. Every
+            // entry is checked: a ray lying in a split plane gives both
+            // children its whole interval, so entries are not always front
+            // to back and the first one beyond the hit does not end the walk
+            // (the property tests found such a ray).
             loop {
                 if sp == 0 {
                     return;

