@@ -1,6 +1,6 @@
 //! Triangles and the watertight ray/triangle test.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 
 use super::{Aabb, Ray};
 
@@ -68,7 +68,7 @@ impl Triangle {
             return false;
         }
         let [a, b, c] = self.v.map(|p| p.as_dvec3());
-        (b - a).cross(c - a) != glam::DVec3::ZERO
+        (b - a).cross(c - a) != DVec3::ZERO
     }
 
     /// Twice the area (length of the edge cross product).
@@ -182,7 +182,7 @@ impl RayShear {
             }
             ((v / det) as f32, (w / det) as f32)
         };
-        let t = plane_distance(tri, self.origin, self.dir);
+        let t = TrianglePlane::new(tri).distance(self.origin, self.dir);
         // `tmin` is exclusive, as Embree's `tnear`: a hit at the origin itself
         // is not a hit. Besides sparing a ray leaving a surface its own
         // triangle, this settles hits that exist only by rounding: a ray
@@ -212,6 +212,22 @@ impl RayShear {
     pub fn decide(
         &self,
         tri: &Triangle,
+        uvw: [f32; 3],
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<TriangleHit> {
+        self.decide_in_plane(tri, || TrianglePlane::new(tri), uvw, tmin, tmax)
+    }
+
+    /// [`RayShear::decide`] with the triangle's plane from `plane`, called
+    /// only when the hit distance is needed: the packet test computes it
+    /// once per triangle for all the rays it decides (the same bits as
+    /// computing it per ray).
+    #[inline(always)]
+    pub fn decide_in_plane(
+        &self,
+        tri: &Triangle,
+        plane: impl FnOnce() -> TrianglePlane,
         [u, v, w]: [f32; 3],
         tmin: f32,
         tmax: f32,
@@ -224,7 +240,7 @@ impl RayShear {
             return None;
         }
         let rcp = 1.0 / det;
-        let t = plane_distance(tri, self.origin, self.dir);
+        let t = plane().distance(self.origin, self.dir);
         // As in `intersect`.
         if !(t > tmin && t <= tmax) {
             return None;
@@ -237,8 +253,8 @@ impl RayShear {
     }
 }
 
-/// The distance along `o + t d` to the triangle's plane, computed in f64
-/// from the plane equation `t = ((v0 - o) . n) / (d . n)`.
+/// A triangle's plane in f64, for the hit distance along `o + t d` from the
+/// plane equation `t = ((v0 - o) . n) / (d . n)`.
 ///
 /// The paper's `t = (U Az + V Bz + W Cz) / det` sums vertex depths that
 /// cancel when the vertices lie much farther from the origin than the hit
@@ -247,12 +263,29 @@ impl RayShear {
 /// evaluated only for rays that passed the edge test, so it costs little.
 /// Its absolute error grows with the vertices' distance from the origin
 /// (~1e-16 of it): a triangle 1e30 away cannot place a hit 3 units away.
-#[inline(always)]
-fn plane_distance(tri: &Triangle, o: Vec3, d: Vec3) -> f32 {
-    let v0 = tri.v[0].as_dvec3();
-    let n = (tri.v[1].as_dvec3() - v0).cross(tri.v[2].as_dvec3() - v0);
-    let den = d.as_dvec3().dot(n);
-    ((v0 - o.as_dvec3()).dot(n) / den) as f32
+#[derive(Clone, Copy, Debug)]
+pub struct TrianglePlane {
+    /// The first vertex.
+    v0: DVec3,
+    /// The (unnormalised) normal `(v1 - v0) x (v2 - v0)`.
+    n: DVec3,
+}
+
+impl TrianglePlane {
+    /// The plane of `tri`, in f64.
+    #[inline(always)]
+    pub fn new(tri: &Triangle) -> Self {
+        let v0 = tri.v[0].as_dvec3();
+        let n = (tri.v[1].as_dvec3() - v0).cross(tri.v[2].as_dvec3() - v0);
+        Self { v0, n }
+    }
+
+    /// The distance along `o + t d` to the plane, rounded to f32.
+    #[inline(always)]
+    pub fn distance(&self, o: Vec3, d: Vec3) -> f32 {
+        let den = d.as_dvec3().dot(self.n);
+        ((self.v0 - o.as_dvec3()).dot(self.n) / den) as f32
+    }
 }
 
 /// Convenience: the watertight test of one ray against one triangle.

@@ -22,7 +22,7 @@ mod avx2;
 
 use glam::Vec3;
 
-use crate::geometry::triangle::RayShear;
+use crate::geometry::triangle::{RayShear, TrianglePlane};
 use crate::geometry::triangle_block::BLOCK_WIDTH;
 use crate::geometry::triangle_packet::PacketShear;
 use crate::geometry::{Ray, Triangle};
@@ -340,11 +340,14 @@ impl KdTree<Triangle> {
                 }
                 let i = indices[b * BLOCK_WIDTH + j];
                 let tri = block.triangle(j);
+                // The plane once for all the rays that need it.
+                let plane = TrianglePlane::new(&tri);
                 while m != 0 {
                     let l = m.trailing_zeros() as usize;
                     m &= m - 1;
                     let uvw = [e[0][l], e[1][l], e[2][l]];
-                    if let Some(h) = p.shear[l].decide(&tri, uvw, p.tmin[l], p.best_t[l]) {
+                    let (tmin, tmax) = (p.tmin[l], p.best_t[l]);
+                    if let Some(h) = p.shear[l].decide_in_plane(&tri, || plane, uvw, tmin, tmax) {
                         keep_closer(&mut p.best_t[l], &mut p.best[l], h, i);
                     }
                 }
