@@ -2,15 +2,17 @@
 //! (read in place from the shared scenes, `$SAHARA_SCENES` to override):
 //! building each kind of tree, tracing the protocol's ray sets on one
 //! thread (closest hit for primary / diffuse / random, any hit for shadow),
-//! primary rays in 4x2 tiles as single rays and as packets, and the two
+//! primary rays in 4x2 tiles as single rays and as packets, and the
 //! leaf tests alone (eight triangles against one ray, one triangle against
-//! eight rays; portable builds, as the benchmark binary is compiled).
+//! eight rays, eight triangles against a packet's frustum; portable builds,
+//! as the benchmark binary is compiled).
 //!
 //! `cargo bench -p sahara-bench --bench kdtree`
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize};
 use sahara_bench::{HitRecord, ProtocolCamera, SceneFrame};
+use sahara_kd::geometry::frustum::Frustum;
 use sahara_kd::geometry::triangle::RayShear;
 use sahara_kd::geometry::triangle_block::BLOCK_WIDTH;
 use sahara_kd::geometry::triangle_packet::PacketShear;
@@ -173,6 +175,22 @@ fn trace(c: &mut Criterion) {
                         .map(|j| p.triangle_edges(block, j).0.count_ones())
                         .sum::<u32>()
                 })
+                .sum::<u32>()
+        })
+    });
+    // The packet's frustum cull: the same packets' frusta against the
+    // block's eight triangles at once (what runs before the test above).
+    let frusta: Vec<Frustum> = shears
+        .chunks(8)
+        .filter_map(|s| Frustum::new(s, 0xff))
+        .collect();
+    assert_eq!(frusta.len(), packets.len(), "camera rays share an origin");
+    g.bench_function("frustum_cull_8", |bench| {
+        bench.iter(|| {
+            let block = std::hint::black_box(&block);
+            frusta
+                .iter()
+                .map(|f| f.survivors(block, BLOCK_WIDTH).count_ones())
                 .sum::<u32>()
         })
     });

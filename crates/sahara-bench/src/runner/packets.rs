@@ -90,7 +90,6 @@ pub fn measure_packets(
         best_cpu = best_cpu.min(thread_cpu_seconds() - c0);
         best = best.min(t0.elapsed().as_secs_f64());
     }
-    eprintln!("DBG packets {:.3}", mrays_per_sec(rays.len(), best_cpu));
     let agrees = out.len() == reference.len()
         && out
             .iter()

@@ -126,7 +126,6 @@ impl Aabb {
         tmin: f32,
         tmax: f32,
     ) -> Option<(f32, f32)> {
-        const GROW: f32 = 1.0 + 2.0 * gamma(3);
         let mut t0 = tmin;
         let mut t1 = tmax;
         for a in 0..3 {
@@ -144,7 +143,7 @@ impl Aabb {
             if near > far {
                 std::mem::swap(&mut near, &mut far);
             }
-            far *= GROW;
+            far *= FAR_GROW;
             // Written so that a NaN `near`/`far` leaves the interval unchanged.
             t0 = if near > t0 { near } else { t0 };
             t1 = if far < t1 { far } else { t1 };
@@ -155,6 +154,10 @@ impl Aabb {
         Some((t0, t1))
     }
 }
+
+/// The factor `1 + 2 gamma(3)` by which [`Aabb::intersect_ray`] enlarges
+/// the far distance.
+pub const FAR_GROW: f32 = 1.0 + 2.0 * gamma(3);
 
 /// pbrt's `gamma(n) = n u / (1 - n u)` bound on the relative error of `n`
 /// rounded f32 operations (u = machine epsilon / 2).

@@ -2,6 +2,7 @@
 
 pub mod aabb;
 pub mod clip;
+pub mod frustum;
 pub mod primitive;
 pub mod ray;
 pub mod triangle;

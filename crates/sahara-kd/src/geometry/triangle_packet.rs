@@ -67,6 +67,14 @@ impl PacketShear {
         Some(p)
     }
 
+    /// The packet form of rays that share the permutation `k`, from their
+    /// origins along `kx`, `ky`, `kz` and their constants `sx`, `sy` by
+    /// lane (what [`PacketShear::new`] gathers from `RayShear`s).
+    #[inline(always)]
+    pub fn from_lanes(k: [usize; 3], o: [Lanes; 3], sx: Lanes, sy: Lanes) -> Self {
+        Self { k, o, sx, sy }
+    }
+
     /// One vertex (coordinates `p`) moved to each ray's origin and sheared,
     /// as `RayShear::sheared` does for one ray.
     #[inline(always)]

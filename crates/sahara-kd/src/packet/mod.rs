@@ -9,8 +9,10 @@
 //! least one ray's interval reaches it, and rays that do not are masked off
 //! there. The per-ray interval arithmetic is the single-ray traversal's,
 //! eight lanes at a time: [`avx2`] with AVX2 intrinsics where the CPU has
-//! them (chosen at run time), the portable walk here otherwise. Leaves are
-//! tested triangle by triangle for all rays at once
+//! them (chosen at run time), the portable walk here otherwise. A leaf's
+//! triangles are first culled eight at a time against the packet's frustum
+//! when its rays share an origin ([`crate::geometry::frustum`]); each block's
+//! survivors are then tested triangle by triangle for all rays at once
 //! ([`crate::geometry::triangle_packet`]) or ray by ray with the block test,
 //! whichever takes fewer tests. Results are bit-identical to
 //! [`KdTree::closest_hit`].
@@ -19,14 +21,14 @@
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+mod setup;
 
-use glam::Vec3;
-
-use crate::geometry::triangle::{RayShear, TrianglePlane};
+use crate::geometry::frustum::Frustum;
+use crate::geometry::triangle::TrianglePlane;
 use crate::geometry::triangle_block::BLOCK_WIDTH;
 use crate::geometry::triangle_packet::PacketShear;
-use crate::geometry::{Ray, Triangle};
-use crate::traverse::{keep_closer, Hit, NoCounters, MARGIN, MAX_DEPTH};
+use crate::geometry::{Ray, Triangle, TriangleBlock};
+use crate::traverse::{keep_closer, Hit, MARGIN, MAX_DEPTH};
 use crate::tree::KdTree;
 
 /// Rays per packet.
@@ -67,10 +69,17 @@ struct Packet {
     t1: Lanes,
     /// The rays' `tmin`.
     tmin: Lanes,
-    /// Each ray's watertight-test constants.
-    shear: [RayShear; PACKET],
-    /// Their packet form, when the live rays share a permutation.
+    /// Directions by axis.
+    dir: [Lanes; 3],
+    /// The watertight test's permutation, when the live rays share it.
+    k: Option<[usize; 3]>,
+    /// With `k`: the rays' shear constants `sx`, `sy`, `sz` by lane (see
+    /// [`Packet::shear`]).
+    s: [Lanes; 3],
+    /// The packet form of the watertight test, with `k`.
     packet_shear: Option<PacketShear>,
+    /// The live rays' frustum, when they also share their origin.
+    frustum: Option<Frustum>,
     /// The closest hit's `t` so far (the ray's `tmax` while there is none).
     best_t: Lanes,
     /// The closest hit so far (`tri == u32::MAX`: none).
@@ -89,20 +98,43 @@ impl KdTree<Triangle> {
     pub fn closest_hit_packet(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         assert!(rays.len() <= PACKET, "{} rays in a packet", rays.len());
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
-        let Some(mut p) = self.packet(rays) else {
-            for (r, o) in rays.iter().zip(out.iter_mut()) {
-                *o = self.closest_hit(r);
-            }
-            return;
-        };
         #[cfg(target_arch = "x86_64")]
         if crate::traverse::simd::avx2() {
             // SAFETY: the CPU has AVX2 (checked at run time).
-            unsafe { self.walk_packet_avx2(&mut p) };
-            return finish(&p, out);
+            return unsafe { self.closest_hit_packet_avx2(rays, out) };
         }
-        self.walk_packet_portable(&mut p);
-        finish(&p, out)
+        match self.packet(rays) {
+            Some(mut p) => {
+                self.walk_packet_portable(&mut p);
+                finish(&p, out);
+            }
+            None => self.closest_hits_one_by_one(rays, out),
+        }
+    }
+
+    /// [`KdTree::closest_hit_packet`] with the set-up and the walk compiled
+    /// for AVX2.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn closest_hit_packet_avx2(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        match self.packet(rays) {
+            Some(mut p) => {
+                // SAFETY: the CPU has AVX2 (the caller's contract).
+                unsafe { self.walk_packet_avx2(&mut p) };
+                finish(&p, out);
+            }
+            None => self.closest_hits_one_by_one(rays, out),
+        }
+    }
+
+    /// The rays of a packet that cannot be traced together, one by one.
+    fn closest_hits_one_by_one(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        for (r, o) in rays.iter().zip(out.iter_mut()) {
+            *o = self.closest_hit(r);
+        }
     }
 
     /// Closest hits of many rays in packets of [`PACKET`] consecutive rays
@@ -116,60 +148,12 @@ impl KdTree<Triangle> {
 
     /// The packet of `rays`, or `None` when they must be traced one by one
     /// (no rays, an empty tree, or direction signs that differ).
+    #[inline(always)]
     fn packet(&self, rays: &[Ray]) -> Option<Packet> {
-        let signs = |r: &Ray| {
-            [
-                r.dir.x.is_sign_negative(),
-                r.dir.y.is_sign_negative(),
-                r.dir.z.is_sign_negative(),
-            ]
-        };
-        let neg = signs(rays.first()?);
-        if self.nodes.is_empty() || rays.iter().any(|r| signs(r) != neg) {
+        if self.nodes.is_empty() {
             return None;
         }
-        let mut p = Packet {
-            neg,
-            org: [[0.0; PACKET]; 3],
-            inv: [[0.0; PACKET]; 3],
-            t0: [OFF.0; PACKET],
-            t1: [OFF.1; PACKET],
-            tmin: [0.0; PACKET],
-            shear: [RayShear::new(Vec3::ZERO, Vec3::Z); PACKET],
-            packet_shear: None,
-            best_t: [0.0; PACKET],
-            best: [NO_HIT; PACKET],
-            closest: [f32::INFINITY; PACKET],
-        };
-        for (l, r) in rays.iter().enumerate() {
-            p.best_t[l] = r.tmax;
-            p.tmin[l] = r.tmin;
-            if !r.is_valid() || r.tmin > r.tmax {
-                continue;
-            }
-            let inv_dir = Vec3::ONE / r.dir;
-            if let Some((a, b)) = self.bounds.intersect_ray(r.origin, inv_dir, r.tmin, r.tmax) {
-                (p.t0[l], p.t1[l]) = (a, b);
-                for k in 0..3 {
-                    p.org[k][l] = r.origin[k];
-                    p.inv[k][l] = inv_dir[k];
-                }
-                p.shear[l] = RayShear::from_ray(r);
-            }
-        }
-        // Lanes that are off borrow a live lane's shear, so that only the
-        // live rays decide whether the permutations agree.
-        p.packet_shear = (0..PACKET).find(|&l| p.t0[l] <= p.t1[l]).and_then(|first| {
-            let mut s = p.shear;
-            for (l, s) in s.iter_mut().enumerate() {
-                let live = p.t0[l] <= p.t1[l];
-                if !live {
-                    *s = p.shear[first];
-                }
-            }
-            PacketShear::new(&s)
-        });
-        Some(p)
+        Packet::setup(rays, &self.bounds)
     }
 
     /// The portable packet walk (for CPUs without AVX2; the reference the
@@ -268,7 +252,9 @@ impl KdTree<Triangle> {
     }
 
     /// Test the leaf at `offset` with `count` triangles for the rays in
-    /// `live` (bit `l` = ray `l`) and update their closest hits.
+    /// `live` (bit `l` = ray `l`) and update their closest hits exactly as
+    /// [`KdTree::leaf_closest`] does ray by ray (the smallest `t`, then the
+    /// smallest index, wins).
     ///
     /// # Safety
     /// `offset` and `count` must be those of a leaf of this tree.
@@ -277,32 +263,26 @@ impl KdTree<Triangle> {
         if count == 0 || live == 0 {
             return;
         }
-        // Ray-parallel when it takes fewer tests: `c` triangle tests for
-        // the packet against `ceil(c / 8)` block tests per ray.
-        let ray_tests = live.count_ones() as usize * count.div_ceil(BLOCK_WIDTH);
-        match p.packet_shear {
-            Some(ps) if ray_tests >= count => {
-                // SAFETY: passed on from the caller.
-                unsafe { self.leaf_closest_packet(&ps, p, live, offset, count) };
+        // SAFETY: passed on from the caller.
+        let (blocks, indices) = unsafe { self.leaf_blocks(offset, count) };
+        let rays = live.count_ones();
+        for (b, block) in blocks.iter().enumerate() {
+            let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
+            let tris = match &p.frustum {
+                Some(f) => f.survivors(block, lanes),
+                None => (1u32 << lanes) - 1,
+            };
+            if tris == 0 {
+                continue;
             }
-            _ => {
-                let mut m = live;
-                while m != 0 {
-                    let l = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    // SAFETY: passed on from the caller.
-                    unsafe {
-                        self.leaf_closest(
-                            &p.shear[l],
-                            p.tmin[l],
-                            offset,
-                            count,
-                            &mut p.best_t[l],
-                            &mut p.best[l],
-                            &mut NoCounters,
-                        )
-                    };
+            let indices = &indices[b * BLOCK_WIDTH..(b + 1) * BLOCK_WIDTH];
+            // Triangle-parallel when it takes fewer tests: one 8-ray test
+            // per triangle left against one 8-triangle test per ray.
+            match p.packet_shear {
+                Some(ps) if rays >= tris.count_ones() => {
+                    block_closest_packet(&ps, p, block, indices, tris, live)
                 }
+                _ => block_closest_rays(p, block, indices, lanes, tris, live),
             }
         }
         for l in 0..PACKET {
@@ -311,46 +291,70 @@ impl KdTree<Triangle> {
             }
         }
     }
+}
 
-    /// The closest-hit test of one leaf for the rays in `live`, triangle by
-    /// triangle with all rays at once; updates the closest hits exactly as
-    /// [`KdTree::leaf_closest`] does ray by ray (the smallest `t`, then the
-    /// smallest index, wins).
-    ///
-    /// # Safety
-    /// `offset` and `count` must be those of a leaf of this tree.
-    #[inline(always)]
-    unsafe fn leaf_closest_packet(
-        &self,
-        ps: &PacketShear,
-        p: &mut Packet,
-        live: u32,
-        offset: usize,
-        count: usize,
-    ) {
-        // SAFETY: passed on from the caller.
-        let (blocks, indices) = unsafe { self.leaf_blocks(offset, count) };
-        for (b, block) in blocks.iter().enumerate() {
-            let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
-            for j in 0..lanes {
-                let (m, e) = ps.triangle_edges(block, j);
-                let mut m = m & live;
-                if m == 0 {
-                    continue;
-                }
-                let i = indices[b * BLOCK_WIDTH + j];
-                let tri = block.triangle(j);
-                // The plane once for all the rays that need it.
-                let plane = TrianglePlane::new(&tri);
-                while m != 0 {
-                    let l = m.trailing_zeros() as usize;
-                    m &= m - 1;
-                    let uvw = [e[0][l], e[1][l], e[2][l]];
-                    let (tmin, tmax) = (p.tmin[l], p.best_t[l]);
-                    if let Some(h) = p.shear[l].decide_in_plane(&tri, || plane, uvw, tmin, tmax) {
-                        keep_closer(&mut p.best_t[l], &mut p.best[l], h, i);
-                    }
-                }
+/// The triangles `tris` of `block` (indices `indices`) against the rays in
+/// `live`, one triangle at a time for all rays.
+#[inline(always)]
+fn block_closest_packet(
+    ps: &PacketShear,
+    p: &mut Packet,
+    block: &TriangleBlock,
+    indices: &[u32],
+    tris: u32,
+    live: u32,
+) {
+    let mut t = tris;
+    while t != 0 {
+        let j = t.trailing_zeros() as usize;
+        t &= t - 1;
+        let (m, e) = ps.triangle_edges(block, j);
+        let mut m = m & live;
+        if m == 0 {
+            continue;
+        }
+        let i = indices[j];
+        let tri = block.triangle(j);
+        // The plane once for all the rays that need it.
+        let plane = TrianglePlane::new(&tri);
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let uvw = [e[0][l], e[1][l], e[2][l]];
+            let (tmin, tmax) = (p.tmin[l], p.best_t[l]);
+            if let Some(h) = p.shear(l).decide_in_plane(&tri, || plane, uvw, tmin, tmax) {
+                keep_closer(&mut p.best_t[l], &mut p.best[l], h, i);
+            }
+        }
+    }
+}
+
+/// The triangles `tris` among the first `lanes` of `block` against the rays
+/// in `live`, one ray at a time with the block test (as
+/// [`KdTree::leaf_closest`] does).
+#[inline(always)]
+fn block_closest_rays(
+    p: &mut Packet,
+    block: &TriangleBlock,
+    indices: &[u32],
+    lanes: usize,
+    tris: u32,
+    live: u32,
+) {
+    let mut r = live;
+    while r != 0 {
+        let l = r.trailing_zeros() as usize;
+        r &= r - 1;
+        let shear = p.shear(l);
+        let (m, e) = shear.block_edges(block, lanes);
+        let mut m = m & tris;
+        while m != 0 {
+            let j = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let uvw = [e[0][j], e[1][j], e[2][j]];
+            let (tmin, tmax) = (p.tmin[l], p.best_t[l]);
+            if let Some(h) = shear.decide(&block.triangle(j), uvw, tmin, tmax) {
+                keep_closer(&mut p.best_t[l], &mut p.best[l], h, indices[j]);
             }
         }
     }
@@ -365,11 +369,7 @@ impl KdTree<Triangle> {
                 self.walk_packet_portable(&mut p);
                 finish(&p, out);
             }
-            None => {
-                for (r, o) in rays.iter().zip(out.iter_mut()) {
-                    *o = self.closest_hit(r);
-                }
-            }
+            None => self.closest_hits_one_by_one(rays, out),
         }
     }
 }
@@ -387,6 +387,7 @@ mod tests {
     use crate::brute;
     use crate::build::{BuildParams, Builder};
     use crate::test_support::{floats, soup};
+    use glam::Vec3;
 
     /// Camera-like packets (a common origin, nearby directions), packets
     /// with mixed direction signs, short ones and invalid rays: every
