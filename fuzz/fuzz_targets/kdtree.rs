@@ -38,6 +38,10 @@ enum RayIn {
         tri: u8,
         weights: [u8; 3],
     },
+    /// As `Toward`, from the input's shared `eye`: packets of these rays
+    /// share their origin, so the packet path culls against their frustum
+    /// (and rays aimed at vertices and edges lie on its planes).
+    FromEye { tri: u8, weights: [u8; 3] },
 }
 
 #[derive(Arbitrary, Debug)]
@@ -45,6 +49,7 @@ struct Input {
     scale: i8,
     triangles: Vec<[[Coord; 3]; 3]>,
     rays: Vec<(RayIn, Option<Coord>, Option<Coord>)>,
+    eye: [Coord; 3],
     bins: u8,
     max_depth: Option<u8>,
     max_leaf_size: u8,
@@ -103,28 +108,32 @@ fuzz_target!(|input: Input| {
         .iter()
         .take(24)
         .map(|(r, tmin, tmax)| {
+            // From `o` towards the point of triangle `tri` with weights
+            // `weights` (its first vertex if they are all zero).
+            let toward = |o: [Coord; 3], tri: u8, weights: [u8; 3]| {
+                let o = point(o, scale);
+                let target = match triangles.get(usize::from(tri)) {
+                    Some(t) => {
+                        let w = weights.map(f32::from);
+                        let sum = w[0] + w[1] + w[2];
+                        if sum == 0.0 {
+                            t.v[0]
+                        } else {
+                            (t.v[0] * w[0] + t.v[1] * w[1] + t.v[2] * w[2]) / sum
+                        }
+                    }
+                    None => Vec3::ZERO,
+                };
+                (o, target - o)
+            };
             let (origin, dir) = match *r {
                 RayIn::Free { origin, dir } => (point(origin, scale), point(dir, scale)),
                 RayIn::Toward {
                     origin,
                     tri,
                     weights,
-                } => {
-                    let o = point(origin, scale);
-                    let target = match triangles.get(usize::from(tri)) {
-                        Some(t) => {
-                            let w = weights.map(f32::from);
-                            let sum = w[0] + w[1] + w[2];
-                            if sum == 0.0 {
-                                t.v[0]
-                            } else {
-                                (t.v[0] * w[0] + t.v[1] * w[1] + t.v[2] * w[2]) / sum
-                            }
-                        }
-                        None => Vec3::ZERO,
-                    };
-                    (o, target - o)
-                }
+                } => toward(origin, tri, weights),
+                RayIn::FromEye { tri, weights } => toward(input.eye, tri, weights),
             };
             let tmin = tmin.map_or(0.0, |c| value(c, scale));
             let tmax = tmax.map_or(f32::INFINITY, |c| value(c, scale));
@@ -176,15 +185,17 @@ fuzz_target!(|input: Input| {
             );
         }
         // Packets: the rays grouped by direction signs (so that most packets
-        // take the packet path; mixed ones fall back to single rays), eight
-        // at a time.
+        // take the packet path; mixed ones fall back to single rays) and
+        // origins (so that packets from the eye are culled against their
+        // frustum), eight at a time.
         let sign = |r: &Ray| {
             usize::from(r.dir.x.is_sign_negative())
                 | usize::from(r.dir.y.is_sign_negative()) << 1
                 | usize::from(r.dir.z.is_sign_negative()) << 2
         };
         let mut order: Vec<usize> = (0..rays.len()).collect();
-        order.sort_by_key(|&i| sign(&rays[i]));
+        // By signs, then by origin: rays from the eye share packets.
+        order.sort_by_key(|&i| (sign(&rays[i]), rays[i].origin.to_array().map(f32::to_bits)));
         for idx in order.chunks(PACKET) {
             let packet: Vec<Ray> = idx.iter().map(|&i| rays[i]).collect();
             let mut got = vec![None; packet.len()];

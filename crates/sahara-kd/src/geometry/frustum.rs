@@ -230,6 +230,50 @@ mod tests {
         );
     }
 
+    /// Triangles outside the wedge but for one vertex placed on an
+    /// extreme ray (up to rounding): whenever the watertight test says that
+    /// ray hits one, the cull keeps it.
+    #[test]
+    fn keeps_triangles_touching_the_wedge_at_a_vertex() {
+        let mut f = floats(404);
+        let mut hits = 0;
+        for round in 0..4000 {
+            let eye = Vec3::new(f(), f(), f()) * 10.0;
+            let axis = round % 6;
+            let mut aim = Vec3::ZERO;
+            aim[axis % 3] = if axis < 3 { 1.0 } else { -1.0 };
+            let rays: Vec<Ray> = (0..8)
+                .map(|_| Ray::new(eye, aim + Vec3::new(f(), f(), f()) * 0.05))
+                .collect();
+            let shears: Vec<RayShear> = rays.iter().map(RayShear::from_ray).collect();
+            let Some(fr) = Frustum::new(&shears, 0xff) else {
+                continue;
+            };
+            // The ray with the smallest or largest sx or sy.
+            let key = |s: &RayShear| if round % 4 < 2 { s.s.x } else { s.s.y };
+            let by = |a: &usize, b: &usize| key(&shears[*a]).total_cmp(&key(&shears[*b]));
+            let l = if round % 2 == 0 {
+                (0..8).min_by(by)
+            } else {
+                (0..8).max_by(by)
+            }
+            .unwrap();
+            let t = 0.5 + f().abs() * 4.0;
+            let v0 = rays[l].origin + rays[l].dir * t;
+            // Away from the packet's middle ray, across the ray's path.
+            let mid = rays.iter().map(|r| r.dir).sum::<Vec3>() / 8.0;
+            let out = (v0 - (eye + mid * t)).normalize();
+            let across = out.cross(rays[l].dir).normalize() * 0.2;
+            let tri = Triangle::new(v0, v0 + out * 0.3 + across, v0 + out * 0.3 - across);
+            let block = TriangleBlock::pack(&[tri]);
+            if shears[l].intersect(&tri, 0.0, f32::INFINITY).is_some() {
+                hits += 1;
+                assert_eq!(fr.survivors(&block, 1), 1, "round {round}: hit but culled");
+            }
+        }
+        assert!(hits > 200, "{hits} hits at a vertex");
+    }
+
     #[test]
     fn refuses_rays_that_do_not_share_an_origin_or_permutation() {
         let a = RayShear::new(Vec3::ZERO, Vec3::new(0.1, 0.0, 1.0));

@@ -412,6 +412,20 @@ mod tests {
                 if p % 13 == 0 {
                     rays[n - 1].tmax = 6.0; // a shorter segment
                 }
+                if p % 5 == 3 {
+                    // From the eye exactly at the vertices and edge
+                    // midpoints of one triangle: the packet's frustum
+                    // planes pass through the vertices its rays aim at.
+                    let t = &tris[(p * 17) % tris.len()];
+                    for (k, r) in rays.iter_mut().enumerate() {
+                        let target = if k % 2 == 0 {
+                            t.v[k % 3]
+                        } else {
+                            (t.v[k % 3] + t.v[(k + 1) % 3]) * 0.5
+                        };
+                        r.dir = target - eye;
+                    }
+                }
                 if p % 5 == 1 {
                     // Axis-parallel rays whose origins lie in split planes
                     // (vertex coordinates): `tp` is NaN or a cell face.
