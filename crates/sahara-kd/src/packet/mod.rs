@@ -103,12 +103,12 @@ impl KdTree<Triangle> {
             // SAFETY: the CPU has AVX2 (checked at run time).
             return unsafe { self.closest_hit_packet_avx2(rays, out) };
         }
-        match self.packet(rays) {
-            Some(mut p) => {
-                self.walk_packet_portable(&mut p);
-                finish(&p, out);
-            }
-            None => self.closest_hits_one_by_one(rays, out),
+        let mut p = Packet::EMPTY;
+        if self.packet(rays, &mut p) {
+            self.walk_packet_portable(&mut p);
+            finish(&p, out);
+        } else {
+            self.closest_hits_one_by_one(rays, out);
         }
     }
 
@@ -120,13 +120,13 @@ impl KdTree<Triangle> {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn closest_hit_packet_avx2(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        match self.packet(rays) {
-            Some(mut p) => {
-                // SAFETY: the CPU has AVX2 (the caller's contract).
-                unsafe { self.walk_packet_avx2(&mut p) };
-                finish(&p, out);
-            }
-            None => self.closest_hits_one_by_one(rays, out),
+        let mut p = Packet::EMPTY;
+        if self.packet(rays, &mut p) {
+            // SAFETY: the CPU has AVX2 (the caller's contract).
+            unsafe { self.walk_packet_avx2(&mut p) };
+            finish(&p, out);
+        } else {
+            self.closest_hits_one_by_one(rays, out);
         }
     }
 
@@ -146,14 +146,11 @@ impl KdTree<Triangle> {
         }
     }
 
-    /// The packet of `rays`, or `None` when they must be traced one by one
-    /// (no rays, an empty tree, or direction signs that differ).
+    /// Make `p` the packet of `rays`; false when they must be traced one
+    /// by one (no rays, an empty tree, or direction signs that differ).
     #[inline(always)]
-    fn packet(&self, rays: &[Ray]) -> Option<Packet> {
-        if self.nodes.is_empty() {
-            return None;
-        }
-        Packet::setup(rays, &self.bounds)
+    fn packet(&self, rays: &[Ray], p: &mut Packet) -> bool {
+        !self.nodes.is_empty() && p.setup(rays, &self.bounds)
     }
 
     /// The portable packet walk (for CPUs without AVX2; the reference the
@@ -364,12 +361,12 @@ fn block_closest_rays(
 impl KdTree<Triangle> {
     /// [`KdTree::closest_hit_packet`] with the portable walk whatever the CPU.
     fn packet_portable(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        match self.packet(rays) {
-            Some(mut p) => {
-                self.walk_packet_portable(&mut p);
-                finish(&p, out);
-            }
-            None => self.closest_hits_one_by_one(rays, out),
+        let mut p = Packet::EMPTY;
+        if self.packet(rays, &mut p) {
+            self.walk_packet_portable(&mut p);
+            finish(&p, out);
+        } else {
+            self.closest_hits_one_by_one(rays, out);
         }
     }
 }

@@ -24,6 +24,7 @@ use crate::geometry::triangle_packet::PacketShear;
 use crate::geometry::{Aabb, Ray};
 
 /// The sign bits of a ray's direction (the near/far order it needs).
+#[inline(always)]
 fn signs(r: &Ray) -> [bool; 3] {
     [
         r.dir.x.is_sign_negative(),
@@ -43,29 +44,64 @@ fn permutation(kz: usize, neg: bool) -> [usize; 3] {
     }
 }
 
+/// `a` with the lanes not in `live` replaced by lane `f`'s value.
+#[inline(always)]
+fn borrow_off_lanes(a: &Lanes, live: u32, f: usize) -> Lanes {
+    let mut a = *a;
+    for l in 0..PACKET {
+        a[l] = if live >> l & 1 != 0 { a[l] } else { a[f] };
+    }
+    a
+}
+
 impl Packet {
-    /// The packet of `rays` (at most [`PACKET`]) in the root cell `bounds`,
-    /// or `None` when they must be traced one by one (no rays, or direction
-    /// signs that differ).
+    /// A packet with every lane off, for [`Packet::setup`] to fill.
+    pub(super) const EMPTY: Packet = Packet {
+        neg: [false; 3],
+        org: [[0.0; PACKET]; 3],
+        inv: [[0.0; PACKET]; 3],
+        t0: [OFF.0; PACKET],
+        t1: [OFF.1; PACKET],
+        tmin: [0.0; PACKET],
+        dir: [[0.0; PACKET]; 3],
+        k: None,
+        s: [[0.0; PACKET]; 3],
+        packet_shear: None,
+        frustum: None,
+        best_t: [0.0; PACKET],
+        best: [NO_HIT; PACKET],
+        closest: [f32::INFINITY; PACKET],
+    };
+
+    /// Make this the packet of `rays` (at most [`PACKET`]) in the root cell
+    /// `bounds`; false when they must be traced one by one (no rays, or
+    /// direction signs that differ). Written in place: returned by value,
+    /// the ~1 KB packet was copied twice (`memmove` in the profile).
     #[inline(always)]
-    pub(super) fn setup(rays: &[Ray], bounds: &Aabb) -> Option<Self> {
-        let first = rays.first()?;
+    pub(super) fn setup(&mut self, rays: &[Ray], bounds: &Aabb) -> bool {
+        let Some(first) = rays.first() else {
+            return false;
+        };
         let neg = signs(first);
-        if rays.iter().any(|r| signs(r) != neg) {
-            return None;
+        // A plain loop: as `any` with a closure, LLVM kept it out of line.
+        for r in rays {
+            if signs(r) != neg {
+                return false;
+            }
         }
         let n = rays.len();
+        let p = self;
+        p.neg = neg;
         // The rays by lane; lanes past `n` repeat the first ray and are off.
-        let (mut o, mut d) = ([[0.0f32; PACKET]; 3], [[0.0f32; PACKET]; 3]);
-        let (mut tmin, mut tmax) = ([0.0f32; PACKET], [0.0f32; PACKET]);
         for l in 0..PACKET {
             let r = rays.get(l).unwrap_or(first);
             for k in 0..3 {
-                o[k][l] = r.origin[k];
-                d[k][l] = r.dir[k];
+                p.org[k][l] = r.origin[k];
+                p.dir[k][l] = r.dir[k];
             }
-            (tmin[l], tmax[l]) = (r.tmin, r.tmax);
+            (p.tmin[l], p.best_t[l]) = (r.tmin, r.tmax);
         }
+        let (o, d, tmin, tmax) = (&p.org, &p.dir, &p.tmin, &p.best_t);
         let mut inv = [[0.0f32; PACKET]; 3];
         let (mut t0, mut t1) = ([0.0f32; PACKET], [0.0f32; PACKET]);
         let mut kz = [0u32; PACKET];
@@ -131,29 +167,18 @@ impl Packet {
         }
         // Lanes that are off keep zero origins and reciprocals (the walks
         // mask them anyway).
-        for l in 0..PACKET {
-            let on = live >> l & 1 != 0;
-            for k in 0..3 {
-                o[k][l] = if on { o[k][l] } else { 0.0 };
-                inv[k][l] = if on { inv[k][l] } else { 0.0 };
+        for (org, inv) in p.org.iter_mut().zip(&mut inv) {
+            for l in 0..PACKET {
+                let on = live >> l & 1 != 0;
+                org[l] = if on { org[l] } else { 0.0 };
+                inv[l] = if on { inv[l] } else { 0.0 };
             }
         }
-        let mut p = Packet {
-            neg,
-            org: o,
-            inv,
-            dir: d,
-            t0,
-            t1,
-            tmin,
-            k: None,
-            s: [[0.0; PACKET]; 3],
-            packet_shear: None,
-            frustum: None,
-            best_t: tmax,
-            best: [NO_HIT; PACKET],
-            closest: [f32::INFINITY; PACKET],
-        };
+        p.inv = inv;
+        (p.t0, p.t1) = (t0, t1);
+        (p.k, p.packet_shear, p.frustum) = (None, None, None);
+        p.best = [NO_HIT; PACKET];
+        p.closest = [f32::INFINITY; PACKET];
         // Lanes past the rays: `tmin` and `best_t` 0 (never read).
         for l in n..PACKET {
             (p.tmin[l], p.best_t[l]) = (0.0, 0.0);
@@ -161,7 +186,7 @@ impl Packet {
         // One permutation for the live rays: the packet forms of the
         // watertight test (and, with one origin, the frustum).
         if live == 0 {
-            return Some(p);
+            return true;
         }
         let f = live.trailing_zeros() as usize;
         let shared =
@@ -173,28 +198,22 @@ impl Packet {
             // (the last is the reciprocal computed above).
             let [sx, sy, sz] = &mut p.s;
             for (l, s) in sx.iter_mut().enumerate() {
-                *s = d[kx][l] / d[kz][l];
+                *s = p.dir[kx][l] / p.dir[kz][l];
             }
             for (l, s) in sy.iter_mut().enumerate() {
-                *s = d[ky][l] / d[kz][l];
+                *s = p.dir[ky][l] / p.dir[kz][l];
             }
             *sz = p.inv[kz];
             p.k = Some(k);
             // Lanes that are off borrow the first live lane's constants, so
             // that their (masked) lanes compute finite values.
-            let pick = |a: &Lanes| {
-                let mut a = *a;
-                for l in 0..PACKET {
-                    a[l] = if live >> l & 1 != 0 { a[l] } else { a[f] };
-                }
-                a
-            };
+            let pick = |a: &Lanes| borrow_off_lanes(a, live, f);
             let (ox, oy, oz) = (pick(&p.org[kx]), pick(&p.org[ky]), pick(&p.org[kz]));
             let (sx, sy) = (pick(&p.s[0]), pick(&p.s[1]));
             p.packet_shear = Some(PacketShear::from_lanes(k, [ox, oy, oz], sx, sy));
             p.frustum = Frustum::from_lanes(k, [&ox, &oy, &oz], &sx, &sy);
         }
-        Some(p)
+        true
     }
 
     /// The watertight-test constants of ray `l` (a live lane), as
@@ -252,9 +271,8 @@ mod tests {
                     r
                 })
                 .collect();
-            let Some(p) = Packet::setup(&rays, &bounds) else {
-                panic!("round {round}: the signs agree");
-            };
+            let mut p = Packet::EMPTY;
+            assert!(p.setup(&rays, &bounds), "round {round}: the signs agree");
             shared += p.k.is_some() as usize;
             for (l, r) in rays.iter().enumerate() {
                 let inv = Vec3::ONE / r.dir;
@@ -295,9 +313,10 @@ mod tests {
         let a = Ray::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 1.0));
         let b = Ray::new(Vec3::ZERO, Vec3::new(1.0, -1.0, 1.0));
         let c = Ray::new(Vec3::ZERO, Vec3::new(1.0, -0.0, 1.0));
-        assert!(Packet::setup(&[a, a], &bounds).is_some());
-        assert!(Packet::setup(&[a, b], &bounds).is_none());
-        assert!(Packet::setup(&[a, c], &bounds).is_none());
-        assert!(Packet::setup(&[], &bounds).is_none());
+        let mut p = Packet::EMPTY;
+        assert!(p.setup(&[a, a], &bounds));
+        assert!(!p.setup(&[a, b], &bounds));
+        assert!(!p.setup(&[a, c], &bounds));
+        assert!(!p.setup(&[], &bounds));
     }
 }
