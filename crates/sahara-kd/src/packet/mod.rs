@@ -103,6 +103,13 @@ impl KdTree<Triangle> {
             // SAFETY: the CPU has AVX2 (checked at run time).
             return unsafe { self.closest_hit_packet_avx2(rays, out) };
         }
+        self.packet_portable(rays, out);
+    }
+
+    /// [`KdTree::closest_hit_packet`] with the portable walk whatever the
+    /// CPU (the fallback, and the reference the AVX2 path is tested
+    /// against).
+    fn packet_portable(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         let mut p = Packet::EMPTY;
         if self.packet(rays, &mut p) {
             self.walk_packet_portable(&mut p);
@@ -290,6 +297,18 @@ impl KdTree<Triangle> {
     }
 }
 
+/// The indices of the set bits of `mask`, lowest first.
+#[inline(always)]
+fn set_bits(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            i
+        })
+    })
+}
+
 /// The triangles `tris` of `block` (indices `indices`) against the rays in
 /// `live`, one triangle at a time for all rays.
 #[inline(always)]
@@ -301,12 +320,9 @@ fn block_closest_packet(
     tris: u32,
     live: u32,
 ) {
-    let mut t = tris;
-    while t != 0 {
-        let j = t.trailing_zeros() as usize;
-        t &= t - 1;
+    for j in set_bits(tris) {
         let (m, e) = ps.triangle_edges(block, j);
-        let mut m = m & live;
+        let m = m & live;
         if m == 0 {
             continue;
         }
@@ -314,9 +330,7 @@ fn block_closest_packet(
         let tri = block.triangle(j);
         // The plane once for all the rays that need it.
         let plane = TrianglePlane::new(&tri);
-        while m != 0 {
-            let l = m.trailing_zeros() as usize;
-            m &= m - 1;
+        for l in set_bits(m) {
             let uvw = [e[0][l], e[1][l], e[2][l]];
             let (tmin, tmax) = (p.tmin[l], p.best_t[l]);
             if let Some(h) = p.shear(l).decide_in_plane(&tri, || plane, uvw, tmin, tmax) {
@@ -338,35 +352,15 @@ fn block_closest_rays(
     tris: u32,
     live: u32,
 ) {
-    let mut r = live;
-    while r != 0 {
-        let l = r.trailing_zeros() as usize;
-        r &= r - 1;
+    for l in set_bits(live) {
         let shear = p.shear(l);
         let (m, e) = shear.block_edges(block, lanes);
-        let mut m = m & tris;
-        while m != 0 {
-            let j = m.trailing_zeros() as usize;
-            m &= m - 1;
+        for j in set_bits(m & tris) {
             let uvw = [e[0][j], e[1][j], e[2][j]];
             let (tmin, tmax) = (p.tmin[l], p.best_t[l]);
             if let Some(h) = shear.decide(&block.triangle(j), uvw, tmin, tmax) {
                 keep_closer(&mut p.best_t[l], &mut p.best[l], h, indices[j]);
             }
-        }
-    }
-}
-
-#[cfg(test)]
-impl KdTree<Triangle> {
-    /// [`KdTree::closest_hit_packet`] with the portable walk whatever the CPU.
-    fn packet_portable(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        let mut p = Packet::EMPTY;
-        if self.packet(rays, &mut p) {
-            self.walk_packet_portable(&mut p);
-            finish(&p, out);
-        } else {
-            self.closest_hits_one_by_one(rays, out);
         }
     }
 }
