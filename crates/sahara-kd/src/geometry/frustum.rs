@@ -31,7 +31,7 @@
 //! tiles); this test costs about a quarter of the 8-ray edge test and checks
 //! eight triangles at once.
 
-use super::triangle::RayShear;
+use super::triangle::{permutation, RayShear};
 use super::triangle_block::{TriangleBlock, BLOCK_WIDTH};
 
 /// Relative slack of the culling planes (that of the traversal's
@@ -110,9 +110,8 @@ impl Frustum {
             hi = [hi[0].max(sx[l]), hi[1].max(sy[l])];
         }
         // The permutation holds the sign of d[kz] (`RayShear::new` swaps
-        // kx and ky for a negative one): kx follows kz cyclically unless
-        // it was swapped.
-        let positive = k[0] == (k[2] + 1) % 3;
+        // kx and ky for a negative one).
+        let positive = k == permutation(k[2], false);
         same.then_some(Self {
             k,
             o: [o[0][0], o[1][0], o[2][0]],

@@ -84,6 +84,20 @@ impl Triangle {
     }
 }
 
+/// The watertight test's axis permutation `[kx, ky, kz]` for the dominant
+/// axis `kz` of a direction whose `kz` component is negative (`neg`) or
+/// not: `kx`, `ky` follow `kz` cyclically, swapped for a negative one to
+/// keep the winding (and so the sign of the edge functions).
+#[inline(always)]
+pub(crate) fn permutation(kz: usize, neg: bool) -> [usize; 3] {
+    let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+    if neg {
+        [ky, kx, kz]
+    } else {
+        [kx, ky, kz]
+    }
+}
+
 /// Per-ray constants of the watertight test (Woop, Benthin, Wald 2013,
 /// "Watertight Ray/Triangle Intersection", JCGT 2(1)): the dimension `kz`
 /// where the direction is largest, and the shear that maps the ray onto +z.
@@ -110,12 +124,7 @@ impl RayShear {
         } else {
             2
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        // Swap to preserve the winding (and so the sign of the edge functions).
-        if dir[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        let [kx, ky, kz] = permutation(kz, dir[kz] < 0.0);
         let s = Vec3::new(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
         Self {
             origin,

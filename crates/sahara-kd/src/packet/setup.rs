@@ -19,7 +19,7 @@ use glam::Vec3;
 use super::{Lanes, Packet, NO_HIT, OFF, PACKET};
 use crate::geometry::aabb::FAR_GROW;
 use crate::geometry::frustum::Frustum;
-use crate::geometry::triangle::RayShear;
+use crate::geometry::triangle::{permutation, RayShear};
 use crate::geometry::triangle_packet::PacketShear;
 use crate::geometry::{Aabb, Ray};
 
@@ -31,17 +31,6 @@ fn signs(r: &Ray) -> [bool; 3] {
         r.dir.y.is_sign_negative(),
         r.dir.z.is_sign_negative(),
     ]
-}
-
-/// `RayShear::new`'s permutation for the dominant axis `kz` of a direction
-/// whose `kz` component is negative (`neg`) or not.
-fn permutation(kz: usize, neg: bool) -> [usize; 3] {
-    let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
-    if neg {
-        [ky, kx, kz]
-    } else {
-        [kx, ky, kz]
-    }
 }
 
 /// `a` with the lanes not in `live` replaced by lane `f`'s value.
