@@ -5,7 +5,11 @@ use glam::Vec3;
 /// A ray `o + t d` restricted to `t` in `(tmin, tmax]` (`tmin` exclusive, as Embree's `tnear`).
 ///
 /// The direction need not be normalised; `t` is measured in units of `d`.
+///
+/// Laid out as eight `f32` (origin, direction, `tmin`, `tmax`), so that the
+/// packet set-up can load eight rays as an 8x8 matrix and transpose it.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
 pub struct Ray {
     /// Origin.
     pub origin: Vec3,

@@ -128,8 +128,9 @@ impl KdTree<Triangle> {
     #[target_feature(enable = "avx2")]
     unsafe fn closest_hit_packet_avx2(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         let mut p = Packet::EMPTY;
-        if self.packet(rays, &mut p) {
-            // SAFETY: the CPU has AVX2 (the caller's contract).
+        // SAFETY: the CPU has AVX2 (the caller's contract).
+        if !self.nodes.is_empty() && unsafe { p.setup_avx2(rays, &self.bounds) } {
+            // SAFETY: as above.
             unsafe { self.walk_packet_avx2(&mut p) };
             finish(&p, out);
         } else {

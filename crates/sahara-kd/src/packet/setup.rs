@@ -23,20 +23,14 @@ use crate::geometry::triangle::{permutation, RayShear};
 use crate::geometry::triangle_packet::PacketShear;
 use crate::geometry::{Aabb, Ray};
 
-/// The sign bits of a ray's direction (the near/far order it needs).
-#[inline(always)]
-fn signs(r: &Ray) -> [bool; 3] {
-    [
-        r.dir.x.is_sign_negative(),
-        r.dir.y.is_sign_negative(),
-        r.dir.z.is_sign_negative(),
-    ]
-}
-
 /// `a` with the lanes not in `live` replaced by lane `f`'s value.
 #[inline(always)]
 fn borrow_off_lanes(a: &Lanes, live: u32, f: usize) -> Lanes {
     let mut a = *a;
+    // Full packets (the common case) have nothing to borrow.
+    if live == (1 << PACKET) - 1 {
+        return a;
+    }
     for l in 0..PACKET {
         a[l] = if live >> l & 1 != 0 { a[l] } else { a[f] };
     }
@@ -68,28 +62,45 @@ impl Packet {
     /// the ~1 KB packet was copied twice (`memmove` in the profile).
     #[inline(always)]
     pub(super) fn setup(&mut self, rays: &[Ray], bounds: &Aabb) -> bool {
-        let Some(first) = rays.first() else {
-            return false;
-        };
-        let neg = signs(first);
-        // A plain loop: as `any` with a closure, LLVM kept it out of line.
-        for r in rays {
-            if signs(r) != neg {
-                return false;
-            }
+        match self.gather(rays) {
+            Some(neg) => self.setup_lanes(rays.len(), neg, bounds),
+            None => false,
         }
-        let n = rays.len();
-        let p = self;
-        p.neg = neg;
-        // The rays by lane; lanes past `n` repeat the first ray and are off.
+    }
+
+    /// Copy `rays` into the lanes (lanes past them repeat the first ray)
+    /// and return the direction signs' bit masks by axis (bit `l`: lane
+    /// `l`'s sign bit), or `None` for no rays.
+    #[inline(always)]
+    pub(super) fn gather(&mut self, rays: &[Ray]) -> Option<[u32; 3]> {
+        let first = rays.first()?;
+        let mut neg = [0u32; 3];
         for l in 0..PACKET {
             let r = rays.get(l).unwrap_or(first);
-            for k in 0..3 {
-                p.org[k][l] = r.origin[k];
-                p.dir[k][l] = r.dir[k];
+            for (k, m) in neg.iter_mut().enumerate() {
+                self.org[k][l] = r.origin[k];
+                self.dir[k][l] = r.dir[k];
+                *m |= (r.dir[k].is_sign_negative() as u32) << l;
             }
-            (p.tmin[l], p.best_t[l]) = (r.tmin, r.tmax);
+            (self.tmin[l], self.best_t[l]) = (r.tmin, r.tmax);
         }
+        Some(neg)
+    }
+
+    /// The rest of the set-up once the lanes hold the `n` rays (see
+    /// [`Packet::setup`]); `neg` as [`Packet::gather`] returns it.
+    #[inline(always)]
+    pub(super) fn setup_lanes(&mut self, n: usize, neg: [u32; 3], bounds: &Aabb) -> bool {
+        debug_assert!((1..=PACKET).contains(&n));
+        // One shared sign per axis among the rays given (the lanes past
+        // them repeat the first ray).
+        let rays_mask = (1u32 << n) - 1;
+        let neg = neg.map(|m| m & rays_mask);
+        if neg.iter().any(|&m| m != 0 && m != rays_mask) {
+            return false;
+        }
+        let p = self;
+        p.neg = neg.map(|m| m != 0);
         let (o, d, tmin, tmax) = (&p.org, &p.dir, &p.tmin, &p.best_t);
         let mut inv = [[0.0f32; PACKET]; 3];
         let (mut t0, mut t1) = ([0.0f32; PACKET], [0.0f32; PACKET]);
@@ -262,6 +273,7 @@ mod tests {
                 .collect();
             let mut p = Packet::EMPTY;
             assert!(p.setup(&rays, &bounds), "round {round}: the signs agree");
+            assert_same_as_avx2(&p, &rays, &bounds);
             shared += p.k.is_some() as usize;
             for (l, r) in rays.iter().enumerate() {
                 let inv = Vec3::ONE / r.dir;
@@ -296,6 +308,27 @@ mod tests {
         assert!(shared > 400, "{shared} packets with a shared permutation");
     }
 
+    /// The AVX2 set-up (the transposed gather) gives packet `p` exactly.
+    fn assert_same_as_avx2(p: &Packet, rays: &[Ray], bounds: &Aabb) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::traverse::simd::avx2() {
+            let mut q = Packet::EMPTY;
+            // SAFETY: the CPU has AVX2.
+            assert!(unsafe { q.setup_avx2(rays, bounds) });
+            let bits =
+                |a: &[Lanes]| -> Vec<u32> { a.iter().flatten().map(|x| x.to_bits()).collect() };
+            assert_eq!(p.neg, q.neg);
+            assert_eq!(bits(&p.org), bits(&q.org));
+            assert_eq!(bits(&p.dir), bits(&q.dir));
+            assert_eq!(bits(&p.inv), bits(&q.inv));
+            assert_eq!(bits(&p.s), bits(&q.s));
+            let scalars = |p: &Packet| bits(&[p.t0, p.t1, p.tmin, p.best_t, p.closest]);
+            assert_eq!(scalars(p), scalars(&q));
+            assert_eq!(p.k, q.k);
+            assert_eq!(p.frustum.is_some(), q.frustum.is_some());
+        }
+    }
+
     #[test]
     fn mixed_signs_are_refused() {
         let bounds = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
@@ -307,5 +340,20 @@ mod tests {
         assert!(!p.setup(&[a, b], &bounds));
         assert!(!p.setup(&[a, c], &bounds));
         assert!(!p.setup(&[], &bounds));
+        // Full packets (the AVX2 set-up's transposed path), a differing
+        // sign in each lane and axis, -0 included.
+        for l in 0..PACKET {
+            for bad in [b, c, Ray::new(Vec3::ZERO, Vec3::new(-1.0, 1.0, 1.0))] {
+                let mut rays = [a; PACKET];
+                rays[l] = bad;
+                assert!(!p.setup(&rays, &bounds));
+                #[cfg(target_arch = "x86_64")]
+                if crate::traverse::simd::avx2() {
+                    // SAFETY: the CPU has AVX2.
+                    assert!(!unsafe { p.setup_avx2(&rays, &bounds) });
+                }
+            }
+        }
+        assert!(p.setup(&[a; PACKET], &bounds));
     }
 }
