@@ -325,7 +325,14 @@ mod tests {
             let scalars = |p: &Packet| bits(&[p.t0, p.t1, p.tmin, p.best_t, p.closest]);
             assert_eq!(scalars(p), scalars(&q));
             assert_eq!(p.k, q.k);
-            assert_eq!(p.frustum.is_some(), q.frustum.is_some());
+            // Debug prints floats exactly (shortest round-trip form).
+            assert_eq!(format!("{:?}", p.frustum), format!("{:?}", q.frustum));
+            assert_eq!(
+                format!("{:?}", p.packet_shear),
+                format!("{:?}", q.packet_shear)
+            );
+            let hits = |p: &Packet| p.best.map(|h| (h.t.to_bits(), h.tri));
+            assert_eq!(hits(p), hits(&q));
         }
     }
 
