@@ -5,7 +5,7 @@
 //! primary rays in 4x2 tiles as single rays and as packets, and the
 //! leaf tests alone (eight triangles against one ray, one triangle against
 //! eight rays, eight triangles against a packet's frustum; portable builds,
-//! as the benchmark binary is compiled).
+//! as the benchmark binary is compiled, and the frustum cull's AVX2 form).
 //!
 //! `cargo bench -p sahara-bench --bench kdtree`
 
@@ -194,6 +194,21 @@ fn trace(c: &mut Criterion) {
                 .sum::<u32>()
         })
     });
+    // The same cull in AVX2 intrinsics (what the packet path runs on such
+    // CPUs).
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        g.bench_function("frustum_cull_8_avx2", |bench| {
+            bench.iter(|| {
+                let block = std::hint::black_box(&block);
+                frusta
+                    .iter()
+                    // SAFETY: the CPU has AVX2 (checked above).
+                    .map(|f| unsafe { f.survivors_avx2(block, BLOCK_WIDTH) }.count_ones())
+                    .sum::<u32>()
+            })
+        });
+    }
     g.finish();
 }
 

@@ -319,7 +319,7 @@ impl KdTree<Triangle> {
             let count = nd.leaf_count() as usize;
             if count != 0 {
                 // SAFETY: `nd` is a leaf of this tree.
-                unsafe { self.packet_leaf(p, nd.leaf_offset() as usize, count, live_rays) };
+                unsafe { self.packet_leaf::<true>(p, nd.leaf_offset() as usize, count, live_rays) };
                 closest = load(&p.closest);
             }
             // Pop the next cell some ray may still find a closer hit in.

@@ -230,7 +230,7 @@ impl KdTree<Triangle> {
             }
             // SAFETY: `nd` is a leaf of this tree.
             unsafe {
-                self.packet_leaf(
+                self.packet_leaf::<false>(
                     p,
                     nd.leaf_offset() as usize,
                     nd.leaf_count() as usize,
@@ -262,9 +262,16 @@ impl KdTree<Triangle> {
     /// smallest index, wins).
     ///
     /// # Safety
-    /// `offset` and `count` must be those of a leaf of this tree.
+    /// `offset` and `count` must be those of a leaf of this tree; with
+    /// `AVX2`, the CPU must have AVX2.
     #[inline(always)]
-    unsafe fn packet_leaf(&self, p: &mut Packet, offset: usize, count: usize, live: u32) {
+    unsafe fn packet_leaf<const AVX2: bool>(
+        &self,
+        p: &mut Packet,
+        offset: usize,
+        count: usize,
+        live: u32,
+    ) {
         if count == 0 || live == 0 {
             return;
         }
@@ -274,6 +281,9 @@ impl KdTree<Triangle> {
         for (b, block) in blocks.iter().enumerate() {
             let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
             let tris = match &p.frustum {
+                #[cfg(target_arch = "x86_64")]
+                // SAFETY: `AVX2` is only set on the AVX2 path.
+                Some(f) if AVX2 => unsafe { f.survivors_avx2(block, lanes) },
                 Some(f) => f.survivors(block, lanes),
                 None => (1u32 << lanes) - 1,
             };
