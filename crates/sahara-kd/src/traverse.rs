@@ -164,7 +164,7 @@ impl<C, F: FnMut(usize, usize, &mut C, &mut f32) -> LeafResult> LeafVisit<C> for
 /// The closest-hit leaf visit of one ray, a named type rather than a
 /// closure so that `#[inline(always)]` can put it into the walk's loop
 /// (LLVM kept the closure out of line: a call per leaf).
-struct ClosestLeaf<'a> {
+struct ClosestLeaf<'a, const AVX2: bool> {
     tree: &'a KdTree<Triangle>,
     shear: &'a RayShear,
     tmin: f32,
@@ -172,12 +172,12 @@ struct ClosestLeaf<'a> {
     best: Hit,
 }
 
-impl<C: Counters> LeafVisit<C> for ClosestLeaf<'_> {
+impl<C: Counters, const AVX2: bool> LeafVisit<C> for ClosestLeaf<'_, AVX2> {
     #[inline(always)]
     fn visit(&mut self, offset: usize, count: usize, c: &mut C, closest: &mut f32) -> LeafResult {
         // SAFETY: the walk passes the `offset`, `count` of a leaf.
         unsafe {
-            self.tree.leaf_closest(
+            self.tree.leaf_closest::<C, AVX2>(
                 self.shear,
                 self.tmin,
                 offset,
@@ -196,7 +196,7 @@ impl<C: Counters> LeafVisit<C> for ClosestLeaf<'_> {
 
 /// The any-hit leaf visit of one ray (a named type for the reason given at
 /// [`ClosestLeaf`]).
-struct AnyLeaf<'a> {
+struct AnyLeaf<'a, const AVX2: bool> {
     tree: &'a KdTree<Triangle>,
     shear: &'a RayShear,
     tmin: f32,
@@ -204,7 +204,7 @@ struct AnyLeaf<'a> {
     found: bool,
 }
 
-impl<C: Counters> LeafVisit<C> for AnyLeaf<'_> {
+impl<C: Counters, const AVX2: bool> LeafVisit<C> for AnyLeaf<'_, AVX2> {
     #[inline(always)]
     fn visit(&mut self, offset: usize, count: usize, c: &mut C, _: &mut f32) -> LeafResult {
         // SAFETY: the walk passes the `offset`, `count` of a leaf.
@@ -212,7 +212,8 @@ impl<C: Counters> LeafVisit<C> for AnyLeaf<'_> {
         for (b, block) in blocks.iter().enumerate() {
             let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
             (0..lanes).for_each(|_| c.triangle());
-            let (mut m, e) = self.shear.block_edges(block, lanes);
+            // SAFETY: `AVX2` only on the AVX2 path.
+            let (mut m, e) = unsafe { self.shear.block_edges_on::<AVX2>(block, lanes) };
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
@@ -242,23 +243,29 @@ impl KdTree<Triangle> {
             // SAFETY: the CPU has AVX2 (checked at run time).
             return unsafe { self.closest_hit_avx2(ray, counters) };
         }
-        self.closest_hit_portable(ray, counters)
+        self.closest_hit_portable::<C, false>(ray, counters)
     }
 
     /// [`KdTree::closest_hit_portable`] compiled for AVX2: the block test's
-    /// eight lanes become one 256-bit operation instead of two SSE ones.
+    /// eight lanes become one 256-bit operation instead of two SSE ones
+    /// (and its intrinsics form, see `triangle_block`).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn closest_hit_avx2<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
-        self.closest_hit_portable(ray, counters)
+        self.closest_hit_portable::<C, true>(ray, counters)
     }
 
     /// The closest-hit traversal, for whatever target features the caller
-    /// is compiled with (inlined into each).
+    /// is compiled with (inlined into each); `AVX2` selects the leaf test's
+    /// intrinsics (only set where the CPU has AVX2).
     #[inline(always)]
-    fn closest_hit_portable<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
+    fn closest_hit_portable<C: Counters, const AVX2: bool>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+    ) -> Option<Hit> {
         let shear = RayShear::from_ray(ray);
-        let mut leaf = ClosestLeaf {
+        let mut leaf = ClosestLeaf::<AVX2> {
             tree: self,
             shear: &shear,
             tmin: ray.tmin,
@@ -288,21 +295,21 @@ impl KdTree<Triangle> {
             // SAFETY: the CPU has AVX2 (checked at run time).
             return unsafe { self.any_hit_avx2(ray, counters) };
         }
-        self.any_hit_portable(ray, counters)
+        self.any_hit_portable::<C, false>(ray, counters)
     }
 
     /// [`KdTree::any_hit_portable`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn any_hit_avx2<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
-        self.any_hit_portable(ray, counters)
+        self.any_hit_portable::<C, true>(ray, counters)
     }
 
     /// The any-hit traversal (inlined into each target-feature variant).
     #[inline(always)]
-    fn any_hit_portable<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+    fn any_hit_portable<C: Counters, const AVX2: bool>(&self, ray: &Ray, counters: &mut C) -> bool {
         let shear = RayShear::from_ray(ray);
-        let mut leaf = AnyLeaf {
+        let mut leaf = AnyLeaf::<AVX2> {
             tree: self,
             shear: &shear,
             tmin: ray.tmin,
@@ -318,10 +325,11 @@ impl KdTree<Triangle> {
     /// among equally distant hits the smallest index wins.
     ///
     /// # Safety
-    /// `offset` and `count` must be those of a leaf of this tree.
+    /// `offset` and `count` must be those of a leaf of this tree; with
+    /// `AVX2`, the CPU must have AVX2.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    pub(crate) unsafe fn leaf_closest<C: Counters>(
+    pub(crate) unsafe fn leaf_closest<C: Counters, const AVX2: bool>(
         &self,
         shear: &RayShear,
         tmin: f32,
@@ -338,7 +346,9 @@ impl KdTree<Triangle> {
             (0..lanes).for_each(|_| counters.triangle());
             // Eight edge tests at once; the scalar test decides the few
             // lanes left (see `triangle_block`).
-            let (mut m, e) = shear.block_edges(block, lanes);
+            // SAFETY: `AVX2` only where the CPU has it (the caller's
+            // contract, below).
+            let (mut m, e) = unsafe { shear.block_edges_on::<AVX2>(block, lanes) };
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
@@ -592,9 +602,15 @@ mod tests {
         for _ in 0..3000 {
             let ray = Ray::new(Vec3::new(f(), f(), f()) * 5.0, Vec3::new(f(), f(), f()));
             let want = brute::closest_hit(&tris, &ray);
-            assert_eq!(tree.closest_hit_portable(&ray, &mut NoCounters), want);
+            assert_eq!(
+                tree.closest_hit_portable::<_, false>(&ray, &mut NoCounters),
+                want
+            );
             assert_eq!(tree.closest_hit(&ray), want);
-            assert_eq!(tree.any_hit_portable(&ray, &mut NoCounters), want.is_some());
+            assert_eq!(
+                tree.any_hit_portable::<_, false>(&ray, &mut NoCounters),
+                want.is_some()
+            );
             assert_eq!(tree.any_hit(&ray), want.is_some());
         }
     }

@@ -16,6 +16,8 @@
 //! --counters`), where the packet test does a half to a quarter of the work.
 
 use super::triangle::RayShear;
+#[cfg(target_arch = "x86_64")]
+use super::triangle_block::edge_lanes_avx2;
 use super::triangle_block::{edge_lanes, TriangleBlock, BLOCK_WIDTH};
 
 const _: () = assert!(
@@ -110,6 +112,56 @@ impl PacketShear {
     }
 }
 
+impl PacketShear {
+    /// [`PacketShear::triangle_edges`], in AVX2 intrinsics when `AVX2`.
+    ///
+    /// # Safety
+    /// With `AVX2`, the CPU must have AVX2.
+    #[inline(always)]
+    pub(crate) unsafe fn triangle_edges_on<const AVX2: bool>(
+        &self,
+        block: &TriangleBlock,
+        lane: usize,
+    ) -> (u32, [Lanes; 3]) {
+        #[cfg(target_arch = "x86_64")]
+        if AVX2 {
+            // SAFETY: the caller's contract.
+            return unsafe { self.triangle_edges_avx2(block, lane) };
+        }
+        self.triangle_edges(block, lane)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl PacketShear {
+    /// [`PacketShear::triangle_edges`] in AVX2 intrinsics (the same
+    /// results).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn triangle_edges_avx2(&self, block: &TriangleBlock, lane: usize) -> (u32, [Lanes; 3]) {
+        use std::arch::x86_64::*;
+        debug_assert!(lane < BLOCK_WIDTH);
+        let [kx, ky, kz] = self.k;
+        // SAFETY: eight f32 per row.
+        let load = |a: &Lanes| unsafe { _mm256_loadu_ps(a.as_ptr()) };
+        let (ox, oy, oz) = (load(&self.o[0]), load(&self.o[1]), load(&self.o[2]));
+        let (sx, sy) = (load(&self.sx), load(&self.sy));
+        let sheared = |k: usize| {
+            let v = &block.v[k];
+            let p = |axis: usize| _mm256_set1_ps(v[axis][lane]);
+            let z = _mm256_sub_ps(p(kz), oz);
+            (
+                _mm256_sub_ps(_mm256_sub_ps(p(kx), ox), _mm256_mul_ps(sx, z)),
+                _mm256_sub_ps(_mm256_sub_ps(p(ky), oy), _mm256_mul_ps(sy, z)),
+            )
+        };
+        edge_lanes_avx2(sheared(0), sheared(1), sheared(2))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -148,6 +200,16 @@ mod tests {
             let p = PacketShear::new(&shears).expect("all rays have kz = z");
             for lane in 0..BLOCK_WIDTH {
                 let (m, e) = p.triangle_edges(&block, lane);
+                #[cfg(target_arch = "x86_64")]
+                if crate::traverse::simd::avx2() {
+                    // SAFETY: the CPU has AVX2.
+                    let (m2, e2) = unsafe { p.triangle_edges_avx2(&block, lane) };
+                    assert_eq!(m, m2);
+                    assert_eq!(
+                        e.map(|r| r.map(f32::to_bits)),
+                        e2.map(|r| r.map(f32::to_bits))
+                    );
+                }
                 for (l, s) in shears.iter().enumerate() {
                     let (bm, be) = s.block_edges(&block, BLOCK_WIDTH);
                     assert_eq!(m >> l & 1, bm >> lane & 1, "ray {l} triangle {lane}");

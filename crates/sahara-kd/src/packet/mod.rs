@@ -295,9 +295,9 @@ impl KdTree<Triangle> {
             // per triangle left against one 8-triangle test per ray.
             match p.packet_shear {
                 Some(ps) if rays >= tris.count_ones() => {
-                    block_closest_packet(&ps, p, block, indices, tris, live)
+                    block_closest_packet::<AVX2>(&ps, p, block, indices, tris, live)
                 }
-                _ => block_closest_rays(p, block, indices, lanes, tris, live),
+                _ => block_closest_rays::<AVX2>(p, block, indices, lanes, tris, live),
             }
         }
         for l in 0..PACKET {
@@ -322,8 +322,10 @@ fn set_bits(mut mask: u32) -> impl Iterator<Item = usize> {
 
 /// The triangles `tris` of `block` (indices `indices`) against the rays in
 /// `live`, one triangle at a time for all rays.
+///
+/// With `AVX2`, the CPU must have AVX2 (the packet leaf's contract).
 #[inline(always)]
-fn block_closest_packet(
+fn block_closest_packet<const AVX2: bool>(
     ps: &PacketShear,
     p: &mut Packet,
     block: &TriangleBlock,
@@ -332,7 +334,8 @@ fn block_closest_packet(
     live: u32,
 ) {
     for j in set_bits(tris) {
-        let (m, e) = ps.triangle_edges(block, j);
+        // SAFETY: `AVX2` only on the AVX2 path.
+        let (m, e) = unsafe { ps.triangle_edges_on::<AVX2>(block, j) };
         let m = m & live;
         if m == 0 {
             continue;
@@ -354,8 +357,10 @@ fn block_closest_packet(
 /// The triangles `tris` among the first `lanes` of `block` against the rays
 /// in `live`, one ray at a time with the block test (as
 /// [`KdTree::leaf_closest`] does).
+///
+/// With `AVX2`, the CPU must have AVX2 (the packet leaf's contract).
 #[inline(always)]
-fn block_closest_rays(
+fn block_closest_rays<const AVX2: bool>(
     p: &mut Packet,
     block: &TriangleBlock,
     indices: &[u32],
@@ -365,7 +370,8 @@ fn block_closest_rays(
 ) {
     for l in set_bits(live) {
         let shear = p.shear(l);
-        let (m, e) = shear.block_edges(block, lanes);
+        // SAFETY: `AVX2` only on the AVX2 path.
+        let (m, e) = unsafe { shear.block_edges_on::<AVX2>(block, lanes) };
         for j in set_bits(m & tris) {
             let uvw = [e[0][j], e[1][j], e[2][j]];
             let (tmin, tmax) = (p.tmin[l], p.best_t[l]);
