@@ -168,17 +168,12 @@ pub(crate) fn edge_lanes_avx2(
     }
     let det = _mm256_add_ps(_mm256_add_ps(u, v), w);
     let zero = _mm256_setzero_ps();
-    let all3 = |f: &dyn Fn(__m256) -> __m256, and: bool| {
-        let (a, b, c) = (f(u), f(v), f(w));
-        if and {
-            _mm256_and_ps(_mm256_and_ps(a, b), c)
-        } else {
-            _mm256_or_ps(_mm256_or_ps(a, b), c)
-        }
-    };
-    let nonzero = all3(&|x| _mm256_cmp_ps::<_CMP_NEQ_UQ>(x, zero), true);
-    let some_neg = all3(&|x| _mm256_cmp_ps::<_CMP_LT_OQ>(x, zero), false);
-    let some_pos = all3(&|x| _mm256_cmp_ps::<_CMP_GT_OQ>(x, zero), false);
+    let ne = |x: __m256| _mm256_cmp_ps::<_CMP_NEQ_UQ>(x, zero);
+    let lt = |x: __m256| _mm256_cmp_ps::<_CMP_LT_OQ>(x, zero);
+    let gt = |x: __m256| _mm256_cmp_ps::<_CMP_GT_OQ>(x, zero);
+    let nonzero = _mm256_and_ps(_mm256_and_ps(ne(u), ne(v)), ne(w));
+    let some_neg = _mm256_or_ps(_mm256_or_ps(lt(u), lt(v)), lt(w));
+    let some_pos = _mm256_or_ps(_mm256_or_ps(gt(u), gt(v)), gt(w));
     let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
     let finite =
         _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_and_ps(det, abs), _mm256_set1_ps(f32::INFINITY));
@@ -207,6 +202,31 @@ impl RayShear {
         }
         self.block_edges(block, lanes)
     }
+}
+
+/// One vertex moved to the ray origin and sheared, as `RayShear::sheared`
+/// does, eight lanes at a time: `(p[kx] - o[kx]) - sx (p[kz] - o[kz])` and
+/// the same with `ky`, `sy`. The block test puts triangles in the lanes
+/// (the ray's constants broadcast), the packet test rays (the vertex
+/// broadcast).
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(crate) fn sheared_avx2(
+    p: [Lanes8; 3],
+    o: [Lanes8; 3],
+    sx: Lanes8,
+    sy: Lanes8,
+) -> (Lanes8, Lanes8) {
+    use std::arch::x86_64::*;
+    let z = _mm256_sub_ps(p[2], o[2]);
+    (
+        _mm256_sub_ps(_mm256_sub_ps(p[0], o[0]), _mm256_mul_ps(sx, z)),
+        _mm256_sub_ps(_mm256_sub_ps(p[1], o[1]), _mm256_mul_ps(sy, z)),
+    )
 }
 
 /// Eight f32 lanes in a 256-bit register (AVX2 paths).
@@ -238,10 +258,11 @@ impl RayShear {
         let sheared = |p: &[[f32; BLOCK_WIDTH]; 3]| {
             // SAFETY: eight f32 per row.
             let load = |a: &[f32; BLOCK_WIDTH]| unsafe { _mm256_loadu_ps(a.as_ptr()) };
-            let z = _mm256_sub_ps(load(&p[kz]), oz);
-            (
-                _mm256_sub_ps(_mm256_sub_ps(load(&p[kx]), ox), _mm256_mul_ps(sx, z)),
-                _mm256_sub_ps(_mm256_sub_ps(load(&p[ky]), oy), _mm256_mul_ps(sy, z)),
+            sheared_avx2(
+                [load(&p[kx]), load(&p[ky]), load(&p[kz])],
+                [ox, oy, oz],
+                sx,
+                sy,
             )
         };
         let v = &block.v;

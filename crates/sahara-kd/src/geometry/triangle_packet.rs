@@ -16,9 +16,9 @@
 //! --counters`), where the packet test does a half to a quarter of the work.
 
 use super::triangle::RayShear;
-#[cfg(target_arch = "x86_64")]
-use super::triangle_block::edge_lanes_avx2;
 use super::triangle_block::{edge_lanes, TriangleBlock, BLOCK_WIDTH};
+#[cfg(target_arch = "x86_64")]
+use super::triangle_block::{edge_lanes_avx2, sheared_avx2};
 
 const _: () = assert!(
     RAYS == BLOCK_WIDTH,
@@ -152,11 +152,7 @@ impl PacketShear {
         let sheared = |k: usize| {
             let v = &block.v[k];
             let p = |axis: usize| _mm256_set1_ps(v[axis][lane]);
-            let z = _mm256_sub_ps(p(kz), oz);
-            (
-                _mm256_sub_ps(_mm256_sub_ps(p(kx), ox), _mm256_mul_ps(sx, z)),
-                _mm256_sub_ps(_mm256_sub_ps(p(ky), oy), _mm256_mul_ps(sy, z)),
-            )
+            sheared_avx2([p(kx), p(ky), p(kz)], [ox, oy, oz], sx, sy)
         };
         edge_lanes_avx2(sheared(0), sheared(1), sheared(2))
     }
