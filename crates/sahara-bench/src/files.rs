@@ -57,7 +57,7 @@ pub fn rays_to_bytes(rays: &[Ray]) -> Vec<u8> {
 /// The rays in ray file bytes, or `None` if the length is not a multiple of
 /// [`RAY_BYTES`].
 pub fn rays_from_bytes(bytes: &[u8]) -> Option<Vec<Ray>> {
-    if bytes.len() % RAY_BYTES != 0 {
+    if !bytes.len().is_multiple_of(RAY_BYTES) {
         return None;
     }
     let rays = bytes
@@ -89,7 +89,7 @@ pub fn hits_to_bytes(records: &[HitRecord]) -> Vec<u8> {
 /// The records in hit file bytes, or `None` if the length is not a multiple
 /// of [`HIT_BYTES`].
 pub fn hits_from_bytes(bytes: &[u8]) -> Option<Vec<HitRecord>> {
-    if bytes.len() % HIT_BYTES != 0 {
+    if !bytes.len().is_multiple_of(HIT_BYTES) {
         return None;
     }
     let records = bytes

@@ -10,19 +10,40 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
+use crate::geometry::leaf_layout::{Indexed, Layout, LeafBlock, Whole};
 use crate::geometry::triangle::RayShear;
 use crate::geometry::triangle_block::BLOCK_WIDTH;
-use crate::geometry::{Aabb, Primitive, Ray, Triangle, TriangleBlock, TriangleHit};
+use crate::geometry::{Aabb, Primitive, Ray, Triangle, TriangleHit, TriangleLeaves};
 use crate::tree::KdTree;
 
 /// Run-time CPU feature selection: the release binary targets baseline
 /// x86-64 (SSE2) and picks the AVX2 build of the traversal where it exists.
+/// The instruction sets a traversal is compiled for (the `SIMD` constant
+/// of the leaf tests): each level has the ones below it.
+pub(crate) mod level {
+    /// Baseline: the lane loops, vectorised by the compiler.
+    pub const PORTABLE: u8 = 0;
+    /// AVX2 intrinsics in the leaf tests.
+    pub const AVX2: u8 = 1;
+    /// AVX2, and AVX-512 (F + VL) for the gathers from a block's vertex
+    /// table (`vpermt2ps`).
+    pub const AVX512: u8 = 2;
+}
+
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod simd {
     /// True when the CPU has AVX2 (std caches the CPUID query).
     #[inline(always)]
     pub fn avx2() -> bool {
         std::arch::is_x86_feature_detected!("avx2")
+    }
+
+    /// True when the CPU has AVX2 and AVX-512 F and VL.
+    #[inline(always)]
+    pub fn avx512() -> bool {
+        avx2()
+            && std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl")
     }
 }
 
@@ -164,29 +185,30 @@ impl<C, F: FnMut(usize, usize, &mut C, &mut f32) -> LeafResult> LeafVisit<C> for
 /// The closest-hit leaf visit of one ray, a named type rather than a
 /// closure so that `#[inline(always)]` can put it into the walk's loop
 /// (LLVM kept the closure out of line: a call per leaf).
-struct ClosestLeaf<'a, const AVX2: bool> {
+struct ClosestLeaf<'a, L: Layout, const SIMD: u8> {
     tree: &'a KdTree<Triangle>,
+    layout: L,
     shear: &'a RayShear,
     tmin: f32,
     best_t: f32,
     best: Hit,
 }
 
-impl<C: Counters, const AVX2: bool> LeafVisit<C> for ClosestLeaf<'_, AVX2> {
+impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for ClosestLeaf<'_, L, SIMD> {
     #[inline(always)]
     fn visit(&mut self, offset: usize, count: usize, c: &mut C, closest: &mut f32) -> LeafResult {
-        // SAFETY: the walk passes the `offset`, `count` of a leaf.
-        unsafe {
-            self.tree.leaf_closest::<C, AVX2>(
-                self.shear,
-                self.tmin,
-                offset,
-                count,
-                &mut self.best_t,
-                &mut self.best,
-                c,
-            )
-        };
+        // SAFETY: the walk passes the `offset`, `count` of a non-empty leaf
+        // of this tree, whose blocks `layout` holds.
+        let blocks = unsafe { self.layout.blocks(offset, count) };
+        self.tree.leaf_closest::<C, SIMD, _>(
+            blocks,
+            self.shear,
+            self.tmin,
+            count,
+            &mut self.best_t,
+            &mut self.best,
+            c,
+        );
         if self.best.tri != u32::MAX {
             *closest = self.best_t;
         }
@@ -196,40 +218,63 @@ impl<C: Counters, const AVX2: bool> LeafVisit<C> for ClosestLeaf<'_, AVX2> {
 
 /// The any-hit leaf visit of one ray (a named type for the reason given at
 /// [`ClosestLeaf`]).
-struct AnyLeaf<'a, const AVX2: bool> {
-    tree: &'a KdTree<Triangle>,
+struct AnyLeaf<'a, L: Layout, const SIMD: u8> {
+    layout: L,
     shear: &'a RayShear,
     tmin: f32,
     tmax: f32,
     found: bool,
 }
 
-impl<C: Counters, const AVX2: bool> LeafVisit<C> for AnyLeaf<'_, AVX2> {
+impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for AnyLeaf<'_, L, SIMD> {
     #[inline(always)]
     fn visit(&mut self, offset: usize, count: usize, c: &mut C, _: &mut f32) -> LeafResult {
-        // SAFETY: the walk passes the `offset`, `count` of a leaf.
-        let (blocks, _) = unsafe { self.tree.leaf_blocks(offset, count) };
-        for (b, block) in blocks.iter().enumerate() {
+        // SAFETY: as in `ClosestLeaf::visit`.
+        let blocks = unsafe { self.layout.blocks(offset, count) };
+        if self.any_in(blocks, count, c) {
+            self.found = true;
+            LeafResult::Stop
+        } else {
+            LeafResult::Continue
+        }
+    }
+}
+
+impl<L: Layout, const SIMD: u8> AnyLeaf<'_, L, SIMD> {
+    /// True if a triangle of `blocks` (a leaf of `count`) is hit.
+    #[inline(always)]
+    fn any_in<C: Counters, B: LeafBlock>(
+        &self,
+        blocks: impl Iterator<Item = B>,
+        count: usize,
+        c: &mut C,
+    ) -> bool {
+        for (b, block) in blocks.enumerate() {
             let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
             (0..lanes).for_each(|_| c.triangle());
-            // SAFETY: `AVX2` only on the AVX2 path.
-            let (mut m, e) = unsafe { self.shear.block_edges_on::<AVX2>(block, lanes) };
+            // SAFETY: `SIMD` is the level the traversal is compiled for.
+            let (mut m, e) = unsafe { block.edges::<SIMD>(self.shear, lanes) };
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
                 let uvw = [e[0][l], e[1][l], e[2][l]];
                 let tri = block.triangle(l);
                 if self.shear.decide(&tri, uvw, self.tmin, self.tmax).is_some() {
-                    self.found = true;
-                    return LeafResult::Stop;
+                    return true;
                 }
             }
         }
-        LeafResult::Continue
+        false
     }
 }
 
 impl KdTree<Triangle> {
+    /// True if the leaf blocks are in the compact (indexed) layout.
+    #[inline(always)]
+    fn compact_leaves(&self) -> bool {
+        matches!(self.leaf_data, TriangleLeaves::Indexed(_))
+    }
+
     /// The closest hit with `t` in `(ray.tmin, ray.tmax]`; among hits at the
     /// same `t`, the one with the smallest triangle index.
     pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
@@ -238,12 +283,29 @@ impl KdTree<Triangle> {
 
     /// [`KdTree::closest_hit`], counting the work done.
     pub fn closest_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
+        // AVX-512 only speeds up the compact layout's gathers; the whole
+        // layout keeps the AVX2 build.
+        #[cfg(target_arch = "x86_64")]
+        if self.compact_leaves() && simd::avx512() {
+            // SAFETY: the CPU has AVX2 and AVX-512 F, VL (checked).
+            return unsafe { self.closest_hit_avx512(ray, counters) };
+        }
         #[cfg(target_arch = "x86_64")]
         if simd::avx2() {
             // SAFETY: the CPU has AVX2 (checked at run time).
             return unsafe { self.closest_hit_avx2(ray, counters) };
         }
-        self.closest_hit_portable::<C, false>(ray, counters)
+        self.closest_hit_portable::<C, { level::PORTABLE }>(ray, counters)
+    }
+
+    /// [`KdTree::closest_hit_portable`] compiled for AVX2 and AVX-512 (F,
+    /// VL): the block test gathers its lanes from the vertex table with one
+    /// two-register permute (`vpermt2ps`) instead of two permutes and a
+    /// blend (see `indexed_block`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    unsafe fn closest_hit_avx512<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
+        self.closest_hit_portable::<C, { level::AVX512 }>(ray, counters)
     }
 
     /// [`KdTree::closest_hit_portable`] compiled for AVX2: the block test's
@@ -252,21 +314,38 @@ impl KdTree<Triangle> {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn closest_hit_avx2<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
-        self.closest_hit_portable::<C, true>(ray, counters)
+        self.closest_hit_portable::<C, { level::AVX2 }>(ray, counters)
     }
 
     /// The closest-hit traversal, for whatever target features the caller
-    /// is compiled with (inlined into each); `AVX2` selects the leaf test's
-    /// intrinsics (only set where the CPU has AVX2).
+    /// is compiled with (inlined into each); `SIMD` selects the leaf test's
+    /// intrinsics (a level the CPU has, see [`level`]).
     #[inline(always)]
-    fn closest_hit_portable<C: Counters, const AVX2: bool>(
+    fn closest_hit_portable<C: Counters, const SIMD: u8>(
         &self,
         ray: &Ray,
         counters: &mut C,
     ) -> Option<Hit> {
+        match &self.leaf_data {
+            TriangleLeaves::Whole(v) => self.closest_hit_in::<C, SIMD, _>(Whole(v), ray, counters),
+            TriangleLeaves::Indexed(p) => {
+                self.closest_hit_in::<C, SIMD, _>(Indexed(p), ray, counters)
+            }
+        }
+    }
+
+    /// [`KdTree::closest_hit_portable`] for the tree's leaf layout.
+    #[inline(always)]
+    fn closest_hit_in<C: Counters, const SIMD: u8, L: Layout>(
+        &self,
+        layout: L,
+        ray: &Ray,
+        counters: &mut C,
+    ) -> Option<Hit> {
         let shear = RayShear::from_ray(ray);
-        let mut leaf = ClosestLeaf::<AVX2> {
+        let mut leaf = ClosestLeaf::<L, SIMD> {
             tree: self,
+            layout,
             shear: &shear,
             tmin: ray.tmin,
             best_t: ray.tmax,
@@ -290,27 +369,55 @@ impl KdTree<Triangle> {
 
     /// [`KdTree::any_hit`], counting the work done.
     pub fn any_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+        // AVX-512 only speeds up the compact layout's gathers; the whole
+        // layout keeps the AVX2 build.
+        #[cfg(target_arch = "x86_64")]
+        if self.compact_leaves() && simd::avx512() {
+            // SAFETY: the CPU has AVX2 and AVX-512 F, VL (checked).
+            return unsafe { self.any_hit_avx512(ray, counters) };
+        }
         #[cfg(target_arch = "x86_64")]
         if simd::avx2() {
             // SAFETY: the CPU has AVX2 (checked at run time).
             return unsafe { self.any_hit_avx2(ray, counters) };
         }
-        self.any_hit_portable::<C, false>(ray, counters)
+        self.any_hit_portable::<C, { level::PORTABLE }>(ray, counters)
+    }
+
+    /// [`KdTree::any_hit_portable`] compiled for AVX2 and AVX-512 (F, VL).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    unsafe fn any_hit_avx512<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+        self.any_hit_portable::<C, { level::AVX512 }>(ray, counters)
     }
 
     /// [`KdTree::any_hit_portable`] compiled for AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn any_hit_avx2<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
-        self.any_hit_portable::<C, true>(ray, counters)
+        self.any_hit_portable::<C, { level::AVX2 }>(ray, counters)
     }
 
     /// The any-hit traversal (inlined into each target-feature variant).
     #[inline(always)]
-    fn any_hit_portable<C: Counters, const AVX2: bool>(&self, ray: &Ray, counters: &mut C) -> bool {
+    fn any_hit_portable<C: Counters, const SIMD: u8>(&self, ray: &Ray, counters: &mut C) -> bool {
+        match &self.leaf_data {
+            TriangleLeaves::Whole(v) => self.any_hit_in::<C, SIMD, _>(Whole(v), ray, counters),
+            TriangleLeaves::Indexed(p) => self.any_hit_in::<C, SIMD, _>(Indexed(p), ray, counters),
+        }
+    }
+
+    /// [`KdTree::any_hit_portable`] for the tree's leaf layout.
+    #[inline(always)]
+    fn any_hit_in<C: Counters, const SIMD: u8, L: Layout>(
+        &self,
+        layout: L,
+        ray: &Ray,
+        counters: &mut C,
+    ) -> bool {
         let shear = RayShear::from_ray(ray);
-        let mut leaf = AnyLeaf::<AVX2> {
-            tree: self,
+        let mut leaf = AnyLeaf::<L, SIMD> {
+            layout,
             shear: &shear,
             tmin: ray.tmin,
             tmax: ray.tmax,
@@ -320,35 +427,29 @@ impl KdTree<Triangle> {
         leaf.found
     }
 
-    /// The closest-hit test of one leaf: updates `best_t` and `best` (whose
-    /// `tri` is `u32::MAX` while there is no hit) with the leaf's triangles;
-    /// among equally distant hits the smallest index wins.
-    ///
-    /// # Safety
-    /// `offset` and `count` must be those of a leaf of this tree; with
-    /// `AVX2`, the CPU must have AVX2.
+    /// The closest-hit test of one leaf, whose `count` triangles are in
+    /// `blocks`: updates `best_t` and `best` (whose `tri` is `u32::MAX`
+    /// while there is no hit) with them; among equally distant hits the
+    /// smallest index wins. `SIMD` is the level the caller is compiled for.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    pub(crate) unsafe fn leaf_closest<C: Counters, const AVX2: bool>(
+    pub(crate) fn leaf_closest<C: Counters, const SIMD: u8, B: LeafBlock>(
         &self,
+        blocks: impl Iterator<Item = B>,
         shear: &RayShear,
         tmin: f32,
-        offset: usize,
         count: usize,
         best_t: &mut f32,
         best: &mut Hit,
         counters: &mut C,
     ) {
-        // SAFETY: passed on from the caller.
-        let (blocks, indices) = unsafe { self.leaf_blocks(offset, count) };
-        for (b, block) in blocks.iter().enumerate() {
+        for (b, block) in blocks.enumerate() {
             let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
             (0..lanes).for_each(|_| counters.triangle());
             // Eight edge tests at once; the scalar test decides the few
             // lanes left (see `triangle_block`).
-            // SAFETY: `AVX2` only where the CPU has it (the caller's
-            // contract, below).
-            let (mut m, e) = unsafe { shear.block_edges_on::<AVX2>(block, lanes) };
+            // SAFETY: `SIMD` is the level the traversal is compiled for.
+            let (mut m, e) = unsafe { block.edges::<SIMD>(shear, lanes) };
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
@@ -357,35 +458,10 @@ impl KdTree<Triangle> {
                     // The index only now: its load missed the cache on
                     // most kept lanes (perf, random rays), and most kept
                     // lanes are not hits within the interval.
-                    let i = indices[b * BLOCK_WIDTH + l];
+                    let i = self.indices[block.run() + l];
                     keep_closer(best_t, best, h, i);
                 }
             }
-        }
-    }
-
-    /// The blocks of the leaf whose run starts at `offset` and holds `count`
-    /// triangles, and its (padded) index run.
-    ///
-    /// # Safety
-    /// `offset` and `count` must be those of a leaf of this tree.
-    #[inline(always)]
-    pub(crate) unsafe fn leaf_blocks(
-        &self,
-        offset: usize,
-        count: usize,
-    ) -> (&[TriangleBlock], &[u32]) {
-        let first = offset / BLOCK_WIDTH;
-        let n = count.div_ceil(BLOCK_WIDTH);
-        debug_assert!(offset % BLOCK_WIDTH == 0 && first + n <= self.leaf_data.len());
-        debug_assert!(offset + n * BLOCK_WIDTH <= self.indices.len());
-        // SAFETY: the build pads every leaf run to whole blocks
-        // (`pad_leaf_runs`) and makes one block per eight run entries.
-        unsafe {
-            (
-                self.leaf_data.get_unchecked(first..first + n),
-                self.indices.get_unchecked(offset..offset + n * BLOCK_WIDTH),
-            )
         }
     }
 
@@ -598,20 +674,36 @@ mod tests {
     fn portable_and_dispatched_traversals_agree_with_brute_force() {
         let mut f = floats(99);
         let tris = soup(&mut f, 3000, 0.4);
-        let tree = KdTree::build(tris.clone(), &BuildParams::default());
-        for _ in 0..3000 {
-            let ray = Ray::new(Vec3::new(f(), f(), f()) * 5.0, Vec3::new(f(), f(), f()));
-            let want = brute::closest_hit(&tris, &ray);
-            assert_eq!(
-                tree.closest_hit_portable::<_, false>(&ray, &mut NoCounters),
-                want
-            );
-            assert_eq!(tree.closest_hit(&ray), want);
-            assert_eq!(
-                tree.any_hit_portable::<_, false>(&ray, &mut NoCounters),
-                want.is_some()
-            );
-            assert_eq!(tree.any_hit(&ray), want.is_some());
+        for compact_leaves in [false, true] {
+            let params = BuildParams {
+                compact_leaves,
+                ..BuildParams::default()
+            };
+            let tree = KdTree::build(tris.clone(), &params);
+            for _ in 0..3000 {
+                let ray = Ray::new(Vec3::new(f(), f(), f()) * 5.0, Vec3::new(f(), f(), f()));
+                let want = brute::closest_hit(&tris, &ray);
+                let mut nc = NoCounters;
+                assert_eq!(
+                    tree.closest_hit_portable::<_, { level::PORTABLE }>(&ray, &mut nc),
+                    want
+                );
+                assert_eq!(tree.closest_hit(&ray), want);
+                assert_eq!(
+                    tree.any_hit_portable::<_, { level::PORTABLE }>(&ray, &mut nc),
+                    want.is_some()
+                );
+                assert_eq!(tree.any_hit(&ray), want.is_some());
+                // The AVX2 build too where the dispatch picks AVX-512.
+                #[cfg(target_arch = "x86_64")]
+                if simd::avx2() {
+                    // SAFETY: the CPU has AVX2.
+                    unsafe {
+                        assert_eq!(tree.closest_hit_avx2(&ray, &mut nc), want);
+                        assert_eq!(tree.any_hit_avx2(&ray, &mut nc), want.is_some());
+                    }
+                }
+            }
         }
     }
 }

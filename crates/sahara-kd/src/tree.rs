@@ -10,8 +10,10 @@ use crate::geometry::{Aabb, Primitive, Triangle};
 /// - Inner node: `word0` is the split position (f32 bits); `word1 >> 2` is
 ///   the index of the child above the plane. The child below the plane is the
 ///   next node in the array (depth-first order).
-/// - Leaf: `word0` is the offset of its first entry in the index array;
-///   `word1 >> 2` is the number of triangles.
+/// - Leaf: `word0` is the offset of its first entry in the index array
+///   (for a triangle tree: of its first block in the leaf data, whose header
+///   holds the index-array offset); `word1 >> 2` is the number of
+///   triangles.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(C)]
 pub struct Node {
@@ -35,7 +37,7 @@ impl Node {
         }
     }
 
-    /// A leaf with `count` triangles starting at `offset` in the index array.
+    /// A leaf with `count` triangles starting at `offset` (see [`Node`]).
     #[inline]
     pub fn leaf(offset: u32, count: u32) -> Self {
         debug_assert!(count <= MAX_NODE_FIELD);
@@ -85,7 +87,8 @@ impl Node {
         }
     }
 
-    /// Offset into the index array (leaves).
+    /// Offset into the index array, or for a non-empty leaf of a triangle
+    /// tree into its leaf data (leaves; see [`KdTree::leaf_primitives`]).
     #[inline(always)]
     pub fn leaf_offset(&self) -> u32 {
         self.word0
@@ -190,8 +193,12 @@ impl<P: Primitive> KdTree<P> {
     /// The primitive indices of leaf `node`.
     #[inline(always)]
     pub fn leaf_primitives(&self, node: &Node) -> &[u32] {
-        let o = node.leaf_offset() as usize;
-        &self.indices[o..o + node.leaf_count() as usize]
+        let c = node.leaf_count() as usize;
+        if c == 0 {
+            return &[];
+        }
+        let o = P::leaf_run(&self.leaf_data, node.leaf_offset());
+        &self.indices[o..o + c]
     }
 
     /// Visit every node with its cell and depth (root depth 0), depth first.

@@ -3,7 +3,7 @@
 use glam::DVec3;
 
 use crate::geometry::triangle_block::BLOCK_WIDTH;
-use crate::geometry::{Aabb, Triangle};
+use crate::geometry::{Aabb, Triangle, TriangleLeaves};
 use crate::tree::{KdTree, Node};
 
 /// Check a tree's structure and coverage; the first problem found is
@@ -46,8 +46,16 @@ pub fn validate(tree: &KdTree, triangles: &[Triangle]) -> Result<(), String> {
             return;
         }
         if n.is_leaf() {
-            let end = n.leaf_offset() as usize + n.leaf_count() as usize;
-            if end > tree.indices().len() {
+            let count = n.leaf_count() as usize;
+            let run = match tree.leaf_data().leaf_run(n.leaf_offset()) {
+                _ if count == 0 => 0,
+                Some(run) => run,
+                None => {
+                    err = Some(format!("leaf {i} points past its leaf data"));
+                    return;
+                }
+            };
+            if run + count > tree.indices().len() {
                 err = Some(format!("leaf {i} indexes past the index array"));
             } else if let Some(&t) = tree
                 .leaf_triangles(n)
@@ -119,28 +127,76 @@ fn check_blocks(tree: &KdTree, triangles: &[Triangle], leaf: &Node) -> Result<()
     if count == 0 {
         return Ok(());
     }
-    if offset % BLOCK_WIDTH != 0 {
-        return Err(format!("run at {offset} is not block aligned"));
+    match tree.leaf_data() {
+        TriangleLeaves::Whole(v) => {
+            if offset % BLOCK_WIDTH != 0 {
+                return Err(format!("run at {offset} is not block aligned"));
+            }
+            let first = offset / BLOCK_WIDTH;
+            let Some(blocks) = v.get(first..first + count.div_ceil(BLOCK_WIDTH)) else {
+                return Err("blocks past the block array".into());
+            };
+            for (b, block) in blocks.iter().enumerate() {
+                let run = offset + b * BLOCK_WIDTH;
+                check_lanes(tree, triangles, count, b, run, |l| Some(block.triangle(l)))?;
+            }
+        }
+        TriangleLeaves::Indexed(pool) => {
+            let (mut at, mut first_run) = (offset, 0);
+            for b in 0..count.div_ceil(BLOCK_WIDTH) {
+                let Some(block) = pool.checked_block(at) else {
+                    return Err(format!(
+                        "block {b} of a leaf starts past the leaf data ({at})"
+                    ));
+                };
+                let run = block.run();
+                if b == 0 {
+                    if run % BLOCK_WIDTH != 0 {
+                        return Err(format!("run at {run} is not block aligned"));
+                    }
+                    first_run = run;
+                } else if run != first_run + b * BLOCK_WIDTH {
+                    let want = first_run + b * BLOCK_WIDTH;
+                    return Err(format!("block {b} names run {run}, not {want}"));
+                }
+                check_lanes(tree, triangles, count, b, run, |l| {
+                    let named = (0..3).all(|v| block.number(v, l) < block.table_len());
+                    named.then(|| block.triangle(l))
+                })?;
+                at += block.len();
+            }
+        }
     }
-    let padded = count.next_multiple_of(BLOCK_WIDTH);
-    let Some(run) = tree.indices().get(offset..offset + padded) else {
+    Ok(())
+}
+
+/// Block `b` of a leaf of `count` triangles, whose lane 0 is index-array
+/// entry `run`: its lanes hold the triangles the entries name, bit for bit
+/// (`lane` gives a lane's triangle, `None` if the block cannot say), and
+/// its padding entries are `u32::MAX`.
+fn check_lanes(
+    tree: &KdTree,
+    triangles: &[Triangle],
+    count: usize,
+    b: usize,
+    run: usize,
+    lane: impl Fn(usize) -> Option<Triangle>,
+) -> Result<(), String> {
+    let Some(entries) = tree.indices().get(run..run + BLOCK_WIDTH) else {
         return Err("padded run past the index array".into());
     };
-    let Some(blocks) = tree
-        .leaf_data()
-        .get(offset / BLOCK_WIDTH..(offset + padded) / BLOCK_WIDTH)
-    else {
-        return Err("blocks past the block array".into());
-    };
-    for (k, &t) in run.iter().enumerate() {
-        let (block, lane) = (&blocks[k / BLOCK_WIDTH], k % BLOCK_WIDTH);
+    for (l, &t) in entries.iter().enumerate() {
+        let k = b * BLOCK_WIDTH + l;
         if k >= count {
             if t != u32::MAX {
                 return Err(format!("padding entry {k} holds {t}"));
             }
             continue;
         }
-        let (got, want) = (block.triangle(lane), triangles[t as usize]);
+        let Some(got) = lane(l) else {
+            return Err(format!("block lane {k} names a vertex past its table"));
+        };
+        let want = triangles[t as usize];
         let bits = |tri: &Triangle| tri.v.map(|p| p.to_array().map(f32::to_bits));
         if bits(&got) != bits(&want) {
             return Err(format!(
@@ -238,24 +294,56 @@ mod tests {
     use super::*;
     use crate::build::BuildParams;
 
-    /// The block check fails on a block that no longer matches its indices.
+    /// The block check fails on a block that no longer matches its
+    /// indices, in either layout; and on an indexed block whose header
+    /// claims more table than the pool holds.
     #[test]
     fn a_corrupted_leaf_block_is_reported() {
-        let tris: Vec<Triangle> = (0..20)
+        // Strips of two triangles sharing an edge: the indexed blocks hold
+        // 4 distinct vertices per pair.
+        let tris: Vec<Triangle> = (0..40)
             .map(|i| {
-                let x = i as f32;
-                Triangle::new(
+                let x = (i / 2) as f32;
+                let (a, b, c, d) = (
                     Vec3::new(x, 0.0, 1.0),
                     Vec3::new(x + 0.5, 0.0, 1.0),
                     Vec3::new(x, 1.0, 1.0),
-                )
+                    Vec3::new(x + 0.5, 1.0, 1.0),
+                );
+                if i % 2 == 0 {
+                    Triangle::new(a, b, c)
+                } else {
+                    Triangle::new(b, d, c)
+                }
             })
             .collect();
-        let mut tree = KdTree::build(tris.clone(), &BuildParams::default());
-        validate(&tree, &tris).unwrap();
-        tree.leaf_data[0].v[1][2][0] += 1.0;
-        let e = validate(&tree, &tris).unwrap_err();
-        assert!(e.contains("block lane"), "{e}");
-        assert!(validate(&tree, &tris[1..]).is_err(), "wrong triangle count");
+        for compact in [false, true] {
+            let params = BuildParams {
+                compact_leaves: compact,
+                ..BuildParams::default()
+            };
+            let mut tree = KdTree::build(tris.clone(), &params);
+            validate(&tree, &tris).unwrap();
+            match &mut tree.leaf_data {
+                TriangleLeaves::Whole(v) => v[0].v[1][2][0] += 1.0,
+                TriangleLeaves::Indexed(p) => {
+                    // The z of the first block's table entry 1 (after the
+                    // eight header words, rows of `stride` entries).
+                    let words = p.words_mut();
+                    let stride = (words[1] >> 8) as usize;
+                    assert!(stride < 24, "a shared-vertex block");
+                    let z = &mut words[8 + 2 * stride + 1];
+                    *z = (f32::from_bits(*z) + 1.0).to_bits();
+                }
+            }
+            let e = validate(&tree, &tris).unwrap_err();
+            assert!(e.contains("block lane"), "{e}");
+            assert!(validate(&tree, &tris[1..]).is_err(), "wrong triangle count");
+            if let TriangleLeaves::Indexed(p) = &mut tree.leaf_data {
+                p.words_mut()[1] |= 200 << 8;
+                let e = validate(&tree, &tris).unwrap_err();
+                assert!(e.contains("past"), "{e}");
+            }
+        }
     }
 }

@@ -216,6 +216,13 @@ fn builders() -> Vec<BuildParams> {
     let mut serial = BuildParams::new(Builder::Sah);
     serial.parallel = false;
     out.push(serial);
+    // The compact leaf layout, with the default tree and a deep one.
+    for base in [BuildParams::new(Builder::Sah), deep] {
+        out.push(BuildParams {
+            compact_leaves: true,
+            ..base
+        });
+    }
     out
 }
 

@@ -275,6 +275,10 @@ pub struct TreeOptions {
     /// exact sweep (0: bins all the way down) [default: the builder's].
     #[arg(long, value_name = "N")]
     pub exact_below: Option<u32>,
+    /// Store each leaf block's distinct vertices once: about half the
+    /// memory of the tree, at 0.9-1.0x the tracing speed.
+    #[arg(long)]
+    pub compact_leaves: bool,
     /// Use only the first FRACTION of the triangles, in file order (0 < F
     /// <= 1; for build-scaling measurements).
     #[arg(long, value_name = "FRACTION", value_parser = parse_subset)]
@@ -293,6 +297,7 @@ impl Default for TreeOptions {
             leaf_width: None,
             lane_cost: None,
             exact_below: None,
+            compact_leaves: false,
             subset: None,
         }
     }
@@ -310,6 +315,7 @@ impl TreeOptions {
         p.leaf_width = self.leaf_width.unwrap_or(p.leaf_width);
         p.lane_cost = self.lane_cost.unwrap_or(p.lane_cost);
         p.exact_below = self.exact_below.unwrap_or(p.exact_below);
+        p.compact_leaves = self.compact_leaves;
         p
     }
 

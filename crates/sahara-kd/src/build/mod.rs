@@ -40,8 +40,8 @@ impl<P: Primitive> KdTree<P> {
                 }
             }
         };
-        let (nodes, indices) = pad_leaf_runs(sub.nodes, &sub.indices, P::LEAF_WIDTH);
-        let leaf_data = P::leaf_data(&triangles, &indices);
+        let (mut nodes, indices) = pad_leaf_runs(sub.nodes, &sub.indices, P::LEAF_WIDTH);
+        let leaf_data = P::leaf_data(&triangles, &indices, &mut nodes, params);
         KdTree {
             nodes,
             indices,

@@ -31,6 +31,7 @@
 //! tiles); this test costs about a quarter of the 8-ray edge test and checks
 //! eight triangles at once.
 
+use super::indexed_block::IndexedBlock;
 use super::triangle::{permutation, RayShear};
 use super::triangle_block::{TriangleBlock, BLOCK_WIDTH};
 
@@ -169,43 +170,84 @@ impl Frustum {
     #[target_feature(enable = "avx2")]
     pub unsafe fn survivors_avx2(&self, block: &TriangleBlock, lanes: usize) -> u32 {
         use std::arch::x86_64::*;
+        // SAFETY: each row is eight f32.
+        let load = |k: usize, a: usize| unsafe { _mm256_loadu_ps(block.v[k][a].as_ptr()) };
+        let v = [
+            [load(0, 0), load(0, 1), load(0, 2)],
+            [load(1, 0), load(1, 1), load(1, 2)],
+            [load(2, 0), load(2, 1), load(2, 2)],
+        ];
+        // SAFETY: AVX2 (the caller's contract).
+        unsafe { self.survivors_lanes_avx2(v, lanes) }
+    }
+
+    /// [`Frustum::survivors_avx2`] of a block as a tree stores it (its lanes
+    /// gathered from the vertex table).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    pub unsafe fn survivors_indexed_avx2(&self, block: IndexedBlock, lanes: usize) -> u32 {
+        // SAFETY: AVX2 (the caller's contract).
+        unsafe { self.survivors_lanes_avx2(block.lanes_avx2(), lanes) }
+    }
+
+    /// The body of [`Frustum::survivors_avx2`], on the lanes `[vertex][axis]`:
+    /// always inlined into the two callers (the lanes stay in registers),
+    /// hence no target feature of its own and no closures.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2, and the caller must be compiled for it.
+    #[cfg(target_arch = "x86_64")]
+    #[inline(always)]
+    unsafe fn survivors_lanes_avx2(
+        &self,
+        v: [[std::arch::x86_64::__m256; 3]; 3],
+        lanes: usize,
+    ) -> u32 {
+        use std::arch::x86_64::*;
         const { assert!(BLOCK_WIDTH == 8) };
         let [kx, ky, kz] = self.k;
-        let set = |x: f32| _mm256_set1_ps(x);
-        let (ox, oy, oz) = (set(self.o[0]), set(self.o[1]), set(self.o[2]));
-        let (sg, rel) = (set(self.sign), set(MARGIN_REL));
-        let ([lx, ly], [hx, hy]) = (self.lo.map(set), self.hi.map(set));
-        let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
-        let sign = _mm256_castsi256_ps(_mm256_set1_epi32(i32::MIN));
-        let all = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
-        let mut out = [all; 5];
-        for p in &block.v {
-            // SAFETY: each row is eight f32.
-            let load = |a: &[f32; BLOCK_WIDTH]| unsafe { _mm256_loadu_ps(a.as_ptr()) };
-            let x = _mm256_mul_ps(_mm256_sub_ps(load(&p[kx]), ox), sg);
-            let y = _mm256_mul_ps(_mm256_sub_ps(load(&p[ky]), oy), sg);
-            let z = _mm256_mul_ps(_mm256_sub_ps(load(&p[kz]), oz), sg);
-            let sum = _mm256_add_ps(
-                _mm256_add_ps(_mm256_and_ps(x, abs), _mm256_and_ps(y, abs)),
-                _mm256_and_ps(z, abs),
+        // SAFETY: AVX2 (the caller's contract).
+        unsafe {
+            let (ox, oy, oz) = (
+                _mm256_set1_ps(self.o[0]),
+                _mm256_set1_ps(self.o[1]),
+                _mm256_set1_ps(self.o[2]),
             );
-            let m = _mm256_mul_ps(sum, rel);
-            let neg_m = _mm256_xor_ps(m, sign);
-            let plane = |a: __m256, s: __m256| _mm256_sub_ps(a, _mm256_mul_ps(s, z));
-            let outside = [
-                _mm256_cmp_ps::<_CMP_LT_OQ>(plane(x, lx), neg_m),
-                _mm256_cmp_ps::<_CMP_GT_OQ>(plane(x, hx), m),
-                _mm256_cmp_ps::<_CMP_LT_OQ>(plane(y, ly), neg_m),
-                _mm256_cmp_ps::<_CMP_GT_OQ>(plane(y, hy), m),
-                _mm256_cmp_ps::<_CMP_LT_OQ>(z, neg_m),
-            ];
-            for (o, c) in out.iter_mut().zip(outside) {
-                *o = _mm256_and_ps(*o, c);
+            let (sg, rel) = (_mm256_set1_ps(self.sign), _mm256_set1_ps(MARGIN_REL));
+            let (lx, ly) = (_mm256_set1_ps(self.lo[0]), _mm256_set1_ps(self.lo[1]));
+            let (hx, hy) = (_mm256_set1_ps(self.hi[0]), _mm256_set1_ps(self.hi[1]));
+            let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
+            let sign = _mm256_castsi256_ps(_mm256_set1_epi32(i32::MIN));
+            let all = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+            let (mut o0, mut o1, mut o2, mut o3, mut o4) = (all, all, all, all, all);
+            for p in &v {
+                let x = _mm256_mul_ps(_mm256_sub_ps(p[kx], ox), sg);
+                let y = _mm256_mul_ps(_mm256_sub_ps(p[ky], oy), sg);
+                let z = _mm256_mul_ps(_mm256_sub_ps(p[kz], oz), sg);
+                let sum = _mm256_add_ps(
+                    _mm256_add_ps(_mm256_and_ps(x, abs), _mm256_and_ps(y, abs)),
+                    _mm256_and_ps(z, abs),
+                );
+                let m = _mm256_mul_ps(sum, rel);
+                let neg_m = _mm256_xor_ps(m, sign);
+                // Outside each plane: x - lx z < -m, x - hx z > m, the same
+                // with y, and z < -m.
+                let px_lo = _mm256_sub_ps(x, _mm256_mul_ps(lx, z));
+                let px_hi = _mm256_sub_ps(x, _mm256_mul_ps(hx, z));
+                let py_lo = _mm256_sub_ps(y, _mm256_mul_ps(ly, z));
+                let py_hi = _mm256_sub_ps(y, _mm256_mul_ps(hy, z));
+                o0 = _mm256_and_ps(o0, _mm256_cmp_ps::<_CMP_LT_OQ>(px_lo, neg_m));
+                o1 = _mm256_and_ps(o1, _mm256_cmp_ps::<_CMP_GT_OQ>(px_hi, m));
+                o2 = _mm256_and_ps(o2, _mm256_cmp_ps::<_CMP_LT_OQ>(py_lo, neg_m));
+                o3 = _mm256_and_ps(o3, _mm256_cmp_ps::<_CMP_GT_OQ>(py_hi, m));
+                o4 = _mm256_and_ps(o4, _mm256_cmp_ps::<_CMP_LT_OQ>(z, neg_m));
             }
+            let culled = _mm256_or_ps(_mm256_or_ps(_mm256_or_ps(o0, o1), _mm256_or_ps(o2, o3)), o4);
+            !(_mm256_movemask_ps(culled) as u32) & ((1u32 << lanes) - 1)
         }
-        let [a, b, c, d, e] = out;
-        let culled = _mm256_or_ps(_mm256_or_ps(_mm256_or_ps(a, b), _mm256_or_ps(c, d)), e);
-        !(_mm256_movemask_ps(culled) as u32) & ((1u32 << lanes) - 1)
     }
 }
 

@@ -3,6 +3,8 @@
 pub mod aabb;
 pub mod clip;
 pub mod frustum;
+pub mod indexed_block;
+pub mod leaf_layout;
 pub mod primitive;
 pub mod ray;
 pub mod triangle;
@@ -10,6 +12,8 @@ pub mod triangle_block;
 pub mod triangle_packet;
 
 pub use aabb::Aabb;
+pub use indexed_block::{IndexedBlock, IndexedBlocks};
+pub use leaf_layout::TriangleLeaves;
 pub use primitive::Primitive;
 pub use ray::Ray;
 pub use triangle::{Triangle, TriangleHit};

@@ -1,8 +1,12 @@
 //! What a kd-tree can be built over.
 
 use super::clip::clipped_bounds;
+use super::indexed_block::IndexedBlocks;
+use super::leaf_layout::TriangleLeaves;
 use super::triangle_block::{TriangleBlock, BLOCK_WIDTH};
 use super::{Aabb, Triangle};
+use crate::build::BuildParams;
+use crate::tree::Node;
 
 /// A primitive a kd-tree can hold: it has bounds, and bounds of its part
 /// inside a cell (for split clipping).
@@ -18,8 +22,18 @@ pub trait Primitive: Send + Sync + Sized {
     type LeafData: Clone + std::fmt::Debug + Default + Send + Sync;
     /// Leaf index runs start at and are padded to a multiple of this.
     const LEAF_WIDTH: usize;
-    /// The leaf data for a padded index array (`u32::MAX` marks padding).
-    fn leaf_data(prims: &[Self], padded_indices: &[u32]) -> Self::LeafData;
+    /// The leaf data for a padded index array (`u32::MAX` marks padding);
+    /// it may re-point the non-empty leaves of `nodes` (whose offsets are
+    /// into that array) at itself.
+    fn leaf_data(
+        prims: &[Self],
+        padded_indices: &[u32],
+        nodes: &mut [Node],
+        params: &BuildParams,
+    ) -> Self::LeafData;
+    /// The index-array offset of the non-empty leaf whose offset field is
+    /// `offset`.
+    fn leaf_run(data: &Self::LeafData, offset: u32) -> usize;
     /// Heap bytes of the leaf data.
     fn leaf_data_bytes(data: &Self::LeafData) -> usize;
 }
@@ -35,24 +49,48 @@ impl Primitive for Triangle {
         Triangle::is_hittable(self)
     }
 
-    /// Copies of the leaves' triangles in leaf order, eight to a block.
-    type LeafData = Vec<TriangleBlock>;
+    /// Copies of the leaves' triangles in leaf order, eight to a block,
+    /// whole or (`BuildParams::compact_leaves`) with each block's distinct
+    /// vertices once; then a leaf's offset is the word offset of its first
+    /// block.
+    type LeafData = TriangleLeaves;
     const LEAF_WIDTH: usize = BLOCK_WIDTH;
-    fn leaf_data(prims: &[Self], padded_indices: &[u32]) -> Vec<TriangleBlock> {
-        padded_indices
-            .chunks(BLOCK_WIDTH)
-            .map(|run| {
-                let tris: Vec<Triangle> = run
-                    .iter()
-                    .filter(|&&i| i != u32::MAX)
-                    .map(|&i| prims[i as usize])
-                    .collect();
-                TriangleBlock::pack(&tris)
-            })
-            .collect()
+    fn leaf_data(
+        prims: &[Self],
+        padded_indices: &[u32],
+        nodes: &mut [Node],
+        params: &BuildParams,
+    ) -> TriangleLeaves {
+        if !params.compact_leaves {
+            return TriangleLeaves::Whole(
+                padded_indices
+                    .chunks(BLOCK_WIDTH)
+                    .map(|run| {
+                        let tris: Vec<Triangle> = run
+                            .iter()
+                            .filter(|&&i| i != u32::MAX)
+                            .map(|&i| prims[i as usize])
+                            .collect();
+                        TriangleBlock::pack(&tris)
+                    })
+                    .collect(),
+            );
+        }
+        let (blocks, starts) = IndexedBlocks::pack(prims, padded_indices);
+        for n in nodes
+            .iter_mut()
+            .filter(|n| n.is_leaf() && n.leaf_count() != 0)
+        {
+            let run = n.leaf_offset() as usize / BLOCK_WIDTH;
+            *n = Node::leaf(starts[run], n.leaf_count());
+        }
+        TriangleLeaves::Indexed(blocks)
     }
-    fn leaf_data_bytes(data: &Vec<TriangleBlock>) -> usize {
-        std::mem::size_of_val(data.as_slice())
+    fn leaf_run(data: &TriangleLeaves, offset: u32) -> usize {
+        data.leaf_run(offset).expect("a leaf offset names a block")
+    }
+    fn leaf_data_bytes(data: &TriangleLeaves) -> usize {
+        data.bytes()
     }
 }
 
@@ -73,7 +111,10 @@ impl Primitive for Aabb {
     /// Box trees hand indices to the caller's closures: nothing extra.
     type LeafData = ();
     const LEAF_WIDTH: usize = 1;
-    fn leaf_data(_: &[Self], _: &[u32]) {}
+    fn leaf_data(_: &[Self], _: &[u32], _: &mut [Node], _: &BuildParams) {}
+    fn leaf_run(_: &(), offset: u32) -> usize {
+        offset as usize
+    }
     fn leaf_data_bytes(_: &()) -> usize {
         0
     }

@@ -16,8 +16,10 @@
 //! are therefore bit-identical to the reference test and the brute-force
 //! oracle.
 
+use crate::traverse::level;
 use glam::Vec3;
 
+use super::indexed_block::IndexedBlock;
 use super::triangle::RayShear;
 use super::Triangle;
 
@@ -185,22 +187,53 @@ pub(crate) fn edge_lanes_avx2(
 }
 
 impl RayShear {
-    /// [`RayShear::block_edges`], in AVX2 intrinsics when `AVX2`.
+    /// [`RayShear::block_edges`] of a block as a tree stores it: each
+    /// distinct vertex sheared once (the same operations, so the same
+    /// lanes), then gathered into the lanes.
+    #[inline(always)]
+    pub fn indexed_edges(
+        &self,
+        block: IndexedBlock,
+        lanes: usize,
+    ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
+        let [kx, ky, kz] = self.k;
+        let (ox, oy, oz) = (self.origin[kx], self.origin[ky], self.origin[kz]);
+        let (sx, sy) = (self.s.x, self.s.y);
+        let mut x = [0.0f32; 3 * BLOCK_WIDTH];
+        let mut y = [0.0f32; 3 * BLOCK_WIDTH];
+        for n in 0..block.table_len() {
+            let p = block.table_vertex(n);
+            let z = p[kz] - oz;
+            x[n] = (p[kx] - ox) - sx * z;
+            y[n] = (p[ky] - oy) - sy * z;
+        }
+        let vertex = |k: usize| {
+            let n: [usize; BLOCK_WIDTH] = std::array::from_fn(|l| block.number(k, l));
+            (n.map(|n| x[n]), n.map(|n| y[n]))
+        };
+        let (mask, e) = edge_lanes(vertex(0), vertex(1), vertex(2));
+        (mask & ((1u32 << lanes) - 1), e)
+    }
+
+    /// [`RayShear::indexed_edges`], in intrinsics at level `SIMD` (AVX2 or
+    /// above; see `crate::traverse::level`).
     ///
     /// # Safety
-    /// With `AVX2`, the CPU must have AVX2.
+    /// The CPU must have the level's instructions, and the caller must be
+    /// compiled for them.
     #[inline(always)]
-    pub(crate) unsafe fn block_edges_on<const AVX2: bool>(
+    pub(crate) unsafe fn block_edges_on<const SIMD: u8>(
         &self,
-        block: &TriangleBlock,
+        block: IndexedBlock,
         lanes: usize,
     ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
         #[cfg(target_arch = "x86_64")]
-        if AVX2 {
-            // SAFETY: the caller's contract.
-            return unsafe { self.block_edges_avx2(block, lanes) };
+        if SIMD >= level::AVX2 {
+            // SAFETY: the caller's contract (and it is compiled for AVX2:
+            // `AVX2` is only set inside the AVX2 traversals).
+            return unsafe { self.indexed_edges_avx2_inlined::<SIMD>(block, lanes) };
         }
-        self.block_edges(block, lanes)
+        self.indexed_edges(block, lanes)
     }
 }
 
@@ -267,6 +300,116 @@ impl RayShear {
         };
         let v = &block.v;
         let (mask, e) = edge_lanes_avx2(sheared(&v[0]), sheared(&v[1]), sheared(&v[2]));
+        (mask & ((1u32 << lanes) - 1), e)
+    }
+
+    /// [`RayShear::indexed_edges`] in AVX2 intrinsics (the same results):
+    /// the (at most 16) distinct vertices sheared in two registers, the
+    /// lanes gathered from them with permutes; a verbatim block's lanes
+    /// are loaded as they are.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn indexed_edges_avx2(
+        &self,
+        block: IndexedBlock,
+        lanes: usize,
+    ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
+        // SAFETY: AVX2 (this function's target feature).
+        unsafe { self.indexed_edges_avx2_inlined::<{ level::AVX2 }>(block, lanes) }
+    }
+
+    /// The body of [`RayShear::indexed_edges_avx2`], always inlined (a
+    /// function with a target feature cannot be): LLVM kept the function
+    /// out of line, and the call per block, with the walk's registers
+    /// spilled around it, cost up to 10% (`perf`).
+    ///
+    /// With `SIMD` at [`level::AVX512`], the gathers are AVX-512 (VL)
+    /// two-register permutes.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 (and AVX-512 F, VL at that level), and the
+    /// caller must be compiled for it.
+    #[inline(always)]
+    pub(crate) unsafe fn indexed_edges_avx2_inlined<const SIMD: u8>(
+        &self,
+        block: IndexedBlock,
+        lanes: usize,
+    ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
+        use std::arch::x86_64::*;
+        let [kx, ky, kz] = self.k;
+        let o = [
+            _mm256_set1_ps(self.origin[kx]),
+            _mm256_set1_ps(self.origin[ky]),
+            _mm256_set1_ps(self.origin[kz]),
+        ];
+        let (sx, sy) = (_mm256_set1_ps(self.s.x), _mm256_set1_ps(self.s.y));
+        if block.is_verbatim() {
+            // SAFETY: AVX2 (the caller's contract).
+            return unsafe { self.verbatim_edges_avx2(block, lanes) };
+        }
+        // SAFETY: not verbatim; AVX2 (the caller's contract). No closures
+        // or `array::from_fn` here: this body has no target feature of its
+        // own, and LLVM left such helpers as calls.
+        unsafe {
+            let (xl, xh) = block.row_avx2(kx);
+            let (yl, yh) = block.row_avx2(ky);
+            let (zl, zh) = block.row_avx2(kz);
+            let (lx, ly) = sheared_avx2([xl, yl, zl], o, sx, sy);
+            let (hx, hy) = sheared_avx2([xh, yh, zh], o, sx, sy);
+            let n0 = block.numbers_avx2(0);
+            let n1 = block.numbers_avx2(1);
+            let n2 = block.numbers_avx2(2);
+            let (mask, e) = edge_lanes_avx2(
+                (
+                    IndexedBlock::gather::<SIMD>((lx, hx), n0),
+                    IndexedBlock::gather::<SIMD>((ly, hy), n0),
+                ),
+                (
+                    IndexedBlock::gather::<SIMD>((lx, hx), n1),
+                    IndexedBlock::gather::<SIMD>((ly, hy), n1),
+                ),
+                (
+                    IndexedBlock::gather::<SIMD>((lx, hx), n2),
+                    IndexedBlock::gather::<SIMD>((ly, hy), n2),
+                ),
+            );
+            (mask & ((1u32 << lanes) - 1), e)
+        }
+    }
+
+    /// [`RayShear::indexed_edges_avx2`] of a verbatim block (its lanes
+    /// loaded as they are); out of line, so that the common path stays
+    /// small enough to be inlined into the traversal (a call per block, with
+    /// the walk's registers spilled around it, cost up to 10%).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2; the block must be verbatim.
+    #[target_feature(enable = "avx2")]
+    #[inline(never)]
+    #[cold]
+    unsafe fn verbatim_edges_avx2(
+        &self,
+        block: IndexedBlock,
+        lanes: usize,
+    ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
+        use std::arch::x86_64::*;
+        let [kx, ky, kz] = self.k;
+        let set = |x: f32| _mm256_set1_ps(x);
+        let o = [
+            set(self.origin[kx]),
+            set(self.origin[ky]),
+            set(self.origin[kz]),
+        ];
+        let (sx, sy) = (set(self.s.x), set(self.s.y));
+        let v: [(Lanes8, Lanes8); 3] = std::array::from_fn(|k| {
+            // SAFETY: a verbatim block; AVX2 (the caller's contract).
+            let p = |a: usize| unsafe { block.slot_avx2(k, a) };
+            sheared_avx2([p(kx), p(ky), p(kz)], o, sx, sy)
+        });
+        let (mask, e) = edge_lanes_avx2(v[0], v[1], v[2]);
         (mask & ((1u32 << lanes) - 1), e)
     }
 }

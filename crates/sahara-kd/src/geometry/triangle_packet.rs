@@ -16,9 +16,10 @@
 //! --counters`), where the packet test does a half to a quarter of the work.
 
 use super::triangle::RayShear;
-use super::triangle_block::{edge_lanes, TriangleBlock, BLOCK_WIDTH};
+use super::triangle_block::{edge_lanes, BLOCK_WIDTH};
 #[cfg(target_arch = "x86_64")]
 use super::triangle_block::{edge_lanes_avx2, sheared_avx2};
+use super::Triangle;
 
 const _: () = assert!(
     RAYS == BLOCK_WIDTH,
@@ -93,42 +94,18 @@ impl PacketShear {
         (x, y)
     }
 
-    /// Triangle `lane` of `block` against the eight rays: the rays the
+    /// Triangle `tri` against the eight rays: the rays the
     /// watertight test may accept, as a bit mask (bit `l` = ray `l`), and
     /// their edge functions `[u, v, w]` for [`RayShear::decide`].
     #[inline(always)]
-    pub fn triangle_edges(&self, block: &TriangleBlock, lane: usize) -> (u32, [Lanes; 3]) {
-        debug_assert!(lane < BLOCK_WIDTH);
-        let vertex = |k: usize| {
-            let v = &block.v[k];
-            [v[0][lane], v[1][lane], v[2][lane]]
-        };
+    pub fn triangle_edges(&self, tri: &Triangle) -> (u32, [Lanes; 3]) {
+        let vertex = |k: usize| tri.v[k].to_array();
         // Lanes are rays here; the step is the block test's, lane for lane.
         edge_lanes(
             self.sheared(vertex(0)),
             self.sheared(vertex(1)),
             self.sheared(vertex(2)),
         )
-    }
-}
-
-impl PacketShear {
-    /// [`PacketShear::triangle_edges`], in AVX2 intrinsics when `AVX2`.
-    ///
-    /// # Safety
-    /// With `AVX2`, the CPU must have AVX2.
-    #[inline(always)]
-    pub(crate) unsafe fn triangle_edges_on<const AVX2: bool>(
-        &self,
-        block: &TriangleBlock,
-        lane: usize,
-    ) -> (u32, [Lanes; 3]) {
-        #[cfg(target_arch = "x86_64")]
-        if AVX2 {
-            // SAFETY: the caller's contract.
-            return unsafe { self.triangle_edges_avx2(block, lane) };
-        }
-        self.triangle_edges(block, lane)
     }
 }
 
@@ -141,27 +118,68 @@ impl PacketShear {
     /// The CPU must have AVX2.
     #[target_feature(enable = "avx2")]
     #[inline]
-    pub fn triangle_edges_avx2(&self, block: &TriangleBlock, lane: usize) -> (u32, [Lanes; 3]) {
+    pub fn triangle_edges_avx2(&self, tri: &Triangle) -> (u32, [Lanes; 3]) {
+        // SAFETY: AVX2 (this function's target feature).
+        unsafe { self.triangle_edges_avx2_inlined(|k, axis| tri.v[k][axis]) }
+    }
+
+    /// The body of [`PacketShear::triangle_edges_avx2`], always inlined
+    /// into the packet traversal (compiled as a function, it was left out
+    /// of line once the leaf test existed for two leaf layouts).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2, and the caller must be compiled for it.
+    #[inline(always)]
+    /// `vertex(k, axis)` is coordinate `axis` of the triangle's vertex `k`
+    /// (read straight from a leaf block: building a `Triangle` first cost
+    /// the packets a few percent).
+    pub(crate) unsafe fn triangle_edges_avx2_inlined(
+        &self,
+        vertex: impl Fn(usize, usize) -> f32,
+    ) -> (u32, [Lanes; 3]) {
         use std::arch::x86_64::*;
-        debug_assert!(lane < BLOCK_WIDTH);
         let [kx, ky, kz] = self.k;
-        // SAFETY: eight f32 per row.
-        let load = |a: &Lanes| unsafe { _mm256_loadu_ps(a.as_ptr()) };
-        let (ox, oy, oz) = (load(&self.o[0]), load(&self.o[1]), load(&self.o[2]));
-        let (sx, sy) = (load(&self.sx), load(&self.sy));
-        let sheared = |k: usize| {
-            let v = &block.v[k];
-            let p = |axis: usize| _mm256_set1_ps(v[axis][lane]);
-            sheared_avx2([p(kx), p(ky), p(kz)], [ox, oy, oz], sx, sy)
-        };
-        edge_lanes_avx2(sheared(0), sheared(1), sheared(2))
+        // SAFETY: eight f32 per row; AVX2 (the caller's contract).
+        unsafe {
+            let o = [
+                _mm256_loadu_ps(self.o[0].as_ptr()),
+                _mm256_loadu_ps(self.o[1].as_ptr()),
+                _mm256_loadu_ps(self.o[2].as_ptr()),
+            ];
+            let (sx, sy) = (
+                _mm256_loadu_ps(self.sx.as_ptr()),
+                _mm256_loadu_ps(self.sy.as_ptr()),
+            );
+            // Written out: `array::map` with intrinsics stayed a call.
+            let v = &vertex;
+            let a = [
+                _mm256_set1_ps(v(0, kx)),
+                _mm256_set1_ps(v(0, ky)),
+                _mm256_set1_ps(v(0, kz)),
+            ];
+            let b = [
+                _mm256_set1_ps(v(1, kx)),
+                _mm256_set1_ps(v(1, ky)),
+                _mm256_set1_ps(v(1, kz)),
+            ];
+            let c = [
+                _mm256_set1_ps(v(2, kx)),
+                _mm256_set1_ps(v(2, ky)),
+                _mm256_set1_ps(v(2, kz)),
+            ];
+            edge_lanes_avx2(
+                sheared_avx2(a, o, sx, sy),
+                sheared_avx2(b, o, sx, sy),
+                sheared_avx2(c, o, sx, sy),
+            )
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{Ray, Triangle};
+    use crate::geometry::{Ray, TriangleBlock};
     use crate::test_support::floats;
     use glam::Vec3;
 
@@ -195,11 +213,11 @@ mod tests {
                 .collect();
             let p = PacketShear::new(&shears).expect("all rays have kz = z");
             for lane in 0..BLOCK_WIDTH {
-                let (m, e) = p.triangle_edges(&block, lane);
+                let (m, e) = p.triangle_edges(&tris[lane]);
                 #[cfg(target_arch = "x86_64")]
                 if crate::traverse::simd::avx2() {
                     // SAFETY: the CPU has AVX2.
-                    let (m2, e2) = unsafe { p.triangle_edges_avx2(&block, lane) };
+                    let (m2, e2) = unsafe { p.triangle_edges_avx2(&tris[lane]) };
                     assert_eq!(m, m2);
                     assert_eq!(
                         e.map(|r| r.map(f32::to_bits)),

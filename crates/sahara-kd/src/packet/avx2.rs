@@ -11,6 +11,8 @@
 //! multiply-add), so both walks visit the same cells and the leaf tests
 //! give bit-identical hits.
 
+use crate::geometry::leaf_layout::Layout;
+use crate::traverse::level;
 use std::arch::x86_64::*;
 
 use super::{Packet, NO_HIT, OFF, PACKET};
@@ -240,7 +242,7 @@ impl KdTree<Triangle> {
     /// # Safety
     /// The CPU must have AVX2.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn walk_packet_avx2(&self, p: &mut Packet) {
+    pub(super) unsafe fn walk_packet_avx2<L: Layout>(&self, layout: L, p: &mut Packet) {
         let load = |a: &[f32; PACKET]| unsafe { _mm256_loadu_ps(a.as_ptr()) };
         let org = [load(&p.org[0]), load(&p.org[1]), load(&p.org[2])];
         let inv = [load(&p.inv[0]), load(&p.inv[1]), load(&p.inv[2])];
@@ -319,7 +321,15 @@ impl KdTree<Triangle> {
             let count = nd.leaf_count() as usize;
             if count != 0 {
                 // SAFETY: `nd` is a leaf of this tree.
-                unsafe { self.packet_leaf::<true>(p, nd.leaf_offset() as usize, count, live_rays) };
+                unsafe {
+                    self.packet_leaf::<{ level::AVX2 }, _>(
+                        layout,
+                        p,
+                        nd.leaf_offset() as usize,
+                        count,
+                        live_rays,
+                    )
+                };
                 closest = load(&p.closest);
             }
             // Pop the next cell some ray may still find a closer hit in.

@@ -24,10 +24,12 @@ mod avx2;
 mod setup;
 
 use crate::geometry::frustum::Frustum;
+use crate::geometry::leaf_layout::{Indexed, Layout, LeafBlock, Whole};
 use crate::geometry::triangle::TrianglePlane;
 use crate::geometry::triangle_block::BLOCK_WIDTH;
 use crate::geometry::triangle_packet::PacketShear;
-use crate::geometry::{Ray, Triangle, TriangleBlock, TriangleHit};
+use crate::geometry::{Ray, Triangle, TriangleHit, TriangleLeaves};
+use crate::traverse::level;
 use crate::traverse::{keep_closer, Hit, MARGIN, MAX_DEPTH};
 use crate::tree::KdTree;
 
@@ -112,7 +114,10 @@ impl KdTree<Triangle> {
     fn packet_portable(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         let mut p = Packet::EMPTY;
         if self.packet(rays, &mut p) {
-            self.walk_packet_portable(&mut p);
+            match &self.leaf_data {
+                TriangleLeaves::Whole(v) => self.walk_packet_portable(Whole(v), &mut p),
+                TriangleLeaves::Indexed(b) => self.walk_packet_portable(Indexed(b), &mut p),
+            }
             finish(&p, out);
         } else {
             self.closest_hits_one_by_one(rays, out);
@@ -130,8 +135,11 @@ impl KdTree<Triangle> {
         let mut p = Packet::EMPTY;
         // SAFETY: the CPU has AVX2 (the caller's contract).
         if !self.nodes.is_empty() && unsafe { p.setup_avx2(rays, &self.bounds) } {
-            // SAFETY: as above.
-            unsafe { self.walk_packet_avx2(&mut p) };
+            // SAFETY (both arms): as above.
+            match &self.leaf_data {
+                TriangleLeaves::Whole(v) => unsafe { self.walk_packet_avx2(Whole(v), &mut p) },
+                TriangleLeaves::Indexed(b) => unsafe { self.walk_packet_avx2(Indexed(b), &mut p) },
+            }
             finish(&p, out);
         } else {
             self.closest_hits_one_by_one(rays, out);
@@ -163,7 +171,7 @@ impl KdTree<Triangle> {
 
     /// The portable packet walk (for CPUs without AVX2; the reference the
     /// AVX2 walk is tested against).
-    fn walk_packet_portable(&self, p: &mut Packet) {
+    fn walk_packet_portable<L: Layout>(&self, layout: L, p: &mut Packet) {
         let (mut t0, mut t1) = (p.t0, p.t1);
         let mut stack = [const { std::mem::MaybeUninit::<Entry>::uninit() }; MAX_DEPTH];
         let mut sp = 0usize;
@@ -230,7 +238,8 @@ impl KdTree<Triangle> {
             }
             // SAFETY: `nd` is a leaf of this tree.
             unsafe {
-                self.packet_leaf::<false>(
+                self.packet_leaf::<{ level::PORTABLE }, _>(
+                    layout,
                     p,
                     nd.leaf_offset() as usize,
                     nd.leaf_count() as usize,
@@ -262,11 +271,13 @@ impl KdTree<Triangle> {
     /// smallest index, wins).
     ///
     /// # Safety
-    /// `offset` and `count` must be those of a leaf of this tree; with
-    /// `AVX2`, the CPU must have AVX2.
+    /// `offset` and `count` must be those of a leaf of this tree, whose
+    /// blocks `layout` holds; the CPU must have the instructions of level
+    /// `SIMD`.
     #[inline(always)]
-    unsafe fn packet_leaf<const AVX2: bool>(
+    unsafe fn packet_leaf<const SIMD: u8, L: Layout>(
         &self,
+        layout: L,
         p: &mut Packet,
         offset: usize,
         count: usize,
@@ -276,28 +287,26 @@ impl KdTree<Triangle> {
             return;
         }
         // SAFETY: passed on from the caller.
-        let (blocks, indices) = unsafe { self.leaf_blocks(offset, count) };
+        let blocks = unsafe { layout.blocks(offset, count) };
         let rays = live.count_ones();
-        for (b, block) in blocks.iter().enumerate() {
+        for (b, block) in blocks.enumerate() {
             let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
             let tris = match &p.frustum {
-                #[cfg(target_arch = "x86_64")]
-                // SAFETY: `AVX2` is only set on the AVX2 path.
-                Some(f) if AVX2 => unsafe { f.survivors_avx2(block, lanes) },
-                Some(f) => f.survivors(block, lanes),
+                // SAFETY: `SIMD` is the level the walk is compiled for.
+                Some(f) => unsafe { block.survivors::<SIMD>(f, lanes) },
                 None => (1u32 << lanes) - 1,
             };
             if tris == 0 {
                 continue;
             }
-            let indices = &indices[b * BLOCK_WIDTH..(b + 1) * BLOCK_WIDTH];
+            let indices = &self.indices[block.run()..block.run() + BLOCK_WIDTH];
             // Triangle-parallel when it takes fewer tests: one 8-ray test
             // per triangle left against one 8-triangle test per ray.
             match p.packet_shear {
                 Some(ps) if rays >= tris.count_ones() => {
-                    block_closest_packet::<AVX2>(&ps, p, block, indices, tris, live)
+                    block_closest_packet::<SIMD>(&ps, p, block, indices, tris, live)
                 }
-                _ => block_closest_rays::<AVX2>(p, block, indices, lanes, tris, live),
+                _ => block_closest_rays::<SIMD>(p, block, indices, lanes, tris, live),
             }
         }
         for l in 0..PACKET {
@@ -323,19 +332,20 @@ fn set_bits(mut mask: u32) -> impl Iterator<Item = usize> {
 /// The triangles `tris` of `block` (indices `indices`) against the rays in
 /// `live`, one triangle at a time for all rays.
 ///
-/// With `AVX2`, the CPU must have AVX2 (the packet leaf's contract).
+/// The CPU must have the instructions of level `SIMD` (the packet leaf's
+/// contract).
 #[inline(always)]
-fn block_closest_packet<const AVX2: bool>(
+fn block_closest_packet<const SIMD: u8>(
     ps: &PacketShear,
     p: &mut Packet,
-    block: &TriangleBlock,
+    block: impl LeafBlock,
     indices: &[u32],
     tris: u32,
     live: u32,
 ) {
     for j in set_bits(tris) {
-        // SAFETY: `AVX2` only on the AVX2 path.
-        let (m, e) = unsafe { ps.triangle_edges_on::<AVX2>(block, j) };
+        // SAFETY: `SIMD` is the level the walk is compiled for.
+        let (m, e) = unsafe { block.packet_edges::<SIMD>(ps, j) };
         let m = m & live;
         if m == 0 {
             continue;
@@ -345,8 +355,8 @@ fn block_closest_packet<const AVX2: bool>(
         // The plane once for all the rays that need it.
         let plane = TrianglePlane::new(&tri);
         #[cfg(target_arch = "x86_64")]
-        if AVX2 {
-            // SAFETY: `AVX2` only on the AVX2 path.
+        if SIMD >= level::AVX2 {
+            // SAFETY: `SIMD` is the level the walk is compiled for.
             unsafe { decide_lanes_avx2(p, &tri, &plane, &e, m, i) };
             continue;
         }
@@ -369,11 +379,16 @@ fn block_closest_packet<const AVX2: bool>(
 /// Why: the scalar f64 division and conversions per ray were the largest
 /// part of the packet test's tail (`perf annotate`).
 ///
+/// Always inlined, without a target feature of its own: compiled as an
+/// AVX2 function, LLVM left it out of line once the packet walk existed
+/// for two leaf layouts, and the call per triangle cost the packets 4-5%
+/// (`perf`, the bunny's camera rays).
+///
 /// # Safety
-/// The CPU must have AVX2.
+/// The CPU must have AVX2, and the caller must be compiled for it.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn decide_lanes_avx2(
+#[inline(always)]
+unsafe fn decide_lanes_avx2(
     p: &mut Packet,
     tri: &Triangle,
     plane: &TrianglePlane,
@@ -381,10 +396,13 @@ fn decide_lanes_avx2(
     m: u32,
     i: u32,
 ) {
-    let t = plane.distances_avx2(
-        [&p.org[0], &p.org[1], &p.org[2]],
-        [&p.dir[0], &p.dir[1], &p.dir[2]],
-    );
+    // SAFETY: AVX2 (the caller's contract).
+    let t = unsafe {
+        plane.distances_avx2(
+            [&p.org[0], &p.org[1], &p.org[2]],
+            [&p.dir[0], &p.dir[1], &p.dir[2]],
+        )
+    };
     for l in set_bits(m) {
         let [u, v, w] = [e[0][l], e[1][l], e[2][l]];
         let (tmin, tmax) = (p.tmin[l], p.best_t[l]);
@@ -413,11 +431,12 @@ fn decide_lanes_avx2(
 /// in `live`, one ray at a time with the block test (as
 /// [`KdTree::leaf_closest`] does).
 ///
-/// With `AVX2`, the CPU must have AVX2 (the packet leaf's contract).
+/// The CPU must have the instructions of level `SIMD` (the packet leaf's
+/// contract).
 #[inline(always)]
-fn block_closest_rays<const AVX2: bool>(
+fn block_closest_rays<const SIMD: u8>(
     p: &mut Packet,
-    block: &TriangleBlock,
+    block: impl LeafBlock,
     indices: &[u32],
     lanes: usize,
     tris: u32,
@@ -425,8 +444,8 @@ fn block_closest_rays<const AVX2: bool>(
 ) {
     for l in set_bits(live) {
         let shear = p.shear(l);
-        // SAFETY: `AVX2` only on the AVX2 path.
-        let (m, e) = unsafe { shear.block_edges_on::<AVX2>(block, lanes) };
+        // SAFETY: `SIMD` is the level the walk is compiled for.
+        let (m, e) = unsafe { block.edges::<SIMD>(&shear, lanes) };
         for j in set_bits(m & tris) {
             let uvw = [e[0][j], e[1][j], e[2][j]];
             let (tmin, tmax) = (p.tmin[l], p.best_t[l]);
@@ -459,8 +478,16 @@ mod tests {
     fn packets_agree_with_brute_force() {
         let mut f = floats(2024);
         let tris = soup(&mut f, 2000, 0.5);
-        for builder in [Builder::Sah, Builder::Binned { bins: 16 }] {
-            let tree = KdTree::build(tris.clone(), &BuildParams::new(builder));
+        let compact = BuildParams {
+            compact_leaves: true,
+            ..BuildParams::new(Builder::Sah)
+        };
+        for params in [
+            BuildParams::new(Builder::Sah),
+            BuildParams::new(Builder::Binned { bins: 16 }),
+            compact,
+        ] {
+            let tree = KdTree::build(tris.clone(), &params);
             for p in 0..400 {
                 let eye = Vec3::new(f(), f(), -6.0);
                 let spread = if p % 4 == 0 { 1.0 } else { 0.05 };

@@ -25,7 +25,7 @@ pub fn get_1d(id: &SampleId, dim: u32) -> f32 {
 /// `count` not above its square root).
 fn grid(count: u32) -> (u32, u32) {
     let mut nx = (count as f64).sqrt() as u32;
-    while nx > 1 && count % nx != 0 {
+    while nx > 1 && !count.is_multiple_of(nx) {
         nx -= 1;
     }
     let nx = nx.max(1);

@@ -1,0 +1,314 @@
+//! The two layouts of a triangle tree's leaf blocks, and what a leaf test
+//! asks of a block in either.
+//!
+//! - [`TriangleLeaves::Whole`] (the default): every lane's three vertices
+//!   written out, 288 bytes per block of eight; the block test loads its
+//!   lanes directly.
+//! - [`TriangleLeaves::Indexed`] (`BuildParams::compact_leaves`): each
+//!   block's distinct vertices once (see `indexed_block`), about half the
+//!   memory (bunny 7.3 -> 4.9 MB, sponza 8.2 -> 5.4, dragon 58.4 -> 37.6).
+//!   Measured against the whole layout (`sahara bench`, 1 thread, best of
+//!   4 interleaved rounds, AVX-512 gathers) on the bunny, the dragon,
+//!   sponza and the teapot in its stadium: camera rays 0.87-0.94x, their
+//!   packets 0.93-0.97x, shadow and diffuse rays 0.88-1.0x, random rays
+//!   0.89-1.05x (the smaller leaf data does not make up for the gathers).
+//!   So it is an option, for scenes where memory counts more than the last
+//!   tenth of speed (Embree's compact scenes make the same trade).
+//!
+//! The leaf tests are written once over `LeafBlock` and compiled for each
+//! layout; each traversal is compiled per layout too (see `Layout`).
+
+use super::frustum::Frustum;
+use super::indexed_block::{IndexedBlock, IndexedBlocks};
+use super::triangle::RayShear;
+use super::triangle_block::{TriangleBlock, BLOCK_WIDTH};
+use super::triangle_packet::PacketShear;
+use super::Triangle;
+#[cfg(target_arch = "x86_64")]
+use crate::traverse::level;
+
+/// The leaf blocks of a triangle tree, in leaf order.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TriangleLeaves {
+    /// Every lane's vertices written out (the default, fastest to test);
+    /// leaf offsets are index-array offsets, block `offset / 8` first.
+    Whole(Vec<TriangleBlock>),
+    /// Each block's distinct vertices once (about half the memory); leaf
+    /// offsets are word offsets of a leaf's first block.
+    Indexed(IndexedBlocks),
+}
+
+impl Default for TriangleLeaves {
+    fn default() -> Self {
+        TriangleLeaves::Whole(Vec::new())
+    }
+}
+
+impl TriangleLeaves {
+    /// Heap bytes of the blocks.
+    pub fn bytes(&self) -> usize {
+        match self {
+            TriangleLeaves::Whole(v) => std::mem::size_of_val(v.as_slice()),
+            TriangleLeaves::Indexed(p) => p.bytes(),
+        }
+    }
+
+    /// The index-array offset of the non-empty leaf whose offset field is
+    /// `offset`, if the leaf data has a block there.
+    pub fn leaf_run(&self, offset: u32) -> Option<usize> {
+        match self {
+            TriangleLeaves::Whole(_) => Some(offset as usize),
+            TriangleLeaves::Indexed(p) => p.checked_block(offset as usize).map(|b| b.run()),
+        }
+    }
+}
+
+/// One block as the leaf tests read it, in either layout.
+pub(crate) trait LeafBlock: Copy {
+    /// The index-array offset of lane 0.
+    fn run(&self) -> usize;
+
+    /// The triangle in `lane`.
+    fn triangle(&self, lane: usize) -> Triangle;
+
+    /// The block test of one ray against the first `lanes` lanes:
+    /// candidate mask and edge functions, as [`RayShear::block_edges`].
+    ///
+    /// # Safety
+    /// The CPU must have the instructions of level `SIMD`, and the caller
+    /// must be compiled for them.
+    unsafe fn edges<const SIMD: u8>(
+        &self,
+        shear: &RayShear,
+        lanes: usize,
+    ) -> (u32, [[f32; BLOCK_WIDTH]; 3]);
+
+    /// The packet test of the triangle in `lane`: as
+    /// [`PacketShear::triangle_edges`].
+    ///
+    /// # Safety
+    /// As [`LeafBlock::edges`].
+    #[inline(always)]
+    unsafe fn packet_edges<const SIMD: u8>(
+        &self,
+        ps: &PacketShear,
+        lane: usize,
+    ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
+        #[cfg(target_arch = "x86_64")]
+        if SIMD >= level::AVX2 {
+            // SAFETY: the caller's contract.
+            return unsafe { ps.triangle_edges_avx2_inlined(|k, axis| self.coord(k, axis, lane)) };
+        }
+        ps.triangle_edges(&self.triangle(lane))
+    }
+
+    /// Coordinate `axis` of vertex `k` of the triangle in `lane`.
+    fn coord(&self, k: usize, axis: usize, lane: usize) -> f32;
+
+    /// The lanes among the first `lanes` that some ray of `frustum` may
+    /// hit, as [`Frustum::survivors`].
+    ///
+    /// # Safety
+    /// As [`LeafBlock::edges`].
+    unsafe fn survivors<const SIMD: u8>(&self, frustum: &Frustum, lanes: usize) -> u32;
+}
+
+/// A block of the whole layout and the index-array offset of its lane 0.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct WholeBlock<'a> {
+    block: &'a TriangleBlock,
+    run: usize,
+}
+
+impl LeafBlock for WholeBlock<'_> {
+    #[inline(always)]
+    fn run(&self) -> usize {
+        self.run
+    }
+
+    #[inline(always)]
+    fn triangle(&self, lane: usize) -> Triangle {
+        self.block.triangle(lane)
+    }
+
+    #[inline(always)]
+    fn coord(&self, k: usize, axis: usize, lane: usize) -> f32 {
+        self.block.v[k][axis][lane]
+    }
+
+    #[inline(always)]
+    unsafe fn edges<const SIMD: u8>(
+        &self,
+        shear: &RayShear,
+        lanes: usize,
+    ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
+        #[cfg(target_arch = "x86_64")]
+        if SIMD >= level::AVX2 {
+            // SAFETY: the caller's contract.
+            return unsafe { shear.block_edges_avx2(self.block, lanes) };
+        }
+        shear.block_edges(self.block, lanes)
+    }
+
+    #[inline(always)]
+    unsafe fn survivors<const SIMD: u8>(&self, frustum: &Frustum, lanes: usize) -> u32 {
+        #[cfg(target_arch = "x86_64")]
+        if SIMD >= level::AVX2 {
+            // SAFETY: the caller's contract.
+            return unsafe { frustum.survivors_avx2(self.block, lanes) };
+        }
+        frustum.survivors(self.block, lanes)
+    }
+}
+
+impl LeafBlock for IndexedBlock<'_> {
+    #[inline(always)]
+    fn run(&self) -> usize {
+        IndexedBlock::run(self)
+    }
+
+    #[inline(always)]
+    fn triangle(&self, lane: usize) -> Triangle {
+        IndexedBlock::triangle(self, lane)
+    }
+
+    #[inline(always)]
+    fn coord(&self, k: usize, axis: usize, lane: usize) -> f32 {
+        self.vertex(k, lane)[axis]
+    }
+
+    #[inline(always)]
+    unsafe fn edges<const SIMD: u8>(
+        &self,
+        shear: &RayShear,
+        lanes: usize,
+    ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
+        // SAFETY: the caller's contract.
+        unsafe { shear.block_edges_on::<SIMD>(*self, lanes) }
+    }
+
+    #[inline(always)]
+    unsafe fn survivors<const SIMD: u8>(&self, frustum: &Frustum, lanes: usize) -> u32 {
+        #[cfg(target_arch = "x86_64")]
+        if SIMD >= level::AVX2 {
+            // SAFETY: the caller's contract.
+            return unsafe { frustum.survivors_indexed_avx2(*self, lanes) };
+        }
+        frustum.survivors(&self.expand(), lanes)
+    }
+}
+
+/// A tree's leaf blocks in one layout, as the traversals read them: each
+/// traversal is compiled once per layout and picks it once per query, so
+/// that its loop holds one leaf test (with both inlined into one loop,
+/// the packets traced 0.94-0.98x as fast).
+pub(crate) trait Layout: Copy {
+    /// One block.
+    type Block<'a>: LeafBlock
+    where
+        Self: 'a;
+
+    /// The blocks of the non-empty leaf with offset field `offset` and
+    /// `count` triangles.
+    ///
+    /// # Safety
+    /// `offset` and `count` must be those of a non-empty leaf of the tree
+    /// these blocks belong to.
+    unsafe fn blocks(&self, offset: usize, count: usize) -> impl Iterator<Item = Self::Block<'_>>;
+}
+
+/// The whole layout's blocks.
+#[derive(Clone, Copy)]
+pub(crate) struct Whole<'a>(pub &'a [TriangleBlock]);
+
+impl Layout for Whole<'_> {
+    type Block<'b>
+        = WholeBlock<'b>
+    where
+        Self: 'b;
+
+    #[inline(always)]
+    unsafe fn blocks(&self, offset: usize, count: usize) -> impl Iterator<Item = WholeBlock<'_>> {
+        // SAFETY: the caller's contract.
+        unsafe { whole_blocks(self.0, offset, count) }
+    }
+}
+
+/// The indexed layout's blocks.
+#[derive(Clone, Copy)]
+pub(crate) struct Indexed<'a>(pub &'a IndexedBlocks);
+
+impl Layout for Indexed<'_> {
+    type Block<'b>
+        = IndexedBlock<'b>
+    where
+        Self: 'b;
+
+    #[inline(always)]
+    unsafe fn blocks(&self, offset: usize, count: usize) -> impl Iterator<Item = IndexedBlock<'_>> {
+        // SAFETY: the caller's contract.
+        unsafe { indexed_blocks(self.0, offset, count) }
+    }
+}
+
+/// The blocks of the whole-layout leaf at index offset `offset` with
+/// `count` triangles.
+///
+/// # Safety
+/// `offset` and `count` must be those of a non-empty leaf of the tree that
+/// owns `blocks`.
+#[inline(always)]
+unsafe fn whole_blocks(
+    blocks: &[TriangleBlock],
+    offset: usize,
+    count: usize,
+) -> impl Iterator<Item = WholeBlock<'_>> {
+    let first = offset / BLOCK_WIDTH;
+    let n = count.div_ceil(BLOCK_WIDTH);
+    debug_assert!(offset.is_multiple_of(BLOCK_WIDTH) && first + n <= blocks.len());
+    // SAFETY: the build pads every leaf run to whole blocks and makes one
+    // block per eight run entries (the caller's contract).
+    let run = unsafe { blocks.get_unchecked(first..first + n) };
+    run.iter().enumerate().map(move |(b, block)| WholeBlock {
+        block,
+        run: offset + b * BLOCK_WIDTH,
+    })
+}
+
+/// The blocks of the indexed-layout leaf whose first block starts at word
+/// `offset`, with `count` triangles.
+///
+/// # Safety
+/// `offset` and `count` must be those of a non-empty leaf of the tree that
+/// owns `pool`.
+#[inline(always)]
+unsafe fn indexed_blocks(pool: &IndexedBlocks, offset: usize, count: usize) -> IndexedRun<'_> {
+    IndexedRun {
+        // SAFETY: the build points a non-empty leaf at its first block.
+        next: unsafe { pool.block(offset) },
+        left: count.div_ceil(BLOCK_WIDTH),
+    }
+}
+
+/// The blocks of one indexed-layout leaf, in order.
+pub(crate) struct IndexedRun<'a> {
+    next: IndexedBlock<'a>,
+    left: usize,
+}
+
+impl<'a> Iterator for IndexedRun<'a> {
+    type Item = IndexedBlock<'a>;
+    #[inline(always)]
+    fn next(&mut self) -> Option<IndexedBlock<'a>> {
+        if self.left == 0 {
+            return None;
+        }
+        self.left -= 1;
+        let b = self.next;
+        if self.left != 0 {
+            // SAFETY: a leaf's blocks follow one another; `left` more.
+            self.next = unsafe { b.next() };
+        }
+        Some(b)
+    }
+}
