@@ -159,9 +159,11 @@ fuzz_target!(|input: Input| {
     let builders = Builder::ALL.into_iter().chain([Builder::Binned {
         bins: 2 + u32::from(input.bins % 63),
     }]);
-    for builder in builders {
+    for (i, builder) in builders.enumerate() {
         let mut params = BuildParams::new(builder);
         params.parallel = false;
+        // Both leaf layouts, alternating over the builders.
+        params.compact_leaves = (i + usize::from(input.bins)) % 2 == 1;
         params.max_depth = input.max_depth.map(|d| u32::from(d % 48));
         params.max_leaf_size = 1 + u32::from(input.max_leaf_size % 8);
         params.empty_bonus = f32::from(input.empty_bonus) / 255.0;

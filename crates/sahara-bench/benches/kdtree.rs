@@ -16,6 +16,7 @@ use sahara_kd::geometry::frustum::Frustum;
 use sahara_kd::geometry::triangle::RayShear;
 use sahara_kd::geometry::triangle_block::BLOCK_WIDTH;
 use sahara_kd::geometry::triangle_packet::PacketShear;
+use sahara_kd::geometry::IndexedBlocks;
 use sahara_kd::packet::PACKET;
 use sahara_kd::{BuildParams, Builder, KdTree, Ray, TriangleBlock};
 use sahara_render::mesh::Mesh;
@@ -157,6 +158,55 @@ fn trace(c: &mut Criterion) {
                 .sum::<u32>()
         })
     });
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        g.bench_function("block_candidates_8_avx2", |bench| {
+            bench.iter(|| {
+                let block = std::hint::black_box(&block);
+                shears
+                    .iter()
+                    // SAFETY: the CPU has AVX2 (checked above).
+                    .map(|s| {
+                        unsafe { s.block_edges_avx2(block, BLOCK_WIDTH) }
+                            .0
+                            .count_ones()
+                    })
+                    .sum::<u32>()
+            })
+        });
+    }
+    // The same filter on the compact layout's block (`--compact-leaves`):
+    // the eight triangles' distinct vertices sheared once, the lanes
+    // gathered from them (portable, and the AVX2 intrinsics form).
+    let run: Vec<u32> = (0..BLOCK_WIDTH as u32).collect();
+    let (pool, starts) = IndexedBlocks::pack(&tris[..BLOCK_WIDTH], &run);
+    let indexed = pool.checked_block(starts[0] as usize).expect("one block");
+    g.bench_function("block_candidates_8_compact", |bench| {
+        bench.iter(|| {
+            let block = std::hint::black_box(indexed);
+            shears
+                .iter()
+                .map(|s| s.indexed_edges(block, BLOCK_WIDTH).0.count_ones())
+                .sum::<u32>()
+        })
+    });
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        g.bench_function("block_candidates_8_compact_avx2", |bench| {
+            bench.iter(|| {
+                let block = std::hint::black_box(indexed);
+                shears
+                    .iter()
+                    // SAFETY: the CPU has AVX2 (checked above).
+                    .map(|s| {
+                        unsafe { s.indexed_edges_avx2(block, BLOCK_WIDTH) }
+                            .0
+                            .count_ones()
+                    })
+                    .sum::<u32>()
+            })
+        });
+    }
     // The packet leaf test: the same rays eight at a time against each
     // triangle of the block (the ray-parallel form of the filter above).
     let packets: Vec<PacketShear> = shears.chunks(8).filter_map(PacketShear::new).collect();
@@ -172,7 +222,7 @@ fn trace(c: &mut Criterion) {
                 .iter()
                 .map(|p| {
                     (0..BLOCK_WIDTH)
-                        .map(|j| p.triangle_edges(block, j).0.count_ones())
+                        .map(|j| p.triangle_edges(&block.triangle(j)).0.count_ones())
                         .sum::<u32>()
                 })
                 .sum::<u32>()

@@ -229,8 +229,16 @@ impl Layout for Whole<'_> {
 
     #[inline(always)]
     unsafe fn blocks(&self, offset: usize, count: usize) -> impl Iterator<Item = WholeBlock<'_>> {
-        // SAFETY: the caller's contract.
-        unsafe { whole_blocks(self.0, offset, count) }
+        let first = offset / BLOCK_WIDTH;
+        let n = count.div_ceil(BLOCK_WIDTH);
+        debug_assert!(offset.is_multiple_of(BLOCK_WIDTH) && first + n <= self.0.len());
+        // SAFETY: the build pads every leaf run to whole blocks and makes
+        // one block per eight run entries (the caller's contract).
+        let run = unsafe { self.0.get_unchecked(first..first + n) };
+        run.iter().enumerate().map(move |(b, block)| WholeBlock {
+            block,
+            run: offset + b * BLOCK_WIDTH,
+        })
     }
 }
 
@@ -246,47 +254,12 @@ impl Layout for Indexed<'_> {
 
     #[inline(always)]
     unsafe fn blocks(&self, offset: usize, count: usize) -> impl Iterator<Item = IndexedBlock<'_>> {
-        // SAFETY: the caller's contract.
-        unsafe { indexed_blocks(self.0, offset, count) }
-    }
-}
-
-/// The blocks of the whole-layout leaf at index offset `offset` with
-/// `count` triangles.
-///
-/// # Safety
-/// `offset` and `count` must be those of a non-empty leaf of the tree that
-/// owns `blocks`.
-#[inline(always)]
-unsafe fn whole_blocks(
-    blocks: &[TriangleBlock],
-    offset: usize,
-    count: usize,
-) -> impl Iterator<Item = WholeBlock<'_>> {
-    let first = offset / BLOCK_WIDTH;
-    let n = count.div_ceil(BLOCK_WIDTH);
-    debug_assert!(offset.is_multiple_of(BLOCK_WIDTH) && first + n <= blocks.len());
-    // SAFETY: the build pads every leaf run to whole blocks and makes one
-    // block per eight run entries (the caller's contract).
-    let run = unsafe { blocks.get_unchecked(first..first + n) };
-    run.iter().enumerate().map(move |(b, block)| WholeBlock {
-        block,
-        run: offset + b * BLOCK_WIDTH,
-    })
-}
-
-/// The blocks of the indexed-layout leaf whose first block starts at word
-/// `offset`, with `count` triangles.
-///
-/// # Safety
-/// `offset` and `count` must be those of a non-empty leaf of the tree that
-/// owns `pool`.
-#[inline(always)]
-unsafe fn indexed_blocks(pool: &IndexedBlocks, offset: usize, count: usize) -> IndexedRun<'_> {
-    IndexedRun {
-        // SAFETY: the build points a non-empty leaf at its first block.
-        next: unsafe { pool.block(offset) },
-        left: count.div_ceil(BLOCK_WIDTH),
+        IndexedRun {
+            // SAFETY: the build points a non-empty leaf at its first block
+            // (the caller's contract).
+            next: unsafe { self.0.block(offset) },
+            left: count.div_ceil(BLOCK_WIDTH),
+        }
     }
 }
 
