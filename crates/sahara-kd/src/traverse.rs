@@ -16,8 +16,6 @@ use crate::geometry::triangle_block::BLOCK_WIDTH;
 use crate::geometry::{Aabb, Primitive, Ray, Triangle, TriangleHit, TriangleLeaves};
 use crate::tree::KdTree;
 
-/// Run-time CPU feature selection: the release binary targets baseline
-/// x86-64 (SSE2) and picks the AVX2 build of the traversal where it exists.
 /// The instruction sets a traversal is compiled for (the `SIMD` constant
 /// of the leaf tests): each level has the ones below it.
 pub(crate) mod level {
@@ -30,6 +28,9 @@ pub(crate) mod level {
     pub const AVX512: u8 = 2;
 }
 
+/// Run-time CPU feature selection: the release binary targets baseline
+/// x86-64 (SSE2) and picks the AVX2 build of the traversal where it exists
+/// (the AVX-512 one for compact leaves).
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod simd {
     /// True when the CPU has AVX2 (std caches the CPUID query).

@@ -8,8 +8,9 @@
 //! 24 vertex slots of [`TriangleBlock`] whole spent about twice the memory
 //! the block needs. The tree with its blocks was 7.3 MB for the bunny and
 //! 8.2 MB for sponza, against Embree's 4.6 + 1.3 and 5.3 + 1.3 MB (issue 5's
-//! memory bar). The AVX2 block test gathers the lanes from the vertex table
-//! with in-register permutes (`vpermps`), shearing each distinct vertex once.
+//! memory bar). The AVX2 block test shears each distinct vertex once and
+//! gathers the lanes from the vertex table with in-register permutes
+//! (`vpermps` and a blend, or one `vpermt2ps` with AVX-512 VL).
 //!
 //! The coordinates are the triangles' own, bit for bit, so every test that
 //! reads a block computes what it computed on the whole copies.
@@ -61,8 +62,10 @@ impl IndexedBlocks {
     /// marking padding) and returns, for each run of eight, the word offset
     /// of its block.
     pub fn pack(prims: &[Triangle], padded_indices: &[u32]) -> (Self, Vec<u32>) {
-        let mut words = Vec::with_capacity(padded_indices.len() * 24 / 8 * 2);
-        let mut starts = Vec::with_capacity(padded_indices.len() / BLOCK_WIDTH);
+        // Room for blocks with a typical table of 12 entries.
+        let blocks = padded_indices.len() / BLOCK_WIDTH;
+        let mut words = Vec::with_capacity(blocks * (HEADER + 3 * 12) + POOL_TAIL);
+        let mut starts = Vec::with_capacity(blocks);
         for (run, chunk) in padded_indices.chunks(BLOCK_WIDTH).enumerate() {
             starts.push(u32::try_from(words.len()).expect("leaf data beyond 2^32 words"));
             let tris: Vec<Triangle> = chunk
@@ -98,9 +101,10 @@ impl IndexedBlocks {
         if w.len() < HEADER {
             return None;
         }
-        let stride = (w[1] >> 8) as usize;
-        let fits = (stride == VERBATIM || stride <= MAX_TABLE && stride.is_multiple_of(4))
-            && HEADER + 3 * stride + POOL_TAIL <= w.len();
+        let (count, stride) = ((w[1] & 0xff) as usize, (w[1] >> 8) as usize);
+        let table = stride == VERBATIM
+            || (4..=MAX_TABLE).contains(&stride) && stride.is_multiple_of(4) && count <= stride;
+        let fits = table && HEADER + 3 * stride + POOL_TAIL <= w.len();
         fits.then_some(IndexedBlock {
             w: w.as_ptr(),
             pool: PhantomData,
@@ -512,18 +516,28 @@ mod tests {
         assert!(verbatim > 10, "{verbatim} verbatim blocks");
     }
 
-    /// A chunk of eight padding entries packs as an empty block, and a
-    /// damaged header is caught by the checked accessor.
+    /// A run of padding packs as an empty block, and a damaged header
+    /// (a table past the pool, more vertices than the table holds) is
+    /// caught by the checked accessor.
     #[test]
     fn checked_block_rejects_overruns() {
         let t = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y);
-        let (mut pool, starts) = IndexedBlocks::pack(
-            &[t],
-            &[0, u32::MAX, 2, 3, 4, 5, 6, 7].map(|i| if i == 0 { 0 } else { u32::MAX }),
+        let (empty, starts) = IndexedBlocks::pack(&[t], &[u32::MAX; 8]);
+        assert_eq!(
+            empty
+                .checked_block(starts[0] as usize)
+                .unwrap()
+                .vertex_count(),
+            0
         );
+        let mut run = [u32::MAX; 8];
+        run[0] = 0;
+        let (mut pool, starts) = IndexedBlocks::pack(&[t], &run);
         let at = starts[0] as usize;
         assert_eq!(pool.checked_block(at).unwrap().vertex_count(), 3);
         pool.words_mut()[at + 1] = 3 | 200 << 8;
+        assert!(pool.checked_block(at).is_none());
+        pool.words_mut()[at + 1] = 9 | 4 << 8;
         assert!(pool.checked_block(at).is_none());
     }
 }
