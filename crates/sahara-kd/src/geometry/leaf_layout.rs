@@ -184,7 +184,7 @@ impl LeafBlock for IndexedBlock<'_> {
         lanes: usize,
     ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
         // SAFETY: the caller's contract.
-        unsafe { shear.block_edges_on::<SIMD>(*self, lanes) }
+        unsafe { shear.indexed_edges_on::<SIMD>(*self, lanes) }
     }
 
     #[inline(always)]

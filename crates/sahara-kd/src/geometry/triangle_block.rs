@@ -222,7 +222,7 @@ impl RayShear {
     /// The CPU must have the level's instructions, and the caller must be
     /// compiled for them.
     #[inline(always)]
-    pub(crate) unsafe fn block_edges_on<const SIMD: u8>(
+    pub(crate) unsafe fn indexed_edges_on<const SIMD: u8>(
         &self,
         block: IndexedBlock,
         lanes: usize,
