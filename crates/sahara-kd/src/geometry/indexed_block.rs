@@ -34,7 +34,7 @@ use std::marker::PhantomData;
 
 use glam::Vec3;
 
-use super::triangle_block::{TriangleBlock, BLOCK_WIDTH};
+use super::triangle_block::{run_triangles, TriangleBlock, BLOCK_WIDTH};
 use super::Triangle;
 #[cfg(target_arch = "x86_64")]
 use crate::traverse::level;
@@ -68,11 +68,7 @@ impl IndexedBlocks {
         let mut starts = Vec::with_capacity(blocks);
         for (run, chunk) in padded_indices.chunks(BLOCK_WIDTH).enumerate() {
             starts.push(u32::try_from(words.len()).expect("leaf data beyond 2^32 words"));
-            let tris: Vec<Triangle> = chunk
-                .iter()
-                .filter(|&&i| i != u32::MAX)
-                .map(|&i| prims[i as usize])
-                .collect();
+            let tris = run_triangles(prims, chunk);
             push_block(&mut words, (run * BLOCK_WIDTH) as u32, &tris);
         }
         words.resize(words.len() + POOL_TAIL, 0);

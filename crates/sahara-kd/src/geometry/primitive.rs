@@ -3,7 +3,7 @@
 use super::clip::clipped_bounds;
 use super::indexed_block::IndexedBlocks;
 use super::leaf_layout::TriangleLeaves;
-use super::triangle_block::{TriangleBlock, BLOCK_WIDTH};
+use super::triangle_block::{run_triangles, TriangleBlock, BLOCK_WIDTH};
 use super::{Aabb, Triangle};
 use crate::build::BuildParams;
 use crate::tree::Node;
@@ -65,14 +65,7 @@ impl Primitive for Triangle {
             return TriangleLeaves::Whole(
                 padded_indices
                     .chunks(BLOCK_WIDTH)
-                    .map(|run| {
-                        let tris: Vec<Triangle> = run
-                            .iter()
-                            .filter(|&&i| i != u32::MAX)
-                            .map(|&i| prims[i as usize])
-                            .collect();
-                        TriangleBlock::pack(&tris)
-                    })
+                    .map(|run| TriangleBlock::pack(&run_triangles(prims, run)))
                     .collect(),
             );
         }

@@ -34,6 +34,15 @@ pub struct TriangleBlock {
     pub v: [[[f32; BLOCK_WIDTH]; 3]; 3],
 }
 
+/// The triangles a run of a padded index array names (`u32::MAX` marks
+/// padding), in order: what one leaf block holds, in either layout.
+pub(crate) fn run_triangles(prims: &[Triangle], run: &[u32]) -> Vec<Triangle> {
+    run.iter()
+        .filter(|&&i| i != u32::MAX)
+        .map(|&i| prims[i as usize])
+        .collect()
+}
+
 impl TriangleBlock {
     /// A block of `tris` (at most eight); unused lanes are zero (and masked
     /// out by the lane count at test time).
