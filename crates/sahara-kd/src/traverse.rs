@@ -707,4 +707,25 @@ mod tests {
             }
         }
     }
+
+    /// The batch queries put each ray's own answer in its own slot, across
+    /// the parallel work items (more rays than one item holds, and a
+    /// partial last item).
+    #[test]
+    fn batches_answer_each_ray_in_its_slot() {
+        let mut f = floats(5);
+        let tree = KdTree::build(soup(&mut f, 2000, 1.0), &BuildParams::default());
+        let rays: Vec<Ray> = (0..3 * BATCH + 37)
+            .map(|_| Ray::new(Vec3::new(f(), f(), f()) * 5.0, Vec3::new(f(), f(), f())))
+            .collect();
+        let mut hits = vec![None; rays.len()];
+        tree.closest_hits(&rays, &mut hits);
+        let mut occluded = vec![false; rays.len()];
+        tree.any_hits(&rays, &mut occluded);
+        assert!(hits.iter().filter(|h| h.is_some()).count() > rays.len() / 10);
+        for (i, r) in rays.iter().enumerate() {
+            assert_eq!(hits[i], tree.closest_hit(r), "ray {i}");
+            assert_eq!(occluded[i], tree.any_hit(r), "ray {i}");
+        }
+    }
 }
