@@ -50,8 +50,8 @@ def bench(config, mesh, sets, runs):
     figures = {}
     for name, s in json.loads(done.stdout)["sets"].items():
         figures[name] = s["mrays_1t_cpu"]
-        if "mrays_packet_1t" in s:
-            figures[name + "_pk"] = s["mrays_packet_1t"]
+        if "mrays_packet_1t_cpu" in s:
+            figures[name + "_pk"] = s["mrays_packet_1t_cpu"]
     return figures
 
 
