@@ -89,7 +89,18 @@ struct Packet {
     /// `best_t` where there is a hit, infinity elsewhere: cells entered
     /// beyond it are skipped, as in `walk`.
     closest: Lanes,
+    /// The triangles last tested against the packet with the packet test
+    /// (a ring of [`MAILBOX`] indices) and the rays each was tested for.
+    mailbox: [(u32, u32); MAILBOX],
+    /// The slot of `mailbox` to overwrite next.
+    mailbox_next: usize,
 }
+
+/// Triangles a packet remembers having tested (its mailbox; Amanatides and
+/// Woo 1987 for grids, Havran 2000 for kd-trees): a triangle referenced by
+/// several leaves is met again in each, and testing it again for the same
+/// rays cannot change their closest hits.
+const MAILBOX: usize = 8;
 
 impl KdTree<Triangle> {
     /// Closest hits of up to [`PACKET`] rays traced as one packet; `out[i]`
@@ -344,13 +355,25 @@ fn block_closest_packet<const SIMD: u8>(
     live: u32,
 ) {
     for j in set_bits(tris) {
+        let i = indices[j];
+        // Tested before for all of these rays (a triangle that spans many
+        // cells, e.g. a large floor): a second test could only offer the
+        // same hits again (with `tmax` lowered since), which change
+        // nothing.
+        if p.mailbox
+            .iter()
+            .any(|&(t, rays)| t == i && rays & live == live)
+        {
+            continue;
+        }
+        p.mailbox[p.mailbox_next] = (i, live);
+        p.mailbox_next = (p.mailbox_next + 1) % MAILBOX;
         // SAFETY: `SIMD` is the level the walk is compiled for.
         let (m, e) = unsafe { block.packet_edges::<SIMD>(ps, j) };
         let m = m & live;
         if m == 0 {
             continue;
         }
-        let i = indices[j];
         let tri = block.triangle(j);
         // The plane once for all the rays that need it.
         let plane = TrianglePlane::new(&tri);

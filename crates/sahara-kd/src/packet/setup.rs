@@ -16,7 +16,7 @@
 
 use glam::Vec3;
 
-use super::{Lanes, Packet, NO_HIT, OFF, PACKET};
+use super::{Lanes, Packet, MAILBOX, NO_HIT, OFF, PACKET};
 use crate::geometry::aabb::FAR_GROW;
 use crate::geometry::frustum::Frustum;
 use crate::geometry::triangle::{permutation, RayShear};
@@ -54,6 +54,8 @@ impl Packet {
         best_t: [0.0; PACKET],
         best: [NO_HIT; PACKET],
         closest: [f32::INFINITY; PACKET],
+        mailbox: [(u32::MAX, 0); MAILBOX],
+        mailbox_next: 0,
     };
 
     /// Make this the packet of `rays` (at most [`PACKET`]) in the root cell
