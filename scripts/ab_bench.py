@@ -8,7 +8,8 @@ Every round runs every mesh under every configuration back to back
 (`sahara bench MESH --json --threads 1 --runs R --sets S`), so that the
 configurations share the machine's moments; the table gives, per mesh and
 set, each configuration's best Mrays/s over the rounds (one thread, by the
-tracing thread's CPU time; `primary_pk` is the 8-ray packet path) and its
+tracing thread's CPU time; `primary_pk` and `primary_pk16` are the 8- and
+16-ray packet paths) and its
 ratio to the first configuration.
 
 Best of several rounds rather than the median: on the shared virtual
@@ -52,6 +53,8 @@ def bench(config, mesh, sets, runs):
         figures[name] = s["mrays_1t_cpu"]
         if "mrays_packet_1t_cpu" in s:
             figures[name + "_pk"] = s["mrays_packet_1t_cpu"]
+        if "mrays_packet16_1t_cpu" in s:
+            figures[name + "_pk16"] = s["mrays_packet16_1t_cpu"]
     return figures
 
 
@@ -76,9 +79,13 @@ def main():
     print("| mesh | set | " + " | ".join(f"`{c}`" for c in a.configs) + " |")
     print("|---|---|" + "---|" * len(a.configs))
     for mesh, name in rows:
-        base = best[(mesh, name, a.configs[0])]
-        cells = [f"{best[(mesh, name, c)]:.3f} ({best[(mesh, name, c)] / base:.3f})"
-                 for c in a.configs]
+        # A figure only some configurations report (e.g. a packet path an
+        # older binary lacks) is shown without a ratio where the first lacks it.
+        base = best.get((mesh, name, a.configs[0]))
+        cells = []
+        for c in a.configs:
+            v = best.get((mesh, name, c))
+            cells.append("-" if v is None else f"{v:.3f}" + (f" ({v / base:.3f})" if base else ""))
         print(f"| {mesh} | {name} | " + " | ".join(cells) + " |")
 
 

@@ -90,7 +90,8 @@ def best(a, b):
     if a is None:
         return b
     for s, v in b["sets"].items():
-        for k in ("mrays_1t", "mrays_all", "mrays_1t_cpu", "mrays_packet_1t", "mrays_packet_1t_cpu"):
+        for k in ("mrays_1t", "mrays_all", "mrays_1t_cpu", "mrays_packet_1t", "mrays_packet_1t_cpu",
+                  "mrays_packet16_1t", "mrays_packet16_1t_cpu"):
             if k in v:
                 a["sets"][s][k] = max(a["sets"][s][k], v[k])
     for k in ("build_ms", "build_medium_ms"):
@@ -157,12 +158,14 @@ def main():
                 print(f"| {name} | {k}, from Embree's primary hits | {sv['rays']:,} | "
                       f"{sv['hits']:,} / {ev['hits']:,} | {sv['t_sum']:.6f} / {ev['t_sum']:.6f} | "
                       f"{'yes' if agree(sv, ev) else '**no**'} | | |")
-        p = s["sets"]["primary"].get("mrays_packet_1t_cpu")
-        for ek, label in (("prim_p8", "8"), ("prim_p16", "16")):
-            if e and ek in e["sets"] and p is not None:
-                ev = e["sets"][ek]["mrays_1t_cpu"]
-                print(f"| {name} | primary packets: Sahara 8 (4x2) / Embree {label} | | | | | "
-                      f"{p:.2f} / {ev:.2f} ({p / ev:.2f}) | |")
+        prim = s["sets"]["primary"]
+        for sk, slabel in (("mrays_packet_1t_cpu", "8 (4x2)"), ("mrays_packet16_1t_cpu", "16 (4x4)")):
+            p = prim.get(sk)
+            for ek, label in (("prim_p8", "8"), ("prim_p16", "16")):
+                if e and ek in e["sets"] and p is not None:
+                    ev = e["sets"][ek]["mrays_1t_cpu"]
+                    print(f"| {name} | primary packets: Sahara {slabel} / Embree {label} | | | | | "
+                          f"{p:.2f} / {ev:.2f} ({p / ev:.2f}) | |")
     print("\n| mesh | triangles | Sahara build ms | Embree HIGH / MEDIUM build ms | "
           "Sahara tree + triangles MB | Embree BVH MB (+ vertex/index buffers) | Sahara SAH cost |")
     print("|---|---|---|---|---|---|---|")

@@ -2,7 +2,8 @@
 //! (read in place from the shared scenes, `$SAHARA_SCENES` to override):
 //! building each kind of tree, tracing the protocol's ray sets on one
 //! thread (closest hit for primary / diffuse / random, any hit for shadow),
-//! primary rays in 4x2 tiles as single rays and as packets, and the
+//! primary rays in 4x2 tiles as single rays and as packets, in 4x4 tiles
+//! as 16-ray packets, and the
 //! leaf tests alone (eight triangles against one ray, one triangle against
 //! eight rays, eight triangles against a packet's frustum; portable builds,
 //! as the benchmark binary is compiled, and the frustum cull's AVX2 form).
@@ -11,13 +12,14 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize};
+use sahara_bench::runner::PacketSize;
 use sahara_bench::{HitRecord, ProtocolCamera, SceneFrame};
 use sahara_kd::geometry::frustum::Frustum;
 use sahara_kd::geometry::triangle::RayShear;
 use sahara_kd::geometry::triangle_block::BLOCK_WIDTH;
 use sahara_kd::geometry::triangle_packet::PacketShear;
 use sahara_kd::geometry::IndexedBlocks;
-use sahara_kd::packet::PACKET;
+use sahara_kd::packet::{PACKET, PACKET16};
 use sahara_kd::{BuildParams, Builder, KdTree, Ray, TriangleBlock};
 use sahara_render::mesh::Mesh;
 
@@ -104,7 +106,7 @@ fn trace(c: &mut Criterion) {
         });
     }
     // The packet path on primary rays: whole 4x2 tiles spread over the image.
-    let order = sahara_bench::runner::packets::tile_order(ImageSize::PROTOCOL);
+    let order = sahara_bench::runner::packets::tile_order(ImageSize::PROTOCOL, PacketSize::Eight);
     let tiles: Vec<&[u32]> = order.chunks(PACKET).collect();
     let step = (tiles.len() / (BATCH / PACKET)).max(1);
     let tiled: Vec<Ray> = tiles
@@ -127,6 +129,25 @@ fn trace(c: &mut Criterion) {
         bench.iter(|| {
             tree.closest_hits_packets(&tiled, &mut out);
             out.iter().filter(|h| h.is_some()).count()
+        })
+    });
+    // The 16-ray packets on as many whole 4x4 tiles, spread the same way.
+    let order16 =
+        sahara_bench::runner::packets::tile_order(ImageSize::PROTOCOL, PacketSize::Sixteen);
+    let tiles16: Vec<&[u32]> = order16.chunks(PACKET16).collect();
+    let step16 = (tiles16.len() / (BATCH / PACKET16)).max(1);
+    let tiled16: Vec<Ray> = tiles16
+        .iter()
+        .step_by(step16)
+        .take(BATCH / PACKET16)
+        .flat_map(|t| t.iter().map(|&i| primary[i as usize]))
+        .collect();
+    let mut out16 = vec![None; tiled16.len()];
+    g.throughput(Throughput::Elements(tiled16.len() as u64));
+    g.bench_function("primary_tiles_packets16", |bench| {
+        bench.iter(|| {
+            tree.closest_hits_packets16(&tiled16, &mut out16);
+            out16.iter().filter(|h| h.is_some()).count()
         })
     });
     g.finish();

@@ -134,6 +134,13 @@ pub struct SetReport {
     /// The same by the tracing thread's CPU time.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mrays_packet_1t_cpu: Option<f64>,
+    /// `primary` only: best Mrays/s on one thread of the 16-ray packet
+    /// path (4x4 pixel tiles).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mrays_packet16_1t: Option<f64>,
+    /// The same by the tracing thread's CPU time.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mrays_packet16_1t_cpu: Option<f64>,
     /// Traversal work, with `--counters`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub counters: Option<CounterReport>,

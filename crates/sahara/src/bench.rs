@@ -7,7 +7,7 @@ use anyhow::{bail, Context, Result};
 use sahara_bench::files::{read_hits, read_rays, write_hits, write_rays};
 use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize, RANDOM_RAYS};
 use sahara_bench::report::{BenchReport, CameraReport, SetReport, SetReports};
-use sahara_bench::runner::{Bench, Pools};
+use sahara_bench::runner::{Bench, PacketSize, Pools};
 use sahara_bench::{HitRecord, ProtocolCamera, Query, SceneFrame, SetKind};
 use sahara_kd::Ray;
 use sahara_render::mesh::Mesh;
@@ -217,13 +217,28 @@ fn protocol_sets(
         let own_hits = if opts.sets.contains(&SetKind::Primary) {
             let (mut report, records) =
                 measure_records(bench, "primary", &primary, Query::ClosestHit, opts);
-            eprintln!("tracing primary in packets of 8 (4x2 tiles) on 1 thread...");
-            let p = bench.measure_packets(&primary, ImageSize::PROTOCOL, &records);
-            if !p.agrees {
-                bail!("primary: the packet path's hits differ from the single-ray path's (a bug)");
+            for size in [PacketSize::Eight, PacketSize::Sixteen] {
+                let (w, h) = size.tile();
+                let n = size.rays();
+                eprintln!("tracing primary in packets of {n} ({w}x{h} tiles) on 1 thread...");
+                let p = bench.measure_packets(&primary, ImageSize::PROTOCOL, &records, size);
+                if !p.agrees {
+                    bail!(
+                        "primary: the {n}-ray packet path's hits differ from the single-ray \
+                         path's (a bug)"
+                    );
+                }
+                let fields = match size {
+                    PacketSize::Eight => {
+                        (&mut report.mrays_packet_1t, &mut report.mrays_packet_1t_cpu)
+                    }
+                    PacketSize::Sixteen => (
+                        &mut report.mrays_packet16_1t,
+                        &mut report.mrays_packet16_1t_cpu,
+                    ),
+                };
+                (*fields.0, *fields.1) = (Some(p.mrays_1t), Some(p.mrays_1t_cpu));
             }
-            report.mrays_packet_1t = Some(p.mrays_1t);
-            report.mrays_packet_1t_cpu = Some(p.mrays_1t_cpu);
             dump_hits(hit_dumps, "primary", &records)?;
             sets.primary = Some(report);
             Some(records)

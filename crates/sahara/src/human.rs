@@ -98,12 +98,28 @@ pub fn bench_report(r: &BenchReport) -> String {
             e.mrays_1t_cpu,
             e.mrays_all
         );
-        if let (Some(p), Some(c)) = (e.mrays_packet_1t, e.mrays_packet_1t_cpu) {
-            let _ = writeln!(
-                s,
-                "{:<8} {:>11} {:>11} {:>22} {:>11.3} {:>11.3} {:>11}",
-                "  packets", "(8 rays,", "4x2 tiles)", "same hits", p, c, "-"
-            );
+        let packets = [
+            (
+                "(8 rays,",
+                "4x2 tiles)",
+                e.mrays_packet_1t,
+                e.mrays_packet_1t_cpu,
+            ),
+            (
+                "(16 rays,",
+                "4x4 tiles)",
+                e.mrays_packet16_1t,
+                e.mrays_packet16_1t_cpu,
+            ),
+        ];
+        for (rays, tiles, p, c) in packets {
+            if let (Some(p), Some(c)) = (p, c) {
+                let _ = writeln!(
+                    s,
+                    "{:<8} {:>11} {:>11} {:>22} {:>11.3} {:>11.3} {:>11}",
+                    "  packets", rays, tiles, "same hits", p, c, "-"
+                );
+            }
         }
     }
     if entries.iter().any(|(_, e)| e.counters.is_some()) {

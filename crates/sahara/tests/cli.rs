@@ -117,6 +117,8 @@ fn bench_json_matches_a_brute_force_count() {
     // The packet path ran (it fails the command if its hits differ).
     assert!(p["mrays_packet_1t"].as_f64().unwrap() > 0.0);
     assert!(p["mrays_packet_1t_cpu"].as_f64().unwrap() > 0.0);
+    assert!(p["mrays_packet16_1t"].as_f64().unwrap() > 0.0);
+    assert!(p["mrays_packet16_1t_cpu"].as_f64().unwrap() > 0.0);
     assert!(sets["random"].get("mrays_packet_1t").is_none());
     assert_eq!(p["hits"].as_u64().unwrap(), hits);
     let got = p["t_sum"].as_f64().unwrap();

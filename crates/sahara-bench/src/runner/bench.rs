@@ -101,22 +101,26 @@ impl Bench {
             mrays_all: m.mrays_all,
             mrays_packet_1t: None,
             mrays_packet_1t_cpu: None,
+            mrays_packet16_1t: None,
+            mrays_packet16_1t_cpu: None,
             counters,
         };
         (report, m)
     }
 
-    /// Time the packet path on one thread over the row-major rays of
-    /// `image` (checked against `reference`, the single-ray records).
+    /// Time the packet path of `size` on one thread over the row-major
+    /// rays of `image` (checked against `reference`, the single-ray
+    /// records).
     pub fn measure_packets(
         &self,
         rays: &[Ray],
         image: crate::protocol::camera::ImageSize,
         reference: &[HitRecord],
+        size: super::PacketSize,
     ) -> super::PacketMeasurement {
         self.pools
             .one
-            .install(|| super::measure_packets(&self.tree, rays, image, self.runs, reference))
+            .install(|| super::measure_packets(&self.tree, rays, image, self.runs, reference, size))
     }
 
     /// The full report, from the mesh's name, the camera and the sets.

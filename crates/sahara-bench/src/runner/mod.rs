@@ -15,7 +15,7 @@ pub mod trace;
 pub use bench::Bench;
 pub use build::{build_timed, BUILD_RUNS};
 pub use counters::{count_set, CountTotals};
-pub use packets::{measure_packets, PacketMeasurement};
+pub use packets::{measure_packets, PacketMeasurement, PacketSize};
 pub use pools::Pools;
 pub use throughput::{measure, Measurement};
 pub use trace::{trace_into, Query, CHUNK};

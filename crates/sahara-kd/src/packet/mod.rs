@@ -18,9 +18,14 @@
 //! [`KdTree::closest_hit`].
 //!
 //! A packet whose rays' direction signs differ is traced ray by ray.
+//!
+//! Sixteen-ray packets ([`KdTree::closest_hit_packet16`]) walk two such
+//! packets together with AVX-512 where the CPU has it ([`avx512`]).
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+#[cfg(target_arch = "x86_64")]
+mod avx512;
 mod setup;
 
 use crate::geometry::frustum::Frustum;
@@ -35,6 +40,9 @@ use crate::tree::KdTree;
 
 /// Rays per packet.
 pub const PACKET: usize = 8;
+
+/// Rays per sixteen-ray packet (two [`PACKET`] halves walked together).
+pub const PACKET16: usize = 2 * PACKET;
 
 type Lanes = [f32; PACKET];
 
@@ -154,6 +162,74 @@ impl KdTree<Triangle> {
             finish(&p, out);
         } else {
             self.closest_hits_one_by_one(rays, out);
+        }
+    }
+
+    /// Closest hits of up to [`PACKET16`] rays traced as one packet (e.g. a
+    /// 4x4 pixel tile: rays `0..8` and `8..16` should each be a coherent
+    /// 4x2 half); `out[i]` answers `rays[i]` exactly as
+    /// [`KdTree::closest_hit`] would.
+    ///
+    /// With AVX-512 the sixteen rays share one walk (`avx512`); without
+    /// it, or when the two halves' direction signs differ, each half is
+    /// traced as a [`PACKET`]-ray packet.
+    ///
+    /// # Panics
+    /// If there are more than [`PACKET16`] rays or `out` differs in length.
+    pub fn closest_hit_packet16(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        assert!(rays.len() <= PACKET16, "{} rays in a packet", rays.len());
+        assert_eq!(rays.len(), out.len(), "one output slot per ray");
+        #[cfg(target_arch = "x86_64")]
+        if rays.len() > PACKET && crate::traverse::simd::avx512() {
+            // SAFETY: the CPU has AVX2 and AVX-512 F (checked at run time).
+            if unsafe { self.closest_hit_packet16_avx512(rays, out) } {
+                return;
+            }
+        }
+        for (r, o) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
+            self.closest_hit_packet(r, o);
+        }
+    }
+
+    /// [`KdTree::closest_hit_packet16`] with the sixteen-lane walk; false
+    /// (and `out` untouched) when the rays cannot share it: an empty tree,
+    /// or halves whose direction signs differ.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 and AVX-512 F; `rays` must hold more than
+    /// [`PACKET`] and at most [`PACKET16`] rays.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f")]
+    unsafe fn closest_hit_packet16_avx512(&self, rays: &[Ray], out: &mut [Option<Hit>]) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let mut h = [Packet::EMPTY, Packet::EMPTY];
+        let (a, b) = rays.split_at(PACKET);
+        // SAFETY (both): the CPU has AVX2 (the caller's contract).
+        if !unsafe { h[0].setup_avx2(a, &self.bounds) }
+            || !unsafe { h[1].setup_avx2(b, &self.bounds) }
+            || h[0].neg != h[1].neg
+        {
+            return false;
+        }
+        // SAFETY (both arms): AVX2 and AVX-512 F (the caller's contract).
+        match &self.leaf_data {
+            TriangleLeaves::Whole(v) => unsafe { self.walk_packet16_avx512(Whole(v), &mut h) },
+            TriangleLeaves::Indexed(v) => unsafe { self.walk_packet16_avx512(Indexed(v), &mut h) },
+        }
+        let (oa, ob) = out.split_at_mut(PACKET);
+        finish(&h[0], oa);
+        finish(&h[1], ob);
+        true
+    }
+
+    /// Closest hits of many rays in packets of [`PACKET16`] consecutive
+    /// rays (see [`KdTree::closest_hit_packet16`]).
+    pub fn closest_hits_packets16(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), out.len(), "one output slot per ray");
+        for (r, o) in rays.chunks(PACKET16).zip(out.chunks_mut(PACKET16)) {
+            self.closest_hit_packet16(r, o);
         }
     }
 
@@ -555,6 +631,65 @@ mod tests {
                 got.fill(None);
                 tree.packet_portable(&rays, &mut got);
                 assert_eq!(got, want, "packet {p} (portable)");
+            }
+        }
+    }
+
+    /// Sixteen-ray packets: 4x4 tiles of camera rays, tiles whose halves
+    /// (or whose rays within a half) differ in direction signs, 9 to 15
+    /// rays, invalid rays and short segments: every answer equals brute
+    /// force, bit for bit, in both leaf layouts (with AVX-512 through the
+    /// sixteen-lane walk, elsewhere through two eight-ray packets).
+    #[test]
+    fn sixteen_ray_packets_agree_with_brute_force() {
+        let mut f = floats(1604);
+        let tris = soup(&mut f, 2000, 0.5);
+        let compact = BuildParams {
+            compact_leaves: true,
+            ..BuildParams::new(Builder::Sah)
+        };
+        for params in [BuildParams::new(Builder::Sah), compact] {
+            let tree = KdTree::build(tris.clone(), &params);
+            for p in 0..300 {
+                let eye = Vec3::new(f(), f(), -6.0);
+                let aim = Vec3::new(f(), f(), 1.0);
+                let n = if p % 7 == 0 { 9 + p % 7 } else { PACKET16 };
+                // A 4x4 tile of directions around `aim`.
+                let step = if p % 3 == 0 { 0.2 } else { 0.01 };
+                let mut rays: Vec<Ray> = (0..n)
+                    .map(|k| {
+                        let (x, y) = ((k % 4) as f32, (k / 4) as f32);
+                        Ray::new(eye, aim + Vec3::new(x, y, 0.0) * step)
+                    })
+                    .collect();
+                if p % 5 == 1 {
+                    // The second half looks the other way along x.
+                    for r in &mut rays[PACKET..] {
+                        r.dir.x = -r.dir.x - 0.01;
+                    }
+                }
+                if p % 5 == 2 {
+                    // One ray of the first half looks back.
+                    rays[3].dir = -rays[3].dir;
+                }
+                if p % 11 == 0 {
+                    rays[n - 1] = Ray::new(eye, Vec3::ZERO); // invalid
+                }
+                if p % 13 == 0 {
+                    rays[n - 2].tmax = 6.0;
+                }
+                let want: Vec<_> = rays.iter().map(|r| brute::closest_hit(&tris, r)).collect();
+                let mut got = vec![None; n];
+                tree.closest_hit_packet16(&rays, &mut got);
+                assert_eq!(got, want, "packet {p}");
+            }
+            let rays: Vec<Ray> = (0..PACKET16 * 20 + 5)
+                .map(|_| Ray::new(Vec3::new(0.0, 0.0, -6.0), Vec3::new(f(), f(), 1.0)))
+                .collect();
+            let mut got = vec![None; rays.len()];
+            tree.closest_hits_packets16(&rays, &mut got);
+            for (r, g) in rays.iter().zip(&got) {
+                assert_eq!(*g, brute::closest_hit(&tris, r));
             }
         }
     }
