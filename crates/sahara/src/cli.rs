@@ -131,7 +131,9 @@ Comparing ray by ray with another tracer (e.g. embree_bench):
 Human-readable results go to stdout, progress to stderr; with --json stdout
 holds exactly one JSON object: mesh, triangles, builder, build_ms,
 memory_bytes, sah_cost, threads, runs, tree_depth, leaves, camera, and
-sets.<name>.{rays, hits, t_sum, mrays_1t, mrays_1t_cpu, mrays_all[, counters]}.";
+sets.<name>.{rays, hits, t_sum, mrays_1t, mrays_1t_cpu, mrays_all[, counters]};
+the primary set adds its packet paths (8 rays on 4x2 tiles, 16 on 4x4):
+mrays_packet_1t[_cpu] and mrays_packet16_1t[_cpu].";
 
 /// Options of `sahara bench`.
 #[derive(Debug, Args)]

@@ -15,8 +15,8 @@
 //! the two "one side only" branches and the stack pops). Sharing it among
 //! sixteen rays traced camera rays 1.06–1.11x as fast as 4x2 packets (1
 //! thread, best of 3 interleaved rounds; Cornell box 1.06x, the four large
-//! meshes 1.09–1.11x), as Embree's 16-ray packets are faster than its
-//! 8-ray ones on the same machine (1.13–1.25x).
+//! meshes 1.07–1.11x); Embree's 16-ray packets are 1.06–1.25x as fast as
+//! its 8-ray ones on the same machine.
 
 use std::arch::x86_64::*;
 
