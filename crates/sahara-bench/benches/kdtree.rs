@@ -19,7 +19,6 @@ use sahara_kd::geometry::triangle::RayShear;
 use sahara_kd::geometry::triangle_block::BLOCK_WIDTH;
 use sahara_kd::geometry::triangle_packet::PacketShear;
 use sahara_kd::geometry::IndexedBlocks;
-use sahara_kd::packet::{PACKET, PACKET16};
 use sahara_kd::{BuildParams, Builder, KdTree, Ray, TriangleBlock};
 use sahara_render::mesh::Mesh;
 
@@ -106,15 +105,7 @@ fn trace(c: &mut Criterion) {
         });
     }
     // The packet path on primary rays: whole 4x2 tiles spread over the image.
-    let order = sahara_bench::runner::packets::tile_order(ImageSize::PROTOCOL, PacketSize::Eight);
-    let tiles: Vec<&[u32]> = order.chunks(PACKET).collect();
-    let step = (tiles.len() / (BATCH / PACKET)).max(1);
-    let tiled: Vec<Ray> = tiles
-        .iter()
-        .step_by(step)
-        .take(BATCH / PACKET)
-        .flat_map(|t| t.iter().map(|&i| primary[i as usize]))
-        .collect();
+    let tiled = spread_tiles(&primary, PacketSize::Eight);
     let mut out = vec![None; tiled.len()];
     g.throughput(Throughput::Elements(tiled.len() as u64));
     g.bench_function("primary_tiles_single", |bench| {
@@ -132,16 +123,7 @@ fn trace(c: &mut Criterion) {
         })
     });
     // The 16-ray packets on as many whole 4x4 tiles, spread the same way.
-    let order16 =
-        sahara_bench::runner::packets::tile_order(ImageSize::PROTOCOL, PacketSize::Sixteen);
-    let tiles16: Vec<&[u32]> = order16.chunks(PACKET16).collect();
-    let step16 = (tiles16.len() / (BATCH / PACKET16)).max(1);
-    let tiled16: Vec<Ray> = tiles16
-        .iter()
-        .step_by(step16)
-        .take(BATCH / PACKET16)
-        .flat_map(|t| t.iter().map(|&i| primary[i as usize]))
-        .collect();
+    let tiled16 = spread_tiles(&primary, PacketSize::Sixteen);
     let mut out16 = vec![None; tiled16.len()];
     g.throughput(Throughput::Elements(tiled16.len() as u64));
     g.bench_function("primary_tiles_packets16", |bench| {
@@ -281,6 +263,21 @@ fn trace(c: &mut Criterion) {
         });
     }
     g.finish();
+}
+
+/// The rays of `BATCH / size.rays()` whole tiles of the protocol image,
+/// evenly spread over it, tile after tile.
+fn spread_tiles(primary: &[Ray], size: PacketSize) -> Vec<Ray> {
+    let order = sahara_bench::runner::packets::tile_order(ImageSize::PROTOCOL, size);
+    let n = size.rays();
+    let tiles: Vec<&[u32]> = order.chunks(n).collect();
+    let step = (tiles.len() / (BATCH / n)).max(1);
+    tiles
+        .iter()
+        .step_by(step)
+        .take(BATCH / n)
+        .flat_map(|t| t.iter().map(|&i| primary[i as usize]))
+        .collect()
 }
 
 criterion_group!(benches, build, trace);
