@@ -228,16 +228,15 @@ fn protocol_sets(
                          path's (a bug)"
                     );
                 }
-                let fields = match size {
+                let figures = (Some(p.mrays_1t), Some(p.mrays_1t_cpu));
+                match size {
                     PacketSize::Eight => {
-                        (&mut report.mrays_packet_1t, &mut report.mrays_packet_1t_cpu)
+                        (report.mrays_packet_1t, report.mrays_packet_1t_cpu) = figures
                     }
-                    PacketSize::Sixteen => (
-                        &mut report.mrays_packet16_1t,
-                        &mut report.mrays_packet16_1t_cpu,
-                    ),
-                };
-                (*fields.0, *fields.1) = (Some(p.mrays_1t), Some(p.mrays_1t_cpu));
+                    PacketSize::Sixteen => {
+                        (report.mrays_packet16_1t, report.mrays_packet16_1t_cpu) = figures
+                    }
+                }
             }
             dump_hits(hit_dumps, "primary", &records)?;
             sets.primary = Some(report);
