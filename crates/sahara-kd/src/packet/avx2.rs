@@ -257,7 +257,18 @@ impl KdTree<Triangle> {
         let mut stack = [const { std::mem::MaybeUninit::<Entry>::uninit() }; MAX_DEPTH];
         let mut sp = 0usize;
         let mut node = 0u32;
-        let mut live = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32;
+        // The intervals widened by the margin and the lanes still on, kept
+        // beside the intervals: they change only where the intervals do (a
+        // cut or a pop), not at the one-sided steps.
+        let derive = |t0: __m256, t1: __m256| {
+            (
+                _mm256_sub_ps(t0, _mm256_mul_ps(_mm256_and_ps(t0, abs), margin)),
+                _mm256_add_ps(t1, _mm256_mul_ps(_mm256_and_ps(t1, abs), margin)),
+                _mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1),
+            )
+        };
+        let (mut lo, mut hi, mut active) = derive(t0, t1);
+        let mut live = _mm256_movemask_ps(active) as u32;
         while live != 0 {
             debug_assert!((node as usize) < self.nodes.len());
             // SAFETY: node indices come from the builder (see `walk`).
@@ -268,13 +279,10 @@ impl KdTree<Triangle> {
                 // SAFETY: `axis` < 3 for an inner node.
                 let (o, iv) = unsafe { (*org.get_unchecked(axis), *inv.get_unchecked(axis)) };
                 let tp = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(nd.split()), o), iv);
-                let hi = _mm256_add_ps(t1, _mm256_mul_ps(_mm256_and_ps(t1, abs), margin));
-                let lo = _mm256_sub_ps(t0, _mm256_mul_ps(_mm256_and_ps(t0, abs), margin));
                 // Ordered comparisons: false for a NaN `tp` (ray in the
                 // plane), as Rust's `>` and `<` are.
                 let near_only = _mm256_cmp_ps::<_CMP_GT_OQ>(tp, hi);
                 let far_only = _mm256_andnot_ps(near_only, _mm256_cmp_ps::<_CMP_LT_OQ>(tp, lo));
-                let active = _mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1);
                 let to_near = _mm256_andnot_ps(far_only, active);
                 let to_far = _mm256_andnot_ps(near_only, active);
                 let (nm, fm) = (_mm256_movemask_ps(to_near), _mm256_movemask_ps(to_far));
@@ -315,9 +323,10 @@ impl KdTree<Triangle> {
                 };
                 sp += 1;
                 (node, t0, t1) = (near, n0, n1);
+                (lo, hi, active) = derive(t0, t1);
                 continue;
             }
-            let live_rays = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32;
+            let live_rays = _mm256_movemask_ps(active) as u32;
             let count = nd.leaf_count() as usize;
             if count != 0 {
                 // SAFETY: `nd` is a leaf of this tree.
@@ -346,6 +355,7 @@ impl KdTree<Triangle> {
                 if live != 0 {
                     t0 = _mm256_blendv_ps(off0, e.t0, keep);
                     t1 = _mm256_blendv_ps(off1, e.t1, keep);
+                    (lo, hi, active) = derive(t0, t1);
                     node = e.node;
                     break;
                 }

@@ -72,7 +72,17 @@ impl KdTree<crate::geometry::Triangle> {
         let mut stack = [const { std::mem::MaybeUninit::<Entry>::uninit() }; MAX_DEPTH];
         let mut sp = 0usize;
         let mut node = 0u32;
-        let mut live = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t0, t1);
+        // As in the eight-lane walk: the widened intervals and the lanes
+        // still on change only at a cut or a pop.
+        let derive = |t0: __m512, t1: __m512| {
+            (
+                _mm512_sub_ps(t0, _mm512_mul_ps(_mm512_abs_ps(t0), margin)),
+                _mm512_add_ps(t1, _mm512_mul_ps(_mm512_abs_ps(t1), margin)),
+                _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t0, t1),
+            )
+        };
+        let (mut lo, mut hi, mut active) = derive(t0, t1);
+        let mut live = active;
         while live != 0 {
             debug_assert!((node as usize) < self.nodes.len());
             // SAFETY: node indices come from the builder (see `walk`).
@@ -85,11 +95,8 @@ impl KdTree<crate::geometry::Triangle> {
                 // The eight-lane walk's decisions, sixteen lanes at once
                 // (ordered comparisons: false for a NaN `tp`).
                 let tp = _mm512_mul_ps(_mm512_sub_ps(_mm512_set1_ps(nd.split()), o), iv);
-                let hi = _mm512_add_ps(t1, _mm512_mul_ps(_mm512_abs_ps(t1), margin));
-                let lo = _mm512_sub_ps(t0, _mm512_mul_ps(_mm512_abs_ps(t0), margin));
                 let near_only = _mm512_cmp_ps_mask::<_CMP_GT_OQ>(tp, hi);
                 let far_only = !near_only & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(tp, lo);
-                let active = _mm512_cmp_ps_mask::<_CMP_LE_OQ>(t0, t1);
                 let to_near = !far_only & active;
                 let to_far = !near_only & active;
                 // Every live ray on one side: intervals unchanged.
@@ -127,11 +134,12 @@ impl KdTree<crate::geometry::Triangle> {
                 };
                 sp += 1;
                 (node, t0, t1) = (near, n0, n1);
+                (lo, hi, active) = derive(t0, t1);
                 continue;
             }
             let count = nd.leaf_count() as usize;
             if count != 0 {
-                let live_rays = u32::from(_mm512_cmp_ps_mask::<_CMP_LE_OQ>(t0, t1));
+                let live_rays = u32::from(active);
                 for (half, p) in h.iter_mut().enumerate() {
                     let m = (live_rays >> (half * PACKET)) & 0xff;
                     // SAFETY: `nd` is a leaf of this tree; AVX2.
@@ -160,6 +168,7 @@ impl KdTree<crate::geometry::Triangle> {
                     live = keep;
                     t0 = _mm512_mask_blend_ps(keep, off0, e.t0);
                     t1 = _mm512_mask_blend_ps(keep, off1, e.t1);
+                    (lo, hi, active) = derive(t0, t1);
                     node = e.node;
                     break;
                 }
