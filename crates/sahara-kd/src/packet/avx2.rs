@@ -45,6 +45,9 @@ impl Packet {
     /// The CPU must have AVX2.
     #[target_feature(enable = "avx2")]
     pub(super) unsafe fn setup_avx2(&mut self, rays: &[Ray], bounds: &Aabb) -> bool {
+        // Whatever the packet held before (it may be reused): both set-ups
+        // write every field the walk reads (all lanes) but the mailbox.
+        (self.mailbox, self.mailbox_next) = (Packet::EMPTY.mailbox, 0);
         let Ok(rays) = <&[Ray; PACKET]>::try_from(rays) else {
             return self.setup(rays, bounds);
         };
