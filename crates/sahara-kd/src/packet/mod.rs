@@ -112,14 +112,15 @@ const MAILBOX: usize = 8;
 
 #[cfg(target_arch = "x86_64")]
 thread_local! {
-    /// The two halves of this thread's sixteen-ray packets, reused from
-    /// packet to packet. A fresh pair was two copies of `Packet::EMPTY`
-    /// (2 KB, `memmove`: ~7% of the sixteen-ray path's samples on the
-    /// teapot in its stadium) whose fields the set-up then overwrote;
-    /// reused, the set-up resets the mailbox and writes the rest as
-    /// before. 16-ray packets 1.01-1.04x (1 thread, best of 3 interleaved
-    /// rounds, five meshes).
-    static HALVES: std::cell::RefCell<[Packet; 2]> =
+    /// This thread's packets, reused from call to call: the two halves of
+    /// a sixteen-ray packet, the first also an eight-ray packet. A fresh
+    /// packet was a copy of `Packet::EMPTY` (1 KB, `memmove`: ~7% of the
+    /// sixteen-ray path's samples on the teapot in its stadium) whose
+    /// fields the set-up then overwrote; reused, the set-up resets the
+    /// mailbox and writes the rest as before. 1 thread, best of 3
+    /// interleaved rounds, five meshes: 16-ray packets 1.01-1.05x, then
+    /// 8-ray packets 1.02-1.05x.
+    static PACKETS: std::cell::RefCell<[Packet; 2]> =
         const { std::cell::RefCell::new([Packet::EMPTY, Packet::EMPTY]) };
 }
 
@@ -164,15 +165,26 @@ impl KdTree<Triangle> {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn closest_hit_packet_avx2(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        let mut p = Packet::EMPTY;
+        // SAFETY: as this function (the caller's contract).
+        PACKETS.with_borrow_mut(|h| unsafe { self.packet8_in(&mut h[0], rays, out) })
+    }
+
+    /// [`KdTree::closest_hit_packet_avx2`] in the packet `p` (whatever it
+    /// held: the set-up writes every field the walk reads).
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn packet8_in(&self, p: &mut Packet, rays: &[Ray], out: &mut [Option<Hit>]) {
         // SAFETY: the CPU has AVX2 (the caller's contract).
         if !self.nodes.is_empty() && unsafe { p.setup_avx2(rays, &self.bounds) } {
             // SAFETY (both arms): as above.
             match &self.leaf_data {
-                TriangleLeaves::Whole(v) => unsafe { self.walk_packet_avx2(Whole(v), &mut p) },
-                TriangleLeaves::Indexed(b) => unsafe { self.walk_packet_avx2(Indexed(b), &mut p) },
+                TriangleLeaves::Whole(v) => unsafe { self.walk_packet_avx2(Whole(v), p) },
+                TriangleLeaves::Indexed(b) => unsafe { self.walk_packet_avx2(Indexed(b), p) },
             }
-            finish(&p, out);
+            finish(p, out);
         } else {
             self.closest_hits_one_by_one(rays, out);
         }
@@ -218,7 +230,7 @@ impl KdTree<Triangle> {
             return false;
         }
         // SAFETY: as this function (the caller's contract).
-        HALVES.with_borrow_mut(|h| unsafe { self.packet16_in(h, rays, out) })
+        PACKETS.with_borrow_mut(|h| unsafe { self.packet16_in(h, rays, out) })
     }
 
     /// [`KdTree::closest_hit_packet16_avx512`] in the halves `h` (whatever
