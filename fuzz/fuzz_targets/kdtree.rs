@@ -15,8 +15,8 @@
 use arbitrary::Arbitrary;
 use glam::Vec3;
 use libfuzzer_sys::fuzz_target;
-use sahara_kd::packet::PACKET;
-use sahara_kd::validate::validate;
+use sahara_kd::PACKET;
+use sahara_kd::validate;
 use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
 
 #[derive(Arbitrary, Debug, Clone, Copy)]

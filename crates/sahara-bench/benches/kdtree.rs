@@ -14,11 +14,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize};
 use sahara_bench::runner::PacketSize;
 use sahara_bench::{HitRecord, ProtocolCamera, SceneFrame};
-use sahara_kd::geometry::frustum::Frustum;
-use sahara_kd::geometry::triangle::RayShear;
-use sahara_kd::geometry::triangle_block::BLOCK_WIDTH;
-use sahara_kd::geometry::triangle_packet::PacketShear;
-use sahara_kd::geometry::IndexedBlocks;
+use sahara_kd::internals::{Frustum, IndexedBlocks, PacketShear, RayShear, BLOCK_WIDTH};
 use sahara_kd::{BuildParams, Builder, KdTree, Ray, TriangleBlock};
 use sahara_render::mesh::Mesh;
 

@@ -5,9 +5,8 @@
 //! (smallest `t`, then smallest triangle index), so a correct tree returns
 //! bit-identical answers.
 
-use crate::geometry::triangle::RayShear;
-use crate::geometry::{Ray, Triangle};
-use crate::traverse::Hit;
+use crate::isect::{Hit, RayShear};
+use crate::math::{Ray, Triangle};
 
 /// The closest hit among all finite triangles.
 pub fn closest_hit(triangles: &[Triangle], ray: &Ray) -> Option<Hit> {

@@ -3,9 +3,10 @@
 //! Kd-trees over triangle soups, built by the surface area heuristic (an
 //! exact O(N log N) event sweep with split clipping, or binned) or by the
 //! naive baselines; front-to-back traversal with early exit for closest-hit
-//! and any-hit queries, single rays or packets of eight, over leaves whose
-//! triangles sit in 8-wide blocks; tree statistics; and the brute-force
-//! oracle the tests hold the tree to. No I/O, no rendering.
+//! and any-hit queries, for single rays, 8- and 16-ray packets and parallel
+//! batches, over leaves whose triangles sit in 8-wide blocks; tree
+//! statistics; a structural validator; and the brute-force oracle the tests
+//! hold the tree to. No I/O, no rendering.
 //!
 //! ```
 //! use glam::Vec3;
@@ -16,20 +17,46 @@
 //! let hit = tree.closest_hit(&Ray::new(Vec3::ZERO, Vec3::Z)).unwrap();
 //! assert_eq!((hit.t, hit.tri), (5.0, 0));
 //! ```
+//!
+//! The crate's rooms, each importing only those above it in this list:
+//! `math` (rays, boxes, triangles, clipping, float slack) and `simd`
+//! (instruction-set levels and dispatch); `isect` (the watertight test and
+//! hit records); `leaf` (leaf storage and the leaf tests) and `build` (the
+//! builders); `kd` (the tree, its node, walks, queries, batches and
+//! packets); then `stats`, `validate` and `brute`. See
+//! `docs/accelerator.md` for the design.
+
+#![deny(missing_docs)]
 
 pub mod brute;
-pub mod build;
-pub mod geometry;
-pub mod packet;
-pub mod stats;
+mod build;
+mod isect;
+mod kd;
+mod leaf;
+mod math;
+mod simd;
+mod stats;
 #[cfg(test)]
 mod test_support;
-pub mod traverse;
-pub mod tree;
-pub mod validate;
+mod validate;
 
-pub use build::{AxisRule, BuildParams, Builder, PositionRule};
-pub use geometry::{Aabb, Primitive, Ray, Triangle, TriangleBlock, TriangleHit};
+pub use build::{AxisRule, BuildParams, Builder, BuiltNode, PositionRule, Primitive, MAX_DEPTH};
+pub use isect::{intersect_ray_triangle, Hit, TriangleHit};
+pub use kd::{
+    BoxTree, Counters, KdTree, LeafStorage, NoCounters, Node, TraversalCounters, MAX_NODE_FIELD,
+    PACKET, PACKET16,
+};
+pub use leaf::{TriangleBlock, TriangleLeaves};
+pub use math::slack::gamma;
+pub use math::{Aabb, Ray, Triangle};
 pub use stats::TreeStats;
-pub use traverse::{Counters, Hit, NoCounters, TraversalCounters};
-pub use tree::{BoxTree, KdTree, Node};
+pub use validate::validate;
+
+/// Internals for the repository's benchmarks and fuzz targets: the leaf
+/// tests and packet forms on their own. Not part of the API; may change
+/// without notice.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::isect::RayShear;
+    pub use crate::leaf::{Frustum, IndexedBlocks, PacketShear, BLOCK_WIDTH};
+}

@@ -1,7 +1,7 @@
 //! Statistics of a finished tree, including its true SAH cost.
 
-use crate::geometry::Primitive;
-use crate::tree::KdTree;
+use crate::kd::KdTree;
+use crate::kd::LeafStorage;
 
 /// Shape, size and cost of a tree.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -46,7 +46,7 @@ pub struct TreeStats {
     pub expected_leaf_tests: f64,
 }
 
-impl<P: Primitive> KdTree<P> {
+impl<P: LeafStorage> KdTree<P> {
     /// Compute the statistics (one pass over the nodes).
     pub fn stats(&self) -> TreeStats {
         let mut s = TreeStats {
@@ -112,8 +112,8 @@ mod tests {
     use glam::Vec3;
 
     use crate::build::{BuildParams, Builder};
-    use crate::geometry::Triangle;
-    use crate::tree::KdTree;
+    use crate::kd::KdTree;
+    use crate::math::Triangle;
 
     /// A single leaf of ten triangles costs K_I per block of W: two blocks
     /// at W = 8, ten tests at W = 1.

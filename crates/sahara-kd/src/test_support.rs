@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use crate::geometry::Triangle;
+use crate::math::Triangle;
 
 /// A deterministic xorshift stream of floats in [-1, 1).
 pub fn floats(seed: u64) -> impl FnMut() -> f32 {

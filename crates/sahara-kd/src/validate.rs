@@ -2,9 +2,10 @@
 
 use glam::DVec3;
 
-use crate::geometry::triangle_block::BLOCK_WIDTH;
-use crate::geometry::{Aabb, Triangle, TriangleLeaves};
-use crate::tree::{KdTree, Node};
+use crate::kd::{KdTree, Node};
+use crate::leaf::TriangleLeaves;
+use crate::leaf::BLOCK_WIDTH;
+use crate::math::{Aabb, Triangle};
 
 /// Check a tree's structure and coverage; the first problem found is
 /// returned as a message.

@@ -13,7 +13,7 @@
 //! equal to the brute-force oracle bit for bit.
 
 use glam::Vec3;
-use sahara_kd::validate::validate;
+use sahara_kd::validate;
 use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
 
 fn builders() -> Vec<BuildParams> {
@@ -205,7 +205,7 @@ fn many_copies_of_one_triangle_stay_within_the_depth_limit() {
         assert_eq!((hit.t, hit.tri), (2.0, 0), "ties go to the smallest index");
         let mut depth = 0;
         tree.visit(|_, _, _, d| depth = depth.max(d));
-        assert!(depth < sahara_kd::traverse::MAX_DEPTH as u32);
+        assert!(depth < sahara_kd::MAX_DEPTH as u32);
     }
 }
 

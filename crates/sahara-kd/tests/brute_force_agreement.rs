@@ -9,7 +9,7 @@ mod common;
 
 use glam::Vec3;
 use proptest::prelude::*;
-use sahara_kd::validate::validate;
+use sahara_kd::validate;
 use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
 
 /// A coordinate: mostly on a coarse grid (so that coplanar, axis-aligned and

@@ -4,7 +4,7 @@
 mod common;
 
 use glam::Vec3;
-use sahara_kd::validate::validate;
+use sahara_kd::validate;
 use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
 
 fn trees(tris: &[Triangle]) -> Vec<(String, KdTree)> {

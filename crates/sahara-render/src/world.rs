@@ -2,7 +2,7 @@
 //! the integrators sample and how one is chosen, and surface hits.
 
 use glam::{Vec2, Vec3};
-use sahara_kd::geometry::aabb::gamma;
+use sahara_kd::gamma;
 use sahara_kd::{BuildParams, Counters, NoCounters, Ray};
 
 use crate::accel::{Accel, RawHit};

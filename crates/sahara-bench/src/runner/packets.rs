@@ -4,8 +4,8 @@
 
 use std::time::Instant;
 
-use sahara_kd::packet::{PACKET, PACKET16};
 use sahara_kd::{Hit, KdTree, Ray};
+use sahara_kd::{PACKET, PACKET16};
 
 use super::throughput::{mrays_per_sec, thread_cpu_seconds};
 use crate::protocol::camera::ImageSize;

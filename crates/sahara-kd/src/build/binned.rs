@@ -9,7 +9,8 @@ use super::cost::{SahModel, Split};
 use super::partition::{count_straddlers, partition, root_refs, Ref};
 use super::subtree::Subtree;
 use super::BuildParams;
-use crate::geometry::{Aabb, Primitive};
+use super::Primitive;
+use crate::math::Aabb;
 
 /// Below this many references a subtree is built on the current thread.
 const PARALLEL_MIN: usize = 2048;

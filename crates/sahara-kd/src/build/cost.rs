@@ -1,7 +1,7 @@
 //! The surface area heuristic for one candidate plane.
 
 use crate::build::BuildParams;
-use crate::geometry::Aabb;
+use crate::math::Aabb;
 
 /// Which side triangles lying in the split plane go to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -5,8 +5,9 @@
 
 use super::partition::{count_straddlers, partition, root_refs, Ref};
 use super::subtree::Subtree;
+use super::Primitive;
 use super::{AxisRule, BuildParams, PositionRule};
-use crate::geometry::{Aabb, Primitive};
+use crate::math::Aabb;
 
 struct Ctx<'a, P> {
     triangles: &'a [P],

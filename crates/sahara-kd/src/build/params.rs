@@ -129,7 +129,7 @@ pub struct BuildParams {
     /// meets it first may vary from run to run.
     pub max_duplication: f32,
     /// Primitives a leaf tests at once: the SAH prices a leaf of `n` at
-    /// `K_I ceil(n / leaf_width)` (triangle trees test [`crate::geometry::triangle_block::BLOCK_WIDTH`]
+    /// `K_I ceil(n / leaf_width)` (triangle trees test eight, the leaf block width
     /// = 8 at a time, so a leaf of 8 costs one test); 1 is the classic model.
     pub leaf_width: u32,
     /// Extra cost of each triangle in a leaf, in leaf tests: the SAH prices
@@ -160,6 +160,9 @@ impl Default for BuildParams {
         Self::new(Builder::Sah)
     }
 }
+
+/// Depth bound of every built tree (and of the walks' stacks).
+pub const MAX_DEPTH: usize = 64;
 
 /// The binned builder's default [`BuildParams::exact_below`]: 2^16.
 ///
@@ -196,7 +199,7 @@ impl BuildParams {
             max_leaf_size,
             parallel: true,
             max_duplication: 64.0,
-            leaf_width: crate::geometry::triangle_block::BLOCK_WIDTH as u32,
+            leaf_width: crate::simd::lanes::WIDTH as u32,
             lane_cost: 0.0,
             exact_below: match builder {
                 Builder::Binned { .. } => EXACT_BELOW,
@@ -224,7 +227,7 @@ impl BuildParams {
         let d = self
             .max_depth
             .unwrap_or_else(|| (8.0 + 1.3 * (n.max(1) as f64).log2()).round() as u32);
-        d.min(crate::traverse::MAX_DEPTH as u32 - 1)
+        d.min(MAX_DEPTH as u32 - 1)
     }
 }
 

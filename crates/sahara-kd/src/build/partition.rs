@@ -3,7 +3,8 @@
 
 use rayon::prelude::*;
 
-use crate::geometry::{Aabb, Primitive};
+use super::Primitive;
+use crate::math::Aabb;
 
 /// A triangle in a cell, with the bounds of its part inside the cell.
 #[derive(Clone, Copy, Debug)]

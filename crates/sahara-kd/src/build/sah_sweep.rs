@@ -16,7 +16,8 @@ use super::cost::{PlanarSide, SahModel, Split};
 use super::partition::Ref;
 use super::subtree::Subtree;
 use super::BuildParams;
-use crate::geometry::{Aabb, Primitive};
+use super::Primitive;
+use crate::math::Aabb;
 
 /// Event kinds, in their sort order at equal position: a triangle that ends
 /// at `p` is left of `p` before one that lies in `p` or starts at `p`.

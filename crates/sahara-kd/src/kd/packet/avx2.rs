@@ -11,18 +11,19 @@
 //! multiply-add), so both walks visit the same cells and the leaf tests
 //! give bit-identical hits.
 
-use crate::geometry::leaf_layout::Layout;
-use crate::traverse::level;
+use crate::leaf::layout::Layout;
+use crate::simd::level;
 use std::arch::x86_64::*;
 
 use super::{Packet, NO_HIT, OFF, PACKET};
-use crate::geometry::aabb::FAR_GROW;
-use crate::geometry::frustum::Frustum;
-use crate::geometry::triangle::permutation;
-use crate::geometry::triangle_packet::PacketShear;
-use crate::geometry::{Aabb, Ray, Triangle};
-use crate::traverse::{MARGIN, MAX_DEPTH};
-use crate::tree::KdTree;
+use crate::build::MAX_DEPTH;
+use crate::isect::permutation;
+use crate::kd::KdTree;
+use crate::leaf::Frustum;
+use crate::leaf::PacketShear;
+use crate::math::slack::FAR_GROW;
+use crate::math::slack::MARGIN;
+use crate::math::{Aabb, Ray, Triangle};
 
 /// A far child and the rays' intervals in it.
 #[derive(Clone, Copy)]

@@ -15,11 +15,12 @@
 //! leaves of two to four triangles on the shared meshes (`sahara bench
 //! --counters`), where the packet test does a half to a quarter of the work.
 
-use super::triangle::RayShear;
-use super::triangle_block::{edge_lanes, BLOCK_WIDTH};
+use super::edges::edge_lanes;
 #[cfg(target_arch = "x86_64")]
-use super::triangle_block::{edge_lanes_avx2, sheared_avx2};
-use super::Triangle;
+use super::edges::{edge_lanes_avx2, sheared_avx2};
+use super::BLOCK_WIDTH;
+use crate::isect::RayShear;
+use crate::math::Triangle;
 
 const _: () = assert!(
     RAYS == BLOCK_WIDTH,
@@ -179,7 +180,8 @@ impl PacketShear {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{Ray, TriangleBlock};
+    use crate::leaf::TriangleBlock;
+    use crate::math::Ray;
     use crate::test_support::floats;
     use glam::Vec3;
 
@@ -215,7 +217,7 @@ mod tests {
             for lane in 0..BLOCK_WIDTH {
                 let (m, e) = p.triangle_edges(&tris[lane]);
                 #[cfg(target_arch = "x86_64")]
-                if crate::traverse::simd::avx2() {
+                if crate::simd::has_avx2() {
                     // SAFETY: the CPU has AVX2.
                     let (m2, e2) = unsafe { p.triangle_edges_avx2(&tris[lane]) };
                     assert_eq!(m, m2);

@@ -31,9 +31,9 @@
 //! tiles); this test costs about a quarter of the 8-ray edge test and checks
 //! eight triangles at once.
 
-use super::indexed_block::IndexedBlock;
-use super::triangle::RayShear;
-use super::triangle_block::{TriangleBlock, BLOCK_WIDTH};
+use super::IndexedBlock;
+use super::{TriangleBlock, BLOCK_WIDTH};
+use crate::isect::RayShear;
 
 /// Relative slack of the culling planes (that of the traversal's
 /// `MARGIN`: 2^-12).
@@ -257,7 +257,7 @@ impl Frustum {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{Ray, Triangle};
+    use crate::math::{Ray, Triangle};
     use crate::test_support::floats;
     use glam::Vec3;
 
@@ -304,7 +304,7 @@ mod tests {
             let m = fr.survivors(&block, lanes);
             assert_eq!(m >> lanes, 0, "lanes past the count are masked");
             #[cfg(target_arch = "x86_64")]
-            if crate::traverse::simd::avx2() {
+            if crate::simd::has_avx2() {
                 // SAFETY: the CPU has AVX2.
                 assert_eq!(
                     unsafe { fr.survivors_avx2(&block, lanes) },
@@ -376,7 +376,7 @@ mod tests {
                 hits += 1;
                 assert_eq!(fr.survivors(&block, 1), 1, "round {round}: hit but culled");
                 #[cfg(target_arch = "x86_64")]
-                if crate::traverse::simd::avx2() {
+                if crate::simd::has_avx2() {
                     // SAFETY: the CPU has AVX2.
                     assert_eq!(unsafe { fr.survivors_avx2(&block, 1) }, 1, "round {round}");
                 }

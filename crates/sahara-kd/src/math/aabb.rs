@@ -2,6 +2,8 @@
 
 use glam::Vec3;
 
+use super::slack::FAR_GROW;
+
 /// An axis-aligned box `[min, max]` (closed). An empty box has `min > max`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
@@ -153,15 +155,4 @@ impl Aabb {
         }
         Some((t0, t1))
     }
-}
-
-/// The factor `1 + 2 gamma(3)` by which [`Aabb::intersect_ray`] enlarges
-/// the far distance.
-pub const FAR_GROW: f32 = 1.0 + 2.0 * gamma(3);
-
-/// pbrt's `gamma(n) = n u / (1 - n u)` bound on the relative error of `n`
-/// rounded f32 operations (u = machine epsilon / 2).
-pub const fn gamma(n: u32) -> f32 {
-    let u = f32::EPSILON * 0.5;
-    (n as f32 * u) / (1.0 - n as f32 * u)
 }

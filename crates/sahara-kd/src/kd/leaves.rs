@@ -1,24 +1,15 @@
-//! What a kd-tree can be built over.
+//! How a tree stores the leaves of each primitive type beside its nodes.
 
-use super::clip::clipped_bounds;
-use super::indexed_block::IndexedBlocks;
-use super::leaf_layout::TriangleLeaves;
-use super::triangle_block::{run_triangles, TriangleBlock, BLOCK_WIDTH};
-use super::{Aabb, Triangle};
-use crate::build::BuildParams;
-use crate::tree::Node;
+use super::Node;
+use crate::build::{BuildParams, Primitive};
+use crate::leaf::{run_triangles, IndexedBlocks, TriangleBlock, TriangleLeaves, BLOCK_WIDTH};
+use crate::math::{Aabb, Triangle};
 
-/// A primitive a kd-tree can hold: it has bounds, and bounds of its part
-/// inside a cell (for split clipping).
-pub trait Primitive: Send + Sync + Sized {
-    /// Bounds of the whole primitive.
-    fn bounds(&self) -> Aabb;
-    /// Bounds of the primitive clipped to `cell`, `None` if they do not meet.
-    fn clipped_bounds(&self, cell: &Aabb) -> Option<Aabb>;
-    /// False for primitives no ray can hit; the tree leaves them out.
-    fn is_hittable(&self) -> bool;
-
-    /// What a tree keeps beside its primitives for fast leaf tests.
+/// A primitive type a [`crate::KdTree`] can hold, and what the tree keeps
+/// beside its nodes for fast leaf tests. Implemented for [`Triangle`]
+/// (leaf blocks of eight) and [`Aabb`] (indices only).
+pub trait LeafStorage: Primitive {
+    /// What a tree keeps beside its nodes for fast leaf tests.
     type LeafData: Clone + std::fmt::Debug + Default + Send + Sync;
     /// Leaf index runs start at and are padded to a multiple of this.
     const LEAF_WIDTH: usize;
@@ -38,17 +29,7 @@ pub trait Primitive: Send + Sync + Sized {
     fn leaf_data_bytes(data: &Self::LeafData) -> usize;
 }
 
-impl Primitive for Triangle {
-    fn bounds(&self) -> Aabb {
-        Triangle::bounds(self)
-    }
-    fn clipped_bounds(&self, cell: &Aabb) -> Option<Aabb> {
-        clipped_bounds(self, cell)
-    }
-    fn is_hittable(&self) -> bool {
-        Triangle::is_hittable(self)
-    }
-
+impl LeafStorage for Triangle {
     /// Copies of the leaves' triangles in leaf order, eight to a block,
     /// whole or (`BuildParams::compact_leaves`) with each block's distinct
     /// vertices once; then a leaf's offset is the word offset of its first
@@ -87,21 +68,8 @@ impl Primitive for Triangle {
     }
 }
 
-/// Boxes, for trees over objects (e.g. the instances of a scene): a box
-/// clipped to a cell is their intersection.
-impl Primitive for Aabb {
-    fn bounds(&self) -> Aabb {
-        *self
-    }
-    fn clipped_bounds(&self, cell: &Aabb) -> Option<Aabb> {
-        let b = self.intersection(*cell);
-        (!b.is_empty()).then_some(b)
-    }
-    fn is_hittable(&self) -> bool {
-        !self.is_empty() && self.min.is_finite() && self.max.is_finite()
-    }
-
-    /// Box trees hand indices to the caller's closures: nothing extra.
+/// Box trees hand indices to the caller's closures: nothing extra.
+impl LeafStorage for Aabb {
     type LeafData = ();
     const LEAF_WIDTH: usize = 1;
     fn leaf_data(_: &[Self], _: &[u32], _: &mut [Node], _: &BuildParams) {}

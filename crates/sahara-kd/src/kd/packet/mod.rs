@@ -11,9 +11,9 @@
 //! eight lanes at a time: [`avx2`] with AVX2 intrinsics where the CPU has
 //! them (chosen at run time), the portable walk here otherwise. A leaf's
 //! triangles are first culled eight at a time against the packet's frustum
-//! when its rays share an origin ([`crate::geometry::frustum`]); each block's
+//! when its rays share an origin ([`crate::leaf::frustum`]); each block's
 //! survivors are then tested triangle by triangle for all rays at once
-//! ([`crate::geometry::triangle_packet`]) or ray by ray with the block test,
+//! ([`crate::leaf::packet_shear`]) or ray by ray with the block test,
 //! whichever takes fewer tests. Results are bit-identical to
 //! [`KdTree::closest_hit`].
 //!
@@ -28,15 +28,19 @@ mod avx2;
 mod avx512;
 mod setup;
 
-use crate::geometry::frustum::Frustum;
-use crate::geometry::leaf_layout::{Indexed, Layout, LeafBlock, Whole};
-use crate::geometry::triangle::TrianglePlane;
-use crate::geometry::triangle_block::BLOCK_WIDTH;
-use crate::geometry::triangle_packet::PacketShear;
-use crate::geometry::{Ray, Triangle, TriangleHit, TriangleLeaves};
-use crate::traverse::level;
-use crate::traverse::{keep_closer, Hit, MARGIN, MAX_DEPTH};
-use crate::tree::KdTree;
+use crate::build::MAX_DEPTH;
+use crate::isect::TriangleHit;
+use crate::isect::TrianglePlane;
+use crate::isect::{keep_closer, Hit};
+use crate::kd::KdTree;
+use crate::leaf::layout::{Indexed, Layout, LeafBlock, Whole};
+use crate::leaf::Frustum;
+use crate::leaf::PacketShear;
+use crate::leaf::TriangleLeaves;
+use crate::leaf::BLOCK_WIDTH;
+use crate::math::slack::MARGIN;
+use crate::math::{Ray, Triangle};
+use crate::simd::level;
 
 /// Rays per packet.
 pub const PACKET: usize = 8;
@@ -134,7 +138,7 @@ impl KdTree<Triangle> {
         assert!(rays.len() <= PACKET, "{} rays in a packet", rays.len());
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
         #[cfg(target_arch = "x86_64")]
-        if crate::traverse::simd::avx2() {
+        if crate::simd::has_avx2() {
             // SAFETY: the CPU has AVX2 (checked at run time).
             return unsafe { self.closest_hit_packet_avx2(rays, out) };
         }
@@ -205,7 +209,7 @@ impl KdTree<Triangle> {
         assert!(rays.len() <= PACKET16, "{} rays in a packet", rays.len());
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
         #[cfg(target_arch = "x86_64")]
-        if rays.len() > PACKET && crate::traverse::simd::avx512() {
+        if rays.len() > PACKET && crate::simd::has_avx512() {
             // SAFETY: the CPU has AVX2 and AVX-512 F (checked at run time).
             if unsafe { self.closest_hit_packet16_avx512(rays, out) } {
                 return;

@@ -17,11 +17,11 @@
 use glam::Vec3;
 
 use super::{Lanes, Packet, MAILBOX, NO_HIT, OFF, PACKET};
-use crate::geometry::aabb::FAR_GROW;
-use crate::geometry::frustum::Frustum;
-use crate::geometry::triangle::{permutation, RayShear};
-use crate::geometry::triangle_packet::PacketShear;
-use crate::geometry::{Aabb, Ray};
+use crate::isect::{permutation, RayShear};
+use crate::leaf::Frustum;
+use crate::leaf::PacketShear;
+use crate::math::slack::FAR_GROW;
+use crate::math::{Aabb, Ray};
 
 /// `a` with the lanes not in `live` replaced by lane `f`'s value.
 #[inline(always)]
@@ -313,7 +313,7 @@ mod tests {
     /// The AVX2 set-up (the transposed gather) gives packet `p` exactly.
     fn assert_same_as_avx2(p: &Packet, rays: &[Ray], bounds: &Aabb) {
         #[cfg(target_arch = "x86_64")]
-        if crate::traverse::simd::avx2() {
+        if crate::simd::has_avx2() {
             let mut q = Packet::EMPTY;
             // SAFETY: the CPU has AVX2.
             assert!(unsafe { q.setup_avx2(rays, bounds) });
@@ -357,7 +357,7 @@ mod tests {
                 rays[l] = bad;
                 assert!(!p.setup(&rays, &bounds));
                 #[cfg(target_arch = "x86_64")]
-                if crate::traverse::simd::avx2() {
+                if crate::simd::has_avx2() {
                     // SAFETY: the CPU has AVX2.
                     assert!(!unsafe { p.setup_avx2(&rays, &bounds) });
                 }

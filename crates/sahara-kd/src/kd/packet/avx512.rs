@@ -21,10 +21,11 @@
 use std::arch::x86_64::*;
 
 use super::{Packet, OFF, PACKET};
-use crate::geometry::leaf_layout::Layout;
-use crate::traverse::level;
-use crate::traverse::{MARGIN, MAX_DEPTH};
-use crate::tree::KdTree;
+use crate::build::MAX_DEPTH;
+use crate::kd::KdTree;
+use crate::leaf::layout::Layout;
+use crate::math::slack::MARGIN;
+use crate::simd::level;
 
 /// A far child and the sixteen rays' intervals in it.
 #[derive(Clone, Copy)]
@@ -48,7 +49,7 @@ unsafe fn join(a: &[f32; PACKET], b: &[f32; PACKET]) -> __m512 {
     }
 }
 
-impl KdTree<crate::geometry::Triangle> {
+impl KdTree<crate::math::Triangle> {
     /// The sixteen-ray walk over the halves `h` (set up, with the same
     /// direction signs), which collect the closest hits.
     ///

@@ -1,12 +1,12 @@
-//! Leaf triangles packed eight to a block (structure of arrays) and the
-//! eight-wide edge test that filters them.
+//! The block test: one ray against the eight triangles of a leaf block, in
+//! either layout.
 //!
 //! A leaf's triangles are copied, in leaf order, into blocks of
 //! [`BLOCK_WIDTH`] so that one leaf visit reads contiguous memory instead of
 //! an index and then a triangle per reference, and so that the edge functions
 //! of the watertight test are computed for eight triangles at once (plain
 //! loops over `[f32; 8]`, which the compiler turns into SIMD: two SSE or one
-//! AVX2 operation per line; see `crate::traverse::simd`).
+//! AVX2 operation per line; see `crate::simd`).
 //!
 //! The block test is a filter, never a decision: it evaluates exactly the
 //! floating-point operations of [`RayShear::intersect`] (same order, no fused
@@ -16,56 +16,14 @@
 //! are therefore bit-identical to the reference test and the brute-force
 //! oracle.
 
-use crate::traverse::level;
-use glam::Vec3;
-
-use super::indexed_block::IndexedBlock;
-use super::triangle::RayShear;
-use super::Triangle;
-
-/// Triangles per block.
-pub const BLOCK_WIDTH: usize = 8;
-
-/// Up to eight triangles, coordinates by vertex, axis and lane.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(32))]
-pub struct TriangleBlock {
-    /// `v[vertex][axis][lane]`.
-    pub v: [[[f32; BLOCK_WIDTH]; 3]; 3],
-}
-
-/// The triangles a run of a padded index array names (`u32::MAX` marks
-/// padding), in order: what one leaf block holds, in either layout.
-pub(crate) fn run_triangles(prims: &[Triangle], run: &[u32]) -> Vec<Triangle> {
-    run.iter()
-        .filter(|&&i| i != u32::MAX)
-        .map(|&i| prims[i as usize])
-        .collect()
-}
-
-impl TriangleBlock {
-    /// A block of `tris` (at most eight); unused lanes are zero (and masked
-    /// out by the lane count at test time).
-    pub fn pack(tris: &[Triangle]) -> Self {
-        assert!(tris.len() <= BLOCK_WIDTH, "{} triangles", tris.len());
-        let mut v = [[[0.0; BLOCK_WIDTH]; 3]; 3];
-        for (lane, t) in tris.iter().enumerate() {
-            for (k, p) in t.v.iter().enumerate() {
-                for axis in 0..3 {
-                    v[k][axis][lane] = p[axis];
-                }
-            }
-        }
-        Self { v }
-    }
-
-    /// The triangle in `lane`, as it was packed.
-    #[inline(always)]
-    pub fn triangle(&self, lane: usize) -> Triangle {
-        let p = |k: usize| Vec3::new(self.v[k][0][lane], self.v[k][1][lane], self.v[k][2][lane]);
-        Triangle::new(p(0), p(1), p(2))
-    }
-}
+use super::edges::edge_lanes;
+#[cfg(target_arch = "x86_64")]
+use super::edges::{edge_lanes_avx2, sheared_avx2};
+use super::{IndexedBlock, TriangleBlock, BLOCK_WIDTH};
+use crate::isect::RayShear;
+#[cfg(target_arch = "x86_64")]
+use crate::simd::lanes::Lanes8;
+use crate::simd::level;
 
 impl RayShear {
     /// One vertex of eight triangles moved to the ray origin and sheared, as
@@ -116,85 +74,6 @@ impl RayShear {
     }
 }
 
-/// Eight lanes of the watertight test's edge step: from the sheared
-/// vertices `a`, `b`, `c` (x and y lanes), the edge functions `[u, v, w]`
-/// and the mask of lanes the test may accept (bit `l` = lane `l`).
-///
-/// The expressions and their order are `RayShear::intersect`'s, so a lane
-/// left out is one the scalar test rejects early: its edge functions are
-/// non-zero with mixed signs and their sum is finite. Shared by the block
-/// test (lanes = triangles) and the packet test (lanes = rays).
-#[inline(always)]
-pub(crate) fn edge_lanes(
-    (ax, ay): ([f32; BLOCK_WIDTH], [f32; BLOCK_WIDTH]),
-    (bx, by): ([f32; BLOCK_WIDTH], [f32; BLOCK_WIDTH]),
-    (cx, cy): ([f32; BLOCK_WIDTH], [f32; BLOCK_WIDTH]),
-) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
-    let mut keep = [false; BLOCK_WIDTH];
-    let mut e = [[0.0f32; BLOCK_WIDTH]; 3];
-    for l in 0..BLOCK_WIDTH {
-        let u = cx[l] * by[l] - cy[l] * bx[l];
-        let v = ax[l] * cy[l] - ay[l] * cx[l];
-        let w = bx[l] * ay[l] - by[l] * ax[l];
-        (e[0][l], e[1][l], e[2][l]) = (u, v, w);
-        let det = u + v + w;
-        let nonzero = u != 0.0 && v != 0.0 && w != 0.0;
-        let mixed = (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0);
-        keep[l] = !(nonzero && det.is_finite() && mixed);
-    }
-    let mut mask = 0u32;
-    for (l, &k) in keep.iter().enumerate() {
-        mask |= (k as u32) << l;
-    }
-    (mask, e)
-}
-
-/// [`edge_lanes`] in AVX2 intrinsics: the same operations lane for lane
-/// (no fused multiply-add; ordered comparisons as Rust's `<`, `>`,
-/// unordered `!=`), so the same edge functions and mask, with the mask from
-/// one `movemask` where the compiled lane loop packed eight bools with a
-/// dozen shuffles (`objdump` of the AVX2 paths).
-///
-/// # Safety
-/// The CPU must have AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-pub(crate) fn edge_lanes_avx2(
-    (ax, ay): (Lanes8, Lanes8),
-    (bx, by): (Lanes8, Lanes8),
-    (cx, cy): (Lanes8, Lanes8),
-) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
-    use std::arch::x86_64::*;
-    let cross = |p: __m256, q: __m256, r: __m256, s: __m256| {
-        _mm256_sub_ps(_mm256_mul_ps(p, q), _mm256_mul_ps(r, s))
-    };
-    let u = cross(cx, by, cy, bx);
-    let v = cross(ax, cy, ay, cx);
-    let w = cross(bx, ay, by, ax);
-    let mut e = [[0.0f32; BLOCK_WIDTH]; 3];
-    for (out, x) in e.iter_mut().zip([u, v, w]) {
-        // SAFETY: eight f32.
-        unsafe { _mm256_storeu_ps(out.as_mut_ptr(), x) };
-    }
-    let det = _mm256_add_ps(_mm256_add_ps(u, v), w);
-    let zero = _mm256_setzero_ps();
-    let ne = |x: __m256| _mm256_cmp_ps::<_CMP_NEQ_UQ>(x, zero);
-    let lt = |x: __m256| _mm256_cmp_ps::<_CMP_LT_OQ>(x, zero);
-    let gt = |x: __m256| _mm256_cmp_ps::<_CMP_GT_OQ>(x, zero);
-    let nonzero = _mm256_and_ps(_mm256_and_ps(ne(u), ne(v)), ne(w));
-    let some_neg = _mm256_or_ps(_mm256_or_ps(lt(u), lt(v)), lt(w));
-    let some_pos = _mm256_or_ps(_mm256_or_ps(gt(u), gt(v)), gt(w));
-    let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
-    let finite =
-        _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_and_ps(det, abs), _mm256_set1_ps(f32::INFINITY));
-    let reject = _mm256_and_ps(
-        _mm256_and_ps(nonzero, finite),
-        _mm256_and_ps(some_neg, some_pos),
-    );
-    (!(_mm256_movemask_ps(reject) as u32) & 0xff, e)
-}
-
 impl RayShear {
     /// [`RayShear::block_edges`] of a block as a tree stores it: each
     /// distinct vertex sheared once (the same operations, so the same
@@ -225,7 +104,7 @@ impl RayShear {
     }
 
     /// [`RayShear::indexed_edges`], in intrinsics at level `SIMD` (AVX2 or
-    /// above; see `crate::traverse::level`).
+    /// above; see `crate::simd::level`).
     ///
     /// # Safety
     /// The CPU must have the level's instructions, and the caller must be
@@ -245,35 +124,6 @@ impl RayShear {
         self.indexed_edges(block, lanes)
     }
 }
-
-/// One vertex moved to the ray origin and sheared, as `RayShear::sheared`
-/// does, eight lanes at a time: `(p[kx] - o[kx]) - sx (p[kz] - o[kz])` and
-/// the same with `ky`, `sy`. The block test puts triangles in the lanes
-/// (the ray's constants broadcast), the packet test rays (the vertex
-/// broadcast).
-///
-/// # Safety
-/// The CPU must have AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[inline]
-pub(crate) fn sheared_avx2(
-    p: [Lanes8; 3],
-    o: [Lanes8; 3],
-    sx: Lanes8,
-    sy: Lanes8,
-) -> (Lanes8, Lanes8) {
-    use std::arch::x86_64::*;
-    let z = _mm256_sub_ps(p[2], o[2]);
-    (
-        _mm256_sub_ps(_mm256_sub_ps(p[0], o[0]), _mm256_mul_ps(sx, z)),
-        _mm256_sub_ps(_mm256_sub_ps(p[1], o[1]), _mm256_mul_ps(sy, z)),
-    )
-}
-
-/// Eight f32 lanes in a 256-bit register (AVX2 paths).
-#[cfg(target_arch = "x86_64")]
-pub(crate) type Lanes8 = std::arch::x86_64::__m256;
 
 #[cfg(target_arch = "x86_64")]
 impl RayShear {
@@ -426,26 +276,9 @@ impl RayShear {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::Ray;
+    use crate::math::{Ray, Triangle};
     use crate::test_support::floats;
-
-    #[test]
-    fn pack_round_trips() {
-        let mut f = floats(7);
-        let tris: Vec<Triangle> = (0..5)
-            .map(|_| {
-                Triangle::new(
-                    Vec3::new(f(), f(), f()),
-                    Vec3::new(f(), f(), f()),
-                    Vec3::new(f(), f(), f()),
-                )
-            })
-            .collect();
-        let b = TriangleBlock::pack(&tris);
-        for (i, t) in tris.iter().enumerate() {
-            assert_eq!(b.triangle(i), *t);
-        }
-    }
+    use glam::Vec3;
 
     /// The filter never drops a lane the scalar test accepts, and it drops
     /// every lane the scalar test rejects by its signs (so it filters).
@@ -500,7 +333,7 @@ mod tests {
     #[test]
     fn avx2_block_edges_equal_the_portable_ones() {
         #[cfg(target_arch = "x86_64")]
-        if crate::traverse::simd::avx2() {
+        if crate::simd::has_avx2() {
             let mut f = floats(4242);
             let mut kept = 0;
             for round in 0..4000 {

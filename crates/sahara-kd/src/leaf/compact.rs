@@ -34,10 +34,10 @@ use std::marker::PhantomData;
 
 use glam::Vec3;
 
-use super::triangle_block::{run_triangles, TriangleBlock, BLOCK_WIDTH};
-use super::Triangle;
+use super::{run_triangles, TriangleBlock, BLOCK_WIDTH};
+use crate::math::Triangle;
 #[cfg(target_arch = "x86_64")]
-use crate::traverse::level;
+use crate::simd::level;
 
 /// Words before a block's vertex table.
 const HEADER: usize = 8;
@@ -494,7 +494,7 @@ mod tests {
                     assert_eq!(bits(&expanded.triangle(l)), bits(want));
                 }
                 #[cfg(target_arch = "x86_64")]
-                if crate::traverse::simd::avx2() {
+                if crate::simd::has_avx2() {
                     // SAFETY: AVX2 checked.
                     let lanes = unsafe { block.lanes_avx2() };
                     for (k, vk) in lanes.iter().enumerate() {

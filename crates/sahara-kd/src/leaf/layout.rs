@@ -18,14 +18,14 @@
 //! The leaf tests are written once over `LeafBlock` and compiled for each
 //! layout; each traversal is compiled per layout too (see `Layout`).
 
-use super::frustum::Frustum;
-use super::indexed_block::{IndexedBlock, IndexedBlocks};
-use super::triangle::RayShear;
-use super::triangle_block::{TriangleBlock, BLOCK_WIDTH};
-use super::triangle_packet::PacketShear;
-use super::Triangle;
+use super::Frustum;
+use super::PacketShear;
+use super::{IndexedBlock, IndexedBlocks};
+use super::{TriangleBlock, BLOCK_WIDTH};
+use crate::isect::RayShear;
+use crate::math::Triangle;
 #[cfg(target_arch = "x86_64")]
-use crate::traverse::level;
+use crate::simd::level;
 
 /// The leaf blocks of a triangle tree, in leaf order.
 #[derive(Clone, Debug, PartialEq)]

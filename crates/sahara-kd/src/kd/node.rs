@@ -1,7 +1,5 @@
-//! The finished tree: 8-byte nodes and the flat triangle-index array.
-
-use crate::build::BuildParams;
-use crate::geometry::{Aabb, Primitive, Triangle};
+//! The 8-byte node: the reference layout every builder's output is
+//! flattened into and every walk reads.
 
 /// One kd-tree node in 8 bytes (the layout of pbrt-v3's `KdAccelNode`,
 /// itself after Havran's thesis).
@@ -99,23 +97,6 @@ impl Node {
     pub fn leaf_count(&self) -> u32 {
         self.word1 >> 2
     }
-
-    /// This node with its child pointer or leaf offset moved by `delta`
-    /// (used when subtrees built apart are concatenated).
-    #[inline]
-    pub(crate) fn shifted(self, node_delta: u32, index_delta: u32) -> Self {
-        if self.is_leaf() {
-            Self {
-                word0: self.word0 + index_delta,
-                ..self
-            }
-        } else {
-            Self {
-                word1: self.word1 + (node_delta << 2),
-                ..self
-            }
-        }
-    }
 }
 
 /// Keeps the path it is placed on a conditional branch: an empty `asm!`
@@ -136,101 +117,6 @@ fn keep_branch() {
     }
 }
 
-/// A kd-tree over primitives: triangles by default.
-///
-/// Build it with [`KdTree::build`]; query a triangle tree with
-/// [`KdTree::closest_hit`] and [`KdTree::any_hit`], a [`BoxTree`] with
-/// closures (see `traverse`).
-#[derive(Clone, Debug)]
-pub struct KdTree<P: Primitive = Triangle> {
-    pub(crate) nodes: Vec<Node>,
-    /// Leaf runs, each starting at a multiple of `P::LEAF_WIDTH` and padded
-    /// to one with `u32::MAX`.
-    pub(crate) indices: Vec<u32>,
-    /// Primitives given to the build (hittable or not).
-    pub(crate) prim_count: usize,
-    /// Leaf-ordered copies for fast tests (triangles: blocks of eight).
-    pub(crate) leaf_data: P::LeafData,
-    pub(crate) bounds: Aabb,
-    pub(crate) params: BuildParams,
-}
-
-impl<P: Primitive> KdTree<P> {
-    /// The nodes, root first, in depth-first order.
-    pub fn nodes(&self) -> &[Node] {
-        &self.nodes
-    }
-
-    /// The leaves' triangle indices, one run per leaf; runs are padded with
-    /// `u32::MAX` to a multiple of the primitive's leaf width.
-    pub fn indices(&self) -> &[u32] {
-        &self.indices
-    }
-
-    /// Number of primitives given to the build (hit indices range over them).
-    /// The tree keeps no copy of them beyond its leaf data: a triangle tree
-    /// stores each referenced triangle in its leaf blocks, a box tree only
-    /// indices.
-    pub fn primitive_count(&self) -> usize {
-        self.prim_count
-    }
-
-    /// The leaf data (for a triangle tree, the leaf blocks in leaf order).
-    pub fn leaf_data(&self) -> &P::LeafData {
-        &self.leaf_data
-    }
-
-    /// The root cell: the bounds of all hittable triangles.
-    pub fn bounds(&self) -> Aabb {
-        self.bounds
-    }
-
-    /// The parameters the tree was built with.
-    pub fn params(&self) -> &BuildParams {
-        &self.params
-    }
-
-    /// The primitive indices of leaf `node`.
-    #[inline(always)]
-    pub fn leaf_primitives(&self, node: &Node) -> &[u32] {
-        let c = node.leaf_count() as usize;
-        if c == 0 {
-            return &[];
-        }
-        let o = P::leaf_run(&self.leaf_data, node.leaf_offset());
-        &self.indices[o..o + c]
-    }
-
-    /// Visit every node with its cell and depth (root depth 0), depth first.
-    pub fn visit(&self, mut f: impl FnMut(u32, &Node, &Aabb, u32)) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let mut stack = vec![(0u32, self.bounds, 0u32)];
-        while let Some((i, cell, depth)) = stack.pop() {
-            let n = &self.nodes[i as usize];
-            f(i, n, &cell, depth);
-            if !n.is_leaf() {
-                let (lo, hi) = cell.split(n.axis(), n.split());
-                stack.push((n.above_child(), hi, depth + 1));
-                stack.push((i + 1, lo, depth + 1));
-            }
-        }
-    }
-}
-
-/// A kd-tree over boxes (e.g. a scene's object instances), queried with
-/// closures that intersect the objects themselves.
-pub type BoxTree = KdTree<Aabb>;
-
-impl KdTree<Triangle> {
-    /// The triangle indices of leaf `node`.
-    #[inline(always)]
-    pub fn leaf_triangles(&self, node: &Node) -> &[u32] {
-        self.leaf_primitives(node)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -244,7 +130,5 @@ mod tests {
         let l = Node::leaf(77, MAX_NODE_FIELD);
         assert!(l.is_leaf());
         assert_eq!((l.leaf_offset(), l.leaf_count()), (77, MAX_NODE_FIELD));
-        assert_eq!(n.shifted(5, 9).above_child(), 12350);
-        assert_eq!(l.shifted(5, 9).leaf_offset(), 86);
     }
 }

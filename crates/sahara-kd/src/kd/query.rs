@@ -1,0 +1,313 @@
+//! Closest-hit and any-hit queries of one ray, over either leaf layout,
+//! for each instruction-set level.
+
+use super::walk::{LeafResult, LeafVisit};
+use super::{Counters, KdTree, NoCounters};
+use crate::isect::{keep_closer, Hit, RayShear};
+use crate::leaf::layout::{Indexed, Layout, LeafBlock, Whole};
+use crate::leaf::{TriangleLeaves, BLOCK_WIDTH};
+use crate::math::{Ray, Triangle};
+use crate::simd::{dispatch, level, Kernel};
+
+/// The closest-hit leaf visit of one ray, a named type rather than a
+/// closure so that `#[inline(always)]` can put it into the walk's loop
+/// (LLVM kept the closure out of line: a call per leaf).
+struct ClosestLeaf<'a, L: Layout, const SIMD: u8> {
+    tree: &'a KdTree<Triangle>,
+    layout: L,
+    shear: &'a RayShear,
+    tmin: f32,
+    best_t: f32,
+    best: Hit,
+}
+
+impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for ClosestLeaf<'_, L, SIMD> {
+    #[inline(always)]
+    fn visit(&mut self, offset: usize, count: usize, c: &mut C, closest: &mut f32) -> LeafResult {
+        // SAFETY: the walk passes the `offset`, `count` of a non-empty leaf
+        // of this tree, whose blocks `layout` holds.
+        let blocks = unsafe { self.layout.blocks(offset, count) };
+        self.tree.leaf_closest::<C, SIMD, _>(
+            blocks,
+            self.shear,
+            self.tmin,
+            count,
+            &mut self.best_t,
+            &mut self.best,
+            c,
+        );
+        if self.best.tri != u32::MAX {
+            *closest = self.best_t;
+        }
+        LeafResult::Continue
+    }
+}
+
+/// The any-hit leaf visit of one ray (a named type for the reason given at
+/// [`ClosestLeaf`]).
+struct AnyLeaf<'a, L: Layout, const SIMD: u8> {
+    layout: L,
+    shear: &'a RayShear,
+    tmin: f32,
+    tmax: f32,
+    found: bool,
+}
+
+impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for AnyLeaf<'_, L, SIMD> {
+    #[inline(always)]
+    fn visit(&mut self, offset: usize, count: usize, c: &mut C, _: &mut f32) -> LeafResult {
+        // SAFETY: as in `ClosestLeaf::visit`.
+        let blocks = unsafe { self.layout.blocks(offset, count) };
+        if self.any_in(blocks, count, c) {
+            self.found = true;
+            LeafResult::Stop
+        } else {
+            LeafResult::Continue
+        }
+    }
+}
+
+impl<L: Layout, const SIMD: u8> AnyLeaf<'_, L, SIMD> {
+    /// True if a triangle of `blocks` (a leaf of `count`) is hit.
+    #[inline(always)]
+    fn any_in<C: Counters, B: LeafBlock>(
+        &self,
+        blocks: impl Iterator<Item = B>,
+        count: usize,
+        c: &mut C,
+    ) -> bool {
+        for (b, block) in blocks.enumerate() {
+            let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
+            (0..lanes).for_each(|_| c.triangle());
+            // SAFETY: `SIMD` is the level the traversal is compiled for.
+            let (mut m, e) = unsafe { block.edges::<SIMD>(self.shear, lanes) };
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let uvw = [e[0][l], e[1][l], e[2][l]];
+                let tri = block.triangle(l);
+                if self.shear.decide(&tri, uvw, self.tmin, self.tmax).is_some() {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+impl KdTree<Triangle> {
+    /// The highest level worth dispatching a single-ray query to: AVX-512
+    /// only speeds up the compact layout's gathers, so the whole layout
+    /// keeps the AVX2 build.
+    #[inline(always)]
+    fn single_ray_level(&self) -> u8 {
+        match self.leaf_data {
+            TriangleLeaves::Whole(_) => level::AVX2,
+            TriangleLeaves::Indexed(_) => level::AVX512,
+        }
+    }
+
+    /// The closest hit with `t` in `(ray.tmin, ray.tmax]`; among hits at the
+    /// same `t`, the one with the smallest triangle index.
+    pub fn closest_hit(&self, ray: &Ray) -> Option<Hit> {
+        self.closest_hit_counted(ray, &mut NoCounters)
+    }
+
+    /// [`KdTree::closest_hit`], counting the work done.
+    pub fn closest_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
+        let q = ClosestQuery {
+            tree: self,
+            ray,
+            counters,
+        };
+        dispatch(self.single_ray_level(), q)
+    }
+
+    /// True if any triangle is hit with `t` in `(ray.tmin, ray.tmax]`
+    /// (occlusion; stops at the first hit found).
+    pub fn any_hit(&self, ray: &Ray) -> bool {
+        self.any_hit_counted(ray, &mut NoCounters)
+    }
+
+    /// [`KdTree::any_hit`], counting the work done.
+    pub fn any_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
+        let q = AnyQuery {
+            tree: self,
+            ray,
+            counters,
+        };
+        dispatch(self.single_ray_level(), q)
+    }
+
+    /// The closest-hit walk over the leaf layout `layout`, at level `SIMD`.
+    #[inline(always)]
+    fn closest_hit_in<C: Counters, const SIMD: u8, L: Layout>(
+        &self,
+        layout: L,
+        ray: &Ray,
+        counters: &mut C,
+    ) -> Option<Hit> {
+        let shear = RayShear::from_ray(ray);
+        let mut leaf = ClosestLeaf::<L, SIMD> {
+            tree: self,
+            layout,
+            shear: &shear,
+            tmin: ray.tmin,
+            best_t: ray.tmax,
+            best: Hit {
+                t: f32::INFINITY,
+                tri: u32::MAX,
+                u: 0.0,
+                v: 0.0,
+            },
+        };
+        self.walk(ray, counters, &mut leaf);
+        let best = leaf.best;
+        (best.tri != u32::MAX).then_some(best)
+    }
+
+    /// The any-hit walk over the leaf layout `layout`, at level `SIMD`.
+    #[inline(always)]
+    fn any_hit_in<C: Counters, const SIMD: u8, L: Layout>(
+        &self,
+        layout: L,
+        ray: &Ray,
+        counters: &mut C,
+    ) -> bool {
+        let shear = RayShear::from_ray(ray);
+        let mut leaf = AnyLeaf::<L, SIMD> {
+            layout,
+            shear: &shear,
+            tmin: ray.tmin,
+            tmax: ray.tmax,
+            found: false,
+        };
+        self.walk(ray, counters, &mut leaf);
+        leaf.found
+    }
+
+    /// The closest-hit test of one leaf, whose `count` triangles are in
+    /// `blocks`: updates `best_t` and `best` (whose `tri` is `u32::MAX`
+    /// while there is no hit) with them; among equally distant hits the
+    /// smallest index wins. `SIMD` is the level the caller is compiled for.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    pub(crate) fn leaf_closest<C: Counters, const SIMD: u8, B: LeafBlock>(
+        &self,
+        blocks: impl Iterator<Item = B>,
+        shear: &RayShear,
+        tmin: f32,
+        count: usize,
+        best_t: &mut f32,
+        best: &mut Hit,
+        counters: &mut C,
+    ) {
+        for (b, block) in blocks.enumerate() {
+            let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
+            (0..lanes).for_each(|_| counters.triangle());
+            // Eight edge tests at once; the scalar test decides the few
+            // lanes left (see `triangle_block`).
+            // SAFETY: `SIMD` is the level the traversal is compiled for.
+            let (mut m, e) = unsafe { block.edges::<SIMD>(shear, lanes) };
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let uvw = [e[0][l], e[1][l], e[2][l]];
+                if let Some(h) = shear.decide(&block.triangle(l), uvw, tmin, *best_t) {
+                    // The index only now: its load missed the cache on
+                    // most kept lanes (perf, random rays), and most kept
+                    // lanes are not hits within the interval.
+                    let i = self.indices[block.run() + l];
+                    keep_closer(best_t, best, h, i);
+                }
+            }
+        }
+    }
+}
+
+/// [`KdTree::closest_hit_counted`] as a kernel for [`dispatch`].
+pub(crate) struct ClosestQuery<'a, C> {
+    pub(crate) tree: &'a KdTree<Triangle>,
+    pub(crate) ray: &'a Ray,
+    pub(crate) counters: &'a mut C,
+}
+
+impl<C: Counters> Kernel for ClosestQuery<'_, C> {
+    type Output = Option<Hit>;
+    #[inline(always)]
+    unsafe fn run<const LEVEL: u8>(self) -> Option<Hit> {
+        let (t, r, c) = (self.tree, self.ray, self.counters);
+        // The layout is picked once per query, so that the walk's loop
+        // holds one leaf test (see `Layout`).
+        match &t.leaf_data {
+            TriangleLeaves::Whole(v) => t.closest_hit_in::<C, LEVEL, _>(Whole(v), r, c),
+            TriangleLeaves::Indexed(p) => t.closest_hit_in::<C, LEVEL, _>(Indexed(p), r, c),
+        }
+    }
+}
+
+/// [`KdTree::any_hit_counted`] as a kernel for [`dispatch`].
+pub(crate) struct AnyQuery<'a, C> {
+    pub(crate) tree: &'a KdTree<Triangle>,
+    pub(crate) ray: &'a Ray,
+    pub(crate) counters: &'a mut C,
+}
+
+impl<C: Counters> Kernel for AnyQuery<'_, C> {
+    type Output = bool;
+    #[inline(always)]
+    unsafe fn run<const LEVEL: u8>(self) -> bool {
+        let (t, r, c) = (self.tree, self.ray, self.counters);
+        match &t.leaf_data {
+            TriangleLeaves::Whole(v) => t.any_hit_in::<C, LEVEL, _>(Whole(v), r, c),
+            TriangleLeaves::Indexed(p) => t.any_hit_in::<C, LEVEL, _>(Indexed(p), r, c),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::brute;
+    use crate::build::BuildParams;
+    use crate::test_support::{floats, soup};
+    use glam::Vec3;
+
+    /// Every level's build of the walk (the portable one is what a CPU
+    /// without AVX2 runs) agrees with brute force bit for bit, in both leaf
+    /// layouts.
+    #[test]
+    fn every_level_agrees_with_brute_force() {
+        let mut f = floats(99);
+        let tris = soup(&mut f, 3000, 0.4);
+        for compact_leaves in [false, true] {
+            let params = BuildParams {
+                compact_leaves,
+                ..BuildParams::default()
+            };
+            let tree = KdTree::build(tris.clone(), &params);
+            for _ in 0..3000 {
+                let ray = Ray::new(Vec3::new(f(), f(), f()) * 5.0, Vec3::new(f(), f(), f()));
+                let want = brute::closest_hit(&tris, &ray);
+                assert_eq!(tree.closest_hit(&ray), want);
+                assert_eq!(tree.any_hit(&ray), want.is_some());
+                for top in [level::PORTABLE, level::AVX2, level::AVX512] {
+                    let counters = &mut NoCounters;
+                    let q = ClosestQuery {
+                        tree: &tree,
+                        ray: &ray,
+                        counters,
+                    };
+                    assert_eq!(dispatch(top, q), want, "level {top}");
+                    let counters = &mut NoCounters;
+                    let q = AnyQuery {
+                        tree: &tree,
+                        ray: &ray,
+                        counters,
+                    };
+                    assert_eq!(dispatch(top, q), want.is_some(), "level {top}");
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,13 @@
+//! The geometry everything else stands on: rays, boxes, triangles, the
+//! clipping of a triangle to a box, and the float slack of the distance
+//! comparisons. Imports nothing else of the crate.
+
+pub(crate) mod aabb;
+pub(crate) mod clip;
+pub(crate) mod ray;
+pub(crate) mod slack;
+pub(crate) mod triangle;
+
+pub use aabb::Aabb;
+pub use ray::Ray;
+pub use triangle::Triangle;

@@ -1,0 +1,107 @@
+//! Instruction-set levels, run-time CPU detection, and the one dispatch
+//! from a query to the copy of its kernel compiled for the best level the
+//! CPU has. Imports nothing else of the crate.
+//!
+//! The release binary targets baseline x86-64 (SSE2). Each query is written
+//! once as a [`Kernel`], generic over a level `LEVEL`; [`dispatch`] runs it
+//! inside a function compiled with that level's target features, so the
+//! kernel (always inlined into it) is compiled once per level, and the
+//! level constant selects the intrinsic forms of the leaf tests.
+
+pub(crate) mod lanes;
+
+/// The instruction-set levels a kernel is compiled for: each level has
+/// the instructions of the ones below it.
+pub(crate) mod level {
+    /// Baseline: the lane loops, vectorised by the compiler.
+    pub const PORTABLE: u8 = 0;
+    /// AVX2 intrinsics in the leaf tests and packet walks.
+    pub const AVX2: u8 = 1;
+    /// AVX2 and AVX-512 (F + VL): the sixteen-ray walk, and the gathers
+    /// from a compact block's vertex table (`vpermt2ps`).
+    pub const AVX512: u8 = 2;
+}
+
+/// True when the CPU has AVX2 (std caches the CPUID query).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) fn has_avx2() -> bool {
+    std::arch::is_x86_feature_detected!("avx2")
+}
+
+/// True when the CPU has AVX2 and AVX-512 F and VL.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) fn has_avx512() -> bool {
+    has_avx2()
+        && std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+}
+
+/// The best level, up to `top`, that this CPU has.
+#[inline(always)]
+pub(crate) fn best_level(top: u8) -> u8 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if top >= level::AVX512 && has_avx512() {
+            return level::AVX512;
+        }
+        if top >= level::AVX2 && has_avx2() {
+            return level::AVX2;
+        }
+    }
+    let _ = top;
+    level::PORTABLE
+}
+
+/// A query written once for every level.
+pub(crate) trait Kernel {
+    /// What the query returns.
+    type Output;
+
+    /// Run the query with level `LEVEL`'s instructions. Implementations
+    /// are `#[inline(always)]`, so that they are compiled into the
+    /// target-feature function [`dispatch`] calls them from.
+    ///
+    /// # Safety
+    /// The CPU must have the level's instructions, and the caller must be
+    /// compiled for them.
+    unsafe fn run<const LEVEL: u8>(self) -> Self::Output;
+}
+
+/// Run `kernel` at the best level up to `top` that this CPU has.
+#[inline(always)]
+pub(crate) fn dispatch<K: Kernel>(top: u8, kernel: K) -> K::Output {
+    match best_level(top) {
+        // SAFETY (both): the CPU has the level's instructions (detected).
+        #[cfg(target_arch = "x86_64")]
+        level::AVX512 => unsafe { run_avx512(kernel) },
+        #[cfg(target_arch = "x86_64")]
+        level::AVX2 => unsafe { run_avx2(kernel) },
+        // SAFETY: the portable level needs nothing.
+        _ => unsafe { kernel.run::<{ level::PORTABLE }>() },
+    }
+}
+
+/// `kernel` compiled for AVX2.
+///
+/// # Safety
+/// The CPU must have AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn run_avx2<K: Kernel>(kernel: K) -> K::Output {
+    // SAFETY: AVX2 (the caller's contract), and this function is compiled
+    // for it.
+    unsafe { kernel.run::<{ level::AVX2 }>() }
+}
+
+/// `kernel` compiled for AVX2 and AVX-512 F, VL.
+///
+/// # Safety
+/// The CPU must have AVX2 and AVX-512 F, VL.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512vl")]
+unsafe fn run_avx512<K: Kernel>(kernel: K) -> K::Output {
+    // SAFETY: as `run_avx2`, for this level.
+    unsafe { kernel.run::<{ level::AVX512 }>() }
+}
