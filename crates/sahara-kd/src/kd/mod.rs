@@ -5,6 +5,7 @@ mod batch;
 mod box_query;
 mod counters;
 mod flatten;
+mod interval;
 mod leaves;
 mod node;
 pub(crate) mod packet;

@@ -7,9 +7,9 @@
 
 use glam::Vec3;
 
+use super::interval::{cut, may_hold_closer, widened_t0, widened_t1};
 use super::{Counters, KdTree, LeafStorage};
 use crate::build::MAX_DEPTH;
-use crate::math::slack::MARGIN;
 use crate::math::Ray;
 
 #[derive(Clone, Copy)]
@@ -102,24 +102,24 @@ impl<P: LeafStorage> KdTree<P> {
                 counters.inner();
                 let axis = n.axis();
                 let (near, far) = n.near_far(node, &neg);
-                // NaN when the ray lies in the plane (o = split, d = 0): then
-                // no comparison holds and both children get the whole
-                // interval, as they must.
+                // NaN when the ray lies in the plane: both children get the
+                // whole interval (see `interval`).
                 let t_plane = (n.split() - origin[axis]) * inv[axis];
-                if t_plane > t1 + t1.abs() * MARGIN {
+                if t_plane > widened_t1(t1) {
                     node = near; // the plane lies beyond the interval
-                } else if t_plane < t0 - t0.abs() * MARGIN {
+                } else if t_plane < widened_t0(t0) {
                     node = far; // the plane lies before the interval
                 } else {
                     debug_assert!(sp < MAX_DEPTH, "tree deeper than the traversal stack");
+                    let (near_t1, far_t0) = cut(t_plane, t0, t1);
                     stack[sp] = std::mem::MaybeUninit::new(StackEntry {
                         node: far,
-                        t0: t_plane.max(t0).min(t1),
+                        t0: far_t0,
                         t1,
                     });
                     sp += 1;
                     node = near;
-                    t1 = t_plane.min(t1).max(t0);
+                    t1 = near_t1;
                 }
                 continue;
             }
@@ -143,7 +143,7 @@ impl<P: LeafStorage> KdTree<P> {
                 sp -= 1;
                 // SAFETY: entries below `sp` were written by the push above.
                 let e = unsafe { stack[sp].assume_init() };
-                if e.t0 <= closest * (1.0 + MARGIN) {
+                if may_hold_closer(e.t0, closest) {
                     node = e.node;
                     t0 = e.t0;
                     t1 = e.t1;
