@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Builds the fuzz seed corpora in fuzz/corpus/<target>/ at run time.
 
-Seeds are small files made from the shared meshes (../shared/scenes beside
-the repository, or $SAHARA_SCENES): the Cornell box whole, the first lines of
+Seeds are small files made from the benchmark meshes ($SAHARA_SCENES, else
+../shared/scenes beside the repository; the Cornell box and the bunny PLY
+fall back to the copies in scenes/assets): the Cornell box whole, the first lines of
 the big OBJ files, PLY files cut down to their first vertices and the faces
 among them (in every encoding), a tiny glTF and GLB, tiny PNG/HDR images and a
 small JPEG texture; plus the hand-made seeds in fuzz/seeds/<target>/. Nothing
@@ -21,6 +22,7 @@ from pathlib import Path
 FUZZ = Path(__file__).resolve().parent
 REPO = FUZZ.parent
 SCENES = Path(os.environ.get("SAHARA_SCENES") or REPO.parent / "shared" / "scenes")
+ASSETS = REPO / "scenes" / "assets"
 CORPUS = FUZZ / "corpus"
 
 
@@ -32,8 +34,10 @@ def put(target, name, data):
 
 def read(rel, limit=None):
     path = SCENES / rel
+    if not path.is_file() and (ASSETS / Path(rel).name).is_file():
+        path = ASSETS / Path(rel).name
     if not path.is_file():
-        print(f"make_seeds: {path} missing, skipped", file=sys.stderr)
+        print(f"make_seeds: {SCENES / rel} missing, skipped", file=sys.stderr)
         return None
     with open(path, "rb") as f:
         return f.read(limit) if limit else f.read()

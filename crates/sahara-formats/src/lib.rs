@@ -1,7 +1,7 @@
 //! `sahara-formats`: files in, plain arrays out; images out, atomically.
 //!
 //! - meshes: [`obj`] (with [`mtl`] materials), [`ply`], [`gltf`] (meshes plus instances);
-//! - scenes: [`scene_file`] (TOML, documented in `SCENE_FORMAT.md`), [`camera`] sidecars;
+//! - scenes: [`scene_file`] (TOML, documented in `docs/scene-format.md`), [`camera`] sidecars;
 //! - to the renderer: [`scene_load`] (a scene file as a `sahara_render::Scene`),
 //!   [`mesh_scene`] (a bare mesh file as one), sharing [`mesh_library`] (each
 //!   mesh file loaded once) and [`material_map`] (MTL / glTF materials);

@@ -1,7 +1,7 @@
 //! Scene files: TOML describing camera, materials, objects, lights and render settings.
 //!
-//! The format is documented in `SCENE_FORMAT.md` beside this crate's
-//! `Cargo.toml`; in short:
+//! The format is documented in `docs/scene-format.md` at the repository
+//! root; in short:
 //!
 //! ```toml
 //! [camera]                       # required

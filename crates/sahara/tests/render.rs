@@ -39,11 +39,8 @@ fn checked_mean(path: &Path, width: u32, height: u32) -> f32 {
 fn every_example_scene_renders() {
     let scenes = example_scenes();
     assert!(scenes.len() >= 3, "{scenes:?}");
-    let shared = sahara_formats::scenes_dir();
-    if !shared.join("bunny/bunny.obj").exists() {
-        println!("note: {} not found; skipping", shared.display());
-        return;
-    }
+    // The scenes' meshes ship in scenes/assets: nothing outside the
+    // repository is needed, so there is nothing to skip.
     let dir = temp_dir("examples");
     for scene in scenes {
         let stem = scene.file_stem().unwrap().to_string_lossy().into_owned();

@@ -1,4 +1,4 @@
-//! A benchmark session: one built tree, its pools, and set measurements.
+//! A benchmark: one built tree, its pools, and set measurements.
 
 use rayon::ThreadPoolBuildError;
 use sahara_kd::{BuildParams, KdTree, Ray, TreeStats};

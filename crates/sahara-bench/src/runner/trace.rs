@@ -36,8 +36,8 @@ pub fn trace_into(tree: &KdTree, rays: &[Ray], query: Query, out: &mut [HitRecor
     assert_eq!(rays.len(), out.len(), "one record per ray");
     // Every chunk its own job (`with_max_len(1)`): rayon otherwise splits
     // the range only a few times unless a thief steals, and a costly
-    // quarter of the image held one thread while the other idled
-    // (teapot_stadium's camera rays: 1.30x on two threads, now 1.9x+).
+    // quarter of the image held one thread while the other idled (see
+    // docs/performance.md, "Measured and kept").
     rays.par_chunks(CHUNK)
         .zip(out.par_chunks_mut(CHUNK))
         .with_max_len(1)

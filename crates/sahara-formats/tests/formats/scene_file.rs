@@ -571,10 +571,8 @@ fn example_scenes() -> PathBuf {
 
 #[test]
 fn every_example_scene_loads() {
-    if !sahara_formats::scenes_dir().exists() {
-        println!("note: shared scenes not found; skipping");
-        return;
-    }
+    // Their meshes ship in scenes/assets, so this needs nothing outside the
+    // repository.
     let mut found = 0;
     for entry in std::fs::read_dir(example_scenes()).unwrap() {
         let path = entry.unwrap().path();
