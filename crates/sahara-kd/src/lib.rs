@@ -52,6 +52,11 @@ pub use math::{Aabb, Ray, Triangle};
 pub use stats::TreeStats;
 pub use validate::validate;
 
+/// The README's library example, compiled and run as a doctest.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeExample;
+
 /// Internals for the repository's benchmarks and fuzz targets: the leaf
 /// tests and packet forms on their own. Not part of the API; may change
 /// without notice.
