@@ -136,12 +136,9 @@ pub struct BuildParams {
     /// a leaf of `n` at `K_I (ceil(n / leaf_width) + lane_cost n)`. It stands
     /// for the work a block test does per triangle that the block does not
     /// amortise (reading 36 bytes, and the exact scalar test of each
-    /// triangle the ray's line passes through). Default 0, measured
-    /// (`--lane-cost`, 1-thread Mrays/s primary/shadow/diffuse/random): 0.25
-    /// helped the Cornell box's primary rays (12.3 -> 16.3) but cost its
-    /// shadow rays (20.6 -> 14.6), and multiplied the memory of bunny and
-    /// sponza by 1.8 (0.25) to 9 (1) (small leaves padded to blocks of
-    /// eight) while slowing them by up to 40%.
+    /// triangle the ray's line passes through). Default 0: larger values
+    /// made smaller leaves, padded to blocks of eight, that cost memory and
+    /// speed on the shared meshes (figures in `docs/performance.md`).
     pub lane_cost: f32,
     /// The binned builder hands a cell of at most this many references to
     /// the exact sweep (0: bins all the way down). Binning the few large
@@ -150,8 +147,9 @@ pub struct BuildParams {
     /// most of the binned build's speed at the exact build's quality.
     pub exact_below: u32,
     /// Store each leaf block's distinct vertices once instead of every
-    /// lane's vertices (about half the memory of a triangle tree, 0.9-1.0x
-    /// the speed; see `geometry::leaf_layout`). Default false.
+    /// lane's vertices: about two thirds of a triangle tree's memory,
+    /// tracing up to a tenth slower (figures in `docs/performance.md`).
+    /// Default false.
     pub compact_leaves: bool,
 }
 
@@ -164,14 +162,10 @@ impl Default for BuildParams {
 /// Depth bound of every built tree (and of the walks' stacks).
 pub const MAX_DEPTH: usize = 64;
 
-/// The binned builder's default [`BuildParams::exact_below`]: 2^16.
-///
-/// Measured on the dragon (`sahara stats dragon.ply --builder binned
-/// --exact-below N --runs 3`, 2 threads; exact build 0.94 s, SAH cost
-/// 1170.7): N = 0 builds in 0.80 s but its tree has SAH cost 1337.7, 95 MB,
-/// and traces 0.82-0.85x as fast as the exact tree; N = 1024: 0.84 s, 1199.9;
-/// N = 8192: 0.88 s, 1185.0, random rays 0.94x; N = 65536: 0.88 s, 1174.0,
-/// 58.9 MB, tracing level with the exact tree.
+/// The binned builder's default [`BuildParams::exact_below`]: 2^16, the
+/// smallest threshold that kept the dragon's tree at the exact build's
+/// SAH cost and tracing speed while building faster (the measurements are
+/// in `docs/performance.md`).
 pub const EXACT_BELOW: u32 = 1 << 16;
 
 impl BuildParams {
@@ -180,11 +174,8 @@ impl BuildParams {
     /// K_T = 15 and an empty bonus of 0.2 are Wald & Havran's (2006,
     /// section 5) values. Their K_I = 20 prices one scalar triangle test;
     /// here K_I prices one eight-wide block test (`leaf_width`) and is 40,
-    /// measured: with K_I = 20, 30, 40 (`sahara bench --intersection-cost`,
-    /// 1-thread Mrays/s, primary/shadow/diffuse/random) teapot_stadium gave
-    /// 4.8/9.7/4.7/14.9, 5.2/10.2/4.8/15.1, 6.3/14.8/5.7/15.2; sponza
-    /// 4.6/7.6/2.1/2.6, 5.2/8.3/2.1/2.8, 5.3/8.8/2.2/2.8; bunny equal within
-    /// 3%; only the dragon preferred 20 (by 9%).
+    /// the fastest of 20, 30 and 40 on the shared meshes but the dragon
+    /// (figures in `docs/performance.md`).
     pub fn new(builder: Builder) -> Self {
         let max_leaf_size = match builder {
             Builder::Naive { .. } => 4,

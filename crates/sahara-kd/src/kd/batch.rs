@@ -12,34 +12,30 @@ pub(crate) const BATCH: usize = 256;
 impl KdTree<Triangle> {
     /// Closest hits of many rays, in parallel; `out[i]` answers `rays[i]`.
     pub fn closest_hits(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        assert_eq!(rays.len(), out.len(), "one output slot per ray");
-        // Work items of 256 rays, and every one its own job
-        // (`with_max_len(1)`): rayon otherwise splits a range only a few
-        // times unless a thief steals, so a costly quarter of an image can
-        // hold one thread while the other idles (teapot_stadium's camera
-        // rays scaled 1.30x on two threads that way).
-        rays.par_chunks(BATCH)
-            .zip(out.par_chunks_mut(BATCH))
-            .with_max_len(1)
-            .for_each(|(rs, os)| {
-                for (r, o) in rs.iter().zip(os) {
-                    *o = self.closest_hit(r);
-                }
-            });
+        in_parallel(rays, out, |r| self.closest_hit(r));
     }
 
     /// Occlusion of many rays, in parallel; `out[i]` answers `rays[i]`.
     pub fn any_hits(&self, rays: &[Ray], out: &mut [bool]) {
-        assert_eq!(rays.len(), out.len(), "one output slot per ray");
-        rays.par_chunks(BATCH)
-            .zip(out.par_chunks_mut(BATCH))
-            .with_max_len(1)
-            .for_each(|(rs, os)| {
-                for (r, o) in rs.iter().zip(os) {
-                    *o = self.any_hit(r);
-                }
-            });
+        in_parallel(rays, out, |r| self.any_hit(r));
     }
+}
+
+/// `out[i] = query(&rays[i])` for every ray, in work items of [`BATCH`]
+/// rays, every one its own job (`with_max_len(1)`): rayon otherwise splits
+/// a range only a few times unless a thief steals, so a costly quarter of
+/// an image could hold one thread while the other idles (see
+/// `docs/performance.md`).
+fn in_parallel<T: Send>(rays: &[Ray], out: &mut [T], query: impl Fn(&Ray) -> T + Sync) {
+    assert_eq!(rays.len(), out.len(), "one output slot per ray");
+    rays.par_chunks(BATCH)
+        .zip(out.par_chunks_mut(BATCH))
+        .with_max_len(1)
+        .for_each(|(rs, os)| {
+            for (r, o) in rs.iter().zip(os) {
+                *o = query(r);
+            }
+        });
 }
 
 #[cfg(test)]

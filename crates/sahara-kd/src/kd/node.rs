@@ -106,8 +106,7 @@ impl Node {
 /// Used where a select would put a load on the traversal's critical path
 /// (`Node::near_far`): as a `cmov`, the next node's address waits for the
 /// node's axis and the ray's sign; as a branch, the predictor guesses it and
-/// the next node's load starts at once. Primary rays traced 1.2-1.4x
-/// faster and shadow rays 1.2-1.5x (bunny, sponza, teapot_stadium).
+/// the next node's load starts at once (figures in `docs/performance.md`).
 #[inline(always)]
 fn keep_branch() {
     // SAFETY: an empty instruction sequence, touching no memory or flags.

@@ -58,7 +58,7 @@ impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for AnyLeaf<'_, L, SIM
     fn visit(&mut self, offset: usize, count: usize, c: &mut C, _: &mut f32) -> LeafResult {
         // SAFETY: as in `ClosestLeaf::visit`.
         let blocks = unsafe { self.layout.blocks(offset, count) };
-        if self.any_in(blocks, count, c) {
+        if self.any_hit_among(blocks, count, c) {
             self.found = true;
             LeafResult::Stop
         } else {
@@ -70,7 +70,7 @@ impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for AnyLeaf<'_, L, SIM
 impl<L: Layout, const SIMD: u8> AnyLeaf<'_, L, SIMD> {
     /// True if a triangle of `blocks` (a leaf of `count`) is hit.
     #[inline(always)]
-    fn any_in<C: Counters, B: LeafBlock>(
+    fn any_hit_among<C: Counters, B: LeafBlock>(
         &self,
         blocks: impl Iterator<Item = B>,
         count: usize,
@@ -141,7 +141,7 @@ impl KdTree<Triangle> {
 
     /// The closest-hit walk over the leaf layout `layout`, at level `SIMD`.
     #[inline(always)]
-    fn closest_hit_in<C: Counters, const SIMD: u8, L: Layout>(
+    fn closest_hit_over<C: Counters, const SIMD: u8, L: Layout>(
         &self,
         layout: L,
         ray: &Ray,
@@ -168,7 +168,7 @@ impl KdTree<Triangle> {
 
     /// The any-hit walk over the leaf layout `layout`, at level `SIMD`.
     #[inline(always)]
-    fn any_hit_in<C: Counters, const SIMD: u8, L: Layout>(
+    fn any_hit_over<C: Counters, const SIMD: u8, L: Layout>(
         &self,
         layout: L,
         ray: &Ray,
@@ -240,8 +240,8 @@ impl<C: Counters> Kernel for ClosestQuery<'_, C> {
         // The layout is picked once per query, so that the walk's loop
         // holds one leaf test (see `Layout`).
         match &t.leaf_data {
-            TriangleLeaves::Whole(v) => t.closest_hit_in::<C, LEVEL, _>(Whole(v), r, c),
-            TriangleLeaves::Indexed(p) => t.closest_hit_in::<C, LEVEL, _>(Indexed(p), r, c),
+            TriangleLeaves::Whole(v) => t.closest_hit_over::<C, LEVEL, _>(Whole(v), r, c),
+            TriangleLeaves::Indexed(p) => t.closest_hit_over::<C, LEVEL, _>(Indexed(p), r, c),
         }
     }
 }
@@ -259,8 +259,8 @@ impl<C: Counters> Kernel for AnyQuery<'_, C> {
     unsafe fn run<const LEVEL: u8>(self) -> bool {
         let (t, r, c) = (self.tree, self.ray, self.counters);
         match &t.leaf_data {
-            TriangleLeaves::Whole(v) => t.any_hit_in::<C, LEVEL, _>(Whole(v), r, c),
-            TriangleLeaves::Indexed(p) => t.any_hit_in::<C, LEVEL, _>(Indexed(p), r, c),
+            TriangleLeaves::Whole(v) => t.any_hit_over::<C, LEVEL, _>(Whole(v), r, c),
+            TriangleLeaves::Indexed(p) => t.any_hit_over::<C, LEVEL, _>(Indexed(p), r, c),
         }
     }
 }

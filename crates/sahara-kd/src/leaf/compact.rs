@@ -6,9 +6,7 @@
 //! connected piece of mesh: 9-12 distinct vertices for 8 triangles on the
 //! bunny, sponza, the dragon and the teapot in its stadium), so storing the
 //! 24 vertex slots of [`TriangleBlock`] whole spent about twice the memory
-//! the block needs. The tree with its blocks was 7.3 MB for the bunny and
-//! 8.2 MB for sponza, against Embree's 4.6 + 1.3 and 5.3 + 1.3 MB (issue 5's
-//! memory bar). The AVX2 block test shears each distinct vertex once and
+//! the block needs (figures in `docs/accelerator.md`). The AVX2 block test shears each distinct vertex once and
 //! gathers the lanes from the vertex table with in-register permutes
 //! (`vpermps` and a blend, or one `vpermt2ps` with AVX-512 VL).
 //!
@@ -298,9 +296,8 @@ impl<'a> IndexedBlock<'a> {
     }
 }
 
-/// Eight f32 lanes in a 256-bit register (AVX2 paths).
 #[cfg(target_arch = "x86_64")]
-type Lanes8 = std::arch::x86_64::__m256;
+use crate::simd::lanes::Lanes8;
 
 #[cfg(target_arch = "x86_64")]
 impl IndexedBlock<'_> {
@@ -328,7 +325,7 @@ impl IndexedBlock<'_> {
     ///
     /// # Safety
     /// The CPU must have AVX2, and the caller must be compiled for it
-    /// (always inlined: see `RayShear::indexed_edges_avx2_inlined`).
+    /// (always inlined: see `RayShear::indexed_edges_intrinsics`).
     #[inline(always)]
     pub(crate) unsafe fn numbers_avx2(&self, k: usize) -> std::arch::x86_64::__m256i {
         use std::arch::x86_64::*;

@@ -113,8 +113,7 @@ impl Frustum {
         // The permutation holds the sign of d[kz] (`RayShear::new` swaps
         // kx and ky for a negative one), so `kx` alone tells. (Comparing
         // whole arrays stored the permutation with two scalar writes and
-        // read it back as one vector, a failed store forwarding: a tenth
-        // of the set-up's samples in `perf annotate`; packets 1.0-1.02x.)
+        // read it back as one vector: a failed store forwarding.)
         let positive = k[0] == (k[2] + 1) % 3;
         same.then_some(Self {
             k,

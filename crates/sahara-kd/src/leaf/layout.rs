@@ -5,15 +5,11 @@
 //!   written out, 288 bytes per block of eight; the block test loads its
 //!   lanes directly.
 //! - [`TriangleLeaves::Indexed`] (`BuildParams::compact_leaves`): each
-//!   block's distinct vertices once (see `indexed_block`), about half the
-//!   memory (bunny 7.3 -> 4.9 MB, sponza 8.2 -> 5.4, dragon 58.4 -> 37.6).
-//!   Measured against the whole layout (`sahara bench`, 1 thread, best of
-//!   4 interleaved rounds, AVX-512 gathers) on the bunny, the dragon,
-//!   sponza and the teapot in its stadium: camera rays 0.87-0.94x, their
-//!   packets 0.93-0.97x, shadow and diffuse rays 0.88-1.0x, random rays
-//!   0.89-1.05x (the smaller leaf data does not make up for the gathers).
-//!   So it is an option, for scenes where memory counts more than the last
-//!   tenth of speed (Embree's compact scenes make the same trade).
+//!   block's distinct vertices once (see `compact`): about two thirds of
+//!   the memory, tracing up to a tenth slower (the gathers cost more than
+//!   the smaller leaf data saves; figures in `docs/performance.md`). It is
+//!   an option, for scenes where memory counts more than the last tenth of
+//!   speed (Embree's compact scenes make the same trade).
 //!
 //! The leaf tests are written once over `LeafBlock` and compiled for each
 //! layout; each traversal is compiled per layout too (see `Layout`).
@@ -33,7 +29,7 @@ pub enum TriangleLeaves {
     /// Every lane's vertices written out (the default, fastest to test);
     /// leaf offsets are index-array offsets, block `offset / 8` first.
     Whole(Vec<TriangleBlock>),
-    /// Each block's distinct vertices once (about half the memory); leaf
+    /// Each block's distinct vertices once (about two thirds of the memory); leaf
     /// offsets are word offsets of a leaf's first block.
     Indexed(IndexedBlocks),
 }
@@ -97,7 +93,7 @@ pub(crate) trait LeafBlock: Copy {
         #[cfg(target_arch = "x86_64")]
         if SIMD >= level::AVX2 {
             // SAFETY: the caller's contract.
-            return unsafe { ps.triangle_edges_avx2_inlined(|k, axis| self.coord(k, axis, lane)) };
+            return unsafe { ps.triangle_edges_intrinsics(|k, axis| self.coord(k, axis, lane)) };
         }
         ps.triangle_edges(&self.triangle(lane))
     }
@@ -184,7 +180,7 @@ impl LeafBlock for IndexedBlock<'_> {
         lanes: usize,
     ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
         // SAFETY: the caller's contract.
-        unsafe { shear.indexed_edges_on::<SIMD>(*self, lanes) }
+        unsafe { shear.indexed_block_edges::<SIMD>(*self, lanes) }
     }
 
     #[inline(always)]
@@ -200,8 +196,8 @@ impl LeafBlock for IndexedBlock<'_> {
 
 /// A tree's leaf blocks in one layout, as the traversals read them: each
 /// traversal is compiled once per layout and picks it once per query, so
-/// that its loop holds one leaf test (with both inlined into one loop,
-/// the packets traced 0.94-0.98x as fast).
+/// that its loop holds one leaf test (both inlined into one loop made the
+/// packets slower).
 pub(crate) trait Layout: Copy {
     /// One block.
     type Block<'a>: LeafBlock

@@ -30,7 +30,7 @@ const _: () = assert!(
 /// Rays per packet test.
 pub const RAYS: usize = 8;
 
-type Lanes = [f32; RAYS];
+use crate::simd::lanes::Lanes;
 
 /// The shear constants of up to eight rays that share one permutation.
 #[derive(Clone, Copy, Debug)]
@@ -121,7 +121,7 @@ impl PacketShear {
     #[inline]
     pub fn triangle_edges_avx2(&self, tri: &Triangle) -> (u32, [Lanes; 3]) {
         // SAFETY: AVX2 (this function's target feature).
-        unsafe { self.triangle_edges_avx2_inlined(|k, axis| tri.v[k][axis]) }
+        unsafe { self.triangle_edges_intrinsics(|k, axis| tri.v[k][axis]) }
     }
 
     /// The body of [`PacketShear::triangle_edges_avx2`], always inlined
@@ -134,7 +134,7 @@ impl PacketShear {
     /// `vertex(k, axis)` is coordinate `axis` of the triangle's vertex `k`
     /// (read straight from a leaf block: building a `Triangle` first cost
     /// the packets a few percent).
-    pub(crate) unsafe fn triangle_edges_avx2_inlined(
+    pub(crate) unsafe fn triangle_edges_intrinsics(
         &self,
         vertex: impl Fn(usize, usize) -> f32,
     ) -> (u32, [Lanes; 3]) {

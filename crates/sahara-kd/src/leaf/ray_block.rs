@@ -110,7 +110,7 @@ impl RayShear {
     /// The CPU must have the level's instructions, and the caller must be
     /// compiled for them.
     #[inline(always)]
-    pub(crate) unsafe fn indexed_edges_on<const SIMD: u8>(
+    pub(crate) unsafe fn indexed_block_edges<const SIMD: u8>(
         &self,
         block: IndexedBlock,
         lanes: usize,
@@ -119,7 +119,7 @@ impl RayShear {
         if SIMD >= level::AVX2 {
             // SAFETY: the caller's contract (and it is compiled for AVX2:
             // `AVX2` is only set inside the AVX2 traversals).
-            return unsafe { self.indexed_edges_avx2_inlined::<SIMD>(block, lanes) };
+            return unsafe { self.indexed_edges_intrinsics::<SIMD>(block, lanes) };
         }
         self.indexed_edges(block, lanes)
     }
@@ -177,7 +177,7 @@ impl RayShear {
         lanes: usize,
     ) -> (u32, [[f32; BLOCK_WIDTH]; 3]) {
         // SAFETY: AVX2 (this function's target feature).
-        unsafe { self.indexed_edges_avx2_inlined::<{ level::AVX2 }>(block, lanes) }
+        unsafe { self.indexed_edges_intrinsics::<{ level::AVX2 }>(block, lanes) }
     }
 
     /// The body of [`RayShear::indexed_edges_avx2`], always inlined (a
@@ -192,7 +192,7 @@ impl RayShear {
     /// The CPU must have AVX2 (and AVX-512 F, VL at that level), and the
     /// caller must be compiled for it.
     #[inline(always)]
-    pub(crate) unsafe fn indexed_edges_avx2_inlined<const SIMD: u8>(
+    pub(crate) unsafe fn indexed_edges_intrinsics<const SIMD: u8>(
         &self,
         block: IndexedBlock,
         lanes: usize,

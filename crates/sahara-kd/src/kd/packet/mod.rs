@@ -213,7 +213,7 @@ impl KdTree<Triangle> {
     /// The CPU must have the level's instructions, and the caller must be
     /// compiled for them.
     #[inline(always)]
-    unsafe fn packet8_in<const SIMD: u8>(
+    unsafe fn trace_packet8<const SIMD: u8>(
         &self,
         p: &mut Packet,
         rays: &[Ray],
@@ -253,7 +253,7 @@ impl KdTree<Triangle> {
     }
 
     /// The sixteen-ray packet of `rays` in the halves `h` (set up as for
-    /// [`KdTree::packet8_in`]), walked with AVX-512; false (and `out`
+    /// [`KdTree::trace_packet8`]), walked with AVX-512; false (and `out`
     /// untouched) when the rays cannot share the walk: an empty tree, or
     /// halves whose direction signs differ.
     ///
@@ -263,7 +263,7 @@ impl KdTree<Triangle> {
     /// [`PACKET16`] rays.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
-    unsafe fn packet16_in(
+    unsafe fn trace_packet16(
         &self,
         h: &mut [Packet; 2],
         rays: &[Ray],
@@ -319,7 +319,7 @@ impl Kernel for Packet8Query<'_> {
     unsafe fn run<const LEVEL: u8>(self) {
         let Self { tree, rays, out, p } = self;
         // SAFETY: the level's instructions (the caller's contract).
-        unsafe { tree.packet8_in::<LEVEL>(p, rays, out) };
+        unsafe { tree.trace_packet8::<LEVEL>(p, rays, out) };
     }
 }
 
@@ -343,7 +343,7 @@ impl Kernel for Packet16Query<'_> {
         if LEVEL >= level::AVX512 {
             // SAFETY: AVX2 and AVX-512 F (the caller's contract); 9 to 16
             // rays (the caller's check).
-            return unsafe { tree.packet16_in(h, rays, out) };
+            return unsafe { tree.trace_packet16(h, rays, out) };
         }
         false
     }

@@ -3,11 +3,10 @@
 //! test's permutation and shear constants, and the frustum.
 //!
 //! Why: set up ray by ray (six divisions, the root clip's branches and a
-//! `RayShear` written per ray, then copied into the packet forms), this
-//! took about 40% of the packet path on the bunny's camera rays: packets
-//! set up but not walked ran at 31 Mrays/s, whole packets at 15 (1 thread,
-//! best of 3). Written as plain loops over the lanes, compiled with AVX2 in
-//! the AVX2 path, it is a few vector divisions and compares.
+//! `RayShear` written per ray, then copied into the packet forms), the
+//! set-up was a large part of the packet path on camera rays (see
+//! `docs/performance.md`). Written over the lanes (plain loops, or AVX2
+//! intrinsics), it is a few vector divisions and compares.
 //!
 //! Each lane computes exactly what `Ray::is_valid`, `Aabb::intersect_ray`
 //! and `RayShear::new` compute for its ray, with the same operations in the
