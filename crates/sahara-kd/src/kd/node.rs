@@ -86,7 +86,7 @@ impl Node {
     }
 
     /// Offset into the index array, or for a non-empty leaf of a triangle
-    /// tree into its leaf data (leaves; see [`KdTree::leaf_primitives`]).
+    /// tree into its leaf data (leaves; see [`crate::KdTree::leaf_primitives`]).
     #[inline(always)]
     pub fn leaf_offset(&self) -> u32 {
         self.word0
