@@ -1,5 +1,5 @@
 //! `sahara-bench`: the ray-casting benchmark protocol of
-//! `shared/bench/PROTOCOL.md` on Sahara's kd-tree.
+//! `docs/bench-protocol.md` on Sahara's kd-tree.
 //!
 //! The crate reads no scene files: it takes a [`sahara_render::mesh::Mesh`]
 //! and, optionally, a camera, and

@@ -128,12 +128,9 @@ pub fn build_scene(file: &SceneFile, name: &str) -> Result<LoadedScene, FormatEr
     for l in &file.lights {
         add_light(&mut scene, l, name)?;
     }
-    let mut warnings = std::mem::take(&mut library.warnings);
-    if !scene.has_light() {
-        warnings.push(format!(
-            "{name}: the scene has no light (no [[light]], emissive material or environment); the image will be black"
-        ));
-    }
+    // A scene without light is reported by `Scene::diagnostics`, with the
+    // other problems of the finished scene.
+    let warnings = std::mem::take(&mut library.warnings);
     Ok(LoadedScene {
         scene,
         settings,

@@ -25,7 +25,7 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Run the ray-casting benchmark protocol (shared/bench/PROTOCOL.md) on a mesh.
+    /// Run the ray-casting benchmark protocol (docs/bench-protocol.md) on a mesh.
     #[command(long_about = BENCH_ABOUT)]
     Bench(BenchArgs),
     /// Build a kd-tree over a mesh and print its statistics and build time.
@@ -99,7 +99,7 @@ pub struct RenderArgs {
 }
 
 const BENCH_ABOUT: &str = "\
-Run the ray-casting benchmark protocol (shared/bench/PROTOCOL.md) on a mesh.
+Run the ray-casting benchmark protocol (docs/bench-protocol.md) on a mesh.
 
 Builds the tree (best of 3 builds), generates the protocol's ray sets on a
 1024x1024 image (primary; shadow and diffuse from Sahara's own primary hits;
@@ -138,7 +138,8 @@ mrays_packet_1t[_cpu] and mrays_packet16_1t[_cpu].";
 /// Options of `sahara bench`.
 #[derive(Debug, Args)]
 pub struct BenchArgs {
-    /// The mesh (.obj or .ply); none for a built-in procedural scene.
+    /// The mesh (.obj, .ply, .gltf or .glb; a glTF scene's meshes are merged
+    /// in scene order); none for a built-in procedural scene.
     pub mesh: Option<PathBuf>,
     /// How to run.
     #[command(flatten)]
@@ -225,7 +226,8 @@ impl Default for BenchOptions {
 /// Options of `sahara stats`.
 #[derive(Debug, Args)]
 pub struct StatsArgs {
-    /// The mesh (.obj or .ply).
+    /// The mesh (.obj, .ply, .gltf or .glb; a glTF scene's meshes are merged
+    /// in scene order).
     pub mesh: PathBuf,
     /// The tree to build.
     #[command(flatten)]

@@ -16,9 +16,6 @@ use crate::cli::RenderArgs;
 use crate::memory;
 use crate::render_options::{resolve, RenderOptions};
 
-/// Most warnings printed one by one; the rest are counted.
-const MAX_WARNINGS_SHOWN: usize = 20;
-
 /// A scene to render, with what its file says about rendering it.
 struct Input {
     scene: Scene,
@@ -38,8 +35,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         warnings,
     } = load_input(args.scene.as_deref())?;
     let mut warnings = warnings;
-    warnings.extend(scene.diagnostics());
-    print_warnings(&warnings);
+    // The finished scene's problems, named after the file they come from.
+    let from_file = args.scene.as_ref().map(|p| p.display().to_string());
+    warnings.extend(scene.diagnostics().into_iter().map(|d| match &from_file {
+        Some(f) => format!("{f}: {d}"),
+        None => d,
+    }));
+    crate::warnings::print(&warnings);
     let RenderOptions {
         settings,
         sampler_name,
@@ -228,23 +230,6 @@ fn load_input(path: Option<&Path>) -> Result<Input> {
         description: path.display().to_string(),
         warnings,
     })
-}
-
-/// Prints warnings (the first [`MAX_WARNINGS_SHOWN`]) and their count.
-fn print_warnings(warnings: &[String]) {
-    for w in warnings.iter().take(MAX_WARNINGS_SHOWN) {
-        eprintln!("warning: {w}");
-    }
-    if warnings.len() > MAX_WARNINGS_SHOWN {
-        eprintln!("... and {} more", warnings.len() - MAX_WARNINGS_SHOWN);
-    }
-    if !warnings.is_empty() {
-        eprintln!(
-            "{} warning{} while loading",
-            warnings.len(),
-            if warnings.len() == 1 { "" } else { "s" }
-        );
-    }
 }
 
 fn stem(path: &Path) -> String {
