@@ -260,3 +260,22 @@ fn a_render_that_cannot_fit_in_memory_is_refused_with_an_estimate() {
     );
     assert!(!out_png.exists());
 }
+
+#[test]
+fn two_identical_exr_renders_are_byte_identical() {
+    let dir = temp_dir("exr-repeat");
+    let mut files = Vec::new();
+    for k in 0..4 {
+        let out = dir.join(format!("r{k}.exr"));
+        let threads = if k % 2 == 0 { "1" } else { "2" };
+        let o = out.to_str().unwrap();
+        let args = ["render", "--width", "16", "--height", "12", "--spp", "2"];
+        let run = sahara(&[&args[..], &["--threads", threads, "-o", o]].concat());
+        assert!(run.status.success(), "{}", stderr(&run));
+        files.push(fs::read(&out).unwrap());
+    }
+    for (k, f) in files.iter().enumerate() {
+        assert!(*f == files[0], "render {k} differs from render 0");
+    }
+    fs::remove_dir_all(dir).unwrap();
+}
