@@ -322,7 +322,7 @@ pub enum IntegratorSpec {
     Distribution {
         /// Largest number of specular/glossy bounces (>= 1, default 8).
         max_depth: u32,
-        /// Samples per area light at every hit (>= 1, default 1).
+        /// Samples per area light at every hit (>= 1, default 4).
         light_samples: u32,
     },
     /// Path tracing with next-event estimation.
@@ -338,7 +338,7 @@ pub enum IntegratorSpec {
     Depth,
     /// Ambient occlusion.
     Ao {
-        /// Rays per pixel sample (>= 1, default 1).
+        /// Rays per pixel sample (>= 1, default 4).
         samples: u32,
         /// Occlusion distance (>= 0; 0: a tenth of the scene's size).
         distance: f32,
@@ -363,7 +363,7 @@ pub enum SamplerKind {
 pub struct SamplerSpec {
     /// Which sampler (default sobol).
     pub kind: SamplerKind,
-    /// Samples per pixel (>= 1, default 16).
+    /// Samples per pixel (>= 1, default 64).
     pub spp: u32,
     /// Seed (>= 0, default 0).
     pub seed: u64,

@@ -11,8 +11,9 @@ use sahara_render::{Filter, Integrator, RenderSettings, SamplerKind, ToneMap};
 
 use crate::cli::RenderArgs;
 
-/// Samples per pixel when neither the command line nor a scene file says.
-pub const DEFAULT_SPP: u32 = 64;
+/// Samples per pixel when neither the command line nor a scene file says
+/// (the renderer's default, which scene files use too).
+pub const DEFAULT_SPP: u32 = sahara_render::integrator::defaults::SPP;
 /// Image side in pixels when neither the command line nor a scene file says.
 pub const DEFAULT_SIDE: u32 = 512;
 

@@ -279,3 +279,67 @@ fn two_identical_exr_renders_are_byte_identical() {
     }
     fs::remove_dir_all(dir).unwrap();
 }
+
+/// A floor quad lit by a disc area light, with `extra` appended.
+fn write_lit_floor(dir: &Path, name: &str, extra: &str) -> PathBuf {
+    let scene = dir.join(name);
+    fs::write(
+        &scene,
+        format!(
+            "[camera]\neye = [0, 2, 3]\ntarget = [0, 0, 0]\n\n\
+             [[object]]\ntype = \"quad\"\ncorner = [-2, 0, 2]\nedge_u = [4, 0, 0]\nedge_v = [0, 0, -4]\n\n\
+             [[light]]\ntype = \"area\"\nshape = \"disc\"\ncenter = [0, 1.5, 0]\nnormal = [0, -1, 0]\n\
+             radius = 0.5\nradiance = [4, 4, 4]\n\n\
+             [film]\nwidth = 8\nheight = 6\n{extra}"
+        ),
+    )
+    .unwrap();
+    scene
+}
+
+#[test]
+fn the_command_line_and_scene_files_share_their_defaults() {
+    let dir = temp_dir("defaults");
+    // The distribution integrator named on the command line, and named
+    // without parameters in a file, render the same image.
+    let plain = write_lit_floor(&dir, "plain.toml", "");
+    let named = write_lit_floor(
+        &dir,
+        "named.toml",
+        "\n[integrator]\nname = \"distribution\"\n",
+    );
+    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+    let run = |args: &[&str]| {
+        let out = sahara(args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stderr(&out)
+    };
+    let log_a = run(&[
+        "render",
+        plain.to_str().unwrap(),
+        "--integrator",
+        "distribution",
+        "-o",
+        a.to_str().unwrap(),
+    ]);
+    let log_b = run(&["render", named.to_str().unwrap(), "-o", b.to_str().unwrap()]);
+    assert!(
+        fs::read(&a).unwrap() == fs::read(&b).unwrap(),
+        "{log_a}\n{log_b}"
+    );
+    // Samples per pixel: the same default with and without a scene file.
+    let c = dir.join("c.png");
+    let log_c = run(&[
+        "render",
+        "--width",
+        "8",
+        "--height",
+        "6",
+        "-o",
+        c.to_str().unwrap(),
+    ]);
+    for log in [&log_a, &log_b, &log_c] {
+        assert!(log.contains(", 64 spp in passes of 8,"), "{log}");
+    }
+    let _ = fs::remove_dir_all(&dir);
+}

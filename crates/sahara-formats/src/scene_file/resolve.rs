@@ -5,6 +5,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
+use sahara_render::integrator::defaults;
 use toml::Spanned;
 
 use super::raw::*;
@@ -71,15 +72,15 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
         integrator: match &raw.integrator {
             Some(i) => ctx.integrator(i.get_ref())?,
             None => IntegratorSpec::Path {
-                max_depth: 8,
-                rr_depth: 3,
+                max_depth: defaults::MAX_DEPTH,
+                rr_depth: defaults::RR_DEPTH,
             },
         },
         sampler: match &raw.sampler {
             Some(s) => ctx.sampler(s.get_ref())?,
             None => SamplerSpec {
                 kind: SamplerKind::Sobol,
-                spp: 16,
+                spp: defaults::SPP,
                 seed: 0,
             },
         },
@@ -749,18 +750,29 @@ impl Ctx<'_> {
         self.only(&present, allowed, &what)?;
         Ok(match i.name.get_ref() {
             IntegratorName::Distribution => IntegratorSpec::Distribution {
-                max_depth: self.count(&i.max_depth, "max_depth", 8, 1)?,
-                light_samples: self.count(&i.light_samples, "light_samples", 1, 1)?,
+                max_depth: self.count(&i.max_depth, "max_depth", defaults::MAX_DEPTH, 1)?,
+                light_samples: self.count(
+                    &i.light_samples,
+                    "light_samples",
+                    defaults::LIGHT_SAMPLES,
+                    1,
+                )?,
             },
             IntegratorName::Path => IntegratorSpec::Path {
-                max_depth: self.count(&i.max_depth, "max_depth", 8, 1)?,
-                rr_depth: self.count(&i.rr_depth, "rr_depth", 3, 0)?,
+                max_depth: self.count(&i.max_depth, "max_depth", defaults::MAX_DEPTH, 1)?,
+                rr_depth: self.count(&i.rr_depth, "rr_depth", defaults::RR_DEPTH, 0)?,
             },
             IntegratorName::Normals => IntegratorSpec::Normals,
             IntegratorName::Depth => IntegratorSpec::Depth,
             IntegratorName::Ao => IntegratorSpec::Ao {
-                samples: self.count(&i.samples, "samples", 1, 1)?,
-                distance: self.number(&i.distance, "distance", 0.0, |d| d >= 0.0, "at least 0")?,
+                samples: self.count(&i.samples, "samples", defaults::AO_SAMPLES, 1)?,
+                distance: self.number(
+                    &i.distance,
+                    "distance",
+                    defaults::AO_DISTANCE,
+                    |d| d >= 0.0,
+                    "at least 0",
+                )?,
             },
             IntegratorName::Cost => IntegratorSpec::Cost,
         })
@@ -784,7 +796,7 @@ impl Ctx<'_> {
                 Some(SamplerName::Independent) => SamplerKind::Independent,
                 Some(SamplerName::Stratified) => SamplerKind::Stratified,
             },
-            spp: self.count(&s.spp, "spp", 16, 1)?,
+            spp: self.count(&s.spp, "spp", defaults::SPP, 1)?,
             seed,
         })
     }

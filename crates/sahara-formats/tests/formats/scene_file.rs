@@ -347,7 +347,7 @@ fn a_minimal_scene_gets_the_documented_defaults() {
         s.sampler,
         SamplerSpec {
             kind: SamplerKind::Sobol,
-            spp: 16,
+            spp: 64,
             seed: 0
         }
     );

@@ -364,3 +364,28 @@ fn a_broken_mesh_is_an_error_naming_the_scene_and_the_mesh() {
     assert!(e.starts_with(&path.display().to_string()), "{e}");
     assert!(e.contains("bad.obj"), "{e}");
 }
+
+#[test]
+fn a_scene_file_integrator_without_parameters_gets_the_command_line_defaults() {
+    let dir = TempDir::new("integrator-defaults");
+    for name in ["path", "distribution", "ao", "normals", "depth", "cost"] {
+        let path = dir.write(
+            &format!("{name}.toml"),
+            format!(
+                "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 8\nheight = 4\n\
+                 [integrator]\nname = \"{name}\"\n"
+            ),
+        );
+        let l = load_scene(&path).unwrap();
+        assert_eq!(
+            Some(l.settings.integrator),
+            Integrator::from_name(name),
+            "{name}"
+        );
+        assert_eq!(
+            l.settings.spp,
+            sahara_render::integrator::defaults::SPP,
+            "{name}"
+        );
+    }
+}
