@@ -95,10 +95,22 @@ pub fn auto_camera(scene: &Scene, name: &str) -> Result<Camera, FormatError> {
             "the mesh has no triangles with finite corners; nothing to frame",
         ));
     }
-    let c = 0.5 * (lo + hi);
+    let c = 0.5 * lo + 0.5 * hi;
     let r = (0.5 * (hi - lo).length()).max(1e-6);
     let eye =
         c + Vec3::new(0.3, 0.5, 1.0).normalize() * (r / (0.5 * AUTO_VFOV_DEG.to_radians()).sin());
+    // Coordinates near the float range put the eye at infinity, and
+    // coordinates far from the origin beside a tiny mesh leave no room
+    // between eye and target.
+    if !(eye.is_finite() && c.is_finite() && r.is_finite()) || eye == c {
+        return Err(FormatError::in_file(
+            name,
+            format!(
+                "the mesh's bounds ({lo} to {hi}) are too large to frame automatically; \
+                 give a camera sidecar (--camera FILE or {{stem}}.camera.json)"
+            ),
+        ));
+    }
     Ok(Camera::look_at(eye, c, Vec3::Y, AUTO_VFOV_DEG, 1.0))
 }
 

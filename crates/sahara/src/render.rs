@@ -67,9 +67,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     )?;
     // Any aspect ratio: the vertical field of view is kept.
     scene.camera.aspect = settings.width as f32 / settings.height as f32;
-    scene
-        .validate()
-        .map_err(|e| anyhow!("invalid scene: {e}"))?;
+    scene.validate().map_err(|e| match &args.scene {
+        Some(p) => anyhow!("{}: invalid scene: {e}", p.display()),
+        None => anyhow!("invalid scene: {e}"),
+    })?;
 
     let cancel = settings.cancel.clone().expect("settings set a cancel flag");
     // SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature): a batch
@@ -194,6 +195,10 @@ fn load_input(path: Option<&Path>) -> Result<Input> {
             warnings: Vec::new(),
         });
     };
+    const EXPECTED: &str = "expected a scene file (.toml) or a mesh (.obj, .ply, .gltf, .glb)";
+    if path.is_dir() {
+        bail!("{}: is a folder; {EXPECTED}", path.display());
+    }
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
@@ -218,10 +223,11 @@ fn load_input(path: Option<&Path>) -> Result<Input> {
             );
             (m.scene, None, m.warnings)
         }
-        _ => bail!(
-            "{}: cannot render .{ext} files; expected a scene file (.toml) or a mesh (.obj, .ply, .gltf, .glb)",
+        "" => bail!(
+            "{}: the file name has no extension; {EXPECTED}",
             path.display()
         ),
+        _ => bail!("{}: cannot render .{ext} files; {EXPECTED}", path.display()),
     };
     Ok(Input {
         scene,

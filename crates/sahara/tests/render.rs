@@ -343,3 +343,102 @@ fn the_command_line_and_scene_files_share_their_defaults() {
     }
     let _ = fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_path_without_a_usable_extension_says_what_it_is() {
+    let dir = temp_dir("no-ext");
+    let bare = dir.join("scene");
+    fs::write(&bare, "[camera]\n").unwrap();
+    for (path, what) in [(dir.clone(), "is a folder"), (bare, "has no extension")] {
+        let out = sahara(&["render", path.to_str().unwrap()]);
+        assert!(!out.status.success());
+        let err = stderr(&out);
+        assert!(
+            err.contains(what) && err.contains(path.to_str().unwrap()),
+            "{err}"
+        );
+        assert!(!err.contains("cannot render . files"), "{err}");
+        assert!(
+            err.contains("expected a scene file (.toml) or a mesh"),
+            "{err}"
+        );
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_mesh_too_large_to_frame_names_the_file() {
+    let dir = temp_dir("huge");
+    let obj = dir.join("huge.obj");
+    fs::write(&obj, "v -3e38 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n").unwrap();
+    let out = sahara(&[
+        "render",
+        obj.to_str().unwrap(),
+        "--width",
+        "4",
+        "--height",
+        "4",
+    ]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(
+        err.contains("huge.obj") && err.contains("too large to frame"),
+        "{err}"
+    );
+    assert!(!err.contains("invalid scene: camera"), "{err}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_no_light_warning_is_printed_once() {
+    let dir = temp_dir("unlit");
+    let scene = dir.join("dark.toml");
+    fs::write(
+        &scene,
+        "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n\n\
+         [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n\n\
+         [film]\nwidth = 4\nheight = 4\n",
+    )
+    .unwrap();
+    let png = dir.join("dark.png");
+    let out = sahara(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        "1",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(err.matches("has no light").count(), 1, "{err}");
+    assert!(
+        err.contains("dark.toml"),
+        "the warning names the file: {err}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_short_ascii_ply_line_is_reported_at_its_line() {
+    let dir = temp_dir("short-ply");
+    let ply = dir.join("short.ply");
+    fs::write(
+        &ply,
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+         element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+         0 0 0\n1 0\n0 1 0\n3 0 1 2\n",
+    )
+    .unwrap();
+    for cmd in ["render", "stats", "bench"] {
+        let out = sahara(&[cmd, ply.to_str().unwrap()]);
+        assert!(!out.status.success(), "{cmd}");
+        let err = stderr(&out);
+        assert!(
+            err.contains("short.ply: line 11:") && err.contains("expected 3 values, found 2"),
+            "{cmd}: {err}"
+        );
+        assert!(!err.contains("nothing to frame"), "{cmd}: {err}");
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
