@@ -89,6 +89,11 @@ pub struct RenderArgs {
     /// equal-time comparisons); --spp is then the samples of each pass.
     #[arg(long, value_name = "SECS")]
     pub time_limit: Option<f64>,
+    /// During a progressive render, rewrite the output (atomically, marked
+    /// partial) with the passes done so far at most every SECS seconds, to
+    /// watch it in an image viewer; the final image replaces it.
+    #[arg(long, value_name = "SECS")]
+    pub preview_every: Option<f64>,
     /// Exposure in stops, for PNG output [default: the scene file's, else 0].
     #[arg(long, allow_negative_numbers = true)]
     pub exposure: Option<f32>,

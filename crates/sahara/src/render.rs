@@ -10,7 +10,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 use sahara_formats::image_out::{write_image, Pixels};
 use sahara_formats::mesh_scene::load_mesh_scene;
 use sahara_formats::scene_load::{load_scene, FileSettings};
-use sahara_render::{builtin, render, Progress, RenderSettings, Scene};
+use sahara_render::{
+    builtin, render_watched, Integrator, Preview, Progress, RenderResult, RenderSettings, Scene,
+    ToneMap,
+};
 
 use crate::cli::RenderArgs;
 use crate::memory;
@@ -83,7 +86,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     })
     .context("cannot install the SIGINT/SIGTERM handler")?;
 
-    let bar = progress_bar(&settings);
     let threads = args.threads.map_or(0, usize::from);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -102,11 +104,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         settings.spp,
         pool.current_num_threads()
     );
+    // Started after the line above, so that it does not draw over it.
+    let bar = progress_bar(&settings);
     let on_progress = |p: Progress| {
         bar.set_position((p.pass as u64) * p.tiles as u64 + p.tiles_done as u64);
-        if p.tiles_done == 1 {
-            bar.set_length(p.passes as u64 * p.tiles as u64);
-        }
         let mrays = p.rays as f64 / p.elapsed.as_secs_f64().max(1e-9) / 1e6;
         let of = if p.passes == u32::MAX {
             String::new()
@@ -115,7 +116,29 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         };
         bar.set_message(format!("pass {}{of} {mrays:.1} Mrays/s", p.pass + 1));
     };
-    let result = pool.install(|| render(&scene, &settings, &on_progress));
+    let output_settings = Output {
+        path: &output,
+        settings: &settings,
+        exposure,
+        tonemap,
+    };
+    let mut show_preview = |r: &RenderResult| {
+        // A preview that cannot be written is a warning: the render goes on.
+        if let Err(e) = output_settings.write(r, true, false) {
+            bar.suspend(|| eprintln!("warning: preview not written: {e:#}"));
+        }
+    };
+    let preview = match args.preview_every {
+        None => None,
+        Some(t) if !(t >= 0.0 && t.is_finite()) => {
+            bail!("--preview-every must be a number of seconds >= 0")
+        }
+        Some(t) => Some(Preview {
+            every: Duration::from_secs_f64(t),
+            show: &mut show_preview,
+        }),
+    };
+    let result = pool.install(|| render_watched(&scene, &settings, &on_progress, preview));
     bar.finish_and_clear();
 
     let s = &result.stats;
@@ -124,44 +147,38 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .cancel
             .as_ref()
             .is_some_and(|c| c.load(Ordering::SeqCst));
-    if s.passes == 0 {
-        bail!("stopped before the first pass completed: no image written");
+    if s.passes == 0 && s.first_pass_pixels == 0 {
+        bail!("stopped before the first pixel was finished: no image written");
     }
-    let rgb = result.film.to_rgb_f32();
-    let rgb8 = if is_exr(&output) {
-        Vec::new()
-    } else {
-        result.film.to_srgb8(exposure, tonemap)
-    };
-    let pixels = if is_exr(&output) {
-        Pixels::LinearRgbF32(&rgb)
-    } else {
-        Pixels::Rgb8(&rgb8)
-    };
-    let metadata = vec![
-        (
-            "sahara:integrator".to_string(),
-            settings.integrator.name().to_string(),
-        ),
-        ("sahara:spp".to_string(), s.spp.to_string()),
-        ("sahara:seed".to_string(), settings.seed.to_string()),
-        ("sahara:partial".to_string(), partial.to_string()),
-    ];
-    write_image(&output, settings.width, settings.height, pixels, &metadata)
-        .map_err(|e| anyhow!("{e}"))
-        .context("cannot write the output image")?;
+    output_settings.write(&result, partial, true)?;
     let secs = s.render_time.as_secs_f64();
+    let pixels = u64::from(settings.width) * u64::from(settings.height);
     eprintln!(
-        "{} {}: {} passes, {} spp, {:.2} s render (+{:.0} ms tree builds), {} rays, {:.2} Mrays/s{}",
-        if partial { "wrote PARTIAL image" } else { "wrote" },
+        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {} rays, {:.2} Mrays/s{}",
+        if partial {
+            "wrote PARTIAL image"
+        } else {
+            "wrote"
+        },
         output.display(),
-        s.passes,
+        if s.passes == 0 {
+            format!(
+                "first pass interrupted, {} of {pixels} pixels finished (the rest black)",
+                s.first_pass_pixels
+            )
+        } else {
+            format!("{} passes", s.passes)
+        },
         s.spp,
         secs,
         s.build_time.as_secs_f64() * 1e3,
         s.rays(),
         s.rays() as f64 / secs.max(1e-9) / 1e6,
-        if s.nan_samples > 0 { format!(", {} NaN samples dropped", s.nan_samples) } else { String::new() }
+        if s.nan_samples > 0 {
+            format!(", {} NaN samples dropped", s.nan_samples)
+        } else {
+            String::new()
+        }
     );
     if partial {
         // Interrupted: the image of the completed passes is on disk.
@@ -170,12 +187,116 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// Where and how the image is written.
+struct Output<'a> {
+    path: &'a Path,
+    settings: &'a RenderSettings,
+    exposure: f32,
+    tonemap: ToneMap,
+}
+
+impl Output<'_> {
+    /// Writes `result` (atomically), marked `partial` or not; `log` prints
+    /// what a debug view's colours mean.
+    fn write(&self, result: &RenderResult, partial: bool, log: bool) -> Result<()> {
+        let settings = self.settings;
+        let s = &result.stats;
+        let exr = is_exr(self.path);
+        let rgb = result.film.to_rgb_f32();
+        let rgb8 = if exr {
+            Vec::new()
+        } else if matches!(settings.integrator, Integrator::Depth) {
+            // Raw distances would be a flat white or grey: map the nearest
+            // to the farthest hit onto white to dark grey (EXR keeps them raw).
+            let range = depth_range(&rgb);
+            if log {
+                match range {
+                    Some((near, far)) => eprintln!(
+                        "depth: nearest hit {near:.4} (white) to farthest {far:.4} (dark grey), \
+                         no hit black; EXR output keeps the raw distances"
+                    ),
+                    None => eprintln!("depth: no ray hit anything"),
+                }
+            }
+            depth_to_gray8(&rgb, range)
+        } else {
+            result.film.to_srgb8(self.exposure, self.tonemap)
+        };
+        let pixels = if exr {
+            Pixels::LinearRgbF32(&rgb)
+        } else {
+            Pixels::Rgb8(&rgb8)
+        };
+        let finished = if s.passes == 0 {
+            s.first_pass_pixels
+        } else {
+            u64::from(settings.width) * u64::from(settings.height)
+        };
+        let metadata = vec![
+            (
+                "sahara:integrator".to_string(),
+                settings.integrator.name().to_string(),
+            ),
+            ("sahara:spp".to_string(), s.spp.to_string()),
+            ("sahara:seed".to_string(), settings.seed.to_string()),
+            ("sahara:partial".to_string(), partial.to_string()),
+            ("sahara:finished_pixels".to_string(), finished.to_string()),
+        ];
+        write_image(
+            self.path,
+            settings.width,
+            settings.height,
+            pixels,
+            &metadata,
+        )
+        .map_err(|e| anyhow!("{e}"))
+        .context("cannot write the output image")
+    }
+}
+
+/// The nearest and farthest distance in a depth image (0 is no hit).
+fn depth_range(rgb: &[f32]) -> Option<(f32, f32)> {
+    let hits = rgb.iter().step_by(3).filter(|d| **d > 0.0 && d.is_finite());
+    let (near, far) = hits.fold((f32::INFINITY, 0.0f32), |(n, f), &d| (n.min(d), f.max(d)));
+    (far > 0.0).then_some((near, far))
+}
+
+/// A depth image as 8-bit grey: `near` white, `far` dark grey (26), no hit black.
+fn depth_to_gray8(rgb: &[f32], range: Option<(f32, f32)>) -> Vec<u8> {
+    let Some((near, far)) = range else {
+        return vec![0; rgb.len()];
+    };
+    let span = (far - near).max(f32::MIN_POSITIVE);
+    rgb.iter()
+        .step_by(3)
+        .flat_map(|&d| {
+            let v = if d > 0.0 && d.is_finite() {
+                let t = ((d - near) / span).clamp(0.0, 1.0);
+                (255.0 * (1.0 - 0.9 * t)).round() as u8
+            } else {
+                0
+            };
+            [v; 3]
+        })
+        .collect()
+}
+
+/// The progress bar: as wide as the terminal, from 0% (a spinner with a
+/// time limit, where the total is unknown).
 fn progress_bar(settings: &RenderSettings) -> ProgressBar {
-    let bar = ProgressBar::new(0);
-    let template = if settings.time_limit.is_some() {
-        "{spinner} {elapsed_precise} {msg} tiles {pos}"
+    let ts = settings.tile_size.max(1);
+    let tiles = u64::from(settings.width.div_ceil(ts)) * u64::from(settings.height.div_ceil(ts));
+    let (len, template) = if settings.time_limit.is_some() {
+        (None, "{spinner} {elapsed_precise} {msg} tiles {pos}")
     } else {
-        "{bar:40} {percent:>3}% {msg} elapsed {elapsed_precise} eta {eta_precise}"
+        (
+            Some(u64::from(settings.passes.max(1)) * tiles),
+            "{wide_bar} {percent:>3}% {msg} {elapsed_precise} eta {eta_precise}",
+        )
+    };
+    let bar = match len {
+        Some(n) => ProgressBar::new(n),
+        None => ProgressBar::no_length(),
     };
     if let Ok(style) = ProgressStyle::with_template(template) {
         bar.set_style(style);

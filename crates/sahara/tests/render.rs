@@ -442,3 +442,42 @@ fn a_short_ascii_ply_line_is_reported_at_its_line() {
     }
     let _ = fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_depth_view_spans_the_visible_range_in_png_and_stays_raw_in_exr() {
+    let dir = temp_dir("depth");
+    let (png, exr) = (dir.join("depth.png"), dir.join("depth.exr"));
+    let mut logs = String::new();
+    for out in [&png, &exr] {
+        let o = sahara(&[
+            "render",
+            "--integrator",
+            "depth",
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--spp",
+            "1",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        logs += &stderr(&o);
+    }
+    assert!(
+        logs.contains("nearest hit") && logs.contains("farthest"),
+        "{logs}"
+    );
+    // PNG: the box's near and far walls are far apart in grey.
+    let (_, _, shown) = load_rgb_f32(&png).unwrap();
+    let (lo, hi) = shown
+        .iter()
+        .fold((f32::INFINITY, 0.0f32), |(l, h), &v| (l.min(v), h.max(v)));
+    assert!(hi > 0.9 && hi - lo > 0.5, "PNG range {lo}..{hi}");
+    // EXR: raw distances (the Cornell box is hundreds of units deep).
+    let (_, _, raw) = load_rgb_f32(&exr).unwrap();
+    let far = raw.iter().fold(0.0f32, |a, &b| a.max(b));
+    assert!(far > 100.0, "EXR holds distances, max {far}");
+    let _ = fs::remove_dir_all(&dir);
+}
