@@ -89,6 +89,14 @@ pub struct RenderArgs {
     /// equal-time comparisons); --spp is then the samples of each pass.
     #[arg(long, value_name = "SECS")]
     pub time_limit: Option<f64>,
+    /// Camera sidecar JSON for a mesh (or the built-in scene), instead of
+    /// <dir>/<stem>.camera.json or the automatic camera.
+    #[arg(long, value_name = "FILE")]
+    pub camera: Option<PathBuf>,
+    /// Kd-tree builder (as for `sahara bench`): a speed setting only, the
+    /// image is the same with any [default: sah].
+    #[arg(long, value_name = "NAME", value_parser = parse_builder)]
+    pub builder: Option<Builder>,
     /// During a progressive render, rewrite the output (atomically, marked
     /// partial) with the passes done so far at most every SECS seconds, to
     /// watch it in an image viewer; the final image replaces it.

@@ -7,12 +7,13 @@ use std::time::Duration;
 
 use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use sahara_formats::camera::read_sidecar;
 use sahara_formats::image_out::{write_image, Pixels};
-use sahara_formats::mesh_scene::load_mesh_scene;
+use sahara_formats::mesh_scene::load_mesh_scene_with_camera;
 use sahara_formats::scene_load::{load_scene, FileSettings};
 use sahara_render::{
-    builtin, render_watched, Integrator, Preview, Progress, RenderResult, RenderSettings, Scene,
-    ToneMap,
+    builtin, render_watched, Camera, Integrator, Preview, Progress, RenderResult, RenderSettings,
+    Scene, ToneMap,
 };
 
 use crate::cli::RenderArgs;
@@ -36,7 +37,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         name,
         description,
         warnings,
-    } = load_input(args.scene.as_deref())?;
+    } = load_input(args.scene.as_deref(), args.camera.as_deref())?;
     let mut warnings = warnings;
     // The finished scene's problems, named after the file they come from.
     let from_file = args.scene.as_ref().map(|p| p.display().to_string());
@@ -306,10 +307,17 @@ fn progress_bar(settings: &RenderSettings) -> ProgressBar {
 }
 
 /// The scene to render: the built-in Cornell box, a scene file or a mesh file.
-fn load_input(path: Option<&Path>) -> Result<Input> {
+fn load_input(path: Option<&Path>, camera: Option<&Path>) -> Result<Input> {
+    let flat = |e: sahara_formats::FormatError| anyhow!("{e}");
     let Some(path) = path else {
+        let mut scene = builtin::cornell_box();
+        if let Some(file) = camera {
+            let c = read_sidecar(file).map_err(flat)?;
+            scene.camera = Camera::look_at(c.eye, c.target, c.up, c.vfov_deg, 1.0);
+            eprintln!("camera: {}", file.display());
+        }
         return Ok(Input {
-            scene: builtin::cornell_box(),
+            scene,
             file: None,
             name: "cornell_box".into(),
             description: "the built-in Cornell box".into(),
@@ -325,14 +333,17 @@ fn load_input(path: Option<&Path>) -> Result<Input> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     // A `FormatError`'s message already names the file and place.
-    let flat = |e: sahara_formats::FormatError| anyhow!("{e}");
     let (scene, file, warnings) = match ext.as_str() {
+        "toml" if camera.is_some() => bail!(
+            "{}: --camera applies to meshes and the built-in scene; a scene file has its own [camera]",
+            path.display()
+        ),
         "toml" => {
             let l = load_scene(path).map_err(flat)?;
             (l.scene, Some(l.settings), l.warnings)
         }
         "obj" | "ply" | "gltf" | "glb" => {
-            let m = load_mesh_scene(path).map_err(flat)?;
+            let m = load_mesh_scene_with_camera(path, camera).map_err(flat)?;
             eprintln!(
                 "camera: {}; light: {}",
                 m.camera_source,

@@ -7,6 +7,7 @@ use std::time::Duration;
 
 use anyhow::{anyhow, bail, Result};
 use sahara_formats::scene_load::FileSettings;
+use sahara_kd::BuildParams;
 use sahara_render::{Filter, Integrator, RenderSettings, SamplerKind, ToneMap};
 
 use crate::cli::RenderArgs;
@@ -116,6 +117,9 @@ pub fn resolve(
             sampler,
             filter,
             integrator,
+            build: args
+                .builder
+                .map_or_else(BuildParams::default, BuildParams::new),
             ..Default::default()
         },
         sampler_name: match sampler {

@@ -481,3 +481,69 @@ fn the_depth_view_spans_the_visible_range_in_png_and_stays_raw_in_exr() {
     assert!(far > 100.0, "EXR holds distances, max {far}");
     let _ = fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn render_takes_a_camera_sidecar_and_a_builder() {
+    let dir = temp_dir("camera-builder");
+    let obj = write_quad(&dir, "Kd 0.8 0.8 0.8");
+    let far = dir.join("far.json");
+    fs::write(&far, r#"{"eye":[0,0,30],"target":[0,0,0],"vfov_deg":60}"#).unwrap();
+    let render = |extra: &[&str], out: &Path| {
+        let args = [
+            "render",
+            obj.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ];
+        let o = sahara(
+            &[
+                &args[..],
+                &["--spp", "2", "-o", out.to_str().unwrap()],
+                extra,
+            ]
+            .concat(),
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    let (near_img, far_img) = (dir.join("near.exr"), dir.join("far.exr"));
+    let log = render(&[], &near_img);
+    assert!(log.contains("quad.camera.json"), "{log}");
+    let log = render(&["--camera", far.to_str().unwrap()], &far_img);
+    assert!(
+        log.contains("camera: ") && log.contains("far.json"),
+        "{log}"
+    );
+    // From ten times as far the view differs.
+    assert!(fs::read(&far_img).unwrap() != fs::read(&near_img).unwrap());
+
+    // The builder changes the speed, never the image.
+    for builder in ["median", "binned16", "rr-middle"] {
+        let out = dir.join(format!("{builder}.exr"));
+        render(&["--builder", builder], &out);
+        assert!(
+            fs::read(&out).unwrap() == fs::read(&near_img).unwrap(),
+            "--builder {builder} changed the image"
+        );
+    }
+    let o = sahara(&["render", obj.to_str().unwrap(), "--builder", "octree"]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("unknown builder 'octree'"),
+        "{}",
+        stderr(&o)
+    );
+    // A missing sidecar names the file.
+    let missing = dir.join("missing.json");
+    let o = sahara(&[
+        "render",
+        obj.to_str().unwrap(),
+        "--camera",
+        missing.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("missing.json"), "{}", stderr(&o));
+    let _ = fs::remove_dir_all(&dir);
+}
