@@ -296,6 +296,9 @@ pub enum LightSpec {
         radiance: Vec3,
         /// Emit from both faces.
         two_sided: bool,
+        /// Name of a `[[material]]` (checked to exist) the light's surface
+        /// scatters with besides emitting; `None`: black but for its emission.
+        material: Option<String>,
     },
     /// Light from infinitely far away in every direction.
     Environment(EnvironmentSpec),

@@ -366,3 +366,19 @@ fn previews_come_between_passes_and_leave_the_image_unchanged() {
     assert_eq!(watched.film.pixels, plain.film.pixels);
     assert_eq!(watched.stats.spp, 4);
 }
+
+#[test]
+fn the_built_in_cornell_light_is_a_white_diffuser_that_emits() {
+    // As in Mitsuba's Cornell box: the light panel reflects (diffuse 0.78)
+    // besides emitting (17, 12, 4).
+    let scene = builtin::cornell_box();
+    let lights: Vec<_> = scene.materials.iter().filter(|m| m.is_emissive()).collect();
+    assert_eq!(lights.len(), 1);
+    assert_eq!(lights[0].emission, Vec3::new(17.0, 12.0, 4.0));
+    assert_eq!(
+        lights[0].bsdf,
+        sahara_render::Bsdf::Diffuse {
+            albedo: Vec3::splat(0.78)
+        }
+    );
+}

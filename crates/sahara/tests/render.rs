@@ -547,3 +547,45 @@ fn render_takes_a_camera_sidecar_and_a_builder() {
     assert!(stderr(&o).contains("missing.json"), "{}", stderr(&o));
     let _ = fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn an_area_light_with_a_material_also_reflects() {
+    let dir = temp_dir("reflecting-light");
+    // The camera sees the back of a one-sided light panel (which emits
+    // nothing that way) under a white sky.
+    let write = |name: &str, extra: &str| {
+        let scene = dir.join(name);
+        fs::write(
+            &scene,
+            format!(
+                "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nvfov = 20\n\n\
+                 [[material]]\nname = \"diffuser\"\ntype = \"diffuse\"\nalbedo = [0.8, 0.8, 0.8]\n\n\
+                 [[light]]\ntype = \"area\"\nshape = \"quad\"\ncorner = [-2, -2, 0]\n\
+                 edge_u = [0, 4, 0]\nedge_v = [4, 0, 0]\nradiance = [5, 5, 5]\n{extra}\n\
+                 [[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n\n\
+                 [film]\nwidth = 8\nheight = 8\n"
+            ),
+        )
+        .unwrap();
+        let out = dir.join(format!("{name}.exr"));
+        let o = sahara(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--spp",
+            "16",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        checked_mean(&out, 8, 8)
+    };
+    let black = write("black.toml", "");
+    let white = write("white.toml", "material = \"diffuser\"\n");
+    assert_eq!(
+        black, 0.0,
+        "without a material the back of the panel is black"
+    );
+    // A white diffuser under a uniform white sky reflects about its albedo.
+    assert!((white - 0.8).abs() < 0.05, "mean {white}");
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -54,7 +54,7 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
     let lights = raw
         .light
         .iter()
-        .map(|l| ctx.light(l))
+        .map(|l| ctx.light(l, &seen))
         .collect::<Result<Vec<_>, _>>()?;
     let environments: Vec<_> = raw
         .light
@@ -597,7 +597,11 @@ impl Ctx<'_> {
     }
 
     /// `[[light]]`.
-    fn light(&self, raw: &Spanned<RawLight>) -> Result<LightSpec, FormatError> {
+    fn light(
+        &self,
+        raw: &Spanned<RawLight>,
+        materials: &HashSet<&str>,
+    ) -> Result<LightSpec, FormatError> {
         let l = raw.get_ref();
         let entry = raw.span();
         let what = format!("a {} light", type_name(&l.kind));
@@ -614,6 +618,7 @@ impl Ctx<'_> {
             ("shape", span(&l.shape)),
             ("map", span(&l.map)),
             ("scale", span(&l.scale)),
+            ("material", span(&l.material)),
         ];
         let allowed: &[&str] = match l.kind.get_ref() {
             LightType::Point => &["position", "intensity"],
@@ -629,6 +634,7 @@ impl Ctx<'_> {
                 "shape",
                 "radiance",
                 "two_sided",
+                "material",
                 "corner",
                 "edge_u",
                 "edge_v",
@@ -699,10 +705,16 @@ impl Ctx<'_> {
                     min: &None,
                     max: &None,
                 };
+                if let Some(m) = &l.material {
+                    if !materials.contains(m.get_ref().as_str()) {
+                        return Err(self.at(m.span(), format!("no [[material]] is named '{}'", m.get_ref())));
+                    }
+                }
                 LightSpec::Area {
                     shape: self.shape(*kind.get_ref(), &entry, &keys, &format!("{what} ({})", type_name(kind)))?,
                     radiance: need_power(&l.radiance, "radiance")?,
                     two_sided: l.two_sided.as_ref().is_some_and(|b| *b.get_ref()),
+                    material: l.material.as_ref().map(|m| m.get_ref().clone()),
                 }
             }
             LightType::Environment => match (&l.radiance, &l.map) {

@@ -283,7 +283,7 @@ fn a_complete_scene_parses_into_the_expected_values() {
     );
     assert!(matches!(
         &s.lights[3],
-        LightSpec::Area { shape: ShapeSpec::Quad { .. }, radiance, two_sided: false } if *radiance == Vec3::splat(8.)
+        LightSpec::Area { shape: ShapeSpec::Quad { .. }, radiance, two_sided: false, material: None } if *radiance == Vec3::splat(8.)
     ));
     assert_eq!(
         s.lights[4],
