@@ -150,12 +150,15 @@ pub enum MaterialKind {
         /// Perceptual roughness in [0, 1].
         roughness: f32,
     },
-    /// A light-emitting surface (black otherwise).
+    /// A light-emitting surface that also reflects diffusely with `albedo`
+    /// (default 0: black but for its emission).
     Emission {
         /// Emitted radiance (>= 0).
         radiance: Vec3,
         /// Emit from both faces (default: only the front).
         two_sided: bool,
+        /// Lambertian reflectance in [0, 1] (default 0).
+        albedo: Vec3,
     },
 }
 

@@ -181,8 +181,9 @@ fn material_of(m: &MaterialSpec, warnings: &mut Vec<String>, name: &str) -> Mate
         MaterialKind::Emission {
             radiance,
             two_sided,
+            albedo,
         } => {
-            let mut out = Material::emitter(*radiance);
+            let mut out = Material::diffuse(*albedo).with_emission(*radiance);
             out.two_sided_emission = *two_sided;
             out
         }

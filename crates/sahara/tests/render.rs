@@ -587,5 +587,36 @@ fn an_area_light_with_a_material_also_reflects() {
     );
     // A white diffuser under a uniform white sky reflects about its albedo.
     assert!((white - 0.8).abs() < 0.05, "mean {white}");
+
+    // An emitting object: an emission material with an albedo reflects too.
+    let object = |name: &str, albedo: &str| {
+        let scene = dir.join(name);
+        fs::write(
+            &scene,
+            format!(
+                "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nvfov = 20\n\n\
+                 [[material]]\nname = \"panel\"\ntype = \"emission\"\nradiance = [5, 5, 5]\n{albedo}\n\
+                 [[object]]\ntype = \"quad\"\ncorner = [-2, -2, 0]\nedge_u = [0, 4, 0]\n\
+                 edge_v = [4, 0, 0]\nmaterial = \"panel\"\n\n\
+                 [[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n\n\
+                 [film]\nwidth = 8\nheight = 8\n"
+            ),
+        )
+        .unwrap();
+        let out = dir.join(format!("{name}.exr"));
+        let o = sahara(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--spp",
+            "16",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        checked_mean(&out, 8, 8)
+    };
+    assert_eq!(object("dark_object.toml", ""), 0.0);
+    let white = object("white_object.toml", "albedo = [0.8, 0.8, 0.8]");
+    assert!((white - 0.8).abs() < 0.05, "mean {white}");
     let _ = fs::remove_dir_all(&dir);
 }

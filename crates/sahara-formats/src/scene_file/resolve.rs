@@ -351,7 +351,7 @@ impl Ctx<'_> {
             MaterialType::Mirror => &["color"],
             MaterialType::Dielectric => &["ior"],
             MaterialType::RoughDielectric => &["ior", "roughness"],
-            MaterialType::Emission => &["radiance", "two_sided"],
+            MaterialType::Emission => &["radiance", "two_sided", "albedo"],
         };
         self.only(&present, allowed, &what)?;
         if m.name.get_ref().is_empty() {
@@ -394,6 +394,7 @@ impl Ctx<'_> {
                     "radiance",
                 )?,
                 two_sided: m.two_sided.as_ref().is_some_and(|b| *b.get_ref()),
+                albedo: self.reflectance(&m.albedo, "albedo", Vec3::ZERO)?,
             },
         };
         Ok(MaterialSpec {

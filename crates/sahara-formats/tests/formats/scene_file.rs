@@ -203,7 +203,8 @@ fn a_complete_scene_parses_into_the_expected_values() {
                 name: "lamp".into(),
                 kind: MaterialKind::Emission {
                     radiance: Vec3::new(5., 5., 4.),
-                    two_sided: true
+                    two_sided: true,
+                    albedo: Vec3::ZERO
                 }
             },
         ]
