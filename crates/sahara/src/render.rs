@@ -209,7 +209,7 @@ impl Output<'_> {
         } else if matches!(settings.integrator, Integrator::Depth) {
             // Raw distances would be a flat white or grey: map the nearest
             // to the farthest hit onto white to dark grey (EXR keeps them raw).
-            let range = depth_range(&rgb);
+            let range = depth_range(&rgb, settings.width, settings.height);
             if log {
                 match range {
                     Some((near, far)) => eprintln!(
@@ -256,11 +256,43 @@ impl Output<'_> {
 }
 
 /// The nearest and farthest distance in a depth image (0 is no hit).
-fn depth_range(rgb: &[f32]) -> Option<(f32, f32)> {
-    let hits = rgb.iter().step_by(3).filter(|d| **d > 0.0 && d.is_finite());
-    let (near, far) = hits.fold((f32::INFINITY, 0.0f32), |(n, f), &d| (n.min(d), f.max(d)));
-    (far > 0.0).then_some((near, far))
+///
+/// The filter blends hit distances with the zeros of missed samples near
+/// silhouettes, which would make them look nearest: the nearest distance
+/// is taken from pixels at least [`SILHOUETTE_MARGIN`] pixels from any
+/// pixel without a hit (all pixels if none is that far).
+fn depth_range(rgb: &[f32], width: u32, height: u32) -> Option<(f32, f32)> {
+    let (w, h) = (width as usize, height as usize);
+    let d = |x: usize, y: usize| rgb[3 * (y * w + x)];
+    let hit = |v: f32| v > 0.0 && v.is_finite();
+    let far = (0..w * h)
+        .map(|k| rgb[3 * k])
+        .filter(|&v| hit(v))
+        .fold(0.0f32, f32::max);
+    if far <= 0.0 {
+        return None;
+    }
+    let m = SILHOUETTE_MARGIN;
+    let interior = |x: usize, y: usize| {
+        (y.saturating_sub(m)..(y + m + 1).min(h))
+            .all(|j| (x.saturating_sub(m)..(x + m + 1).min(w)).all(|i| hit(d(i, j))))
+    };
+    let nearest = |only_interior: bool| {
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .filter(|&(x, y)| hit(d(x, y)) && (!only_interior || interior(x, y)))
+            .map(|(x, y)| d(x, y))
+            .fold(f32::INFINITY, f32::min)
+    };
+    let near = match nearest(true) {
+        n if n.is_finite() => n,
+        _ => nearest(false),
+    };
+    Some((near.min(far), far))
 }
+
+/// Pixels around a silhouette that [`depth_range`] leaves out of the nearest distance.
+const SILHOUETTE_MARGIN: usize = 3;
 
 /// A depth image as 8-bit grey: `near` white, `far` dark grey (26), no hit black.
 fn depth_to_gray8(rgb: &[f32], range: Option<(f32, f32)>) -> Vec<u8> {
@@ -378,4 +410,42 @@ fn stem(path: &Path) -> String {
 fn is_exr(path: &Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A `w x h` depth image (three equal channels per pixel) from `f(x, y)`.
+    fn image(w: u32, h: u32, f: impl Fn(u32, u32) -> f32) -> Vec<f32> {
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .flat_map(|(x, y)| [f(x, y); 3])
+            .collect()
+    }
+
+    #[test]
+    fn depth_range_ignores_silhouette_blends() {
+        // A 10x10 object at distance 2 to 3 on a background of misses; its
+        // border pixels are blends with the misses (0.5).
+        let rgb = image(20, 20, |x, y| {
+            let inside = (5..15).contains(&x) && (5..15).contains(&y);
+            let border = x == 5 || x == 14 || y == 5 || y == 14;
+            match (inside, border) {
+                (false, _) => 0.0,
+                (true, true) => 0.5,
+                (true, false) => 2.0 + x as f32 / 20.0,
+            }
+        });
+        let (near, far) = depth_range(&rgb, 20, 20).unwrap();
+        assert!(near >= 2.0, "near {near}");
+        assert!((far - (2.0 + 13.0 / 20.0)).abs() < 1e-6, "far {far}");
+        let grey = depth_to_gray8(&rgb, Some((near, far)));
+        assert_eq!(grey[0], 0, "a miss is black");
+        assert_eq!(grey[3 * (20 * 6 + 13)], 26, "the farthest hit is dark grey");
+        // No hit at all: no range, a black image.
+        let none = image(4, 4, |_, _| 0.0);
+        assert_eq!(depth_range(&none, 4, 4), None);
+        assert!(depth_to_gray8(&none, None).iter().all(|&v| v == 0));
+    }
 }
