@@ -56,7 +56,7 @@ pub enum FormatError {
         message: String,
     },
     /// `load_mesh` was given a file whose extension is not a mesh format it knows.
-    #[error("{path}: unsupported mesh file extension {extension:?}; expected .obj or .ply")]
+    #[error("{path}: {}", unsupported_mesh(extension))]
     UnsupportedExtension {
         /// The file, as given by the caller.
         path: String,
@@ -136,5 +136,15 @@ impl FormatError {
             path: path.to_owned(),
             message: message.into(),
         }
+    }
+}
+
+/// The message of [`FormatError::UnsupportedExtension`].
+fn unsupported_mesh(extension: &str) -> String {
+    let expected = "expected a mesh (.obj, .ply, .gltf or .glb)";
+    if extension.is_empty() {
+        format!("the file name has no extension; {expected}")
+    } else {
+        format!("unsupported mesh file extension {extension:?}; {expected}")
     }
 }

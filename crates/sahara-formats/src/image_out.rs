@@ -136,12 +136,73 @@ pub fn write_exr(
         SpecificChannels::rgb(pixel),
     );
     let image = Image::from_layer(layer);
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| FormatError::in_file(&name, format!("cannot encode EXR: {e}")))?;
+    let mut bytes = bytes.into_inner();
+    // The encoder writes the custom attributes in hash-map order, which
+    // changes from run to run: put the header in name order so that the
+    // same image gives the same bytes.
+    sort_exr_header(&mut bytes)
+        .map_err(|e| FormatError::in_file(&name, format!("cannot encode EXR: {e}")))?;
     write_atomically(path, |out: &mut BufWriter<std::fs::File>| {
-        image
-            .write()
-            .to_buffered(out)
-            .map_err(|e| FormatError::in_file(&name, format!("cannot encode EXR: {e}")))
+        out.write_all(&bytes)
+            .and_then(|()| out.flush())
+            .map_err(|e| FormatError::write(path, e))
     })
+}
+
+/// Reorders the attributes of a single-part EXR file's header by name, in
+/// place. The header keeps its length, so the offset table after it stays
+/// valid.
+fn sort_exr_header(bytes: &mut [u8]) -> Result<(), String> {
+    const MULTIPART: u32 = 0x1000;
+    let truncated = || "the encoded header is truncated".to_string();
+    let version = bytes.get(4..8).ok_or_else(truncated)?;
+    if u32::from_le_bytes(version.try_into().expect("4 bytes")) & MULTIPART != 0 {
+        return Err("a multi-part file was encoded".into());
+    }
+    let start = 8;
+    let mut attributes: Vec<(usize, usize)> = Vec::new();
+    let mut at = start;
+    // Each attribute: name NUL, type NUL, i32 size, value; a NUL ends the header.
+    loop {
+        let first = *bytes.get(at).ok_or_else(truncated)?;
+        if first == 0 {
+            break;
+        }
+        let begin = at;
+        for _ in 0..2 {
+            let nul = bytes[at..]
+                .iter()
+                .position(|&b| b == 0)
+                .ok_or_else(truncated)?;
+            at += nul + 1;
+        }
+        let size = bytes.get(at..at + 4).ok_or_else(truncated)?;
+        let size = i32::from_le_bytes(size.try_into().expect("4 bytes"));
+        let size = usize::try_from(size).map_err(|_| "negative attribute size".to_string())?;
+        at += 4 + size;
+        if at > bytes.len() {
+            return Err(truncated());
+        }
+        attributes.push((begin, at));
+    }
+    let end = at;
+    let name = |&(b, _): &(usize, usize)| {
+        let n = bytes[b..].iter().position(|&c| c == 0).unwrap_or(0);
+        bytes[b..b + n].to_vec()
+    };
+    let mut sorted = attributes.clone();
+    sorted.sort_by_key(name);
+    let header: Vec<u8> = sorted
+        .iter()
+        .flat_map(|&(b, e)| bytes[b..e].iter().copied())
+        .collect();
+    bytes[start..end].copy_from_slice(&header);
+    Ok(())
 }
 
 /// EXR header attributes the format itself defines; metadata may not reuse them.

@@ -37,15 +37,54 @@ use sahara_render::mesh::Mesh;
 
 pub use error::FormatError;
 
-/// Loads a mesh, choosing the format by extension (`.obj` or `.ply`, any case).
+/// Loads a mesh, choosing the format by extension (`.obj`, `.ply`, `.gltf` or
+/// `.glb`, any case); see [`load_mesh_with_warnings`].
 pub fn load_mesh(path: &Path) -> Result<Mesh, FormatError> {
+    load_mesh_with_warnings(path).map(|(mesh, _)| mesh)
+}
+
+/// Loads a mesh as [`load_mesh`] does, with the problems that did not stop
+/// loading (one line each, naming the file).
+///
+/// A glTF file becomes one triangle list: every use of a mesh by a node of
+/// the scene, in scene order, with the node's transform applied to its
+/// vertices (so triangle `k` is the same triangle the renderer sees).
+pub fn load_mesh_with_warnings(path: &Path) -> Result<(Mesh, Vec<String>), FormatError> {
     let extension = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     match extension.as_str() {
-        "obj" => obj::load_obj(path),
-        "ply" => ply::load_ply(path),
+        "obj" => Ok((obj::load_obj(path)?, Vec::new())),
+        "ply" => Ok((ply::load_ply(path)?, Vec::new())),
+        "gltf" | "glb" => {
+            let g = gltf::load_gltf(path)?;
+            let mut mesh = Mesh::default();
+            for inst in &g.instances {
+                let part = &g.meshes[inst.mesh].mesh;
+                let base = mesh.positions.len();
+                let base32 = u32::try_from(base)
+                    .ok()
+                    .filter(|b| {
+                        u32::try_from(part.positions.len())
+                            .is_ok_and(|n| b.checked_add(n).is_some())
+                    })
+                    .ok_or_else(|| {
+                        FormatError::in_file(
+                            &path.display().to_string(),
+                            "the scene's mesh uses have more than 2^32 vertices in all",
+                        )
+                    })?;
+                mesh.positions.extend(
+                    part.positions
+                        .iter()
+                        .map(|&p| inst.transform.transform_point3(p)),
+                );
+                mesh.indices
+                    .extend(part.indices.iter().map(|t| t.map(|i| i + base32)));
+            }
+            Ok((mesh, g.warnings))
+        }
         _ => Err(FormatError::UnsupportedExtension {
             path: path.display().to_string(),
             extension,

@@ -38,6 +38,16 @@ pub struct MeshScene {
 
 /// Loads a mesh file with its materials, camera and (if needed) the default light.
 pub fn load_mesh_scene(path: &Path) -> Result<MeshScene, FormatError> {
+    load_mesh_scene_with_camera(path, None)
+}
+
+/// Loads a mesh file as [`load_mesh_scene`] does, with the camera of the
+/// sidecar `camera` if given (instead of `<stem>.camera.json` or the
+/// automatic one).
+pub fn load_mesh_scene_with_camera(
+    path: &Path,
+    camera: Option<&Path>,
+) -> Result<MeshScene, FormatError> {
     // Placeholder camera until the bounds are known.
     let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
     let mut library = MeshLibrary::new();
@@ -49,8 +59,8 @@ pub fn load_mesh_scene(path: &Path) -> Result<MeshScene, FormatError> {
             material: file.material,
         });
     }
-    let sidecar = sidecar_path(path);
-    let (camera, camera_source) = if sidecar.exists() {
+    let sidecar = camera.map_or_else(|| sidecar_path(path), Path::to_path_buf);
+    let (camera, camera_source) = if camera.is_some() || sidecar.exists() {
         let c = read_sidecar(&sidecar)?;
         (
             Camera::look_at(c.eye, c.target, c.up, c.vfov_deg, 1.0),
@@ -95,10 +105,22 @@ pub fn auto_camera(scene: &Scene, name: &str) -> Result<Camera, FormatError> {
             "the mesh has no triangles with finite corners; nothing to frame",
         ));
     }
-    let c = 0.5 * (lo + hi);
+    let c = 0.5 * lo + 0.5 * hi;
     let r = (0.5 * (hi - lo).length()).max(1e-6);
     let eye =
         c + Vec3::new(0.3, 0.5, 1.0).normalize() * (r / (0.5 * AUTO_VFOV_DEG.to_radians()).sin());
+    // Coordinates near the float range put the eye at infinity, and
+    // coordinates far from the origin beside a tiny mesh leave no room
+    // between eye and target.
+    if !(eye.is_finite() && c.is_finite() && r.is_finite()) || eye == c {
+        return Err(FormatError::in_file(
+            name,
+            format!(
+                "the mesh's bounds ({lo} to {hi}) are too large to frame automatically; \
+                 give a camera sidecar (--camera FILE or {{stem}}.camera.json)"
+            ),
+        ));
+    }
     Ok(Camera::look_at(eye, c, Vec3::Y, AUTO_VFOV_DEG, 1.0))
 }
 

@@ -4,7 +4,9 @@
 //! scalar type; other properties are skipped). Triangles come from the `face`
 //! element's `vertex_indices` (or `vertex_index`, or else its first list)
 //! property, polygons fan-triangulated as `(v0, vi, vi+1)`; faces with fewer
-//! than three indices give no triangles. Other elements are skipped.
+//! than three indices give no triangles. Other elements are skipped. In an
+//! ascii file every record is one line: a line with too few or too many
+//! values is an error at that line.
 //!
 //! Header counts are never trusted: before an element is read (and anything
 //! allocated for it), its count times its smallest possible record size is
@@ -204,6 +206,7 @@ fn list_len<R: Reader>(
             ),
         ));
     };
+    r.more_values(n);
     if !r.fits(n, item) {
         return Err(r.error(
             at,
@@ -244,6 +247,7 @@ fn read_vertices<R: Reader>(
     // `check_count` has bounded the count by the file size.
     mesh.positions.reserve_exact(element.count as usize);
     for v in 0..element.count {
+        r.begin_record(element.properties.len() as u64);
         let mut p = [0.0f32; 3];
         for (property, axis) in element.properties.iter().zip(axes) {
             let ctx = |e| with_context(e, element, v, &property.name);
@@ -256,6 +260,7 @@ fn read_vertices<R: Reader>(
                 }
             }
         }
+        r.end_record()?;
         mesh.positions.push(Vec3::from_array(p));
     }
     Ok(())
@@ -272,6 +277,7 @@ fn read_faces<R: Reader>(
     mesh.indices.reserve(element.count as usize);
     let mut polygon: Vec<u32> = Vec::new();
     for f in 0..element.count {
+        r.begin_record(element.properties.len() as u64);
         for (p, property) in element.properties.iter().enumerate() {
             let ctx = |e| with_context(e, element, f, &property.name);
             match property.kind {
@@ -305,12 +311,14 @@ fn read_faces<R: Reader>(
                 }
             }
         }
+        r.end_record()?;
     }
     Ok(())
 }
 
 fn skip_element<R: Reader>(r: &mut R, element: &Element) -> Result<(), FormatError> {
     for i in 0..element.count {
+        r.begin_record(element.properties.len() as u64);
         for property in &element.properties {
             let ctx = |e| with_context(e, element, i, &property.name);
             match property.kind {
@@ -321,6 +329,7 @@ fn skip_element<R: Reader>(r: &mut R, element: &Element) -> Result<(), FormatErr
                 }
             }
         }
+        r.end_record()?;
     }
     Ok(())
 }

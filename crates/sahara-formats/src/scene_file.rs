@@ -150,12 +150,15 @@ pub enum MaterialKind {
         /// Perceptual roughness in [0, 1].
         roughness: f32,
     },
-    /// A light-emitting surface (black otherwise).
+    /// A light-emitting surface that also reflects diffusely with `albedo`
+    /// (default 0: black but for its emission).
     Emission {
         /// Emitted radiance (>= 0).
         radiance: Vec3,
         /// Emit from both faces (default: only the front).
         two_sided: bool,
+        /// Lambertian reflectance in [0, 1] (default 0).
+        albedo: Vec3,
     },
 }
 
@@ -296,6 +299,9 @@ pub enum LightSpec {
         radiance: Vec3,
         /// Emit from both faces.
         two_sided: bool,
+        /// Name of a `[[material]]` (checked to exist) the light's surface
+        /// scatters with besides emitting; `None`: black but for its emission.
+        material: Option<String>,
     },
     /// Light from infinitely far away in every direction.
     Environment(EnvironmentSpec),
@@ -322,7 +328,7 @@ pub enum IntegratorSpec {
     Distribution {
         /// Largest number of specular/glossy bounces (>= 1, default 8).
         max_depth: u32,
-        /// Samples per area light at every hit (>= 1, default 1).
+        /// Samples per area light at every hit (>= 1, default 4).
         light_samples: u32,
     },
     /// Path tracing with next-event estimation.
@@ -338,7 +344,7 @@ pub enum IntegratorSpec {
     Depth,
     /// Ambient occlusion.
     Ao {
-        /// Rays per pixel sample (>= 1, default 1).
+        /// Rays per pixel sample (>= 1, default 4).
         samples: u32,
         /// Occlusion distance (>= 0; 0: a tenth of the scene's size).
         distance: f32,
@@ -363,7 +369,7 @@ pub enum SamplerKind {
 pub struct SamplerSpec {
     /// Which sampler (default sobol).
     pub kind: SamplerKind,
-    /// Samples per pixel (>= 1, default 16).
+    /// Samples per pixel (>= 1, default 64).
     pub spp: u32,
     /// Seed (>= 0, default 0).
     pub seed: u64,

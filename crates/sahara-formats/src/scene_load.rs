@@ -126,14 +126,11 @@ pub fn build_scene(file: &SceneFile, name: &str) -> Result<LoadedScene, FormatEr
         ));
     }
     for l in &file.lights {
-        add_light(&mut scene, l, name)?;
+        add_light(&mut scene, l, &named, name)?;
     }
-    let mut warnings = std::mem::take(&mut library.warnings);
-    if !scene.has_light() {
-        warnings.push(format!(
-            "{name}: the scene has no light (no [[light]], emissive material or environment); the image will be black"
-        ));
-    }
+    // A scene without light is reported by `Scene::diagnostics`, with the
+    // other problems of the finished scene.
+    let warnings = std::mem::take(&mut library.warnings);
     Ok(LoadedScene {
         scene,
         settings,
@@ -184,8 +181,9 @@ fn material_of(m: &MaterialSpec, warnings: &mut Vec<String>, name: &str) -> Mate
         MaterialKind::Emission {
             radiance,
             two_sided,
+            albedo,
         } => {
-            let mut out = Material::emitter(*radiance);
+            let mut out = Material::diffuse(*albedo).with_emission(*radiance);
             out.two_sided_emission = *two_sided;
             out
         }
@@ -193,7 +191,16 @@ fn material_of(m: &MaterialSpec, warnings: &mut Vec<String>, name: &str) -> Mate
 }
 
 /// Adds a `[[light]]`: explicit lights, emissive shapes, or the environment.
-fn add_light(scene: &mut Scene, l: &LightSpec, name: &str) -> Result<(), FormatError> {
+///
+/// An area light with a `material` scatters light with that material's BSDF
+/// (and texture) besides emitting its own radiance; without one its surface
+/// is black but for the emission.
+fn add_light(
+    scene: &mut Scene,
+    l: &LightSpec,
+    named: &HashMap<&str, u32>,
+    name: &str,
+) -> Result<(), FormatError> {
     match l {
         LightSpec::Point {
             position,
@@ -216,8 +223,16 @@ fn add_light(scene: &mut Scene, l: &LightSpec, name: &str) -> Result<(), FormatE
             shape,
             radiance,
             two_sided,
+            material,
         } => {
-            let mut m = Material::emitter(*radiance);
+            // The resolver checked that the name exists.
+            let surface = material.as_deref().and_then(|n| named.get(n));
+            let mut m = match surface {
+                Some(&id) => scene.materials[id as usize]
+                    .clone()
+                    .with_emission(*radiance),
+                None => Material::emitter(*radiance),
+            };
             m.two_sided_emission = *two_sided;
             let m = scene.add_material(m);
             let shape = shapes::shape_of(shape).ok_or_else(|| {

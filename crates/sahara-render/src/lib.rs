@@ -42,7 +42,9 @@ pub use integrator::Integrator;
 pub use light::{Environment, Light};
 pub use material::{Bsdf, Material};
 pub use mesh::{Mesh, SceneMesh};
-pub use render::{render, Progress, RenderResult, RenderSettings, RenderStats};
+pub use render::{
+    render, render_watched, Preview, Progress, RenderResult, RenderSettings, RenderStats,
+};
 pub use sampler::SamplerKind;
 pub use scene::Scene;
 pub use shape::Shape;

@@ -23,6 +23,18 @@ impl Mesh {
         Triangle::from_indexed(&self.positions, &self.indices)
     }
 
+    /// Number of triangles no ray can hit (a corner missing, not finite, or
+    /// zero area): the kd-tree skips them.
+    pub fn unhittable_count(&self) -> usize {
+        self.indices
+            .iter()
+            .filter(|t| {
+                let v = t.map(|k| self.positions.get(k as usize).copied().unwrap_or(Vec3::NAN));
+                !Triangle::new(v[0], v[1], v[2]).is_hittable()
+            })
+            .count()
+    }
+
     /// Bounds of the vertices that triangles use.
     pub fn bounds(&self) -> Aabb {
         self.indices

@@ -38,7 +38,8 @@ pub struct RenderSettings {
     /// Stop starting passes after this long; a pass under way when it runs
     /// out is abandoned (the first pass always completes).
     pub time_limit: Option<Duration>,
-    /// Set to true (e.g. on Ctrl-C) to stop; the passes completed are kept.
+    /// Set to true (e.g. on Ctrl-C) to stop; the passes completed are kept,
+    /// and if the first pass is under way, the pixels it has finished.
     pub cancel: Option<Arc<AtomicBool>>,
     /// Seed of every random decision.
     pub seed: u64,
@@ -114,6 +115,10 @@ pub struct RenderStats {
     pub render_time: Duration,
     /// True if the render stopped on cancel or time limit before `passes`.
     pub stopped_early: bool,
+    /// Pixels finished (with all `spp` samples of the pass) in a first pass
+    /// stopped by cancel; 0 otherwise. The image holds these pixels and is
+    /// black elsewhere.
+    pub first_pass_pixels: u64,
 }
 
 impl RenderStats {
@@ -132,6 +137,15 @@ pub struct CostMaps {
     pub tests: Vec<f32>,
     /// The value shown as full heat.
     pub scale: f32,
+}
+
+/// What [`render_watched`] calls between passes, at most once per `every`.
+pub struct Preview<'a> {
+    /// Shortest time between two calls.
+    pub every: Duration,
+    /// Called with the image of the passes completed so far (not after the
+    /// last pass: that image is the render's result).
+    pub show: &'a mut (dyn FnMut(&RenderResult) + Send),
 }
 
 /// The image and what it cost.
@@ -154,6 +168,19 @@ struct Tile {
     y1: u32,
 }
 
+impl Tile {
+    /// Number of pixels.
+    fn pixels(&self) -> u32 {
+        (self.x1 - self.x0) * (self.y1 - self.y0)
+    }
+
+    /// The `k`-th pixel in render order (rows top to bottom).
+    fn pixel(&self, k: u32) -> (u32, u32) {
+        let w = self.x1 - self.x0;
+        (self.x0 + k % w, self.y0 + k / w)
+    }
+}
+
 /// A tile's filtered samples over its pixels plus the filter margin.
 struct TileOut {
     /// Buffer origin and size (clipped to the image).
@@ -166,6 +193,8 @@ struct TileOut {
     stats: TraceStats,
     nan: u64,
     negative: u64,
+    /// Pixels rendered, in render order (all of them unless stopped).
+    pixels_done: u32,
 }
 
 /// Renders `scene`; `progress` is called from worker threads as tiles
@@ -174,6 +203,18 @@ pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
     progress: &(dyn Fn(Progress) + Sync),
+) -> RenderResult {
+    render_watched(scene, settings, progress, None)
+}
+
+/// Renders `scene` as [`render`] does, also handing the image of the passes
+/// completed so far to `preview` between passes, at most once per
+/// `preview.every` (a preview does not change the final image).
+pub fn render_watched(
+    scene: &Scene,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(Progress) + Sync),
+    mut preview: Option<Preview<'_>>,
 ) -> RenderResult {
     let start = Instant::now();
     let world = World::new(scene, &settings.build);
@@ -197,6 +238,7 @@ pub fn render(
         ..Default::default()
     };
     let render_start = Instant::now();
+    let mut last_preview = Instant::now();
     let cancelled = || {
         settings
             .cancel
@@ -206,6 +248,8 @@ pub fn render(
     let out_of_time = || settings.time_limit.is_some_and(|t| start.elapsed() >= t);
     let passes = settings.passes.max(1);
     let rays_so_far = std::sync::atomic::AtomicU64::new(0);
+    // Pixels finished in an interrupted first pass (None: not interrupted).
+    let mut finished: Option<Vec<bool>> = None;
     for pass in 0..passes {
         if cancelled() || (pass > 0 && out_of_time()) {
             stats.stopped_early = true;
@@ -213,6 +257,9 @@ pub fn render(
         }
         let done = AtomicU32::new(0);
         let abandon = AtomicBool::new(false);
+        // The first pass stops pixel by pixel on cancel, so that a long
+        // first pass still leaves the pixels it finished.
+        let stop_pixel = || pass == 0 && cancelled();
         let outs: Vec<Option<TileOut>> = tiles
             .par_iter()
             // One job per tile: rayon otherwise hands out a few large runs
@@ -223,7 +270,10 @@ pub fn render(
                     abandon.store(true, Ordering::Relaxed);
                     return None;
                 }
-                let out = render_tile(&world, settings, *tile, pass, w, h);
+                let out = render_tile(&world, settings, *tile, pass, w, h, &stop_pixel);
+                if out.pixels_done < tile.pixels() {
+                    abandon.store(true, Ordering::Relaxed);
+                }
                 let d = done.fetch_add(1, Ordering::Relaxed) + 1;
                 let t = &out.stats;
                 let rays = rays_so_far.fetch_add(
@@ -243,9 +293,29 @@ pub fn render(
                 Some(out)
             })
             .collect();
-        if outs.iter().any(Option::is_none) {
+        let complete = outs
+            .iter()
+            .zip(&tiles)
+            .all(|(o, t)| o.as_ref().is_some_and(|o| o.pixels_done == t.pixels()));
+        if !complete && pass > 0 {
+            // A later pass is dropped whole: every pixel keeps the same
+            // number of samples.
             stats.stopped_early = true;
             break;
+        }
+        if !complete {
+            // The first pass, interrupted: keep the pixels it finished.
+            let mut mask = vec![false; (w * h) as usize];
+            for (out, tile) in outs.iter().zip(&tiles) {
+                if let Some(out) = out {
+                    for k in 0..out.pixels_done {
+                        let (x, y) = tile.pixel(k);
+                        mask[(y * w + x) as usize] = true;
+                    }
+                }
+            }
+            stats.first_pass_pixels = mask.iter().filter(|&&m| m).count() as u64;
+            finished = Some(mask);
         }
         // Merge in tile order: the sums' order is fixed.
         for out in outs.into_iter().flatten() {
@@ -261,15 +331,47 @@ pub fn render(
             stats.nan_samples += out.nan;
             stats.negative_samples += out.negative;
         }
+        if !complete {
+            stats.stopped_early = true;
+            break;
+        }
         stats.passes += 1;
+        if let Some(p) = preview.as_mut() {
+            if pass + 1 < passes && last_preview.elapsed() >= p.every {
+                let mut snapshot = stats;
+                snapshot.spp = stats.passes * settings.spp;
+                snapshot.render_time = render_start.elapsed();
+                snapshot.stopped_early = true;
+                (p.show)(&finish(&sum, &wsum, None, snapshot, settings, w, h));
+                last_preview = Instant::now();
+            }
+        }
     }
-    stats.spp = stats.passes * settings.spp;
+    stats.spp = if finished.is_some() {
+        settings.spp
+    } else {
+        stats.passes * settings.spp
+    };
     stats.render_time = render_start.elapsed();
+    finish(&sum, &wsum, finished.as_deref(), stats, settings, w, h)
+}
+
+/// The image of the sums so far (black where `finished` says a pixel was not).
+fn finish(
+    sum: &[DVec3],
+    wsum: &[f64],
+    finished: Option<&[bool]>,
+    stats: RenderStats,
+    settings: &RenderSettings,
+    w: u32,
+    h: u32,
+) -> RenderResult {
     let mut film = Film::new(w, h);
-    for (p, (s, wt)) in film.pixels.iter_mut().zip(sum.iter().zip(&wsum)) {
+    for (k, (p, (s, wt))) in film.pixels.iter_mut().zip(sum.iter().zip(wsum)).enumerate() {
+        let keep = finished.is_none_or(|f| f[k]);
         // Negative lobes (Mitchell) can make an estimate negative near
         // edges; the film holds radiance, which is not.
-        *p = if *wt > 0.0 {
+        *p = if *wt > 0.0 && keep {
             (*s / *wt).as_vec3().max(Vec3::ZERO)
         } else {
             Vec3::ZERO
@@ -301,8 +403,17 @@ fn filter_margin(f: &Filter) -> u32 {
     (f.radius() - 0.5).ceil().max(0.0) as u32
 }
 
-/// Renders one pass of one tile.
-fn render_tile(world: &World, s: &RenderSettings, t: Tile, pass: u32, w: u32, h: u32) -> TileOut {
+/// Renders one pass of one tile; `stop` is asked before each pixel, and
+/// once it says so, the rest of the tile is left out.
+fn render_tile(
+    world: &World,
+    s: &RenderSettings,
+    t: Tile,
+    pass: u32,
+    w: u32,
+    h: u32,
+    stop: &dyn Fn() -> bool,
+) -> TileOut {
     let m = filter_margin(&s.filter);
     let bx = t.x0.saturating_sub(m);
     let by = t.y0.saturating_sub(m);
@@ -318,12 +429,16 @@ fn render_tile(world: &World, s: &RenderSettings, t: Tile, pass: u32, w: u32, h:
         stats: TraceStats::default(),
         nan: 0,
         negative: 0,
+        pixels_done: 0,
     };
     let camera = &world.scene.camera;
     let inv = Vec2::new(1.0 / w as f32, 1.0 / h as f32);
     let r = s.filter.radius();
     for y in t.y0..t.y1 {
         for x in t.x0..t.x1 {
+            if stop() {
+                return out;
+            }
             let stream = hash2(s.seed, (y as u64) * w as u64 + x as u64);
             for index in 0..s.spp {
                 let sampler = PixelSampler {
@@ -379,6 +494,7 @@ fn render_tile(world: &World, s: &RenderSettings, t: Tile, pass: u32, w: u32, h:
                     }
                 }
             }
+            out.pixels_done += 1;
         }
     }
     out

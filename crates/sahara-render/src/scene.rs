@@ -160,17 +160,7 @@ impl Scene {
     pub fn diagnostics(&self) -> Vec<String> {
         let mut out = Vec::new();
         for (i, m) in self.meshes.iter().enumerate() {
-            let skipped = m.mesh.indices.iter().filter(|t| {
-                let v = t.map(|k| {
-                    m.mesh
-                        .positions
-                        .get(k as usize)
-                        .copied()
-                        .unwrap_or(glam::Vec3::NAN)
-                });
-                !sahara_kd::Triangle::new(v[0], v[1], v[2]).is_hittable()
-            });
-            let n = skipped.count();
+            let n = m.mesh.unhittable_count();
             if n > 0 {
                 out.push(format!(
                     "mesh {i}: {n} of {} triangles skipped (non-finite coordinates or zero area)",
@@ -179,7 +169,11 @@ impl Scene {
             }
         }
         if !self.has_light() {
-            out.push("the scene has no light: the image will be black".to_string());
+            out.push(
+                "the scene has no light (no light source, emissive material or environment): \
+                 the image will be black"
+                    .to_string(),
+            );
         }
         out
     }

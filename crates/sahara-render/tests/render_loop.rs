@@ -289,3 +289,96 @@ fn instances_share_one_tree() {
     let hit = r.film.pixels.iter().filter(|p| p.length() > 0.0).count();
     assert!(hit > 300, "{hit} pixels see a sphere");
 }
+
+#[test]
+fn an_interrupted_first_pass_keeps_the_pixels_it_finished() {
+    let scene = builtin::cornell_box();
+    let mut s = settings(16, 16, 8, Integrator::default());
+    // A box filter: each pixel only gets its own samples, so a finished
+    // pixel is the same whether its neighbours were rendered or not.
+    s.filter = Filter::box_filter();
+    s.tile_size = 4;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let full = pool.install(|| render(&scene, &s, &|_| {}));
+    assert_eq!(full.stats.first_pass_pixels, 0);
+
+    // Cancel as the second tile finishes: on one thread tiles run in order,
+    // so exactly the first two tiles (the top-left 8x4 pixels) are done.
+    let cancel = Arc::new(AtomicBool::new(false));
+    s.cancel = Some(cancel.clone());
+    s.passes = 3;
+    let r = pool.install(|| {
+        render(&scene, &s, &|p| {
+            if p.tiles_done == 2 {
+                cancel.store(true, std::sync::atomic::Ordering::SeqCst);
+            }
+        })
+    });
+    assert!(r.stats.stopped_early);
+    assert_eq!(r.stats.passes, 0);
+    assert_eq!(r.stats.first_pass_pixels, 32);
+    assert_eq!(
+        r.stats.spp, 8,
+        "the finished pixels have the pass's samples"
+    );
+    for y in 0..16 {
+        for x in 0..16 {
+            let k = y * 16 + x;
+            let (got, want) = (r.film.pixels[k], full.film.pixels[k]);
+            if x < 8 && y < 4 {
+                assert_eq!(
+                    got.to_array().map(f32::to_bits),
+                    want.to_array().map(f32::to_bits)
+                );
+                assert!(got != Vec3::ZERO);
+            } else {
+                assert_eq!(got, Vec3::ZERO, "pixel ({x}, {y}) was not rendered");
+            }
+        }
+    }
+}
+
+#[test]
+fn previews_come_between_passes_and_leave_the_image_unchanged() {
+    let scene = builtin::cornell_box();
+    let mut s = settings(12, 12, 1, Integrator::default());
+    s.passes = 4;
+    let plain = render(&scene, &s, &|_| {});
+    let mut seen = Vec::new();
+    let watched = sahara_render::render_watched(
+        &scene,
+        &s,
+        &|_| {},
+        Some(sahara_render::Preview {
+            every: Duration::ZERO,
+            show: &mut |r| seen.push((r.stats.spp, r.film.mean(0, 0, 12, 12))),
+        }),
+    );
+    // Passes 1 to 3; the image of pass 4 is the result itself.
+    assert_eq!(
+        seen.iter().map(|(spp, _)| *spp).collect::<Vec<_>>(),
+        [1, 2, 3]
+    );
+    assert!(seen.iter().all(|(_, mean)| mean.x > 0.0));
+    assert_eq!(watched.film.pixels, plain.film.pixels);
+    assert_eq!(watched.stats.spp, 4);
+}
+
+#[test]
+fn the_built_in_cornell_light_is_a_white_diffuser_that_emits() {
+    // As in Mitsuba's Cornell box: the light panel reflects (diffuse 0.78)
+    // besides emitting (17, 12, 4).
+    let scene = builtin::cornell_box();
+    let lights: Vec<_> = scene.materials.iter().filter(|m| m.is_emissive()).collect();
+    assert_eq!(lights.len(), 1);
+    assert_eq!(lights[0].emission, Vec3::new(17.0, 12.0, 4.0));
+    assert_eq!(
+        lights[0].bsdf,
+        sahara_render::Bsdf::Diffuse {
+            albedo: Vec3::splat(0.78)
+        }
+    );
+}

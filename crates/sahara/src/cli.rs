@@ -25,7 +25,7 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Run the ray-casting benchmark protocol (shared/bench/PROTOCOL.md) on a mesh.
+    /// Run the ray-casting benchmark protocol (docs/bench-protocol.md) on a mesh.
     #[command(long_about = BENCH_ABOUT)]
     Bench(BenchArgs),
     /// Build a kd-tree over a mesh and print its statistics and build time.
@@ -89,6 +89,19 @@ pub struct RenderArgs {
     /// equal-time comparisons); --spp is then the samples of each pass.
     #[arg(long, value_name = "SECS")]
     pub time_limit: Option<f64>,
+    /// Camera sidecar JSON for a mesh (or the built-in scene), instead of
+    /// <dir>/<stem>.camera.json or the automatic camera.
+    #[arg(long, value_name = "FILE")]
+    pub camera: Option<PathBuf>,
+    /// Kd-tree builder (as for `sahara bench`): a speed setting only, the
+    /// image is the same with any [default: sah].
+    #[arg(long, value_name = "NAME", value_parser = parse_builder)]
+    pub builder: Option<Builder>,
+    /// During a progressive render, rewrite the output (atomically, marked
+    /// partial) with the passes done so far at most every SECS seconds, to
+    /// watch it in an image viewer; the final image replaces it.
+    #[arg(long, value_name = "SECS")]
+    pub preview_every: Option<f64>,
     /// Exposure in stops, for PNG output [default: the scene file's, else 0].
     #[arg(long, allow_negative_numbers = true)]
     pub exposure: Option<f32>,
@@ -99,7 +112,7 @@ pub struct RenderArgs {
 }
 
 const BENCH_ABOUT: &str = "\
-Run the ray-casting benchmark protocol (shared/bench/PROTOCOL.md) on a mesh.
+Run the ray-casting benchmark protocol (docs/bench-protocol.md) on a mesh.
 
 Builds the tree (best of 3 builds), generates the protocol's ray sets on a
 1024x1024 image (primary; shadow and diffuse from Sahara's own primary hits;
@@ -138,7 +151,8 @@ mrays_packet_1t[_cpu] and mrays_packet16_1t[_cpu].";
 /// Options of `sahara bench`.
 #[derive(Debug, Args)]
 pub struct BenchArgs {
-    /// The mesh (.obj or .ply); none for a built-in procedural scene.
+    /// The mesh (.obj, .ply, .gltf or .glb; a glTF scene's meshes are merged
+    /// in scene order); none for a built-in procedural scene.
     pub mesh: Option<PathBuf>,
     /// How to run.
     #[command(flatten)]
@@ -225,7 +239,8 @@ impl Default for BenchOptions {
 /// Options of `sahara stats`.
 #[derive(Debug, Args)]
 pub struct StatsArgs {
-    /// The mesh (.obj or .ply).
+    /// The mesh (.obj, .ply, .gltf or .glb; a glTF scene's meshes are merged
+    /// in scene order).
     pub mesh: PathBuf,
     /// The tree to build.
     #[command(flatten)]

@@ -8,14 +8,24 @@ use sahara_bench::{ProtocolCamera, SceneFrame};
 use sahara_formats::camera::{read_sidecar, sidecar_path, CameraSidecar};
 use sahara_render::mesh::Mesh;
 
-/// Load a mesh and check that the protocol can use it (triangles, indices
-/// in range).
+/// Load a mesh (`.obj`, `.ply`, `.gltf`, `.glb`; a glTF scene's meshes
+/// merged in scene order), print its loading warnings, and check that the
+/// protocol can use it (triangles, indices in range).
 pub fn load_mesh(path: &Path) -> Result<Mesh> {
     // A `FormatError`'s message already holds its cause: flatten it so the
     // cause is not printed twice by `{:#}`.
-    let mesh = sahara_formats::load_mesh(path)
+    let (mesh, mut warnings) = sahara_formats::load_mesh_with_warnings(path)
         .map_err(|e| anyhow!("{e}"))
         .with_context(|| format!("cannot load mesh {}", path.display()))?;
+    let skipped = mesh.unhittable_count();
+    if skipped > 0 {
+        warnings.push(format!(
+            "{}: {skipped} of {} triangles skipped (non-finite coordinates or zero area)",
+            path.display(),
+            mesh.triangle_count()
+        ));
+    }
+    crate::warnings::print(&warnings);
     SceneFrame::from_mesh(&mesh).with_context(|| format!("mesh {}", path.display()))?;
     Ok(mesh)
 }

@@ -1,7 +1,7 @@
 //! `sahara`: the command line of the Sahara ray tracer.
 //!
 //! `sahara bench` runs the ray-casting benchmark protocol
-//! (`shared/bench/PROTOCOL.md`), `sahara stats` prints a tree's statistics;
+//! (`docs/bench-protocol.md`), `sahara stats` prints a tree's statistics;
 //! with no subcommand it benchmarks a built-in procedural scene.
 
 mod bench;
@@ -13,6 +13,7 @@ mod memory;
 mod render;
 mod render_options;
 mod stats;
+mod warnings;
 
 use std::process::ExitCode;
 

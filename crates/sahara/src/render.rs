@@ -7,17 +7,18 @@ use std::time::Duration;
 
 use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use sahara_formats::camera::read_sidecar;
 use sahara_formats::image_out::{write_image, Pixels};
-use sahara_formats::mesh_scene::load_mesh_scene;
+use sahara_formats::mesh_scene::load_mesh_scene_with_camera;
 use sahara_formats::scene_load::{load_scene, FileSettings};
-use sahara_render::{builtin, render, Progress, RenderSettings, Scene};
+use sahara_render::{
+    builtin, render_watched, Camera, Integrator, Preview, Progress, RenderResult, RenderSettings,
+    Scene, ToneMap,
+};
 
 use crate::cli::RenderArgs;
 use crate::memory;
 use crate::render_options::{resolve, RenderOptions};
-
-/// Most warnings printed one by one; the rest are counted.
-const MAX_WARNINGS_SHOWN: usize = 20;
 
 /// A scene to render, with what its file says about rendering it.
 struct Input {
@@ -36,10 +37,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         name,
         description,
         warnings,
-    } = load_input(args.scene.as_deref())?;
+    } = load_input(args.scene.as_deref(), args.camera.as_deref())?;
     let mut warnings = warnings;
-    warnings.extend(scene.diagnostics());
-    print_warnings(&warnings);
+    // The finished scene's problems, named after the file they come from.
+    let from_file = args.scene.as_ref().map(|p| p.display().to_string());
+    warnings.extend(scene.diagnostics().into_iter().map(|d| match &from_file {
+        Some(f) => format!("{f}: {d}"),
+        None => d,
+    }));
+    crate::warnings::print(&warnings);
     let RenderOptions {
         settings,
         sampler_name,
@@ -65,9 +71,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     )?;
     // Any aspect ratio: the vertical field of view is kept.
     scene.camera.aspect = settings.width as f32 / settings.height as f32;
-    scene
-        .validate()
-        .map_err(|e| anyhow!("invalid scene: {e}"))?;
+    scene.validate().map_err(|e| match &args.scene {
+        Some(p) => anyhow!("{}: invalid scene: {e}", p.display()),
+        None => anyhow!("invalid scene: {e}"),
+    })?;
 
     let cancel = settings.cancel.clone().expect("settings set a cancel flag");
     // SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature): a batch
@@ -80,7 +87,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     })
     .context("cannot install the SIGINT/SIGTERM handler")?;
 
-    let bar = progress_bar(&settings);
     let threads = args.threads.map_or(0, usize::from);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -99,11 +105,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         settings.spp,
         pool.current_num_threads()
     );
+    // Started after the line above, so that it does not draw over it.
+    let bar = progress_bar(&settings);
     let on_progress = |p: Progress| {
         bar.set_position((p.pass as u64) * p.tiles as u64 + p.tiles_done as u64);
-        if p.tiles_done == 1 {
-            bar.set_length(p.passes as u64 * p.tiles as u64);
-        }
         let mrays = p.rays as f64 / p.elapsed.as_secs_f64().max(1e-9) / 1e6;
         let of = if p.passes == u32::MAX {
             String::new()
@@ -112,7 +117,29 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         };
         bar.set_message(format!("pass {}{of} {mrays:.1} Mrays/s", p.pass + 1));
     };
-    let result = pool.install(|| render(&scene, &settings, &on_progress));
+    let output_settings = Output {
+        path: &output,
+        settings: &settings,
+        exposure,
+        tonemap,
+    };
+    let mut show_preview = |r: &RenderResult| {
+        // A preview that cannot be written is a warning: the render goes on.
+        if let Err(e) = output_settings.write(r, true, false) {
+            bar.suspend(|| eprintln!("warning: preview not written: {e:#}"));
+        }
+    };
+    let preview = match args.preview_every {
+        None => None,
+        Some(t) if !(t >= 0.0 && t.is_finite()) => {
+            bail!("--preview-every must be a number of seconds >= 0")
+        }
+        Some(t) => Some(Preview {
+            every: Duration::from_secs_f64(t),
+            show: &mut show_preview,
+        }),
+    };
+    let result = pool.install(|| render_watched(&scene, &settings, &on_progress, preview));
     bar.finish_and_clear();
 
     let s = &result.stats;
@@ -121,44 +148,38 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .cancel
             .as_ref()
             .is_some_and(|c| c.load(Ordering::SeqCst));
-    if s.passes == 0 {
-        bail!("stopped before the first pass completed: no image written");
+    if s.passes == 0 && s.first_pass_pixels == 0 {
+        bail!("stopped before the first pixel was finished: no image written");
     }
-    let rgb = result.film.to_rgb_f32();
-    let rgb8 = if is_exr(&output) {
-        Vec::new()
-    } else {
-        result.film.to_srgb8(exposure, tonemap)
-    };
-    let pixels = if is_exr(&output) {
-        Pixels::LinearRgbF32(&rgb)
-    } else {
-        Pixels::Rgb8(&rgb8)
-    };
-    let metadata = vec![
-        (
-            "sahara:integrator".to_string(),
-            settings.integrator.name().to_string(),
-        ),
-        ("sahara:spp".to_string(), s.spp.to_string()),
-        ("sahara:seed".to_string(), settings.seed.to_string()),
-        ("sahara:partial".to_string(), partial.to_string()),
-    ];
-    write_image(&output, settings.width, settings.height, pixels, &metadata)
-        .map_err(|e| anyhow!("{e}"))
-        .context("cannot write the output image")?;
+    output_settings.write(&result, partial, true)?;
     let secs = s.render_time.as_secs_f64();
+    let pixels = u64::from(settings.width) * u64::from(settings.height);
     eprintln!(
-        "{} {}: {} passes, {} spp, {:.2} s render (+{:.0} ms tree builds), {} rays, {:.2} Mrays/s{}",
-        if partial { "wrote PARTIAL image" } else { "wrote" },
+        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {} rays, {:.2} Mrays/s{}",
+        if partial {
+            "wrote PARTIAL image"
+        } else {
+            "wrote"
+        },
         output.display(),
-        s.passes,
+        if s.passes == 0 {
+            format!(
+                "first pass interrupted, {} of {pixels} pixels finished (the rest black)",
+                s.first_pass_pixels
+            )
+        } else {
+            format!("{} passes", s.passes)
+        },
         s.spp,
         secs,
         s.build_time.as_secs_f64() * 1e3,
         s.rays(),
         s.rays() as f64 / secs.max(1e-9) / 1e6,
-        if s.nan_samples > 0 { format!(", {} NaN samples dropped", s.nan_samples) } else { String::new() }
+        if s.nan_samples > 0 {
+            format!(", {} NaN samples dropped", s.nan_samples)
+        } else {
+            String::new()
+        }
     );
     if partial {
         // Interrupted: the image of the completed passes is on disk.
@@ -167,12 +188,148 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// Where and how the image is written.
+struct Output<'a> {
+    path: &'a Path,
+    settings: &'a RenderSettings,
+    exposure: f32,
+    tonemap: ToneMap,
+}
+
+impl Output<'_> {
+    /// Writes `result` (atomically), marked `partial` or not; `log` prints
+    /// what a debug view's colours mean.
+    fn write(&self, result: &RenderResult, partial: bool, log: bool) -> Result<()> {
+        let settings = self.settings;
+        let s = &result.stats;
+        let exr = is_exr(self.path);
+        let rgb = result.film.to_rgb_f32();
+        let rgb8 = if exr {
+            Vec::new()
+        } else if matches!(settings.integrator, Integrator::Depth) {
+            // Raw distances would be a flat white or grey: map the nearest
+            // to the farthest hit onto white to dark grey (EXR keeps them raw).
+            let range = depth_range(&rgb, settings.width, settings.height);
+            if log {
+                match range {
+                    Some((near, far)) => eprintln!(
+                        "depth: nearest hit {near:.4} (white) to farthest {far:.4} (dark grey), \
+                         no hit black; EXR output keeps the raw distances"
+                    ),
+                    None => eprintln!("depth: no ray hit anything"),
+                }
+            }
+            depth_to_gray8(&rgb, range)
+        } else {
+            result.film.to_srgb8(self.exposure, self.tonemap)
+        };
+        let pixels = if exr {
+            Pixels::LinearRgbF32(&rgb)
+        } else {
+            Pixels::Rgb8(&rgb8)
+        };
+        let finished = if s.passes == 0 {
+            s.first_pass_pixels
+        } else {
+            u64::from(settings.width) * u64::from(settings.height)
+        };
+        let metadata = vec![
+            (
+                "sahara:integrator".to_string(),
+                settings.integrator.name().to_string(),
+            ),
+            ("sahara:spp".to_string(), s.spp.to_string()),
+            ("sahara:seed".to_string(), settings.seed.to_string()),
+            ("sahara:partial".to_string(), partial.to_string()),
+            ("sahara:finished_pixels".to_string(), finished.to_string()),
+        ];
+        write_image(
+            self.path,
+            settings.width,
+            settings.height,
+            pixels,
+            &metadata,
+        )
+        .map_err(|e| anyhow!("{e}"))
+        .context("cannot write the output image")
+    }
+}
+
+/// The nearest and farthest distance in a depth image (0 is no hit).
+///
+/// The filter blends hit distances with the zeros of missed samples near
+/// silhouettes, which would make them look nearest: the nearest distance
+/// is taken from pixels at least [`SILHOUETTE_MARGIN`] pixels from any
+/// pixel without a hit (all pixels if none is that far).
+fn depth_range(rgb: &[f32], width: u32, height: u32) -> Option<(f32, f32)> {
+    let (w, h) = (width as usize, height as usize);
+    let d = |x: usize, y: usize| rgb[3 * (y * w + x)];
+    let hit = |v: f32| v > 0.0 && v.is_finite();
+    let far = (0..w * h)
+        .map(|k| rgb[3 * k])
+        .filter(|&v| hit(v))
+        .fold(0.0f32, f32::max);
+    if far <= 0.0 {
+        return None;
+    }
+    let m = SILHOUETTE_MARGIN;
+    let interior = |x: usize, y: usize| {
+        (y.saturating_sub(m)..(y + m + 1).min(h))
+            .all(|j| (x.saturating_sub(m)..(x + m + 1).min(w)).all(|i| hit(d(i, j))))
+    };
+    let nearest = |only_interior: bool| {
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .filter(|&(x, y)| hit(d(x, y)) && (!only_interior || interior(x, y)))
+            .map(|(x, y)| d(x, y))
+            .fold(f32::INFINITY, f32::min)
+    };
+    let near = match nearest(true) {
+        n if n.is_finite() => n,
+        _ => nearest(false),
+    };
+    Some((near.min(far), far))
+}
+
+/// Pixels around a silhouette that [`depth_range`] leaves out of the nearest distance.
+const SILHOUETTE_MARGIN: usize = 3;
+
+/// A depth image as 8-bit grey: `near` white, `far` dark grey (26), no hit black.
+fn depth_to_gray8(rgb: &[f32], range: Option<(f32, f32)>) -> Vec<u8> {
+    let Some((near, far)) = range else {
+        return vec![0; rgb.len()];
+    };
+    let span = (far - near).max(f32::MIN_POSITIVE);
+    rgb.iter()
+        .step_by(3)
+        .flat_map(|&d| {
+            let v = if d > 0.0 && d.is_finite() {
+                let t = ((d - near) / span).clamp(0.0, 1.0);
+                (255.0 * (1.0 - 0.9 * t)).round() as u8
+            } else {
+                0
+            };
+            [v; 3]
+        })
+        .collect()
+}
+
+/// The progress bar: as wide as the terminal, from 0% (a spinner with a
+/// time limit, where the total is unknown).
 fn progress_bar(settings: &RenderSettings) -> ProgressBar {
-    let bar = ProgressBar::new(0);
-    let template = if settings.time_limit.is_some() {
-        "{spinner} {elapsed_precise} {msg} tiles {pos}"
+    let ts = settings.tile_size.max(1);
+    let tiles = u64::from(settings.width.div_ceil(ts)) * u64::from(settings.height.div_ceil(ts));
+    let (len, template) = if settings.time_limit.is_some() {
+        (None, "{spinner} {elapsed_precise} {msg} tiles {pos}")
     } else {
-        "{bar:40} {percent:>3}% {msg} elapsed {elapsed_precise} eta {eta_precise}"
+        (
+            Some(u64::from(settings.passes.max(1)) * tiles),
+            "{wide_bar} {percent:>3}% {msg} {elapsed_precise} eta {eta_precise}",
+        )
+    };
+    let bar = match len {
+        Some(n) => ProgressBar::new(n),
+        None => ProgressBar::no_length(),
     };
     if let Ok(style) = ProgressStyle::with_template(template) {
         bar.set_style(style);
@@ -182,29 +339,43 @@ fn progress_bar(settings: &RenderSettings) -> ProgressBar {
 }
 
 /// The scene to render: the built-in Cornell box, a scene file or a mesh file.
-fn load_input(path: Option<&Path>) -> Result<Input> {
+fn load_input(path: Option<&Path>, camera: Option<&Path>) -> Result<Input> {
+    let flat = |e: sahara_formats::FormatError| anyhow!("{e}");
     let Some(path) = path else {
+        let mut scene = builtin::cornell_box();
+        if let Some(file) = camera {
+            let c = read_sidecar(file).map_err(flat)?;
+            scene.camera = Camera::look_at(c.eye, c.target, c.up, c.vfov_deg, 1.0);
+            eprintln!("camera: {}", file.display());
+        }
         return Ok(Input {
-            scene: builtin::cornell_box(),
+            scene,
             file: None,
             name: "cornell_box".into(),
             description: "the built-in Cornell box".into(),
             warnings: Vec::new(),
         });
     };
+    const EXPECTED: &str = "expected a scene file (.toml) or a mesh (.obj, .ply, .gltf, .glb)";
+    if path.is_dir() {
+        bail!("{}: is a folder; {EXPECTED}", path.display());
+    }
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     // A `FormatError`'s message already names the file and place.
-    let flat = |e: sahara_formats::FormatError| anyhow!("{e}");
     let (scene, file, warnings) = match ext.as_str() {
+        "toml" if camera.is_some() => bail!(
+            "{}: --camera applies to meshes and the built-in scene; a scene file has its own [camera]",
+            path.display()
+        ),
         "toml" => {
             let l = load_scene(path).map_err(flat)?;
             (l.scene, Some(l.settings), l.warnings)
         }
         "obj" | "ply" | "gltf" | "glb" => {
-            let m = load_mesh_scene(path).map_err(flat)?;
+            let m = load_mesh_scene_with_camera(path, camera).map_err(flat)?;
             eprintln!(
                 "camera: {}; light: {}",
                 m.camera_source,
@@ -216,10 +387,11 @@ fn load_input(path: Option<&Path>) -> Result<Input> {
             );
             (m.scene, None, m.warnings)
         }
-        _ => bail!(
-            "{}: cannot render .{ext} files; expected a scene file (.toml) or a mesh (.obj, .ply, .gltf, .glb)",
+        "" => bail!(
+            "{}: the file name has no extension; {EXPECTED}",
             path.display()
         ),
+        _ => bail!("{}: cannot render .{ext} files; {EXPECTED}", path.display()),
     };
     Ok(Input {
         scene,
@@ -230,23 +402,6 @@ fn load_input(path: Option<&Path>) -> Result<Input> {
     })
 }
 
-/// Prints warnings (the first [`MAX_WARNINGS_SHOWN`]) and their count.
-fn print_warnings(warnings: &[String]) {
-    for w in warnings.iter().take(MAX_WARNINGS_SHOWN) {
-        eprintln!("warning: {w}");
-    }
-    if warnings.len() > MAX_WARNINGS_SHOWN {
-        eprintln!("... and {} more", warnings.len() - MAX_WARNINGS_SHOWN);
-    }
-    if !warnings.is_empty() {
-        eprintln!(
-            "{} warning{} while loading",
-            warnings.len(),
-            if warnings.len() == 1 { "" } else { "s" }
-        );
-    }
-}
-
 fn stem(path: &Path) -> String {
     path.file_stem()
         .map_or("render".into(), |s| s.to_string_lossy().into_owned())
@@ -255,4 +410,42 @@ fn stem(path: &Path) -> String {
 fn is_exr(path: &Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A `w x h` depth image (three equal channels per pixel) from `f(x, y)`.
+    fn image(w: u32, h: u32, f: impl Fn(u32, u32) -> f32) -> Vec<f32> {
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .flat_map(|(x, y)| [f(x, y); 3])
+            .collect()
+    }
+
+    #[test]
+    fn depth_range_ignores_silhouette_blends() {
+        // A 10x10 object at distance 2 to 3 on a background of misses; its
+        // border pixels are blends with the misses (0.5).
+        let rgb = image(20, 20, |x, y| {
+            let inside = (5..15).contains(&x) && (5..15).contains(&y);
+            let border = x == 5 || x == 14 || y == 5 || y == 14;
+            match (inside, border) {
+                (false, _) => 0.0,
+                (true, true) => 0.5,
+                (true, false) => 2.0 + x as f32 / 20.0,
+            }
+        });
+        let (near, far) = depth_range(&rgb, 20, 20).unwrap();
+        assert!(near >= 2.0, "near {near}");
+        assert!((far - (2.0 + 13.0 / 20.0)).abs() < 1e-6, "far {far}");
+        let grey = depth_to_gray8(&rgb, Some((near, far)));
+        assert_eq!(grey[0], 0, "a miss is black");
+        assert_eq!(grey[3 * (20 * 6 + 13)], 26, "the farthest hit is dark grey");
+        // No hit at all: no range, a black image.
+        let none = image(4, 4, |_, _| 0.0);
+        assert_eq!(depth_range(&none, 4, 4), None);
+        assert!(depth_to_gray8(&none, None).iter().all(|&v| v == 0));
+    }
 }

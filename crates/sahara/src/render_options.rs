@@ -7,12 +7,14 @@ use std::time::Duration;
 
 use anyhow::{anyhow, bail, Result};
 use sahara_formats::scene_load::FileSettings;
+use sahara_kd::BuildParams;
 use sahara_render::{Filter, Integrator, RenderSettings, SamplerKind, ToneMap};
 
 use crate::cli::RenderArgs;
 
-/// Samples per pixel when neither the command line nor a scene file says.
-pub const DEFAULT_SPP: u32 = 64;
+/// Samples per pixel when neither the command line nor a scene file says
+/// (the renderer's default, which scene files use too).
+pub const DEFAULT_SPP: u32 = sahara_render::integrator::defaults::SPP;
 /// Image side in pixels when neither the command line nor a scene file says.
 pub const DEFAULT_SIDE: u32 = 512;
 
@@ -115,6 +117,9 @@ pub fn resolve(
             sampler,
             filter,
             integrator,
+            build: args
+                .builder
+                .map_or_else(BuildParams::default, BuildParams::new),
             ..Default::default()
         },
         sampler_name: match sampler {

@@ -304,3 +304,121 @@ fn a_truncated_ray_file_is_a_clear_error() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--dump random"));
     fs::remove_dir_all(dir).unwrap();
 }
+
+/// An OBJ of two triangles, one with a NaN corner.
+fn write_nan_obj(dir: &Path) -> PathBuf {
+    let obj = dir.join("nan.obj");
+    fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 1 1\nv 1 1 1\nv 0 1 1\nf 1 2 3\nf 4 5 6\n",
+    )
+    .unwrap();
+    obj
+}
+
+#[test]
+fn every_command_warns_about_skipped_triangles() {
+    let dir = temp_dir("nan-warn");
+    let obj = write_nan_obj(&dir);
+    let obj = obj.to_str().unwrap();
+    let png = dir.join("nan.png");
+    for args in [
+        &[
+            "bench",
+            obj,
+            "--runs",
+            "1",
+            "--threads",
+            "1",
+            "--sets",
+            "primary",
+        ][..],
+        &["stats", obj],
+        &["stats", obj, "--json"],
+        &[
+            "render",
+            obj,
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--spp",
+            "1",
+            "-o",
+            png.to_str().unwrap(),
+        ],
+    ] {
+        let out = sahara(args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {err}");
+        assert!(
+            err.contains("nan.obj") && err.contains("1 of 2 triangles skipped"),
+            "{args:?}: {err}"
+        );
+        assert!(err.contains("1 warning while loading"), "{args:?}: {err}");
+    }
+    // The JSON on stdout stays one object.
+    let out = sahara(&["stats", obj, "--json"]);
+    assert_eq!(stdout_json(&out)["triangles"], 2);
+    fs::remove_dir_all(dir).unwrap();
+}
+
+/// A glTF file (external buffer) whose scene uses a one-triangle mesh from
+/// two nodes, moved apart.
+fn write_two_node_gltf(dir: &Path) -> PathBuf {
+    let bin: Vec<u8> = [0f32, 0., 0., 1., 0., 0., 0., 1., 0.]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    fs::write(dir.join("tri.bin"), &bin).unwrap();
+    let gltf = dir.join("two.gltf");
+    fs::write(
+        &gltf,
+        r#"{
+  "asset": {"version": "2.0"},
+  "buffers": [{"uri": "tri.bin", "byteLength": 36}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [1, 1, 0]}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+  "nodes": [{"mesh": 0}, {"mesh": 0, "translation": [3, 0, 0]}],
+  "scenes": [{"nodes": [0, 1]}],
+  "scene": 0
+}"#,
+    )
+    .unwrap();
+    gltf
+}
+
+#[test]
+fn bench_and_stats_take_gltf_meshes() {
+    let dir = temp_dir("gltf-cmds");
+    let gltf = write_two_node_gltf(&dir);
+    let gltf = gltf.to_str().unwrap();
+    let j = stdout_json(&sahara(&["stats", gltf, "--json"]));
+    assert_eq!(j["triangles"], 2, "both node uses are merged: {j}");
+    let j = stdout_json(&sahara(&[
+        "bench",
+        gltf,
+        "--json",
+        "--runs",
+        "1",
+        "--threads",
+        "1",
+        "--sets",
+        "primary",
+    ]));
+    assert_eq!(j["triangles"], 2, "{j}");
+    // The auto camera frames both triangles: some primary rays hit.
+    assert!(j["sets"]["primary"]["hits"].as_u64().unwrap() > 0, "{j}");
+    fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn bench_help_points_at_the_repository_protocol() {
+    let out = sahara(&["bench", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    assert!(help.contains("docs/bench-protocol.md"), "{help}");
+    assert!(!help.contains("shared/bench"), "{help}");
+}

@@ -257,3 +257,363 @@ fn a_render_that_cannot_fit_in_memory_is_refused_with_an_estimate() {
     );
     assert!(!out_png.exists());
 }
+
+#[test]
+fn two_identical_exr_renders_are_byte_identical() {
+    let dir = temp_dir("exr-repeat");
+    let mut files = Vec::new();
+    for k in 0..4 {
+        let out = dir.join(format!("r{k}.exr"));
+        let threads = if k % 2 == 0 { "1" } else { "2" };
+        let o = out.to_str().unwrap();
+        let args = ["render", "--width", "16", "--height", "12", "--spp", "2"];
+        let run = sahara(&[&args[..], &["--threads", threads, "-o", o]].concat());
+        assert!(run.status.success(), "{}", stderr(&run));
+        files.push(fs::read(&out).unwrap());
+    }
+    for (k, f) in files.iter().enumerate() {
+        assert!(*f == files[0], "render {k} differs from render 0");
+    }
+    fs::remove_dir_all(dir).unwrap();
+}
+
+/// A floor quad lit by a disc area light, with `extra` appended.
+fn write_lit_floor(dir: &Path, name: &str, extra: &str) -> PathBuf {
+    let scene = dir.join(name);
+    fs::write(
+        &scene,
+        format!(
+            "[camera]\neye = [0, 2, 3]\ntarget = [0, 0, 0]\n\n\
+             [[object]]\ntype = \"quad\"\ncorner = [-2, 0, 2]\nedge_u = [4, 0, 0]\nedge_v = [0, 0, -4]\n\n\
+             [[light]]\ntype = \"area\"\nshape = \"disc\"\ncenter = [0, 1.5, 0]\nnormal = [0, -1, 0]\n\
+             radius = 0.5\nradiance = [4, 4, 4]\n\n\
+             [film]\nwidth = 8\nheight = 6\n{extra}"
+        ),
+    )
+    .unwrap();
+    scene
+}
+
+#[test]
+fn the_command_line_and_scene_files_share_their_defaults() {
+    let dir = temp_dir("defaults");
+    // The distribution integrator named on the command line, and named
+    // without parameters in a file, render the same image.
+    let plain = write_lit_floor(&dir, "plain.toml", "");
+    let named = write_lit_floor(
+        &dir,
+        "named.toml",
+        "\n[integrator]\nname = \"distribution\"\n",
+    );
+    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+    let run = |args: &[&str]| {
+        let out = sahara(args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stderr(&out)
+    };
+    let log_a = run(&[
+        "render",
+        plain.to_str().unwrap(),
+        "--integrator",
+        "distribution",
+        "-o",
+        a.to_str().unwrap(),
+    ]);
+    let log_b = run(&["render", named.to_str().unwrap(), "-o", b.to_str().unwrap()]);
+    assert!(
+        fs::read(&a).unwrap() == fs::read(&b).unwrap(),
+        "{log_a}\n{log_b}"
+    );
+    // Samples per pixel: the same default with and without a scene file.
+    let c = dir.join("c.png");
+    let log_c = run(&[
+        "render",
+        "--width",
+        "8",
+        "--height",
+        "6",
+        "-o",
+        c.to_str().unwrap(),
+    ]);
+    for log in [&log_a, &log_b, &log_c] {
+        assert!(log.contains(", 64 spp in passes of 8,"), "{log}");
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_path_without_a_usable_extension_says_what_it_is() {
+    let dir = temp_dir("no-ext");
+    let bare = dir.join("scene");
+    fs::write(&bare, "[camera]\n").unwrap();
+    for (path, what) in [(dir.clone(), "is a folder"), (bare, "has no extension")] {
+        let out = sahara(&["render", path.to_str().unwrap()]);
+        assert!(!out.status.success());
+        let err = stderr(&out);
+        assert!(
+            err.contains(what) && err.contains(path.to_str().unwrap()),
+            "{err}"
+        );
+        assert!(!err.contains("cannot render . files"), "{err}");
+        assert!(
+            err.contains("expected a scene file (.toml) or a mesh"),
+            "{err}"
+        );
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_mesh_too_large_to_frame_names_the_file() {
+    let dir = temp_dir("huge");
+    let obj = dir.join("huge.obj");
+    fs::write(&obj, "v -3e38 0 0\nv 3e38 0 0\nv 0 3e38 0\nf 1 2 3\n").unwrap();
+    let out = sahara(&[
+        "render",
+        obj.to_str().unwrap(),
+        "--width",
+        "4",
+        "--height",
+        "4",
+    ]);
+    assert!(!out.status.success());
+    let err = stderr(&out);
+    assert!(
+        err.contains("huge.obj") && err.contains("too large to frame"),
+        "{err}"
+    );
+    assert!(!err.contains("invalid scene: camera"), "{err}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_no_light_warning_is_printed_once() {
+    let dir = temp_dir("unlit");
+    let scene = dir.join("dark.toml");
+    fs::write(
+        &scene,
+        "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n\n\
+         [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n\n\
+         [film]\nwidth = 4\nheight = 4\n",
+    )
+    .unwrap();
+    let png = dir.join("dark.png");
+    let out = sahara(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        "1",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert_eq!(err.matches("has no light").count(), 1, "{err}");
+    assert!(
+        err.contains("dark.toml"),
+        "the warning names the file: {err}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_short_ascii_ply_line_is_reported_at_its_line() {
+    let dir = temp_dir("short-ply");
+    let ply = dir.join("short.ply");
+    fs::write(
+        &ply,
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+         element face 1\nproperty list uchar int vertex_indices\nend_header\n\
+         0 0 0\n1 0\n0 1 0\n3 0 1 2\n",
+    )
+    .unwrap();
+    for cmd in ["render", "stats", "bench"] {
+        let out = sahara(&[cmd, ply.to_str().unwrap()]);
+        assert!(!out.status.success(), "{cmd}");
+        let err = stderr(&out);
+        assert!(
+            err.contains("short.ply: line 11:") && err.contains("expected 3 values, found 2"),
+            "{cmd}: {err}"
+        );
+        assert!(!err.contains("nothing to frame"), "{cmd}: {err}");
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_depth_view_spans_the_visible_range_in_png_and_stays_raw_in_exr() {
+    let dir = temp_dir("depth");
+    let (png, exr) = (dir.join("depth.png"), dir.join("depth.exr"));
+    let mut logs = String::new();
+    for out in [&png, &exr] {
+        let o = sahara(&[
+            "render",
+            "--integrator",
+            "depth",
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--spp",
+            "1",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        logs += &stderr(&o);
+    }
+    assert!(
+        logs.contains("nearest hit") && logs.contains("farthest"),
+        "{logs}"
+    );
+    // PNG: the box's near and far walls are far apart in grey.
+    let (_, _, shown) = load_rgb_f32(&png).unwrap();
+    let (lo, hi) = shown
+        .iter()
+        .fold((f32::INFINITY, 0.0f32), |(l, h), &v| (l.min(v), h.max(v)));
+    assert!(hi > 0.9 && hi - lo > 0.5, "PNG range {lo}..{hi}");
+    // EXR: raw distances (the Cornell box is hundreds of units deep).
+    let (_, _, raw) = load_rgb_f32(&exr).unwrap();
+    let far = raw.iter().fold(0.0f32, |a, &b| a.max(b));
+    assert!(far > 100.0, "EXR holds distances, max {far}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn render_takes_a_camera_sidecar_and_a_builder() {
+    let dir = temp_dir("camera-builder");
+    let obj = write_quad(&dir, "Kd 0.8 0.8 0.8");
+    let far = dir.join("far.json");
+    fs::write(&far, r#"{"eye":[0,0,30],"target":[0,0,0],"vfov_deg":60}"#).unwrap();
+    let render = |extra: &[&str], out: &Path| {
+        let args = [
+            "render",
+            obj.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ];
+        let o = sahara(
+            &[
+                &args[..],
+                &["--spp", "2", "-o", out.to_str().unwrap()],
+                extra,
+            ]
+            .concat(),
+        );
+        assert!(o.status.success(), "{}", stderr(&o));
+        stderr(&o)
+    };
+    let (near_img, far_img) = (dir.join("near.exr"), dir.join("far.exr"));
+    let log = render(&[], &near_img);
+    assert!(log.contains("quad.camera.json"), "{log}");
+    let log = render(&["--camera", far.to_str().unwrap()], &far_img);
+    assert!(
+        log.contains("camera: ") && log.contains("far.json"),
+        "{log}"
+    );
+    // From ten times as far the view differs.
+    assert!(fs::read(&far_img).unwrap() != fs::read(&near_img).unwrap());
+
+    // The builder changes the speed, never the image.
+    for builder in ["median", "binned16", "rr-middle"] {
+        let out = dir.join(format!("{builder}.exr"));
+        render(&["--builder", builder], &out);
+        assert!(
+            fs::read(&out).unwrap() == fs::read(&near_img).unwrap(),
+            "--builder {builder} changed the image"
+        );
+    }
+    let o = sahara(&["render", obj.to_str().unwrap(), "--builder", "octree"]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("unknown builder 'octree'"),
+        "{}",
+        stderr(&o)
+    );
+    // A missing sidecar names the file.
+    let missing = dir.join("missing.json");
+    let o = sahara(&[
+        "render",
+        obj.to_str().unwrap(),
+        "--camera",
+        missing.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("missing.json"), "{}", stderr(&o));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn an_area_light_with_a_material_also_reflects() {
+    let dir = temp_dir("reflecting-light");
+    // The camera sees the back of a one-sided light panel (which emits
+    // nothing that way) under a white sky.
+    let write = |name: &str, extra: &str| {
+        let scene = dir.join(name);
+        fs::write(
+            &scene,
+            format!(
+                "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nvfov = 20\n\n\
+                 [[material]]\nname = \"diffuser\"\ntype = \"diffuse\"\nalbedo = [0.8, 0.8, 0.8]\n\n\
+                 [[light]]\ntype = \"area\"\nshape = \"quad\"\ncorner = [-2, -2, 0]\n\
+                 edge_u = [0, 4, 0]\nedge_v = [4, 0, 0]\nradiance = [5, 5, 5]\n{extra}\n\
+                 [[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n\n\
+                 [film]\nwidth = 8\nheight = 8\n"
+            ),
+        )
+        .unwrap();
+        let out = dir.join(format!("{name}.exr"));
+        let o = sahara(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--spp",
+            "16",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        checked_mean(&out, 8, 8)
+    };
+    let black = write("black.toml", "");
+    let white = write("white.toml", "material = \"diffuser\"\n");
+    assert_eq!(
+        black, 0.0,
+        "without a material the back of the panel is black"
+    );
+    // A white diffuser under a uniform white sky reflects about its albedo.
+    assert!((white - 0.8).abs() < 0.05, "mean {white}");
+
+    // An emitting object: an emission material with an albedo reflects too.
+    let object = |name: &str, albedo: &str| {
+        let scene = dir.join(name);
+        fs::write(
+            &scene,
+            format!(
+                "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nvfov = 20\n\n\
+                 [[material]]\nname = \"panel\"\ntype = \"emission\"\nradiance = [5, 5, 5]\n{albedo}\n\
+                 [[object]]\ntype = \"quad\"\ncorner = [-2, -2, 0]\nedge_u = [0, 4, 0]\n\
+                 edge_v = [4, 0, 0]\nmaterial = \"panel\"\n\n\
+                 [[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n\n\
+                 [film]\nwidth = 8\nheight = 8\n"
+            ),
+        )
+        .unwrap();
+        let out = dir.join(format!("{name}.exr"));
+        let o = sahara(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--spp",
+            "16",
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        checked_mean(&out, 8, 8)
+    };
+    assert_eq!(object("dark_object.toml", ""), 0.0);
+    let white = object("white_object.toml", "albedo = [0.8, 0.8, 0.8]");
+    assert!((white - 0.8).abs() < 0.05, "mean {white}");
+    let _ = fs::remove_dir_all(&dir);
+}

@@ -28,9 +28,27 @@ fn exr_text(path: &std::path::Path, key: &str) -> Option<String> {
 /// Starts an open-ended render of the built-in scene into `out`, waits until
 /// it has rendered for `after`, sends `signal` and returns (exit code, stderr).
 fn interrupt(out: &std::path::Path, signal: &str, after: Duration) -> (Option<i32>, String) {
+    let args = ["--width", "24", "--height", "16", "--spp", "1"];
+    interrupt_render(
+        &[&args[..], &["--time-limit", "600"]].concat(),
+        out,
+        signal,
+        after,
+    )
+}
+
+/// Starts `sahara render ARGS --threads 1 -o OUT`, waits until it has
+/// rendered for `after`, sends `signal` and returns (exit code, stderr).
+fn interrupt_render(
+    args: &[&str],
+    out: &std::path::Path,
+    signal: &str,
+    after: Duration,
+) -> (Option<i32>, String) {
     let mut child = Command::new(SAHARA)
-        .args(["render", "--width", "24", "--height", "16", "--spp", "1"])
-        .args(["--time-limit", "600", "--threads", "1", "-o"])
+        .arg("render")
+        .args(args)
+        .args(["--threads", "1", "-o"])
         .arg(out)
         .stderr(Stdio::piped())
         .stdout(Stdio::null())
@@ -90,4 +108,114 @@ fn sigint_writes_the_completed_passes_marked_partial() {
     assert_eq!(code, Some(130), "{log}");
     assert!(log.contains("wrote PARTIAL image"), "{log}");
     assert_eq!(exr_text(&out, "sahara:partial").as_deref(), Some("true"));
+}
+
+#[test]
+fn sigint_in_the_first_pass_keeps_the_finished_pixels_marked_partial() {
+    let dir = temp_dir("first-pass");
+    let out = dir.join("image.exr");
+    // One pass of 4096 samples per pixel: many seconds on one thread.
+    let args = [
+        "--width",
+        "48",
+        "--height",
+        "32",
+        "--spp",
+        "4096",
+        "--pass-spp",
+        "4096",
+    ];
+    let (code, log) = interrupt_render(&args, &out, "-INT", Duration::from_millis(1500));
+    assert_eq!(code, Some(130), "{log}");
+    assert!(log.contains("wrote PARTIAL image"), "{log}");
+    assert!(log.contains("first pass interrupted"), "{log}");
+    assert_eq!(exr_text(&out, "sahara:partial").as_deref(), Some("true"));
+    assert_eq!(exr_text(&out, "sahara:spp").as_deref(), Some("4096"));
+    let finished: usize = exr_text(&out, "sahara:finished_pixels")
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        finished > 0 && finished < 48 * 32,
+        "{finished} pixels: {log}"
+    );
+    let (w, h, rgb) = sahara_formats::image_in::load_rgb_f32(&out).unwrap();
+    assert_eq!((w, h), (48, 32));
+    assert!(rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
+    // The finished pixels are lit; the unfinished ones are black.
+    let lit = rgb.chunks(3).filter(|p| p.iter().any(|v| *v > 0.0)).count();
+    assert!(lit > 0 && lit <= finished, "{lit} lit, {finished} finished");
+}
+
+#[test]
+fn previews_are_rewritten_while_rendering_and_marked_partial() {
+    let dir = temp_dir("preview");
+    let out = dir.join("preview.exr");
+    let mut child = Command::new(SAHARA)
+        .args([
+            "render", "--width", "16", "--height", "16", "--spp", "1000000",
+        ])
+        .args([
+            "--pass-spp",
+            "1",
+            "--preview-every",
+            "0.2",
+            "--threads",
+            "1",
+            "-o",
+        ])
+        .arg(&out)
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .expect("run sahara");
+    let start = Instant::now();
+    let mut seen_spp = Vec::new();
+    while seen_spp.len() < 2 {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no previews: {seen_spp:?}"
+        );
+        assert!(child.try_wait().unwrap().is_none(), "sahara stopped");
+        if out.exists() {
+            assert_eq!(exr_text(&out, "sahara:partial").as_deref(), Some("true"));
+            let spp: u32 = exr_text(&out, "sahara:spp").unwrap().parse().unwrap();
+            if seen_spp.last() != Some(&spp) {
+                seen_spp.push(spp);
+            }
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(seen_spp[1] > seen_spp[0], "{seen_spp:?}");
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let mut log = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut log)
+        .unwrap();
+    assert_eq!(child.wait().unwrap().code(), Some(130), "{log}");
+
+    // A render that completes: the final image replaces the previews.
+    let done = dir.join("done.exr");
+    let o = Command::new(SAHARA)
+        .args(["render", "--width", "8", "--height", "8", "--spp", "6"])
+        .args(["--pass-spp", "1", "--preview-every", "0", "-o"])
+        .arg(&done)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(exr_text(&done, "sahara:partial").as_deref(), Some("false"));
+    assert_eq!(exr_text(&done, "sahara:spp").as_deref(), Some("6"));
+    let mut names: Vec<_> = fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["done.exr", "preview.exr"], "{names:?}");
 }

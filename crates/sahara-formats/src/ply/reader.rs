@@ -26,6 +26,15 @@ pub(crate) trait Reader {
     fn slack(&self) -> u64;
     /// An error at position `at` (from [`Reader::here`]).
     fn error(&self, at: u64, message: String) -> FormatError;
+    /// Starts a record of (at least) `values` values: an ascii record must
+    /// be one line.
+    fn begin_record(&mut self, _values: u64) {}
+    /// The record holds `n` more values than announced (a list's items).
+    fn more_values(&mut self, _n: u64) {}
+    /// Ends the record: an ascii line must hold no more values.
+    fn end_record(&mut self) -> Result<(), FormatError> {
+        Ok(())
+    }
 }
 
 /// Packed values in either byte order.
@@ -151,12 +160,15 @@ impl Reader for Binary<'_> {
     }
 }
 
-/// Whitespace-separated numbers, one record per line by convention (not enforced).
+/// Whitespace-separated numbers, one record per line (a short or long line
+/// is an error naming it: `expected 3 values, found 2`).
 pub(crate) struct Ascii<'a> {
     bytes: &'a [u8],
     pos: usize,
     line: u64,
     name: &'a str,
+    /// The record being read: its line, values expected and values read.
+    record: Option<(u64, u64, u64)>,
 }
 
 impl<'a> Ascii<'a> {
@@ -167,6 +179,7 @@ impl<'a> Ascii<'a> {
             pos,
             line: line as u64,
             name,
+            record: None,
         }
     }
 
@@ -186,6 +199,13 @@ impl<'a> Ascii<'a> {
     /// The next token, or an error saying a `ty` value was expected.
     fn token(&mut self, ty: Scalar) -> Result<&'a str, FormatError> {
         self.skip_space();
+        if let Some((line, expected, found)) = &mut self.record {
+            if self.line != *line || self.pos >= self.bytes.len() {
+                let (line, expected, found) = (*line, *expected, *found);
+                return Err(self.error(line, format!("expected {expected} values, found {found}")));
+            }
+            *found += 1;
+        }
         let start = self.pos;
         while self
             .bytes
@@ -282,5 +302,31 @@ impl Reader for Ascii<'_> {
 
     fn error(&self, at: u64, message: String) -> FormatError {
         FormatError::at_line(self.name, at as usize, message)
+    }
+
+    fn begin_record(&mut self, values: u64) {
+        self.skip_space();
+        self.record = Some((self.line, values, 0));
+    }
+
+    fn more_values(&mut self, n: u64) {
+        if let Some((_, expected, _)) = &mut self.record {
+            *expected += n;
+        }
+    }
+
+    fn end_record(&mut self) -> Result<(), FormatError> {
+        let Some((line, expected, _)) = self.record.take() else {
+            return Ok(());
+        };
+        // The rest of the line must be blank.
+        let rest = self.bytes[self.pos..]
+            .iter()
+            .take_while(|&&b| b != b'\n')
+            .any(|b| !b.is_ascii_whitespace());
+        if rest {
+            return Err(self.error(line, format!("expected {expected} values, found more")));
+        }
+        Ok(())
     }
 }

@@ -173,6 +173,7 @@ pub(super) struct RawLight {
     pub radius: Opt<f32>,
     pub map: Opt<String>,
     pub scale: Opt<f32>,
+    pub material: Opt<String>,
 }
 
 /// Integrator names.

@@ -5,6 +5,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
+use sahara_render::integrator::defaults;
 use toml::Spanned;
 
 use super::raw::*;
@@ -53,7 +54,7 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
     let lights = raw
         .light
         .iter()
-        .map(|l| ctx.light(l))
+        .map(|l| ctx.light(l, &seen))
         .collect::<Result<Vec<_>, _>>()?;
     let environments: Vec<_> = raw
         .light
@@ -71,15 +72,15 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
         integrator: match &raw.integrator {
             Some(i) => ctx.integrator(i.get_ref())?,
             None => IntegratorSpec::Path {
-                max_depth: 8,
-                rr_depth: 3,
+                max_depth: defaults::MAX_DEPTH,
+                rr_depth: defaults::RR_DEPTH,
             },
         },
         sampler: match &raw.sampler {
             Some(s) => ctx.sampler(s.get_ref())?,
             None => SamplerSpec {
                 kind: SamplerKind::Sobol,
-                spp: 16,
+                spp: defaults::SPP,
                 seed: 0,
             },
         },
@@ -350,7 +351,7 @@ impl Ctx<'_> {
             MaterialType::Mirror => &["color"],
             MaterialType::Dielectric => &["ior"],
             MaterialType::RoughDielectric => &["ior", "roughness"],
-            MaterialType::Emission => &["radiance", "two_sided"],
+            MaterialType::Emission => &["radiance", "two_sided", "albedo"],
         };
         self.only(&present, allowed, &what)?;
         if m.name.get_ref().is_empty() {
@@ -393,6 +394,7 @@ impl Ctx<'_> {
                     "radiance",
                 )?,
                 two_sided: m.two_sided.as_ref().is_some_and(|b| *b.get_ref()),
+                albedo: self.reflectance(&m.albedo, "albedo", Vec3::ZERO)?,
             },
         };
         Ok(MaterialSpec {
@@ -596,7 +598,11 @@ impl Ctx<'_> {
     }
 
     /// `[[light]]`.
-    fn light(&self, raw: &Spanned<RawLight>) -> Result<LightSpec, FormatError> {
+    fn light(
+        &self,
+        raw: &Spanned<RawLight>,
+        materials: &HashSet<&str>,
+    ) -> Result<LightSpec, FormatError> {
         let l = raw.get_ref();
         let entry = raw.span();
         let what = format!("a {} light", type_name(&l.kind));
@@ -613,6 +619,7 @@ impl Ctx<'_> {
             ("shape", span(&l.shape)),
             ("map", span(&l.map)),
             ("scale", span(&l.scale)),
+            ("material", span(&l.material)),
         ];
         let allowed: &[&str] = match l.kind.get_ref() {
             LightType::Point => &["position", "intensity"],
@@ -628,6 +635,7 @@ impl Ctx<'_> {
                 "shape",
                 "radiance",
                 "two_sided",
+                "material",
                 "corner",
                 "edge_u",
                 "edge_v",
@@ -698,10 +706,16 @@ impl Ctx<'_> {
                     min: &None,
                     max: &None,
                 };
+                if let Some(m) = &l.material {
+                    if !materials.contains(m.get_ref().as_str()) {
+                        return Err(self.at(m.span(), format!("no [[material]] is named '{}'", m.get_ref())));
+                    }
+                }
                 LightSpec::Area {
                     shape: self.shape(*kind.get_ref(), &entry, &keys, &format!("{what} ({})", type_name(kind)))?,
                     radiance: need_power(&l.radiance, "radiance")?,
                     two_sided: l.two_sided.as_ref().is_some_and(|b| *b.get_ref()),
+                    material: l.material.as_ref().map(|m| m.get_ref().clone()),
                 }
             }
             LightType::Environment => match (&l.radiance, &l.map) {
@@ -749,18 +763,29 @@ impl Ctx<'_> {
         self.only(&present, allowed, &what)?;
         Ok(match i.name.get_ref() {
             IntegratorName::Distribution => IntegratorSpec::Distribution {
-                max_depth: self.count(&i.max_depth, "max_depth", 8, 1)?,
-                light_samples: self.count(&i.light_samples, "light_samples", 1, 1)?,
+                max_depth: self.count(&i.max_depth, "max_depth", defaults::MAX_DEPTH, 1)?,
+                light_samples: self.count(
+                    &i.light_samples,
+                    "light_samples",
+                    defaults::LIGHT_SAMPLES,
+                    1,
+                )?,
             },
             IntegratorName::Path => IntegratorSpec::Path {
-                max_depth: self.count(&i.max_depth, "max_depth", 8, 1)?,
-                rr_depth: self.count(&i.rr_depth, "rr_depth", 3, 0)?,
+                max_depth: self.count(&i.max_depth, "max_depth", defaults::MAX_DEPTH, 1)?,
+                rr_depth: self.count(&i.rr_depth, "rr_depth", defaults::RR_DEPTH, 0)?,
             },
             IntegratorName::Normals => IntegratorSpec::Normals,
             IntegratorName::Depth => IntegratorSpec::Depth,
             IntegratorName::Ao => IntegratorSpec::Ao {
-                samples: self.count(&i.samples, "samples", 1, 1)?,
-                distance: self.number(&i.distance, "distance", 0.0, |d| d >= 0.0, "at least 0")?,
+                samples: self.count(&i.samples, "samples", defaults::AO_SAMPLES, 1)?,
+                distance: self.number(
+                    &i.distance,
+                    "distance",
+                    defaults::AO_DISTANCE,
+                    |d| d >= 0.0,
+                    "at least 0",
+                )?,
             },
             IntegratorName::Cost => IntegratorSpec::Cost,
         })
@@ -784,7 +809,7 @@ impl Ctx<'_> {
                 Some(SamplerName::Independent) => SamplerKind::Independent,
                 Some(SamplerName::Stratified) => SamplerKind::Stratified,
             },
-            spp: self.count(&s.spp, "spp", 16, 1)?,
+            spp: self.count(&s.spp, "spp", defaults::SPP, 1)?,
             seed,
         })
     }

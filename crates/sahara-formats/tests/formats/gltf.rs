@@ -256,6 +256,32 @@ fn node_hierarchy_world_transforms_and_shared_meshes() {
     assert!(p.abs_diff_eq(Vec3::new(8., 2., 0.), 1e-6), "{p}");
 }
 
+#[test]
+fn load_mesh_merges_every_node_use_in_scene_order_with_its_transform() {
+    let dir = TempDir::new("gltf-merged");
+    let bin = triangle_buffer();
+    let uri = format!(
+        r#""uri": "data:application/octet-stream;base64,{}","#,
+        base64(&bin)
+    );
+    let nodes = r#""nodes": [
+    {"mesh": 0, "translation": [10, 0, 0]},
+    {"mesh": 0, "translation": [0, 5, 0]}
+  ],
+  "scenes": [{"nodes": [1, 0]}],
+  "scene": 0"#;
+    let json = triangle_json(&uri, bin.len(), nodes).replace(r#", "material": 0"#, "");
+    let path = dir.write("two.gltf", json);
+    let (mesh, warnings) = sahara_formats::load_mesh_with_warnings(&path).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(mesh.indices.len(), 2);
+    let corner = |t: usize, k: usize| mesh.positions[mesh.indices[t][k] as usize];
+    // Scene order: node 1 (moved up by 5) first, then node 0 (moved by 10 in x).
+    assert_eq!(corner(0, 1), Vec3::new(1., 5., 0.));
+    assert_eq!(corner(1, 1), Vec3::new(11., 0., 0.));
+    assert_eq!(sahara_formats::load_mesh(&path).unwrap(), mesh);
+}
+
 /// A GLB file: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded).
 fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
     let mut json = json.as_bytes().to_vec();

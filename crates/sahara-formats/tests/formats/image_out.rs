@@ -119,6 +119,37 @@ fn exr_values_and_metadata_round_trip_exactly() {
 }
 
 #[test]
+fn the_same_exr_is_written_byte_for_byte_every_time() {
+    let dir = TempDir::new("exr-bytes");
+    let rgb: Vec<f32> = (0..4 * 3 * 3).map(|i| i as f32 * 0.25).collect();
+    let meta: Vec<(String, String)> = (0..8)
+        .map(|i| (format!("sahara:key{i}"), format!("value {i}")))
+        .collect();
+    let first = dir.0.join("first.exr");
+    write_exr(&first, 4, 3, &rgb, &meta).unwrap();
+    let expected = fs::read(&first).unwrap();
+    for k in 0..6 {
+        let again = dir.0.join(format!("again{k}.exr"));
+        write_exr(&again, 4, 3, &rgb, &meta).unwrap();
+        assert!(fs::read(&again).unwrap() == expected, "write {k} differs");
+    }
+    // Still a valid file with every attribute.
+    let header = exr::meta::MetaData::read_from_file(&first, false).unwrap();
+    let other = &header.headers[0].own_attributes.other;
+    for (key, value) in &meta {
+        match other.get(&exr::meta::attribute::Text::from(key.as_str())) {
+            Some(exr::meta::attribute::AttributeValue::Text(t)) => {
+                assert_eq!(&t.to_string(), value)
+            }
+            v => panic!("{key}: {v:?}"),
+        }
+    }
+    let (w, h, back) = sahara_formats::image_in::load_rgb_f32(&first).unwrap();
+    assert_eq!((w, h), (4, 3));
+    assert_eq!(back, rgb);
+}
+
+#[test]
 fn write_image_picks_the_format_by_extension_in_any_case() {
     let dir = TempDir::new("ext");
     let rgb = [0.25f32; 3];

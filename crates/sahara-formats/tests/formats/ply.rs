@@ -520,6 +520,33 @@ fn non_numeric_ascii_tokens_report_the_line() {
 }
 
 #[test]
+fn an_ascii_line_with_too_few_or_too_many_values_is_an_error_at_that_line() {
+    let head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    // Line 11 holds two values: without the line check the next line's
+    // first value would be taken as its z.
+    let short = format!("{head}0 0 0\n1 0\n0 1 0\n3 0 1 2\n");
+    assert_fails(
+        parse_ply(short.as_bytes(), "short.ply"),
+        &["short.ply: line 11:", "expected 3 values, found 2"],
+    );
+    let long = format!("{head}0 0 0\n1 0 0 7\n0 1 0\n3 0 1 2\n");
+    assert_fails(
+        parse_ply(long.as_bytes(), "long.ply"),
+        &["long.ply: line 11:", "expected 3 values, found more"],
+    );
+    // A face line shorter than its list length says.
+    let face = format!("{head}0 0 0\n1 0 0\n0 1 0\n3 0 1\n");
+    assert_fails(
+        parse_ply(face.as_bytes(), "face.ply"),
+        &["face.ply: line 13:", "expected 4 values, found 3"],
+    );
+    // Blank lines between records and trailing spaces are fine.
+    let ok = format!("{head}0 0 0  \n\n1 0 0\r\n0 1 0\n3 0 1 2");
+    assert_eq!(parse_ply(ok.as_bytes(), "ok.ply").unwrap().indices.len(), 1);
+}
+
+#[test]
 fn nan_and_inf_coordinates_load() {
     let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
                 element face 1\nproperty list uchar int vertex_indices\nend_header\n\

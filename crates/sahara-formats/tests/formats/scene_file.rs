@@ -203,7 +203,8 @@ fn a_complete_scene_parses_into_the_expected_values() {
                 name: "lamp".into(),
                 kind: MaterialKind::Emission {
                     radiance: Vec3::new(5., 5., 4.),
-                    two_sided: true
+                    two_sided: true,
+                    albedo: Vec3::ZERO
                 }
             },
         ]
@@ -283,7 +284,7 @@ fn a_complete_scene_parses_into_the_expected_values() {
     );
     assert!(matches!(
         &s.lights[3],
-        LightSpec::Area { shape: ShapeSpec::Quad { .. }, radiance, two_sided: false } if *radiance == Vec3::splat(8.)
+        LightSpec::Area { shape: ShapeSpec::Quad { .. }, radiance, two_sided: false, material: None } if *radiance == Vec3::splat(8.)
     ));
     assert_eq!(
         s.lights[4],
@@ -347,7 +348,7 @@ fn a_minimal_scene_gets_the_documented_defaults() {
         s.sampler,
         SamplerSpec {
             kind: SamplerKind::Sobol,
-            spp: 16,
+            spp: 64,
             seed: 0
         }
     );

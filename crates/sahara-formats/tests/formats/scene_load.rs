@@ -364,3 +364,65 @@ fn a_broken_mesh_is_an_error_naming_the_scene_and_the_mesh() {
     assert!(e.starts_with(&path.display().to_string()), "{e}");
     assert!(e.contains("bad.obj"), "{e}");
 }
+
+#[test]
+fn a_scene_file_integrator_without_parameters_gets_the_command_line_defaults() {
+    let dir = TempDir::new("integrator-defaults");
+    for name in ["path", "distribution", "ao", "normals", "depth", "cost"] {
+        let path = dir.write(
+            &format!("{name}.toml"),
+            format!(
+                "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 8\nheight = 4\n\
+                 [integrator]\nname = \"{name}\"\n"
+            ),
+        );
+        let l = load_scene(&path).unwrap();
+        assert_eq!(
+            Some(l.settings.integrator),
+            Integrator::from_name(name),
+            "{name}"
+        );
+        assert_eq!(
+            l.settings.spp,
+            sahara_render::integrator::defaults::SPP,
+            "{name}"
+        );
+    }
+}
+
+#[test]
+fn an_area_light_carries_the_material_it_names() {
+    let dir = TempDir::new("area-material");
+    let scene = |light_extra: &str| {
+        format!(
+            "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 8\nheight = 4\n\
+             [[material]]\nname = \"diffuser\"\ntype = \"diffuse\"\nalbedo = [0.78, 0.78, 0.78]\n\
+             [[light]]\ntype = \"area\"\nshape = \"quad\"\ncorner = [0, 0, 0]\nedge_u = [1, 0, 0]\n\
+             edge_v = [0, 1, 0]\nradiance = [17, 12, 4]\n{light_extra}"
+        )
+    };
+    let with = dir.write("with.toml", scene("material = \"diffuser\"\n"));
+    let l = load_scene(&with).unwrap();
+    let m = l.scene.materials.iter().find(|m| m.is_emissive()).unwrap();
+    assert_eq!(m.emission, Vec3::new(17.0, 12.0, 4.0));
+    assert_eq!(
+        m.bsdf,
+        Bsdf::Diffuse {
+            albedo: Vec3::splat(0.78)
+        }
+    );
+    // Without a material the panel is black but for its emission, as before.
+    let without = dir.write("without.toml", scene(""));
+    let l = load_scene(&without).unwrap();
+    let m = l.scene.materials.iter().find(|m| m.is_emissive()).unwrap();
+    assert_eq!(m.bsdf, Bsdf::Diffuse { albedo: Vec3::ZERO });
+    // An unknown name is an error at its line.
+    let bad = dir.write("bad.toml", scene("material = \"nope\"\n"));
+    let e = load_scene(&bad).unwrap_err().to_string();
+    assert!(
+        e.contains("bad.toml")
+            && e.contains("line 18")
+            && e.contains("no [[material]] is named 'nope'"),
+        "{e}"
+    );
+}

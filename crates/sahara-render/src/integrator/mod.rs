@@ -52,11 +52,29 @@ pub enum Integrator {
     Cost,
 }
 
+/// The default parameters of every integrator, used by the command line
+/// and by scene files alike.
+pub mod defaults {
+    /// Largest number of scattering events of `path` and of specular/glossy
+    /// bounces of `distribution`.
+    pub const MAX_DEPTH: u32 = 8;
+    /// Bounces before Russian roulette starts in `path`.
+    pub const RR_DEPTH: u32 = 3;
+    /// Samples per area light (and environment) at every hit of `distribution`.
+    pub const LIGHT_SAMPLES: u32 = 4;
+    /// Rays per pixel sample of `ao`.
+    pub const AO_SAMPLES: u32 = 4;
+    /// Occlusion distance of `ao` (0: a tenth of the scene's radius).
+    pub const AO_DISTANCE: f32 = 0.0;
+    /// Samples per pixel of a render that does not say.
+    pub const SPP: u32 = 64;
+}
+
 impl Default for Integrator {
     fn default() -> Self {
         Integrator::Path {
-            max_depth: 8,
-            rr_depth: 3,
+            max_depth: defaults::MAX_DEPTH,
+            rr_depth: defaults::RR_DEPTH,
         }
     }
 }
@@ -75,19 +93,19 @@ impl Integrator {
         }
     }
 
-    /// The integrator called `name` with default parameters.
+    /// The integrator called `name` with the default parameters of [`defaults`].
     pub fn from_name(name: &str) -> Option<Self> {
         Some(match name {
             "path" => Integrator::default(),
             "distribution" => Integrator::Distribution {
-                max_depth: 5,
-                light_samples: 4,
+                max_depth: defaults::MAX_DEPTH,
+                light_samples: defaults::LIGHT_SAMPLES,
             },
             "normals" => Integrator::Normals,
             "depth" => Integrator::Depth,
             "ao" => Integrator::Ao {
-                samples: 4,
-                distance: 0.0,
+                samples: defaults::AO_SAMPLES,
+                distance: defaults::AO_DISTANCE,
             },
             "cost" => Integrator::Cost,
             _ => return None,
