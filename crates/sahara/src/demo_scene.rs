@@ -1,5 +1,5 @@
-//! The built-in scene benchmarked when `sahara` runs with no subcommand: a
-//! sphere and a torus on a ground plane, made in code (no files needed).
+//! The built-in scene `sahara bench` traces when given no mesh: a sphere
+//! and a torus on a ground plane, made in code (no files needed).
 
 use std::f32::consts::{PI, TAU};
 

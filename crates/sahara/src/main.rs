@@ -1,8 +1,9 @@
 //! `sahara`: the command line of the Sahara ray tracer.
 //!
-//! `sahara bench` runs the ray-casting benchmark protocol
-//! (`docs/bench-protocol.md`), `sahara stats` prints a tree's statistics;
-//! with no subcommand it benchmarks a built-in procedural scene.
+//! `sahara render` renders a scene file, a mesh or the built-in Cornell box
+//! (also what `sahara` alone does); `sahara bench` runs the ray-casting
+//! benchmark protocol (`docs/bench-protocol.md`); `sahara stats` prints a
+//! tree's statistics.
 
 mod bench;
 mod cli;
