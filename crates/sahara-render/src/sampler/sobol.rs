@@ -11,11 +11,12 @@
 //! The values are exactly those of `sobol_burley::sample(index, 0 | 1,
 //! seed)`, computed more cheaply: what depends only on the pixel sample
 //! (the index, its bit reversal, the first half of the seed hash) is done
-//! once per pixel sample in [`SobolSample::new`], and a 2D draw shuffles its
-//! index once for both coordinates.
+//! once per pixel sample in [`SobolSample::new`]; a 2D draw shuffles its
+//! index once for both coordinates; and the two Sobol dimensions are
+//! evaluated in closed form instead of by a walk over direction vectors.
 
 use glam::Vec2;
-use sobol_burley::parts::{hash, owen_scramble_rev, sobol_rev, u32_to_f32_norm};
+use sobol_burley::parts::{hash, owen_scramble_rev, u32_to_f32_norm};
 
 use super::SampleId;
 use crate::hash::mix64;
@@ -65,30 +66,53 @@ impl SobolSample {
         (s ^ (s >> 32)) as u32
     }
 
-    /// The shuffled sample index under `seed`, bit-reversed.
+    /// The shuffled sample index under `seed` (16 bits, not reversed).
     #[inline(always)]
-    fn shuffled_index_rev(&self, seed: u32) -> u32 {
-        owen_scramble_rev(self.index_rev, hash(seed ^ SHUFFLE_KEY))
+    fn shuffled_index(&self, seed: u32) -> u32 {
+        let rev = owen_scramble_rev(self.index_rev, hash(seed ^ SHUFFLE_KEY));
+        // Only the top 16 bits of the reversed index enter the sequence.
+        (rev & 0xffff_0000).reverse_bits()
     }
 
     /// One scrambled Sobol number for dimension `dim`.
     #[inline]
     pub fn get_1d(&self, dim: u32) -> f32 {
         let seed = self.seed(dim);
-        let rev = self.shuffled_index_rev(seed);
-        scramble(sobol_rev(rev, 0), seed, DIM0_KEY)
+        let n = self.shuffled_index(seed);
+        scramble(sobol0_rev(n), seed, DIM0_KEY)
     }
 
     /// One scrambled 2D Sobol point for dimension `dim`.
     #[inline]
     pub fn get_2d(&self, dim: u32) -> Vec2 {
         let seed = self.seed(dim);
-        let rev = self.shuffled_index_rev(seed);
+        let n = self.shuffled_index(seed);
         Vec2::new(
-            scramble(sobol_rev(rev, 0), seed, DIM0_KEY),
-            scramble(sobol_rev(rev, 1), seed, DIM1_KEY),
+            scramble(sobol0_rev(n), seed, DIM0_KEY),
+            scramble(sobol1_rev(n), seed, DIM1_KEY),
         )
     }
+}
+
+/// Sobol dimension 0 (van der Corput) of the 16-bit index `n`, bit-reversed:
+/// output bit `31 - i` is index bit `i`, so reversed it is the index.
+#[inline(always)]
+fn sobol0_rev(n: u32) -> u32 {
+    n
+}
+
+/// Sobol dimension 1 of the 16-bit index `n`, bit-reversed. Its generator
+/// matrix is Pascal's triangle mod 2: output bit `31 - i` is the xor of the
+/// index bits `j` with `binom(j, i)` odd, i.e. (Lucas) with `i` a submask of
+/// `j`. That superset sum over the four bits of a bit position takes four
+/// shift-and-xor steps.
+#[inline(always)]
+fn sobol1_rev(mut n: u32) -> u32 {
+    n ^= (n >> 1) & 0x5555;
+    n ^= (n >> 2) & 0x3333;
+    n ^= (n >> 4) & 0x0f0f;
+    n ^= (n >> 8) & 0x00ff;
+    n
 }
 
 /// Owen-scrambles the bit-reversed Sobol value `sobol_rev` of one dimension
@@ -141,6 +165,17 @@ mod tests {
             (0xdead_beef, 1 << 40),
         ] {
             assert_eq!(hash2(a, b), mix64(mix64(a ^ HASH2_KEY).wrapping_add(b)));
+        }
+    }
+
+    #[test]
+    fn closed_form_dimensions_match_the_direction_vectors() {
+        // Every 16-bit index: the top 16 bits of the reversed index are all
+        // that `sobol_rev` reads.
+        for n in 0..MAX_INDEX {
+            let rev = n.reverse_bits();
+            assert_eq!(sobol0_rev(n), sobol_burley::parts::sobol_rev(rev, 0), "{n}");
+            assert_eq!(sobol1_rev(n), sobol_burley::parts::sobol_rev(rev, 1), "{n}");
         }
     }
 
