@@ -215,6 +215,94 @@ mod tests {
         }
     }
 
+    /// Whether `points` (2^k of them) put exactly one point in each
+    /// elementary interval `[i / 2^a, (i + 1) / 2^a) x [j / 2^b, (j + 1) /
+    /// 2^b)` of every shape `a + b = k`: the (0, k, 2)-net property.
+    fn is_0_k_2_net(points: &[Vec2], k: u32) -> Result<(), String> {
+        assert_eq!(points.len(), 1 << k);
+        for a in 0..=k {
+            let b = k - a;
+            let mut hit = vec![false; 1 << k];
+            for (n, p) in points.iter().enumerate() {
+                let (cx, cy) = (p.x * (1u32 << a) as f32, p.y * (1u32 << b) as f32);
+                let cell = cx as usize + (cy as usize) * (1 << a);
+                if hit[cell] {
+                    return Err(format!(
+                        "2^{a} x 2^{b} cell {cell} holds a second point, {n}"
+                    ));
+                }
+                hit[cell] = true;
+            }
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn first_2_to_the_k_points_of_a_pixel_are_stratified() {
+        // As the renderer draws them: samples of a pixel in passes of
+        // `count`, through `PixelSampler`, for the camera dimensions, the
+        // per-bounce blocks and the many-sample dimensions; also across the
+        // start of the second 2^16-sample sequence.
+        use super::super::{dims, PixelSampler, SamplerKind};
+        let dimensions = [
+            dims::FILM,
+            dims::LENS,
+            dims::TIME,
+            dims::bounce(0, dims::LIGHT_POINT),
+            dims::bounce(0, dims::BSDF_DIR),
+            dims::bounce(7, dims::ROULETTE),
+            dims::extra(2, 3, 5),
+        ];
+        let count = 8;
+        for pixel in 0..6u64 {
+            let stream = hash2(pixel / 3, pixel);
+            let first_pass = if pixel % 3 == 2 { MAX_INDEX / count } else { 0 };
+            for &dim in &dimensions {
+                for k in 0..=12 {
+                    let points: Vec<Vec2> = (0..1u32 << k)
+                        .map(|n| {
+                            let id = SampleId {
+                                stream,
+                                pass: first_pass + n / count,
+                                index: n % count,
+                                count,
+                            };
+                            PixelSampler::new(SamplerKind::Sobol, id).get_2d(dim)
+                        })
+                        .collect();
+                    if let Err(e) = is_0_k_2_net(&points, k) {
+                        panic!("pixel {pixel}, dimension {dim}, 2^{k} points: {e}");
+                    }
+                    // A 1D draw is the first coordinate of the 2D one.
+                    for (n, p) in points.iter().enumerate() {
+                        let id = SampleId {
+                            stream,
+                            pass: first_pass + n as u32 / count,
+                            index: n as u32 % count,
+                            count,
+                        };
+                        let x = PixelSampler::new(SamplerKind::Sobol, id).get_1d(dim);
+                        assert_eq!(x.to_bits(), p.x.to_bits());
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_net_check_catches_a_broken_sequence() {
+        // The second coordinate of dimension 1 taken from a different seed
+        // than the first (a plausible bug) is no longer a net.
+        let points: Vec<Vec2> = (0..64u32)
+            .map(|i| Vec2::new(sobol_burley::sample(i, 0, 5), sobol_burley::sample(i, 1, 6)))
+            .collect();
+        assert!(is_0_k_2_net(&points, 6).is_err());
+        let points: Vec<Vec2> = (0..64u32)
+            .map(|i| Vec2::new(sobol_burley::sample(i, 0, 5), sobol_burley::sample(i, 1, 5)))
+            .collect();
+        assert!(is_0_k_2_net(&points, 6).is_ok());
+    }
+
     #[test]
     fn first_16_points_are_elementary_intervals() {
         // A (0, 2)-sequence puts one of 16 points in each 4x4 cell.
