@@ -441,15 +441,15 @@ fn render_tile(
             }
             let stream = hash2(s.seed, (y as u64) * w as u64 + x as u64);
             for index in 0..s.spp {
-                let sampler = PixelSampler {
-                    kind: s.sampler,
-                    id: SampleId {
+                let sampler = PixelSampler::new(
+                    s.sampler,
+                    SampleId {
                         stream,
                         pass,
                         index,
                         count: s.spp,
                     },
-                };
+                );
                 let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
                 let (ray, time) = camera.generate_ray(
                     pos * inv,

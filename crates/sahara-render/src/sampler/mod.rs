@@ -41,23 +41,45 @@ pub struct SampleId {
 }
 
 /// The sampler of one pixel sample: the draw functions of a [`SamplerKind`]
-/// bound to a [`SampleId`].
+/// bound to a [`SampleId`], with what the generator can compute once per
+/// pixel sample rather than once per draw.
 #[derive(Clone, Copy, Debug)]
 pub struct PixelSampler {
-    /// The generator.
-    pub kind: SamplerKind,
-    /// The sample.
-    pub id: SampleId,
+    kind: SamplerKind,
+    id: SampleId,
+    sobol: sobol::SobolSample,
 }
 
 impl PixelSampler {
+    /// The sampler of pixel sample `id` under generator `kind`.
+    #[inline]
+    pub fn new(kind: SamplerKind, id: SampleId) -> Self {
+        let sobol = match kind {
+            SamplerKind::Sobol => sobol::SobolSample::new(&id),
+            _ => sobol::SobolSample::default(),
+        };
+        Self { kind, id, sobol }
+    }
+
+    /// The generator.
+    #[inline]
+    pub fn kind(&self) -> SamplerKind {
+        self.kind
+    }
+
+    /// The sample.
+    #[inline]
+    pub fn id(&self) -> SampleId {
+        self.id
+    }
+
     /// One number in `[0, 1)` for dimension `dim`.
     #[inline]
     pub fn get_1d(&self, dim: u32) -> f32 {
         match self.kind {
             SamplerKind::Independent => independent::get_1d(&self.id, dim),
             SamplerKind::Stratified => stratified::get_1d(&self.id, dim),
-            SamplerKind::Sobol => sobol::get_1d(&self.id, dim),
+            SamplerKind::Sobol => self.sobol.get_1d(dim),
         }
     }
 
@@ -67,7 +89,7 @@ impl PixelSampler {
         match self.kind {
             SamplerKind::Independent => independent::get_2d(&self.id, dim),
             SamplerKind::Stratified => stratified::get_2d(&self.id, dim),
-            SamplerKind::Sobol => sobol::get_2d(&self.id, dim),
+            SamplerKind::Sobol => self.sobol.get_2d(dim),
         }
     }
 }
