@@ -293,7 +293,7 @@ pub struct TreeOptions {
     #[arg(long, value_name = "N")]
     pub exact_below: Option<u32>,
     /// Store each leaf block's distinct vertices once: about two thirds of
-    /// the tree's memory, tracing up to a tenth slower.
+    /// the tree's memory, tracing some 3-13% slower.
     #[arg(long)]
     pub compact_leaves: bool,
     /// Use only the first FRACTION of the triangles, in file order (0 < F

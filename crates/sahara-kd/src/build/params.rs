@@ -148,7 +148,7 @@ pub struct BuildParams {
     pub exact_below: u32,
     /// Store each leaf block's distinct vertices once instead of every
     /// lane's vertices: about two thirds of a triangle tree's memory,
-    /// tracing up to a tenth slower (figures in `docs/performance.md`).
+    /// tracing some 3-13% slower (figures in `docs/performance.md`).
     /// Default false.
     pub compact_leaves: bool,
 }

@@ -6,7 +6,7 @@
 //!   lanes directly.
 //! - [`TriangleLeaves::Indexed`] (`BuildParams::compact_leaves`): each
 //!   block's distinct vertices once (see `compact`): about two thirds of
-//!   the memory, tracing up to a tenth slower (the gathers cost more than
+//!   the memory, tracing some 3-13% slower (the gathers cost more than
 //!   the smaller leaf data saves; figures in `docs/performance.md`). It is
 //!   an option, for scenes where memory counts more than the last tenth of
 //!   speed (Embree's compact scenes make the same trade).
