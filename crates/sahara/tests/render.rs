@@ -564,17 +564,7 @@ fn an_area_light_with_a_material_also_reflects() {
             ),
         )
         .unwrap();
-        let out = dir.join(format!("{name}.exr"));
-        let o = sahara(&[
-            "render",
-            scene.to_str().unwrap(),
-            "--spp",
-            "16",
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        checked_mean(&out, 8, 8)
+        render_mean_8x8(&scene, &dir.join(format!("{name}.exr")))
     };
     let black = write("black.toml", "");
     let white = write("white.toml", "material = \"diffuser\"\n");
@@ -600,20 +590,24 @@ fn an_area_light_with_a_material_also_reflects() {
             ),
         )
         .unwrap();
-        let out = dir.join(format!("{name}.exr"));
-        let o = sahara(&[
-            "render",
-            scene.to_str().unwrap(),
-            "--spp",
-            "16",
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        checked_mean(&out, 8, 8)
+        render_mean_8x8(&scene, &dir.join(format!("{name}.exr")))
     };
     assert_eq!(object("dark_object.toml", ""), 0.0);
     let white = object("white_object.toml", "albedo = [0.8, 0.8, 0.8]");
     assert!((white - 0.8).abs() < 0.05, "mean {white}");
     let _ = fs::remove_dir_all(&dir);
+}
+
+/// Render `scene` (an 8x8 film) at 16 spp to the EXR `out`; its mean.
+fn render_mean_8x8(scene: &Path, out: &Path) -> f32 {
+    let o = sahara(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        "16",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    checked_mean(out, 8, 8)
 }
