@@ -9,7 +9,7 @@ Every round runs every mesh under every configuration back to back
 configurations share the machine's moments; the table gives, per mesh and
 set, each configuration's best Mrays/s over the rounds (one thread, by the
 tracing thread's CPU time; `primary_pk` and `primary_pk16` are the 8- and
-16-ray packet paths) and its
+16-ray packet paths, `SET_batch` one batch call over the set) and its
 ratio to the first configuration.
 
 Best of several rounds rather than the median: on the shared virtual
@@ -51,6 +51,8 @@ def bench(config, mesh, sets, runs):
     figures = {}
     for name, s in json.loads(done.stdout)["sets"].items():
         figures[name] = s["mrays_1t_cpu"]
+        if "mrays_batch_1t_cpu" in s:
+            figures[name + "_batch"] = s["mrays_batch_1t_cpu"]
         if "mrays_packet_1t_cpu" in s:
             figures[name + "_pk"] = s["mrays_packet_1t_cpu"]
         if "mrays_packet16_1t_cpu" in s:

@@ -127,6 +127,12 @@ pub struct SetReport {
     pub mrays_1t_cpu: f64,
     /// Best Mrays/s on all threads.
     pub mrays_all: f64,
+    /// Best Mrays/s on one thread of the batch query over the whole set
+    /// (`KdTree::closest_hits` / `KdTree::any_hits`), checked hit for hit
+    /// against single rays.
+    pub mrays_batch_1t: f64,
+    /// The same by the tracing thread's CPU time.
+    pub mrays_batch_1t_cpu: f64,
     /// `primary` only: best Mrays/s on one thread of the packet path (8 rays
     /// per packet, 4x2 pixel tiles).
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -323,6 +323,9 @@ fn measure_records(
         human::count(bench.threads(), "thread")
     );
     let (report, m) = bench.measure(rays, query, opts.counters);
+    if !m.batch_agrees {
+        eprintln!("WARNING: {name}: the batch query and single rays give different results");
+    }
     if !m.threads_agree {
         eprintln!(
             "WARNING: {name}: the 1-thread and {}-thread results differ",

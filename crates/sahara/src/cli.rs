@@ -144,7 +144,9 @@ Comparing ray by ray with another tracer (e.g. embree_bench):
 Human-readable results go to stdout, progress to stderr; with --json stdout
 holds exactly one JSON object: mesh, triangles, builder, build_ms,
 memory_bytes, sah_cost, threads, runs, tree_depth, leaves, camera, and
-sets.<name>.{rays, hits, t_sum, mrays_1t, mrays_1t_cpu, mrays_all[, counters]};
+sets.<name>.{rays, hits, t_sum, mrays_1t, mrays_1t_cpu, mrays_all,
+mrays_batch_1t, mrays_batch_1t_cpu[, counters]} (batch: one closest_hits or
+any_hits call over the set, checked hit for hit against single rays);
 the primary set adds its packet paths (8 rays on 4x2 tiles, 16 on 4x4):
 mrays_packet_1t[_cpu] and mrays_packet16_1t[_cpu].";
 

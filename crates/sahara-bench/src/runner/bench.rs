@@ -99,6 +99,8 @@ impl Bench {
             mrays_1t: m.mrays_1t,
             mrays_1t_cpu: m.mrays_1t_cpu,
             mrays_all: m.mrays_all,
+            mrays_batch_1t: m.mrays_batch_1t,
+            mrays_batch_1t_cpu: m.mrays_batch_1t_cpu,
             mrays_packet_1t: None,
             mrays_packet_1t_cpu: None,
             mrays_packet16_1t: None,

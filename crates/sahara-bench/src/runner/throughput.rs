@@ -6,7 +6,7 @@ use std::time::Instant;
 use sahara_kd::{KdTree, Ray};
 
 use super::pools::Pools;
-use super::trace::{trace_into, Query};
+use super::trace::{trace_batch_into, trace_into, Query};
 use crate::record::{checksum, HitRecord};
 
 /// The results and speed of one set.
@@ -27,6 +27,13 @@ pub struct Measurement {
     pub mrays_all: f64,
     /// True if the all-thread runs gave the same records as the 1-thread runs.
     pub threads_agree: bool,
+    /// Best Mrays/s on one thread of the batch query (`closest_hits` or
+    /// `any_hits` over the whole set).
+    pub mrays_batch_1t: f64,
+    /// The same by the tracing thread's CPU time.
+    pub mrays_batch_1t_cpu: f64,
+    /// True if the batch query gave the same records as single rays.
+    pub batch_agrees: bool,
 }
 
 /// Million rays per second for `rays` rays in `secs` seconds (0 for no rays).
@@ -64,13 +71,26 @@ fn best_of(
     runs: usize,
     out: &mut [HitRecord],
 ) -> (f64, f64) {
+    best_of_with(trace_into, tree, rays, query, pool, runs, out)
+}
+
+/// [`best_of`] with the tracing function `trace`.
+fn best_of_with(
+    trace: fn(&KdTree, &[Ray], Query, &mut [HitRecord]),
+    tree: &KdTree,
+    rays: &[Ray],
+    query: Query,
+    pool: &rayon::ThreadPool,
+    runs: usize,
+    out: &mut [HitRecord],
+) -> (f64, f64) {
     let mut best = f64::INFINITY;
     let mut best_cpu = f64::INFINITY;
     for _ in 0..runs.max(1) {
         let t0 = Instant::now();
         let cpu = pool.install(|| {
             let c0 = thread_cpu_seconds();
-            trace_into(tree, rays, query, out);
+            trace(tree, rays, query, out);
             thread_cpu_seconds() - c0
         });
         best = best.min(t0.elapsed().as_secs_f64());
@@ -102,8 +122,23 @@ pub fn measure(
         .iter()
         .zip(&records_all)
         .all(|(a, b)| a.tri == b.tri && a.t.to_bits() == b.t.to_bits());
+    let mut records_batch = vec![HitRecord::MISS; rays.len()];
+    let (mrays_batch_1t, mrays_batch_1t_cpu) = best_of_with(
+        trace_batch_into,
+        tree,
+        rays,
+        query,
+        &pools.one,
+        runs,
+        &mut records_batch,
+    );
+    let same = |a: &HitRecord, b: &HitRecord| a.tri == b.tri && a.t.to_bits() == b.t.to_bits();
+    let batch_agrees = records.iter().zip(&records_batch).all(|(a, b)| same(a, b));
     let (hits, t_sum) = checksum(&records);
     Measurement {
+        mrays_batch_1t,
+        mrays_batch_1t_cpu,
+        batch_agrees,
         records,
         hits,
         t_sum,
@@ -142,7 +177,8 @@ mod tests {
         let m = measure(&tree, &rays, Query::ClosestHit, &pools, 2);
         assert_eq!(m.hits, 2500);
         assert_eq!(m.t_sum, 2500.0 * 3.0);
-        assert!(m.threads_agree);
+        assert!(m.threads_agree && m.batch_agrees);
+        assert!(m.mrays_batch_1t > 0.0 && m.mrays_batch_1t_cpu > 0.0);
         assert!(m.mrays_1t > 0.0 && m.mrays_all > 0.0);
         let m = measure(&tree, &rays, Query::AnyHit, &pools, 1);
         assert_eq!((m.hits, m.t_sum), (2500, 0.0));

@@ -55,6 +55,32 @@ pub fn trace_into(tree: &KdTree, rays: &[Ray], query: Query, out: &mut [HitRecor
         });
 }
 
+/// Trace `rays` into `out` with one call of the tree's batch query
+/// (`KdTree::closest_hits` or `KdTree::any_hits`), which splits the rays
+/// over the current rayon pool itself.
+///
+/// # Panics
+/// If `out` and `rays` differ in length.
+pub fn trace_batch_into(tree: &KdTree, rays: &[Ray], query: Query, out: &mut [HitRecord]) {
+    assert_eq!(rays.len(), out.len(), "one record per ray");
+    match query {
+        Query::ClosestHit => {
+            let mut hits = vec![None; rays.len()];
+            tree.closest_hits(rays, &mut hits);
+            for (h, o) in hits.into_iter().zip(out) {
+                *o = HitRecord::from_closest(h);
+            }
+        }
+        Query::AnyHit => {
+            let mut occluded = vec![false; rays.len()];
+            tree.any_hits(rays, &mut occluded);
+            for (h, o) in occluded.into_iter().zip(out) {
+                *o = HitRecord::from_occluded(h);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
