@@ -60,22 +60,10 @@ pub(crate) fn thread_cpu_seconds() -> f64 {
     ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
 
-/// Best Mrays/s of `runs` traces of `rays` on `pool` into `out`: by wall
+/// Best Mrays/s of `runs` traces of `rays` by `trace` on `pool` into `out`: by wall
 /// clock, and by the CPU time of the thread that ran it (meaningful for a
 /// one-thread pool, where that thread traced every ray).
 fn best_of(
-    tree: &KdTree,
-    rays: &[Ray],
-    query: Query,
-    pool: &rayon::ThreadPool,
-    runs: usize,
-    out: &mut [HitRecord],
-) -> (f64, f64) {
-    best_of_with(trace_into, tree, rays, query, pool, runs, out)
-}
-
-/// [`best_of`] with the tracing function `trace`.
-fn best_of_with(
     trace: fn(&KdTree, &[Ray], Query, &mut [HitRecord]),
     tree: &KdTree,
     rays: &[Ray],
@@ -115,15 +103,29 @@ pub fn measure(
     pools
         .one
         .install(|| trace_into(tree, rays, query, &mut records));
-    let (mrays_1t, mrays_1t_cpu) = best_of(tree, rays, query, &pools.one, runs, &mut records);
+    let (mrays_1t, mrays_1t_cpu) = best_of(
+        trace_into,
+        tree,
+        rays,
+        query,
+        &pools.one,
+        runs,
+        &mut records,
+    );
     let mut records_all = vec![HitRecord::MISS; rays.len()];
-    let (mrays_all, _) = best_of(tree, rays, query, &pools.all, runs, &mut records_all);
-    let threads_agree = records
-        .iter()
-        .zip(&records_all)
-        .all(|(a, b)| a.tri == b.tri && a.t.to_bits() == b.t.to_bits());
+    let (mrays_all, _) = best_of(
+        trace_into,
+        tree,
+        rays,
+        query,
+        &pools.all,
+        runs,
+        &mut records_all,
+    );
+    let same = |a: &HitRecord, b: &HitRecord| a.tri == b.tri && a.t.to_bits() == b.t.to_bits();
+    let threads_agree = records.iter().zip(&records_all).all(|(a, b)| same(a, b));
     let mut records_batch = vec![HitRecord::MISS; rays.len()];
-    let (mrays_batch_1t, mrays_batch_1t_cpu) = best_of_with(
+    let (mrays_batch_1t, mrays_batch_1t_cpu) = best_of(
         trace_batch_into,
         tree,
         rays,
@@ -132,7 +134,6 @@ pub fn measure(
         runs,
         &mut records_batch,
     );
-    let same = |a: &HitRecord, b: &HitRecord| a.tri == b.tri && a.t.to_bits() == b.t.to_bits();
     let batch_agrees = records.iter().zip(&records_batch).all(|(a, b)| same(a, b));
     let (hits, t_sum) = checksum(&records);
     Measurement {
