@@ -97,7 +97,6 @@ struct Packet {
 /// rays cannot change their closest hits.
 const MAILBOX: usize = 8;
 
-#[cfg(target_arch = "x86_64")]
 thread_local! {
     /// This thread's packets, reused from call to call: the two halves of
     /// a sixteen-ray packet, the first also an eight-ray packet. A fresh
@@ -118,30 +117,18 @@ impl KdTree<Triangle> {
     pub fn closest_hit_packet(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         assert!(rays.len() <= PACKET, "{} rays in a packet", rays.len());
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
-        #[cfg(target_arch = "x86_64")]
-        if crate::simd::has_avx2() {
-            // The thread's packet is borrowed here, outside the kernel: a
-            // closure is compiled without its caller's target features, so
-            // the walk must not sit in one.
-            PACKETS.with_borrow_mut(|h| {
-                let k = Packet8Query {
-                    tree: self,
-                    rays,
-                    out,
-                    p: &mut h[0],
-                };
-                dispatch(level::AVX2, k)
-            });
-            return;
-        }
-        let mut p = Packet::EMPTY;
-        let k = Packet8Query {
-            tree: self,
-            rays,
-            out,
-            p: &mut p,
-        };
-        dispatch(level::PORTABLE, k);
+        // The thread's packet is borrowed here, outside the kernel: a
+        // closure is compiled without its caller's target features, so the
+        // walk must not sit in one.
+        PACKETS.with_borrow_mut(|h| {
+            let k = Packet8Query {
+                tree: self,
+                rays,
+                out,
+                p: &mut h[0],
+            };
+            dispatch(level::AVX2, k)
+        });
     }
 
     /// Closest hits of up to [`PACKET16`] rays traced as one packet (e.g. a
@@ -158,23 +145,20 @@ impl KdTree<Triangle> {
     pub fn closest_hit_packet16(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         assert!(rays.len() <= PACKET16, "{} rays in a packet", rays.len());
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
-        if rays.len() > PACKET {
-            #[cfg(target_arch = "x86_64")]
-            if crate::simd::has_avx512() {
-                // Borrowed outside the kernel, as in `closest_hit_packet`.
-                let traced = PACKETS.with_borrow_mut(|h| {
-                    let k = Packet16Query {
-                        tree: self,
-                        rays,
-                        out,
-                        h,
-                    };
-                    dispatch(level::AVX512, k)
-                });
-                if traced {
-                    return;
-                }
-            }
+        // Borrowed outside the kernel, as in `closest_hit_packet`; false
+        // below the AVX-512 level or when the halves cannot share a walk.
+        let traced = rays.len() > PACKET
+            && PACKETS.with_borrow_mut(|h| {
+                let k = Packet16Query {
+                    tree: self,
+                    rays,
+                    out,
+                    h,
+                };
+                dispatch(level::AVX512, k)
+            });
+        if traced {
+            return;
         }
         for (r, o) in rays.chunks(PACKET).zip(out.chunks_mut(PACKET)) {
             self.closest_hit_packet(r, o);
@@ -325,7 +309,6 @@ impl Kernel for Packet8Query<'_> {
 
 /// The sixteen-lane walk of [`KdTree::closest_hit_packet16`] as a kernel
 /// for [`dispatch`]: true when it traced the rays.
-#[cfg(target_arch = "x86_64")]
 struct Packet16Query<'a> {
     tree: &'a KdTree<Triangle>,
     rays: &'a [Ray],
@@ -334,17 +317,18 @@ struct Packet16Query<'a> {
     h: &'a mut [Packet; 2],
 }
 
-#[cfg(target_arch = "x86_64")]
 impl Kernel for Packet16Query<'_> {
     type Output = bool;
     #[inline(always)]
     unsafe fn run<const LEVEL: u8>(self) -> bool {
         let Self { tree, rays, out, h } = self;
+        #[cfg(target_arch = "x86_64")]
         if LEVEL >= level::AVX512 {
             // SAFETY: AVX2 and AVX-512 F (the caller's contract); 9 to 16
             // rays (the caller's check).
             return unsafe { tree.trace_packet16(h, rays, out) };
         }
+        let _ = (tree, rays, out, h);
         false
     }
 }
