@@ -19,7 +19,8 @@ use sahara_kd::BuildParams;
 use crate::film::{heat_color, Film};
 use crate::filter::Filter;
 use crate::hash::hash2;
-use crate::integrator::{Context, Integrator, TraceStats};
+use crate::integrator::wavefront::Wavefront;
+use crate::integrator::{Context, Integrator, PathState, TraceStats};
 use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
 use crate::scene::Scene;
 use crate::world::World;
@@ -403,8 +404,12 @@ fn filter_margin(f: &Filter) -> u32 {
     (f.radius() - 0.5).ceil().max(0.0) as u32
 }
 
-/// Renders one pass of one tile; `stop` is asked before each pixel, and
-/// once it says so, the rest of the tile is left out.
+/// Rows of a tile whose samples are traced as one batch by the stepped
+/// integrators: 4x4 pixel blocks make the camera packets.
+const STRIP_ROWS: u32 = 4;
+
+/// Renders one pass of one tile; `stop` is asked before each strip of rows,
+/// and once it says so, the rest of the tile is left out.
 fn render_tile(
     world: &World,
     s: &RenderSettings,
@@ -431,71 +436,163 @@ fn render_tile(
         negative: 0,
         pixels_done: 0,
     };
-    let camera = &world.scene.camera;
-    let inv = Vec2::new(1.0 / w as f32, 1.0 / h as f32);
     let r = s.filter.radius();
-    for y in t.y0..t.y1 {
-        for x in t.x0..t.x1 {
-            if stop() {
-                return out;
-            }
-            let stream = hash2(s.seed, (y as u64) * w as u64 + x as u64);
-            for index in 0..s.spp {
-                let sampler = PixelSampler::new(
-                    s.sampler,
-                    SampleId {
-                        stream,
-                        pass,
-                        index,
-                        count: s.spp,
-                    },
-                );
-                let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
-                let (ray, time) = camera.generate_ray(
-                    pos * inv,
-                    sampler.get_2d(dims::LENS),
-                    sampler.get_1d(dims::TIME),
-                );
-                let mut ctx = Context {
-                    world,
-                    sampler,
-                    stats: &mut out.stats,
-                };
-                let mut l = s.integrator.li(&mut ctx, &ray, time);
-                // Guard, count, never hide: a NaN or infinite sample is a
-                // bug somewhere; it is zeroed so one cannot ruin a pixel,
-                // and reported in the statistics.
-                if !l.is_finite() {
-                    out.nan += 1;
-                    l = Vec3::ZERO;
-                }
-                if l.min_element() < 0.0 {
-                    out.negative += 1;
-                    l = l.max(Vec3::ZERO);
-                }
-                // Splat to every pixel centre within the filter radius.
-                let px0 = x.saturating_sub(m).max(bx);
-                let px1 = (x + m).min(w - 1);
-                let py0 = y.saturating_sub(m).max(by);
-                let py1 = (y + m).min(h - 1);
-                for py in py0..=py1 {
-                    let dy = pos.y - (py as f32 + 0.5);
-                    if dy.abs() > r {
-                        continue;
+    let stepped = s.integrator.is_stepped();
+    let rows = if stepped { STRIP_ROWS } else { 1 };
+    let mut strip = Strip::default();
+    for y0 in (t.y0..t.y1).step_by(rows as usize) {
+        if stop() {
+            return out;
+        }
+        let y1 = (y0 + rows).min(t.y1);
+        strip.render(world, s, t.x0, t.x1, y0, y1, pass, w, h, &mut out.stats);
+        let mut k = 0;
+        for y in y0..y1 {
+            for x in t.x0..t.x1 {
+                for _ in 0..s.spp {
+                    let pos = strip.pos[k];
+                    let mut l = strip.radiance[k];
+                    k += 1;
+                    // Guard, count, never hide: a NaN or infinite sample is
+                    // a bug somewhere; it is zeroed so one cannot ruin a
+                    // pixel, and reported in the statistics.
+                    if !l.is_finite() {
+                        out.nan += 1;
+                        l = Vec3::ZERO;
                     }
-                    let wy = s.filter.eval_1d(dy);
-                    for px in px0..=px1 {
-                        let wt = wy * s.filter.eval_1d(pos.x - (px as f32 + 0.5));
-                        if wt != 0.0 {
-                            let k = ((py - by) * bw + (px - bx)) as usize;
-                            out.sum[k] += l * wt;
-                            out.weight[k] += wt;
+                    if l.min_element() < 0.0 {
+                        out.negative += 1;
+                        l = l.max(Vec3::ZERO);
+                    }
+                    // Splat to every pixel centre within the filter radius.
+                    let px0 = x.saturating_sub(m).max(bx);
+                    let px1 = (x + m).min(w - 1);
+                    let py0 = y.saturating_sub(m).max(by);
+                    let py1 = (y + m).min(h - 1);
+                    for py in py0..=py1 {
+                        let dy = pos.y - (py as f32 + 0.5);
+                        if dy.abs() > r {
+                            continue;
+                        }
+                        let wy = s.filter.eval_1d(dy);
+                        for px in px0..=px1 {
+                            let wt = wy * s.filter.eval_1d(pos.x - (px as f32 + 0.5));
+                            if wt != 0.0 {
+                                let k = ((py - by) * bw + (px - bx)) as usize;
+                                out.sum[k] += l * wt;
+                                out.weight[k] += wt;
+                            }
                         }
                     }
                 }
             }
-            out.pixels_done += 1;
         }
+        out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
     }
     out
+}
+
+/// The samples of a strip of a tile's rows: film positions and radiance,
+/// pixel by pixel (rows top to bottom) and sample by sample.
+#[derive(Default)]
+struct Strip {
+    pos: Vec<Vec2>,
+    radiance: Vec<Vec3>,
+    paths: Vec<PathState>,
+    /// Where each path's radiance goes in `radiance`.
+    slot: Vec<u32>,
+    wavefront: Wavefront,
+}
+
+impl Strip {
+    /// Renders the samples of pixels `[x0, x1) x [y0, y1)` of pass `pass`.
+    #[allow(clippy::too_many_arguments)]
+    fn render(
+        &mut self,
+        world: &World,
+        s: &RenderSettings,
+        x0: u32,
+        x1: u32,
+        y0: u32,
+        y1: u32,
+        pass: u32,
+        w: u32,
+        h: u32,
+        stats: &mut TraceStats,
+    ) {
+        let camera = &world.scene.camera;
+        let inv = Vec2::new(1.0 / w as f32, 1.0 / h as f32);
+        let spp = s.spp;
+        let n = ((x1 - x0) * (y1 - y0) * spp) as usize;
+        self.pos.clear();
+        self.pos.resize(n, Vec2::ZERO);
+        self.radiance.clear();
+        self.radiance.resize(n, Vec3::ZERO);
+        let sampler_at = |x: u32, y: u32, index: u32| {
+            let stream = hash2(s.seed, (y as u64) * w as u64 + x as u64);
+            PixelSampler::new(
+                s.sampler,
+                SampleId {
+                    stream,
+                    pass,
+                    index,
+                    count: spp,
+                },
+            )
+        };
+        let slot_of =
+            |x: u32, y: u32, index: u32| (((y - y0) * (x1 - x0) + (x - x0)) * spp + index) as usize;
+        if !s.integrator.is_stepped() {
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    for index in 0..spp {
+                        let sampler = sampler_at(x, y, index);
+                        let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
+                        let (ray, time) = camera.generate_ray(
+                            pos * inv,
+                            sampler.get_2d(dims::LENS),
+                            sampler.get_1d(dims::TIME),
+                        );
+                        let mut ctx = Context {
+                            world,
+                            sampler,
+                            stats,
+                        };
+                        let k = slot_of(x, y, index);
+                        self.pos[k] = pos;
+                        self.radiance[k] = s.integrator.li(&mut ctx, &ray, time);
+                    }
+                }
+            }
+            return;
+        }
+        // The paths in camera-packet order: 4x4 pixel blocks, each block's
+        // samples index by index.
+        self.paths.clear();
+        self.slot.clear();
+        for bx in (x0..x1).step_by(4) {
+            for index in 0..spp {
+                for y in y0..y1 {
+                    for x in bx..(bx + 4).min(x1) {
+                        let sampler = sampler_at(x, y, index);
+                        let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
+                        let (ray, time) = camera.generate_ray(
+                            pos * inv,
+                            sampler.get_2d(dims::LENS),
+                            sampler.get_1d(dims::TIME),
+                        );
+                        let k = slot_of(x, y, index);
+                        self.pos[k] = pos;
+                        self.slot.push(k as u32);
+                        self.paths.push(PathState::new(ray, time, sampler));
+                    }
+                }
+            }
+        }
+        self.wavefront
+            .trace(&s.integrator, world, stats, &mut self.paths);
+        for (p, &k) in self.paths.iter().zip(&self.slot) {
+            self.radiance[k as usize] = p.l;
+        }
+    }
 }

@@ -7,11 +7,15 @@
 pub mod top_level;
 
 use glam::Affine3A;
-use sahara_kd::{Aabb, BuildParams, Counters, KdTree, Ray};
+use sahara_kd::{Aabb, BuildParams, Counters, Hit, KdTree, NoCounters, Ray, PACKET16};
 
 use crate::instance::{Instance, Placement};
 use crate::mesh::SceneMesh;
 use top_level::InstanceList;
+
+/// Most instances whose trees [`Accel::closest_packet`] traces a packet
+/// through one after another, without the top level.
+const PACKET_INSTANCES: usize = 8;
 
 /// A hit before shading: which instance and triangle, where.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -82,6 +86,11 @@ impl Accel {
         self.trees.len()
     }
 
+    /// Number of instances.
+    pub fn instance_count(&self) -> usize {
+        self.placed.len()
+    }
+
     /// Bytes held by the kd-trees (nodes, leaf indices, triangles, leaf
     /// blocks).
     pub fn tree_bytes(&self) -> usize {
@@ -132,6 +141,48 @@ impl Accel {
             Some(h.t)
         });
         best
+    }
+
+    /// Closest hits of up to [`PACKET16`] rays, `rays[i]` at shutter
+    /// fraction `s[i]`, exactly as [`Accel::closest`] finds them: a scene
+    /// of a few instances traces the rays as one packet through each
+    /// instance's tree in turn (see [`KdTree::closest_hit_packet16`]),
+    /// each ray's interval cut at its closest hit so far; a scene of more
+    /// instances, ray by ray through the top level.
+    pub fn closest_packet(&self, rays: &[Ray], s: &[f32], out: &mut [Option<RawHit>]) {
+        let n = rays.len();
+        assert!(n <= PACKET16 && s.len() == n && out.len() == n);
+        if self.placed.len() > PACKET_INSTANCES {
+            for ((r, &s), o) in rays.iter().zip(s).zip(out.iter_mut()) {
+                *o = self.closest(r, s, &mut NoCounters);
+            }
+            return;
+        }
+        out.fill(None);
+        let mut obj = [Ray::new(glam::Vec3::ZERO, glam::Vec3::X); PACKET16];
+        let mut hits: [Option<Hit>; PACKET16] = [None; PACKET16];
+        for (i, p) in self.placed.iter().enumerate() {
+            let i = i as u32;
+            for k in 0..n {
+                let tmax = out[k].map_or(rays[k].tmax, |b| b.t);
+                obj[k] = Self::object_ray(p, &rays[k], s[k], tmax);
+            }
+            self.trees[p.mesh as usize].closest_hit_packet16(&obj[..n], &mut hits[..n]);
+            for k in 0..n {
+                let Some(h) = hits[k] else { continue };
+                // The tie rule of `closest`: the lower instance index wins.
+                if out[k].is_some_and(|b| b.t < h.t || (b.t == h.t && b.instance <= i)) {
+                    continue;
+                }
+                out[k] = Some(RawHit {
+                    t: h.t,
+                    instance: i,
+                    tri: h.tri,
+                    u: h.u,
+                    v: h.v,
+                });
+            }
+        }
     }
 
     /// True if anything but instance `ignore` lies along `ray` within its

@@ -7,61 +7,68 @@
 //! delta bounces only; after a glossy bounce the direct-lighting estimate
 //! already holds them.
 
-use glam::Vec3;
-use sahara_kd::Ray;
-
+use super::state::{Deferred, Op, PathState};
 use super::{light_contribution, Context, Shading};
 use crate::sampler::dims;
+use crate::world::SurfaceHit;
+use glam::Vec3;
 
-/// Radiance along `ray` with up to `max_depth` specular/glossy bounces.
-pub fn li(ctx: &mut Context, ray: &Ray, time: f32, max_depth: u32, light_samples: u32) -> Vec3 {
+/// One step of the path in `st`, whose ray found `hit`: emission seen
+/// there, every light's samples (deferred to `out`, waiting on their
+/// shadow rays) and the next ray, with up to `max_depth` specular/glossy
+/// bounces. Returns whether the path goes on.
+pub(crate) fn step(
+    ctx: &mut Context,
+    st: &mut PathState,
+    hit: Option<SurfaceHit>,
+    max_depth: u32,
+    light_samples: u32,
+    out: &mut Vec<Deferred>,
+) -> bool {
     let world = ctx.world;
-    let mut l = Vec3::ZERO;
-    let mut beta = Vec3::ONE;
-    let mut ray = *ray;
-    let mut count_emission = true;
-    let mut depth = 0u32;
-    loop {
-        let Some(hit) = world.intersect(&ray, time) else {
-            if count_emission {
-                l += beta * world.env_radiance(ray.dir);
-            }
-            break;
-        };
-        let sh = Shading::new(world, &hit, ray.dir);
-        let mat = sh.material;
-        if count_emission {
-            l += beta * mat.emitted(hit.ng.dot(sh.wo_world));
+    let ray = st.ray;
+    let Some(hit) = hit else {
+        if st.prev_delta {
+            st.l += st.beta * world.env_radiance(ray.dir);
         }
-        if !mat.bsdf.is_delta() {
-            for (j, light) in world.lights.iter().enumerate() {
-                let n = if light.is_delta() { 1 } else { light_samples };
-                let mut sum = Vec3::ZERO;
-                for k in 0..n {
-                    let u = ctx.sampler.get_2d(dims::extra(depth, j as u32, k));
-                    let Some(ls) = light.sample(hit.p, u) else {
-                        continue;
-                    };
-                    if let Some((c, _)) = light_contribution(ctx, &hit, &sh, &ls, time) {
-                        sum += c / ls.pdf;
-                    }
+        return false;
+    };
+    let sh = Shading::new(world, &hit, ray.dir);
+    let mat = sh.material;
+    if st.prev_delta {
+        st.l += st.beta * mat.emitted(hit.ng.dot(sh.wo_world));
+    }
+    let depth = st.depth;
+    if !mat.bsdf.is_delta() {
+        for (j, light) in world.lights.iter().enumerate() {
+            let n = if light.is_delta() { 1 } else { light_samples };
+            for k in 0..n {
+                let u = ctx.sampler.get_2d(dims::extra(depth, j as u32, k));
+                let Some(ls) = light.sample(hit.p, u) else {
+                    continue;
+                };
+                if let Some((c, _, shadow)) = light_contribution(ctx, &hit, &sh, &ls, st.time) {
+                    out.push(Deferred {
+                        shadow: Some(shadow),
+                        op: Op::Sum(c / ls.pdf),
+                    });
                 }
-                l += beta * sum / n as f32;
             }
-        }
-        if depth >= max_depth || mat.bsdf.is_diffuse() {
-            break;
-        }
-        let Some((s, next)) = sh.sample_bounce(ctx, &hit, depth) else {
-            break;
-        };
-        beta *= s.weight;
-        count_emission = s.delta;
-        ray = next;
-        depth += 1;
-        if beta == Vec3::ZERO {
-            break;
+            out.push(Deferred {
+                shadow: None,
+                op: Op::Flush { beta: st.beta, n },
+            });
         }
     }
-    l
+    if depth >= max_depth || mat.bsdf.is_diffuse() {
+        return false;
+    }
+    let Some((s, next)) = sh.sample_bounce(ctx, &hit, depth) else {
+        return false;
+    };
+    st.beta *= s.weight;
+    st.prev_delta = s.delta;
+    st.ray = next;
+    st.depth += 1;
+    st.beta != Vec3::ZERO
 }

@@ -2,8 +2,10 @@
 //! debug views.
 
 pub mod debug;
-pub mod distribution;
-pub mod path;
+mod distribution;
+mod path;
+mod state;
+pub(crate) mod wavefront;
 
 use glam::Vec3;
 use sahara_kd::{Ray, TraversalCounters};
@@ -13,7 +15,9 @@ use crate::material::{BsdfSample, Material};
 use crate::sampler::dims;
 use crate::sampler::PixelSampler;
 use crate::sampling::Frame;
-use crate::world::{SurfaceHit, World};
+use crate::world::{ShadowQuery, SurfaceHit, World};
+use state::Deferred;
+pub(crate) use state::PathState;
 
 /// Which estimator computes a pixel sample's radiance.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -146,24 +150,68 @@ pub struct Context<'w, 'a> {
 }
 
 impl Integrator {
-    /// Radiance along a camera ray at `time`.
+    /// Radiance along a camera ray at `time`, the ray queries answered one
+    /// at a time (the render loop answers them in batches, with the same
+    /// result bit for bit: see [`wavefront`]).
     pub fn li(&self, ctx: &mut Context, ray: &Ray, time: f32) -> Vec3 {
         ctx.stats.camera_rays += 1;
         match *self {
-            Integrator::Path {
-                max_depth,
-                rr_depth,
-            } => path::li(ctx, ray, time, max_depth, rr_depth),
-            Integrator::Distribution {
-                max_depth,
-                light_samples,
-            } => distribution::li(ctx, ray, time, max_depth, light_samples.max(1)),
+            Integrator::Path { .. } | Integrator::Distribution { .. } => {
+                let world = ctx.world;
+                let mut st = PathState::new(*ray, time, ctx.sampler);
+                let mut deferred = Vec::new();
+                loop {
+                    let hit = world.intersect(&st.ray, time);
+                    let more = self.step(ctx, &mut st, hit, &mut deferred);
+                    for d in deferred.drain(..) {
+                        st.apply(&d.op, d.shadow.is_none_or(|q| world.visible(&q)));
+                    }
+                    if !more {
+                        break;
+                    }
+                }
+                st.l
+            }
             Integrator::Normals => debug::normals(ctx, ray, time),
             Integrator::Depth => debug::depth(ctx, ray, time),
             Integrator::Ao { samples, distance } => {
                 debug::ao(ctx, ray, time, samples.max(1), distance)
             }
             Integrator::Cost => debug::cost(ctx, ray, time),
+        }
+    }
+
+    /// True for the integrators written as steps over path states (path
+    /// and distribution), which the render loop traces in batches.
+    pub(crate) fn is_stepped(&self) -> bool {
+        matches!(
+            self,
+            Integrator::Path { .. } | Integrator::Distribution { .. }
+        )
+    }
+
+    /// One step of a stepped integrator's path `st`, whose ray found `hit`;
+    /// contributions waiting on shadow rays go to `out`. Returns whether
+    /// the path goes on (with `st.ray`).
+    #[inline]
+    pub(crate) fn step(
+        &self,
+        ctx: &mut Context,
+        st: &mut PathState,
+        hit: Option<SurfaceHit>,
+        out: &mut Vec<Deferred>,
+    ) -> bool {
+        ctx.sampler = st.sampler;
+        match *self {
+            Integrator::Path {
+                max_depth,
+                rr_depth,
+            } => path::step(ctx, st, hit, max_depth, rr_depth, out),
+            Integrator::Distribution {
+                max_depth,
+                light_samples,
+            } => distribution::step(ctx, st, hit, max_depth, light_samples.max(1), out),
+            _ => false,
         }
     }
 }
@@ -241,16 +289,16 @@ impl Shading<'_> {
     }
 }
 
-/// Unoccluded light from a light sample: `f |cos| Li` (not divided by the
-/// pdf) and the BSDF's density for the direction; `None` if blocked or
-/// zero.
+/// Light from a light sample if nothing blocks it: `f |cos| Li` (not
+/// divided by the pdf), the BSDF's density for the direction, and the
+/// shadow ray that decides whether it arrives (counted); `None` if zero.
 pub(crate) fn light_contribution(
     ctx: &mut Context,
     hit: &SurfaceHit,
     sh: &Shading,
     ls: &LightSample,
     time: f32,
-) -> Option<(Vec3, f32)> {
+) -> Option<(Vec3, f32, ShadowQuery)> {
     if !sh.side_ok(hit, ls.wi) {
         return None;
     }
@@ -261,11 +309,8 @@ pub(crate) fn light_contribution(
         return None;
     }
     ctx.stats.shadow_rays += 1;
-    if !ctx
+    let shadow = ctx
         .world
-        .unoccluded(hit.spawn_origin(ls.wi), ls.wi, ls.dist, time, ls.ignore)
-    {
-        return None;
-    }
-    Some((c, e.pdf))
+        .shadow_query(hit.spawn_origin(ls.wi), ls.wi, ls.dist, time, ls.ignore);
+    Some((c, e.pdf, shadow))
 }

@@ -1,0 +1,110 @@
+//! A pixel sample's path in flight, between one ray query and the next.
+//!
+//! The path tracer and the distribution ray tracer are written as steps: a
+//! step takes the closest hit of the path's current ray, adds what it can
+//! to the sample's radiance, and leaves behind the path's next ray (if the
+//! path goes on) and the light contributions that wait on a shadow ray
+//! ([`Deferred`]). Whoever drives the steps answers the ray queries: one
+//! at a time ([`super::Integrator::li`]) or a whole tile's paths per step
+//! in batches ([`super::wavefront`]). Both apply every sample's deferred
+//! contributions in the order its step made them, before its next step, so
+//! the radiance is summed in the same order and comes out bit for bit the
+//! same either way.
+
+use glam::Vec3;
+use sahara_kd::Ray;
+
+use crate::sampler::PixelSampler;
+use crate::world::ShadowQuery;
+
+/// One pixel sample's path between two steps.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PathState {
+    /// The ray the next step needs the closest hit of.
+    pub ray: Ray,
+    /// The sample's time.
+    pub time: f32,
+    /// The sample's random numbers.
+    pub sampler: PixelSampler,
+    /// Radiance gathered so far.
+    pub l: Vec3,
+    /// Throughput of the path so far.
+    pub beta: Vec3,
+    /// Scattering events so far.
+    pub depth: u32,
+    /// Whether the last scattering was a delta lobe (true for camera
+    /// rays): emission found by the next ray counts in full.
+    pub prev_delta: bool,
+    /// Density of the last scattering's direction.
+    pub prev_pdf: f32,
+    /// Point of the last scattering.
+    pub prev_p: Vec3,
+    /// Running sum of one light's samples (the distribution tracer).
+    pub light_sum: Vec3,
+}
+
+impl PathState {
+    /// A path starting with camera ray `ray` at `time`.
+    #[inline]
+    pub fn new(ray: Ray, time: f32, sampler: PixelSampler) -> Self {
+        Self {
+            ray,
+            time,
+            sampler,
+            l: Vec3::ZERO,
+            beta: Vec3::ONE,
+            depth: 0,
+            prev_delta: true,
+            prev_pdf: 0.0,
+            prev_p: ray.origin,
+            light_sum: Vec3::ZERO,
+        }
+    }
+
+    /// Applies a deferred contribution, `visible` telling whether its
+    /// shadow ray (if it has one) reached the light.
+    #[inline]
+    pub fn apply(&mut self, op: &Op, visible: bool) {
+        match *op {
+            Op::Add(v) => {
+                if visible {
+                    self.l += v;
+                }
+            }
+            Op::Sum(v) => {
+                if visible {
+                    self.light_sum += v;
+                }
+            }
+            Op::Flush { beta, n } => {
+                self.l += beta * self.light_sum / n as f32;
+                self.light_sum = Vec3::ZERO;
+            }
+        }
+    }
+}
+
+/// What a deferred contribution does to its sample.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Op {
+    /// `l += v` if the shadow ray is unblocked.
+    Add(Vec3),
+    /// `light_sum += v` if the shadow ray is unblocked.
+    Sum(Vec3),
+    /// `l += beta * light_sum / n`, then `light_sum = 0` (no shadow ray).
+    Flush {
+        /// The throughput at the vertex.
+        beta: Vec3,
+        /// The light's sample count.
+        n: u32,
+    },
+}
+
+/// A light contribution waiting on its shadow ray.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Deferred {
+    /// The shadow ray, if the contribution has one.
+    pub shadow: Option<ShadowQuery>,
+    /// What to do with the sample's radiance.
+    pub op: Op,
+}
