@@ -570,9 +570,12 @@ impl Strip {
         // samples index by index.
         self.paths.clear();
         self.slot.clear();
-        for bx in (x0..x1).step_by(4) {
+        for (bx, by) in (y0..y1)
+            .step_by(4)
+            .flat_map(|by| (x0..x1).step_by(4).map(move |bx| (bx, by)))
+        {
             for index in 0..spp {
-                for y in y0..y1 {
+                for y in by..(by + 4).min(y1) {
                     for x in bx..(bx + 4).min(x1) {
                         let sampler = sampler_at(x, y, index);
                         let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);

@@ -27,6 +27,42 @@ pub(crate) struct Wavefront {
     /// The round's deferred contributions, and the path each belongs to.
     deferred: Vec<Deferred>,
     owner: Vec<u32>,
+    /// Whether each deferred contribution's shadow ray is unblocked.
+    visible: Vec<bool>,
+    /// The order in which to trace a batch's rays.
+    order: Vec<u32>,
+}
+
+/// A stand-in ray for the ordering of contributions without a shadow ray.
+const NO_RAY: Ray = Ray {
+    origin: glam::Vec3::ZERO,
+    dir: glam::Vec3::ONE,
+    tmin: 0.0,
+    tmax: 0.0,
+};
+
+/// Indices of `rays` grouped by direction octant (the three sign bits),
+/// in their given order within each group: a counting sort.
+fn octant_order(rays: &[Ray], order: &mut Vec<u32>) {
+    let octant = |r: &Ray| {
+        (r.dir.x.is_sign_negative() as usize)
+            | (r.dir.y.is_sign_negative() as usize) << 1
+            | (r.dir.z.is_sign_negative() as usize) << 2
+    };
+    let mut start = [0u32; 9];
+    for r in rays {
+        start[octant(r) + 1] += 1;
+    }
+    for o in 0..8 {
+        start[o + 1] += start[o];
+    }
+    order.clear();
+    order.resize(rays.len(), 0);
+    for (j, r) in rays.iter().enumerate() {
+        let o = octant(r);
+        order[start[o] as usize] = j as u32;
+        start[o] += 1;
+    }
 }
 
 impl Wavefront {
@@ -67,8 +103,14 @@ impl Wavefront {
                 }
                 first = false;
             } else {
-                for ((r, &t), h) in self.rays.iter().zip(&self.times).zip(&mut self.hits) {
-                    *h = world.intersect(r, t);
+                // Ray by ray, grouped by direction octant: rays that share
+                // their signs walk the tree's cells in the same order, which
+                // the branch predictor follows (figures in
+                // docs/performance.md).
+                octant_order(&self.rays, &mut self.order);
+                for &j in &self.order {
+                    let j = j as usize;
+                    self.hits[j] = world.intersect(&self.rays[j], self.times[j]);
                 }
             }
             // Every live path's step.
@@ -88,10 +130,24 @@ impl Wavefront {
                     self.next.push(i);
                 }
             }
-            // The shadow rays, then their contributions in the order made.
-            for (d, &i) in self.deferred.iter().zip(&self.owner) {
-                let visible = d.shadow.is_none_or(|q| world.visible(&q));
-                paths[i as usize].apply(&d.op, visible);
+            // The shadow rays, grouped by octant, then their contributions
+            // in the order made.
+            self.rays.clear();
+            self.visible.clear();
+            self.visible.resize(self.deferred.len(), true);
+            for d in &self.deferred {
+                // Contributions without a shadow ray take a placeholder
+                // that the loop below skips.
+                self.rays.push(d.shadow.map_or(NO_RAY, |q| q.ray));
+            }
+            octant_order(&self.rays, &mut self.order);
+            for &j in &self.order {
+                if let Some(q) = &self.deferred[j as usize].shadow {
+                    self.visible[j as usize] = world.visible(q);
+                }
+            }
+            for ((d, &i), &v) in self.deferred.iter().zip(&self.owner).zip(&self.visible) {
+                paths[i as usize].apply(&d.op, v);
             }
             std::mem::swap(&mut self.live, &mut self.next);
         }
