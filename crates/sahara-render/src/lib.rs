@@ -17,6 +17,7 @@
 pub mod accel;
 pub mod builtin;
 pub mod camera;
+mod cpu_time;
 pub mod distribution;
 pub mod film;
 pub mod filter;

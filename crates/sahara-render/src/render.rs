@@ -16,6 +16,7 @@ use glam::{DVec3, Vec2, Vec3};
 use rayon::prelude::*;
 use sahara_kd::BuildParams;
 
+use crate::cpu_time::process_cpu_time;
 use crate::film::{heat_color, Film};
 use crate::filter::Filter;
 use crate::hash::hash2;
@@ -114,6 +115,9 @@ pub struct RenderStats {
     pub build_time: Duration,
     /// Time spent rendering passes.
     pub render_time: Duration,
+    /// CPU time of all threads spent rendering passes (zero where the
+    /// platform does not report it).
+    pub render_cpu_time: Duration,
     /// True if the render stopped on cancel or time limit before `passes`.
     pub stopped_early: bool,
     /// Pixels finished (with all `spp` samples of the pass) in a first pass
@@ -239,6 +243,7 @@ pub fn render_watched(
         ..Default::default()
     };
     let render_start = Instant::now();
+    let cpu_start = process_cpu_time();
     let mut last_preview = Instant::now();
     let cancelled = || {
         settings
@@ -354,6 +359,7 @@ pub fn render_watched(
         stats.passes * settings.spp
     };
     stats.render_time = render_start.elapsed();
+    stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
     finish(&sum, &wsum, finished.as_deref(), stats, settings, w, h)
 }
 

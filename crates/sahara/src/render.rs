@@ -155,7 +155,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let secs = s.render_time.as_secs_f64();
     let pixels = u64::from(settings.width) * u64::from(settings.height);
     eprintln!(
-        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {} rays, {:.2} Mrays/s{}",
+        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {:.2} CPU s, {} rays, {:.2} Mrays/s{}",
         if partial {
             "wrote PARTIAL image"
         } else {
@@ -173,6 +173,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         s.spp,
         secs,
         s.build_time.as_secs_f64() * 1e3,
+        s.render_cpu_time.as_secs_f64(),
         s.rays(),
         s.rays() as f64 / secs.max(1e-9) / 1e6,
         if s.nan_samples > 0 {
