@@ -155,7 +155,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let secs = s.render_time.as_secs_f64();
     let pixels = u64::from(settings.width) * u64::from(settings.height);
     eprintln!(
-        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {:.2} CPU s, {} rays, {:.2} Mrays/s{}",
+        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {:.3} CPU s, {} rays, {:.2} Mrays/s{}",
         if partial {
             "wrote PARTIAL image"
         } else {
