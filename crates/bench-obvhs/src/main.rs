@@ -149,40 +149,42 @@ fn main() -> Result<()> {
         .collect();
     let params = preset(&a.preset)?;
     let start = Instant::now();
+    // The two layouts have the same query methods but no common trait.
+    macro_rules! trace_with {
+        ($bvh:expr) => {{
+            let bvh = $bvh;
+            eprintln!(
+                "{} built in {:.1} ms",
+                a.layout,
+                start.elapsed().as_secs_f64() * 1e3
+            );
+            let prim = |id: usize| &tris[bvh.primitive_indices[id] as usize];
+            if a.any_hit {
+                measure(&rays, a.runs, |r| {
+                    (!bvh.ray_traverse_miss(*r, |r, id| prim(id).intersect(r))).then_some(0.0)
+                })
+            } else {
+                measure(&rays, a.runs, |r| {
+                    let mut hit = RayHit::none();
+                    bvh.ray_traverse(*r, &mut hit, |r, id| prim(id).intersect(r))
+                        .then_some(hit.t)
+                })
+            }
+        }};
+    }
+    let mut build_time = Duration::default();
     let (hits, t_sum, mrays) = if a.layout == "cwbvh" {
-        let bvh =
-            obvhs::cwbvh::builder::build_cwbvh_from_tris(&tris, params, &mut Duration::default());
-        let build = start.elapsed();
-        eprintln!("cwbvh built in {:.1} ms", build.as_secs_f64() * 1e3);
-        let prim = |id: usize| &tris[bvh.primitive_indices[id] as usize];
-        if a.any_hit {
-            measure(&rays, a.runs, |r| {
-                (!bvh.ray_traverse_miss(*r, |r, id| prim(id).intersect(r))).then_some(0.0)
-            })
-        } else {
-            measure(&rays, a.runs, |r| {
-                let mut hit = RayHit::none();
-                bvh.ray_traverse(*r, &mut hit, |r, id| prim(id).intersect(r))
-                    .then_some(hit.t)
-            })
-        }
+        trace_with!(obvhs::cwbvh::builder::build_cwbvh_from_tris(
+            &tris,
+            params,
+            &mut build_time
+        ))
     } else {
-        let bvh =
-            obvhs::bvh2::builder::build_bvh2_from_tris(&tris, params, &mut Duration::default());
-        let build = start.elapsed();
-        eprintln!("bvh2 built in {:.1} ms", build.as_secs_f64() * 1e3);
-        let prim = |id: usize| &tris[bvh.primitive_indices[id] as usize];
-        if a.any_hit {
-            measure(&rays, a.runs, |r| {
-                (!bvh.ray_traverse_miss(*r, |r, id| prim(id).intersect(r))).then_some(0.0)
-            })
-        } else {
-            measure(&rays, a.runs, |r| {
-                let mut hit = RayHit::none();
-                bvh.ray_traverse(*r, &mut hit, |r, id| prim(id).intersect(r))
-                    .then_some(hit.t)
-            })
-        }
+        trace_with!(obvhs::bvh2::builder::build_bvh2_from_tris(
+            &tris,
+            params,
+            &mut build_time
+        ))
     };
     println!(
         "{{\"layout\": \"{}\", \"preset\": \"{}\", \"triangles\": {}, \"rays\": {}, \"hits\": {hits}, \"t_sum\": {t_sum:.6}, \"mrays_1t_cpu\": {mrays:.3}}}",
