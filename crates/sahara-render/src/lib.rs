@@ -32,6 +32,8 @@ pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod shape;
+pub mod split;
+pub mod sums;
 pub mod texture;
 pub mod world;
 
@@ -44,9 +46,12 @@ pub use light::{Environment, Light};
 pub use material::{Bsdf, Material};
 pub use mesh::{Mesh, SceneMesh};
 pub use render::{
-    render, render_watched, Preview, Progress, RenderResult, RenderSettings, RenderStats,
+    cost_maps, render, render_watched, CostMaps, Preview, Progress, RenderResult, RenderSettings,
+    RenderStats,
 };
 pub use sampler::SamplerKind;
 pub use scene::Scene;
 pub use shape::Shape;
+pub use split::PixelWindow;
+pub use sums::{PixelSum, SumBuffer};
 pub use texture::Texture;
