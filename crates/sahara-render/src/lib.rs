@@ -18,6 +18,7 @@ pub mod accel;
 pub mod builtin;
 pub mod camera;
 mod cpu_time;
+pub mod digest;
 pub mod distribution;
 pub mod film;
 pub mod filter;
