@@ -339,3 +339,67 @@ fn part_options_are_checked() {
         assert!(stderr(&r).contains(what), "{args:?}: {}", stderr(&r));
     }
 }
+
+mod random_splits {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
+
+        /// Random frames and random splits (1-7 tiles x 1-5 sample ranges,
+        /// some without pixels or samples): the merged EXR and PNG are the
+        /// whole frame's bytes.
+        #[test]
+        fn random_splits_merge_to_the_whole_frame(
+            (w, h, spp, pass) in (1u32..=20, 1u32..=14, 1u32..=9, 1u32..=4),
+            (sampler, filter, integrator, seed) in (0usize..3, 0usize..4, 0usize..4, 0u64..100),
+            tiles in 1u32..=7,
+            cuts in proptest::collection::vec(0.0f64..=1.0, 0..=4),
+        ) {
+            let dir = temp_dir(&format!("farm-random-{w}-{h}-{spp}-{seed}-{tiles}"));
+            let pass = pass.min(spp);
+            let total = spp.div_ceil(pass) * pass;
+            let frame: Vec<String> = [
+                "render", "--width", &w.to_string(), "--height", &h.to_string(),
+                "--spp", &spp.to_string(), "--pass-spp", &pass.to_string(),
+                "--sampler", ["independent", "stratified", "sobol"][sampler],
+                "--filter", ["box", "tent", "gaussian", "mitchell"][filter],
+                "--integrator", ["path", "distribution", "ao", "normals"][integrator],
+                "--seed", &seed.to_string(), "--threads", "2",
+            ].iter().map(|s| s.to_string()).collect();
+            let run = |extra: &[String], out: &Path| {
+                let mut a = frame.clone();
+                a.extend(extra.iter().cloned());
+                a.extend(["-o".to_string(), out.display().to_string()]);
+                let a: Vec<&str> = a.iter().map(String::as_str).collect();
+                let r = sahara(&a);
+                assert!(r.status.success(), "{a:?}: {}", stderr(&r));
+            };
+            let mut bounds: Vec<u32> = cuts.iter().map(|c| (c * total as f64) as u32).collect();
+            bounds.extend([0, total]);
+            bounds.sort_unstable();
+            let mut files = Vec::new();
+            for i in 0..tiles {
+                for r in bounds.windows(2) {
+                    let p = dir.join(format!("p{i}-{}-{}.exr", r[0], r[1]));
+                    run(&[
+                        "--part".into(), format!("{i}/{tiles}"),
+                        "--samples".into(), format!("{}..{}", r[0], r[1]),
+                    ], &p);
+                    files.push(p);
+                }
+            }
+            for ext in ["exr", "png"] {
+                let whole = dir.join(format!("whole.{ext}"));
+                run(&[], &whole);
+                let merged = dir.join(format!("merged.{ext}"));
+                let m = merge(&files, &merged, &[]);
+                prop_assert!(m.status.success(), "{}", stderr(&m));
+                prop_assert!(fs::read(&merged).unwrap() == fs::read(&whole).unwrap(),
+                    "the merged {} differs", ext);
+            }
+            fs::remove_dir_all(&dir).unwrap();
+        }
+    }
+}
