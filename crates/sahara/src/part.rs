@@ -150,6 +150,10 @@ pub fn write(
                 format!("{:.3}", s.render_time.as_secs_f64()),
             ),
             (
+                "render_cpu_seconds".into(),
+                format!("{:.3}", s.render_cpu_time.as_secs_f64()),
+            ),
+            (
                 "build_seconds".into(),
                 format!("{:.3}", s.build_time.as_secs_f64()),
             ),
