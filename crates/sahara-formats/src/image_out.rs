@@ -157,7 +157,7 @@ pub fn write_exr(
 /// Reorders the attributes of a single-part EXR file's header by name, in
 /// place. The header keeps its length, so the offset table after it stays
 /// valid.
-fn sort_exr_header(bytes: &mut [u8]) -> Result<(), String> {
+pub(crate) fn sort_exr_header(bytes: &mut [u8]) -> Result<(), String> {
     const MULTIPART: u32 = 0x1000;
     let truncated = || "the encoded header is truncated".to_string();
     let version = bytes.get(4..8).ok_or_else(truncated)?;

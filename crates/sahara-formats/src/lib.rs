@@ -6,6 +6,7 @@
 //!   [`mesh_scene`] (a bare mesh file as one), sharing [`mesh_library`] (each
 //!   mesh file loaded once) and [`material_map`] (MTL / glTF materials);
 //! - images: [`image_out`] (PNG/EXR via [`atomic`] replacement), [`image_in`] (textures);
+//! - render parts: [`part_file`] (a piece of a frame and its exact sums, as EXR);
 //! - every error is a [`FormatError`]: one line naming the file and the place.
 //!
 //! Meshes come out as [`sahara_render::mesh::Mesh`]: one merged triangle list
@@ -26,6 +27,7 @@ pub mod mesh_library;
 pub mod mesh_scene;
 pub mod mtl;
 pub mod obj;
+pub mod part_file;
 pub mod ply;
 pub mod scene_file;
 pub mod scene_load;

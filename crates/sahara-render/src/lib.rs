@@ -18,6 +18,7 @@ pub mod accel;
 pub mod builtin;
 pub mod camera;
 mod cpu_time;
+pub mod digest;
 pub mod distribution;
 pub mod film;
 pub mod filter;
@@ -32,6 +33,8 @@ pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod shape;
+pub mod split;
+pub mod sums;
 pub mod texture;
 pub mod world;
 
@@ -44,9 +47,12 @@ pub use light::{Environment, Light};
 pub use material::{Bsdf, Material};
 pub use mesh::{Mesh, SceneMesh};
 pub use render::{
-    render, render_watched, Preview, Progress, RenderResult, RenderSettings, RenderStats,
+    cost_maps, render, render_watched, CostMaps, Preview, Progress, RenderResult, RenderSettings,
+    RenderStats,
 };
 pub use sampler::SamplerKind;
 pub use scene::Scene;
 pub use shape::Shape;
+pub use split::PixelWindow;
+pub use sums::{PixelSum, SumBuffer};
 pub use texture::Texture;

@@ -1,18 +1,19 @@
 //! The render loop: progressive passes of tiles rendered in parallel.
 //!
 //! Determinism: every random number is a function of (seed, pixel, pass,
-//! sample, dimension), each pixel's samples are taken in a fixed order,
-//! and samples are splatted with the filter into per-tile buffers (a tile
-//! plus a margin of the filter's radius) that are merged into the image in
-//! tile order after each pass. Floating-point sums therefore happen in the
-//! same order whatever the number of threads or the order tiles finish in,
-//! and the same seed gives the same image bit for bit.
+//! sample, dimension), and samples are splatted with the filter into
+//! per-tile buffers (a tile plus a margin of the filter's radius) of exact
+//! fixed-point sums ([`crate::sums`]) that are added into the image after
+//! each pass. The sums do not depend on how samples are grouped, so the
+//! same seed gives the same image bit for bit whatever the number of
+//! threads, the order tiles finish in, or the split of the frame into
+//! windows and sample ranges rendered separately and added up.
 
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use glam::{DVec3, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use sahara_kd::BuildParams;
 
@@ -24,6 +25,8 @@ use crate::integrator::wavefront::Wavefront;
 use crate::integrator::{Context, Integrator, PathState, TraceStats};
 use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
 use crate::scene::Scene;
+use crate::split::PixelWindow;
+use crate::sums::{filter_margin, SumBuffer};
 use crate::world::World;
 
 /// How to render.
@@ -58,6 +61,14 @@ pub struct RenderSettings {
     /// Full scale of the `cost` heat map in work units per camera ray
     /// (None: the image's maximum).
     pub cost_scale: Option<f32>,
+    /// The pixels whose sums the render produces (None: the whole image).
+    /// Every sample whose filter footprint reaches them is rendered, so a
+    /// window's sums are those of the whole frame's render over it.
+    pub window: Option<PixelWindow>,
+    /// The sample indices of every pixel to render, counted over all
+    /// passes: sample `k` is index `k % spp` of pass `k / spp` (None:
+    /// `0..spp * passes`). The passes rendered are those the range meets.
+    pub samples: Option<std::ops::Range<u32>>,
 }
 
 impl Default for RenderSettings {
@@ -76,6 +87,8 @@ impl Default for RenderSettings {
             tile_size: 32,
             build: BuildParams::default(),
             cost_scale: None,
+            window: None,
+            samples: None,
         }
     }
 }
@@ -103,7 +116,8 @@ pub struct Progress {
 pub struct RenderStats {
     /// Passes completed (and in the image).
     pub passes: u32,
-    /// Samples per pixel in the image.
+    /// Samples per pixel in the image (of a sample range: those of the
+    /// range in the completed passes, the first of them at the range's start).
     pub spp: u32,
     /// Work counted over the completed passes.
     pub trace: TraceStats,
@@ -156,8 +170,11 @@ pub struct Preview<'a> {
 /// The image and what it cost.
 #[derive(Clone, Debug)]
 pub struct RenderResult {
-    /// The image (black if no pass completed).
+    /// The image of the window (black if no pass completed).
     pub film: Film,
+    /// The window's exact sums over the completed passes (and, in an
+    /// interrupted first pass, over the tiles it finished).
+    pub sums: SumBuffer,
     /// Counts and times.
     pub stats: RenderStats,
     /// Raw per-pixel work of the `cost` view.
@@ -188,13 +205,8 @@ impl Tile {
 
 /// A tile's filtered samples over its pixels plus the filter margin.
 struct TileOut {
-    /// Buffer origin and size (clipped to the image).
-    bx: u32,
-    by: u32,
-    bw: u32,
-    bh: u32,
-    sum: Vec<Vec3>,
-    weight: Vec<f32>,
+    /// Over the tile plus the margin, clipped to the window.
+    sums: SumBuffer,
     stats: TraceStats,
     nan: u64,
     negative: u64,
@@ -225,19 +237,24 @@ pub fn render_watched(
     let world = World::new(scene, &settings.build);
     let build_time = start.elapsed();
     let (w, h) = (settings.width.max(1), settings.height.max(1));
+    let window = settings
+        .window
+        .unwrap_or(PixelWindow::full(w, h))
+        .intersect(&PixelWindow::full(w, h));
+    // The pixels whose samples reach the window.
+    let region = window.grow(filter_margin(&settings.filter), w, h);
     let ts = settings.tile_size.max(1);
-    let tiles: Vec<Tile> = (0..h.div_ceil(ts))
+    let tiles: Vec<Tile> = (0..region.height().div_ceil(ts))
         .flat_map(|ty| {
-            (0..w.div_ceil(ts)).map(move |tx| Tile {
-                x0: tx * ts,
-                y0: ty * ts,
-                x1: ((tx + 1) * ts).min(w),
-                y1: ((ty + 1) * ts).min(h),
+            (0..region.width().div_ceil(ts)).map(move |tx| Tile {
+                x0: region.x0 + tx * ts,
+                y0: region.y0 + ty * ts,
+                x1: (region.x0 + (tx + 1) * ts).min(region.x1),
+                y1: (region.y0 + (ty + 1) * ts).min(region.y1),
             })
         })
         .collect();
-    let mut sum = vec![DVec3::ZERO; (w * h) as usize];
-    let mut wsum = vec![0.0f64; (w * h) as usize];
+    let mut sums = SumBuffer::new(window.x0, window.y0, window.width(), window.height());
     let mut stats = RenderStats {
         build_time,
         ..Default::default()
@@ -252,31 +269,59 @@ pub fn render_watched(
             .is_some_and(|c| c.load(Ordering::Relaxed))
     };
     let out_of_time = || settings.time_limit.is_some_and(|t| start.elapsed() >= t);
-    let passes = settings.passes.max(1);
+    let spp = settings.spp.max(1);
+    let all_passes = settings.passes.max(1);
+    // The passes the sample range meets, and the range within each.
+    let (first_pass, passes, first, last) = match &settings.samples {
+        None => (0, all_passes, 0u64, u64::from(all_passes) * u64::from(spp)),
+        Some(r) if r.start >= r.end => (0, 0, 0, 0),
+        Some(r) => (
+            r.start / spp,
+            r.end.div_ceil(spp) - r.start / spp,
+            u64::from(r.start),
+            u64::from(r.end),
+        ),
+    };
+    let indices_of = |pass: u32| {
+        let base = u64::from(pass) * u64::from(spp);
+        let i0 = first.saturating_sub(base).min(u64::from(spp)) as u32;
+        let i1 = last.saturating_sub(base).min(u64::from(spp)) as u32;
+        i0..i1
+    };
     let rays_so_far = std::sync::atomic::AtomicU64::new(0);
     // Pixels finished in an interrupted first pass (None: not interrupted).
     let mut finished: Option<Vec<bool>> = None;
-    for pass in 0..passes {
-        if cancelled() || (pass > 0 && out_of_time()) {
+    for n in 0..passes {
+        let pass = first_pass + n;
+        if cancelled() || (n > 0 && out_of_time()) {
             stats.stopped_early = true;
             break;
         }
+        let indices = indices_of(pass);
         let done = AtomicU32::new(0);
         let abandon = AtomicBool::new(false);
         // The first pass stops pixel by pixel on cancel, so that a long
         // first pass still leaves the pixels it finished.
-        let stop_pixel = || pass == 0 && cancelled();
+        let stop_pixel = || n == 0 && cancelled();
         let outs: Vec<Option<TileOut>> = tiles
             .par_iter()
             // One job per tile: rayon otherwise hands out a few large runs
             // of tiles, and one costly run can leave the other cores idle.
             .with_max_len(1)
             .map(|tile| {
-                if abandon.load(Ordering::Relaxed) || cancelled() || (pass > 0 && out_of_time()) {
+                if abandon.load(Ordering::Relaxed) || cancelled() || (n > 0 && out_of_time()) {
                     abandon.store(true, Ordering::Relaxed);
                     return None;
                 }
-                let out = render_tile(&world, settings, *tile, pass, w, h, &stop_pixel);
+                let out = render_tile(
+                    &world,
+                    settings,
+                    *tile,
+                    &window,
+                    pass,
+                    indices.clone(),
+                    &stop_pixel,
+                );
                 if out.pixels_done < tile.pixels() {
                     abandon.store(true, Ordering::Relaxed);
                 }
@@ -289,7 +334,7 @@ pub fn render_watched(
                     + t.bounce_rays
                     + t.shadow_rays;
                 progress(Progress {
-                    pass,
+                    pass: n,
                     passes,
                     tiles_done: d,
                     tiles: tiles.len() as u32,
@@ -303,36 +348,33 @@ pub fn render_watched(
             .iter()
             .zip(&tiles)
             .all(|(o, t)| o.as_ref().is_some_and(|o| o.pixels_done == t.pixels()));
-        if !complete && pass > 0 {
+        if !complete && n > 0 {
             // A later pass is dropped whole: every pixel keeps the same
             // number of samples.
             stats.stopped_early = true;
             break;
         }
         if !complete {
-            // The first pass, interrupted: keep the pixels it finished.
-            let mut mask = vec![false; (w * h) as usize];
+            // The first pass, interrupted: keep the window's pixels it finished.
+            let mut mask = vec![false; window.pixels() as usize];
             for (out, tile) in outs.iter().zip(&tiles) {
                 if let Some(out) = out {
                     for k in 0..out.pixels_done {
                         let (x, y) = tile.pixel(k);
-                        mask[(y * w + x) as usize] = true;
+                        if (window.x0..window.x1).contains(&x)
+                            && (window.y0..window.y1).contains(&y)
+                        {
+                            let i = (y - window.y0) * window.width() + (x - window.x0);
+                            mask[i as usize] = true;
+                        }
                     }
                 }
             }
             stats.first_pass_pixels = mask.iter().filter(|&&m| m).count() as u64;
             finished = Some(mask);
         }
-        // Merge in tile order: the sums' order is fixed.
         for out in outs.into_iter().flatten() {
-            for j in 0..out.bh {
-                for i in 0..out.bw {
-                    let k = (j * out.bw + i) as usize;
-                    let p = ((out.by + j) * w + out.bx + i) as usize;
-                    sum[p] += out.sum[k].as_dvec3();
-                    wsum[p] += out.weight[k] as f64;
-                }
-            }
+            sums.add(&out.sums);
             stats.trace += out.stats;
             stats.nan_samples += out.nan;
             stats.negative_samples += out.negative;
@@ -342,59 +384,55 @@ pub fn render_watched(
             break;
         }
         stats.passes += 1;
+        stats.spp += indices.len() as u32;
         if let Some(p) = preview.as_mut() {
-            if pass + 1 < passes && last_preview.elapsed() >= p.every {
+            if n + 1 < passes && last_preview.elapsed() >= p.every {
                 let mut snapshot = stats;
-                snapshot.spp = stats.passes * settings.spp;
                 snapshot.render_time = render_start.elapsed();
                 snapshot.stopped_early = true;
-                (p.show)(&finish(&sum, &wsum, None, snapshot, settings, w, h));
+                (p.show)(&finish(sums.clone(), None, snapshot, settings));
                 last_preview = Instant::now();
             }
         }
     }
-    stats.spp = if finished.is_some() {
-        settings.spp
-    } else {
-        stats.passes * settings.spp
-    };
+    if finished.is_some() {
+        stats.spp = indices_of(first_pass).len() as u32;
+    }
     stats.render_time = render_start.elapsed();
     stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
-    finish(&sum, &wsum, finished.as_deref(), stats, settings, w, h)
+    finish(sums, finished.as_deref(), stats, settings)
 }
 
 /// The image of the sums so far (black where `finished` says a pixel was not).
 fn finish(
-    sum: &[DVec3],
-    wsum: &[f64],
+    sums: SumBuffer,
     finished: Option<&[bool]>,
     stats: RenderStats,
     settings: &RenderSettings,
-    w: u32,
-    h: u32,
 ) -> RenderResult {
-    let mut film = Film::new(w, h);
-    for (k, (p, (s, wt))) in film.pixels.iter_mut().zip(sum.iter().zip(wsum)).enumerate() {
+    let mut film = Film::new(sums.width, sums.height);
+    for (k, (p, s)) in film.pixels.iter_mut().zip(&sums.sums).enumerate() {
         let keep = finished.is_none_or(|f| f[k]);
-        // Negative lobes (Mitchell) can make an estimate negative near
-        // edges; the film holds radiance, which is not.
-        *p = if *wt > 0.0 && keep {
-            (*s / *wt).as_vec3().max(Vec3::ZERO)
-        } else {
-            Vec3::ZERO
-        };
+        *p = if keep { s.value() } else { Vec3::ZERO };
     }
-    let cost =
-        matches!(settings.integrator, Integrator::Cost).then(|| cost_maps(&mut film, settings));
-    RenderResult { film, stats, cost }
+    let cost = matches!(settings.integrator, Integrator::Cost)
+        .then(|| cost_maps(&mut film, settings.cost_scale));
+    RenderResult {
+        film,
+        sums,
+        stats,
+        cost,
+    }
 }
 
-/// Turns the raw cost film into a heat map, returning the raw values.
-fn cost_maps(film: &mut Film, settings: &RenderSettings) -> CostMaps {
+/// Turns the raw film of the `cost` view into its heat map (full heat at
+/// `scale` work units per camera ray, or at the image's maximum if None),
+/// returning the raw values.
+pub fn cost_maps(film: &mut Film, scale: Option<f32>) -> CostMaps {
     let steps: Vec<f32> = film.pixels.iter().map(|p| p.x).collect();
     let tests: Vec<f32> = film.pixels.iter().map(|p| p.y).collect();
     let max = film.pixels.iter().map(|p| p.x + p.y).fold(0.0f32, f32::max);
-    let scale = settings.cost_scale.unwrap_or(max).max(1e-6);
+    let scale = scale.unwrap_or(max).max(1e-6);
     for p in &mut film.pixels {
         *p = heat_color((p.x + p.y) / scale);
     }
@@ -405,44 +443,40 @@ fn cost_maps(film: &mut Film, settings: &RenderSettings) -> CostMaps {
     }
 }
 
-/// Pixels beyond a pixel's own that its samples reach through the filter.
-fn filter_margin(f: &Filter) -> u32 {
-    (f.radius() - 0.5).ceil().max(0.0) as u32
-}
-
 /// Rows of a tile whose samples are traced as one batch by the stepped
 /// integrators: 4x4 pixel blocks make the camera packets.
 const STRIP_ROWS: u32 = 4;
 
-/// Renders one pass of one tile; `stop` is asked before each strip of rows,
-/// and once it says so, the rest of the tile is left out.
+/// Renders sample indices `indices` of pass `pass` of one tile, splatting
+/// them into the window's pixels they reach; `stop` is asked before each
+/// strip of rows, and once it says so, the rest of the tile is left out.
+#[allow(clippy::too_many_arguments)]
 fn render_tile(
     world: &World,
     s: &RenderSettings,
     t: Tile,
+    window: &PixelWindow,
     pass: u32,
-    w: u32,
-    h: u32,
+    indices: std::ops::Range<u32>,
     stop: &dyn Fn() -> bool,
 ) -> TileOut {
+    let (w, h) = (s.width.max(1), s.height.max(1));
     let m = filter_margin(&s.filter);
-    let bx = t.x0.saturating_sub(m);
-    let by = t.y0.saturating_sub(m);
-    let bw = (t.x1 + m).min(w) - bx;
-    let bh = (t.y1 + m).min(h) - by;
+    let reach = PixelWindow {
+        x0: t.x0,
+        x1: t.x1,
+        y0: t.y0,
+        y1: t.y1,
+    }
+    .grow(m, w, h)
+    .intersect(window);
     let mut out = TileOut {
-        bx,
-        by,
-        bw,
-        bh,
-        sum: vec![Vec3::ZERO; (bw * bh) as usize],
-        weight: vec![0.0; (bw * bh) as usize],
+        sums: SumBuffer::new(reach.x0, reach.y0, reach.width(), reach.height()),
         stats: TraceStats::default(),
         nan: 0,
         negative: 0,
         pixels_done: 0,
     };
-    let r = s.filter.radius();
     let stepped = s.integrator.is_stepped();
     let rows = if stepped { STRIP_ROWS } else { 1 };
     let mut strip = Strip::default();
@@ -451,11 +485,21 @@ fn render_tile(
             return out;
         }
         let y1 = (y0 + rows).min(t.y1);
-        strip.render(world, s, t.x0, t.x1, y0, y1, pass, w, h, &mut out.stats);
+        strip.render(
+            world,
+            s,
+            t.x0,
+            t.x1,
+            y0,
+            y1,
+            pass,
+            indices.clone(),
+            &mut out.stats,
+        );
         let mut k = 0;
         for y in y0..y1 {
             for x in t.x0..t.x1 {
-                for _ in 0..s.spp {
+                for _ in indices.clone() {
                     let pos = strip.pos[k];
                     let mut l = strip.radiance[k];
                     k += 1;
@@ -470,26 +514,7 @@ fn render_tile(
                         out.negative += 1;
                         l = l.max(Vec3::ZERO);
                     }
-                    // Splat to every pixel centre within the filter radius.
-                    let px0 = x.saturating_sub(m).max(bx);
-                    let px1 = (x + m).min(w - 1);
-                    let py0 = y.saturating_sub(m).max(by);
-                    let py1 = (y + m).min(h - 1);
-                    for py in py0..=py1 {
-                        let dy = pos.y - (py as f32 + 0.5);
-                        if dy.abs() > r {
-                            continue;
-                        }
-                        let wy = s.filter.eval_1d(dy);
-                        for px in px0..=px1 {
-                            let wt = wy * s.filter.eval_1d(pos.x - (px as f32 + 0.5));
-                            if wt != 0.0 {
-                                let k = ((py - by) * bw + (px - bx)) as usize;
-                                out.sum[k] += l * wt;
-                                out.weight[k] += wt;
-                            }
-                        }
-                    }
+                    out.sums.splat(&s.filter, m, x, y, pos, l);
                 }
             }
         }
@@ -511,7 +536,8 @@ struct Strip {
 }
 
 impl Strip {
-    /// Renders the samples of pixels `[x0, x1) x [y0, y1)` of pass `pass`.
+    /// Renders sample indices `indices` of pass `pass` of pixels
+    /// `[x0, x1) x [y0, y1)`.
     #[allow(clippy::too_many_arguments)]
     fn render(
         &mut self,
@@ -522,14 +548,15 @@ impl Strip {
         y0: u32,
         y1: u32,
         pass: u32,
-        w: u32,
-        h: u32,
+        indices: std::ops::Range<u32>,
         stats: &mut TraceStats,
     ) {
+        let (w, h) = (s.width.max(1), s.height.max(1));
         let camera = &world.scene.camera;
         let inv = Vec2::new(1.0 / w as f32, 1.0 / h as f32);
         let spp = s.spp;
-        let n = ((x1 - x0) * (y1 - y0) * spp) as usize;
+        let per_pixel = indices.len() as u32;
+        let n = ((x1 - x0) * (y1 - y0) * per_pixel) as usize;
         self.pos.clear();
         self.pos.resize(n, Vec2::ZERO);
         self.radiance.clear();
@@ -546,12 +573,13 @@ impl Strip {
                 },
             )
         };
-        let slot_of =
-            |x: u32, y: u32, index: u32| (((y - y0) * (x1 - x0) + (x - x0)) * spp + index) as usize;
+        let slot_of = |x: u32, y: u32, index: u32| {
+            (((y - y0) * (x1 - x0) + (x - x0)) * per_pixel + index - indices.start) as usize
+        };
         if !s.integrator.is_stepped() {
             for y in y0..y1 {
                 for x in x0..x1 {
-                    for index in 0..spp {
+                    for index in indices.clone() {
                         let sampler = sampler_at(x, y, index);
                         let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
                         let (ray, time) = camera.generate_ray(
@@ -580,7 +608,7 @@ impl Strip {
             .step_by(4)
             .flat_map(|by| (x0..x1).step_by(4).map(move |bx| (bx, by)))
         {
-            for index in 0..spp {
+            for index in indices.clone() {
                 for y in by..(by + 4).min(y1) {
                     for x in bx..(bx + 4).min(x1) {
                         let sampler = sampler_at(x, y, index);

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use clap::{ArgAction, Args, Parser, Subcommand};
+use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
 use sahara_bench::SetKind;
 use sahara_kd::{BuildParams, Builder};
 use sahara_render::mesh::Mesh;
@@ -32,6 +32,32 @@ pub enum Command {
     Stats(StatsArgs),
     /// Render a scene (built-in Cornell box, a mesh file, or a scene file) to PNG or EXR.
     Render(RenderArgs),
+    /// Merge render parts into the frame: the same bytes as the frame rendered whole.
+    Merge(MergeArgs),
+}
+
+/// How `--part` divides a frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, ValueEnum)]
+pub enum Split {
+    /// Pixel regions of nearly equal pixel counts.
+    #[default]
+    Tiles,
+    /// Contiguous ranges of every pixel's sample indices.
+    Samples,
+}
+
+/// Options of `sahara merge`.
+#[derive(Debug, Args, Clone, PartialEq)]
+pub struct MergeArgs {
+    /// The part files (.exr) that `sahara render --part / --crop / --samples` wrote.
+    #[arg(required = true, value_name = "PARTS")]
+    pub parts: Vec<PathBuf>,
+    /// The frame to write: .exr or .png.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// Also merge parts that were interrupted (partial), saying what was merged.
+    #[arg(long)]
+    pub allow_partial: bool,
 }
 
 /// Options of `sahara render`.
@@ -109,6 +135,69 @@ pub struct RenderArgs {
     /// else clamp].
     #[arg(long, value_name = "NAME")]
     pub tonemap: Option<String>,
+    /// Render part I (0-based) of N of the frame, divided as --split says,
+    /// and write it as a part file (.exr) for `sahara merge`.
+    #[arg(long, value_name = "I/N", value_parser = parse_part)]
+    pub part: Option<(u32, u32)>,
+    /// How --part divides the frame: tiles (pixel regions) or samples
+    /// (ranges of every pixel's samples) [default: tiles].
+    #[arg(long, value_name = "HOW", requires = "part")]
+    pub split: Option<Split>,
+    /// Render only the crop window X0,X1,Y0,Y1, fractions of the image (y
+    /// from the top; pixel bounds rounded up, as pbrt-v4's); writes a part
+    /// file. With --part tiles, the tiles divide the crop window.
+    #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = parse_crop)]
+    pub crop: Option<[f64; 4]>,
+    /// Render only sample indices START..END of every pixel (counted over
+    /// all passes, 0..spp); writes a part file. With --part samples, the
+    /// parts divide this range.
+    #[arg(long, value_name = "START..END", value_parser = parse_samples)]
+    pub samples: Option<std::ops::Range<u32>>,
+    /// With a part: if the output already holds this part of this frame,
+    /// complete, do not render it again (for retried farm tasks).
+    #[arg(long)]
+    pub skip_existing: bool,
+}
+
+/// `I/N` with I < N.
+fn parse_part(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("'{s}' is not a part I/N with 0 <= I < N (I counts from 0)");
+    let (i, n) = s.split_once('/').ok_or_else(bad)?;
+    let (i, n): (u32, u32) = (i.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?);
+    if i >= n {
+        return Err(bad());
+    }
+    Ok((i, n))
+}
+
+/// `x0,x1,y0,y1`, fractions with x0 <= x1 and y0 <= y1.
+fn parse_crop(s: &str) -> Result<[f64; 4], String> {
+    let bad = || {
+        format!(
+            "'{s}' is not a crop window x0,x1,y0,y1 of fractions in [0, 1] with x0 <= x1, y0 <= y1"
+        )
+    };
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().map_err(|_| bad()))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x0, x1, y0, y1] if v.iter().all(|f| (0.0..=1.0).contains(f)) && x0 <= x1 && y0 <= y1 => {
+            Ok([x0, x1, y0, y1])
+        }
+        _ => Err(bad()),
+    }
+}
+
+/// `START..END` with START <= END.
+fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
+    let bad = || format!("'{s}' is not a sample range START..END with START <= END");
+    let (a, b) = s.split_once("..").ok_or_else(bad)?;
+    let (a, b): (u32, u32) = (a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?);
+    if a > b {
+        return Err(bad());
+    }
+    Ok(a..b)
 }
 
 const BENCH_ABOUT: &str = "\

@@ -3,7 +3,8 @@
 //! `sahara render` renders a scene file, a mesh or the built-in Cornell box
 //! (also what `sahara` alone does); `sahara bench` runs the ray-casting
 //! benchmark protocol (`docs/bench-protocol.md`); `sahara stats` prints a
-//! tree's statistics.
+//! tree's statistics; `sahara merge` assembles the parts of a frame
+//! rendered in pieces.
 
 mod bench;
 mod cli;
@@ -11,6 +12,8 @@ mod demo_scene;
 mod human;
 mod input;
 mod memory;
+mod merge;
+mod part;
 mod render;
 mod render_options;
 mod stats;
@@ -28,6 +31,7 @@ fn main() -> ExitCode {
         Some(Command::Bench(args)) => bench::run_file(args),
         Some(Command::Stats(args)) => stats::run(args),
         Some(Command::Render(args)) => render::run(args),
+        Some(Command::Merge(args)) => merge::run(args),
         None => render::run(&RenderArgs::default()),
     };
     match result {

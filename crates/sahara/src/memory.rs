@@ -10,9 +10,9 @@ use anyhow::{bail, Result};
 /// capped by `BuildParams::max_duplication`).
 pub const BYTES_PER_TRIANGLE: u64 = 256;
 
-/// Bytes per film pixel: the film, the per-tile splat buffers of a pass
-/// and the 8- or 32-bit output copy.
-pub const BYTES_PER_PIXEL: u64 = 64;
+/// Bytes per film pixel: the exact sums (four 128-bit integers), the film,
+/// the per-tile splat buffers of a pass and the 8- or 32-bit output copy.
+pub const BYTES_PER_PIXEL: u64 = 96;
 
 /// Memory the machine can still give, from `/proc/meminfo` (None where that
 /// cannot be read, e.g. off Linux).
@@ -58,11 +58,11 @@ mod tests {
 
     #[test]
     fn a_render_that_does_not_fit_is_refused_with_its_estimate() {
-        // 65536^2 pixels at 64 bytes = 256 GiB.
+        // 65536^2 pixels at 96 bytes = 384 GiB.
         let e = check_fits(1000, 65536, 65536, Some(24 << 30))
             .unwrap_err()
             .to_string();
-        assert!(e.contains("256.0 GiB") && e.contains("24.0 GiB"), "{e}");
+        assert!(e.contains("384.0 GiB") && e.contains("24.0 GiB"), "{e}");
         assert!(check_fits(1_000_000, 1024, 1024, Some(24 << 30)).is_ok());
         // Unknown availability never refuses.
         assert!(check_fits(u64::MAX / 512, 65536, 65536, None).is_ok());

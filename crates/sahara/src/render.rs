@@ -18,6 +18,7 @@ use sahara_render::{
 
 use crate::cli::RenderArgs;
 use crate::memory;
+use crate::part;
 use crate::render_options::{resolve, RenderOptions};
 
 /// A scene to render, with what its file says about rendering it.
@@ -47,12 +48,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }));
     crate::warnings::print(&warnings);
     let RenderOptions {
-        settings,
+        mut settings,
         sampler_name,
         exposure,
         tonemap,
         output,
     } = resolve(args, file.as_ref(), &name)?;
+    let piece = part::plan(args, &settings)?;
+    if piece.is_some() && !is_exr(&output) {
+        bail!(
+            "{}: a part (--part, --crop, --samples) is written as OpenEXR: name a .exr file",
+            output.display()
+        );
+    }
     // Refuse an unwritable output now, not after the render.
     sahara_formats::atomic::check_writable(&output)
         .map_err(|e| anyhow!("{e}"))
@@ -63,18 +71,37 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .iter()
         .map(|m| m.mesh.indices.len() as u64)
         .sum();
-    memory::check_fits(
-        triangles,
-        settings.width,
-        settings.height,
-        memory::available_bytes(),
-    )?;
+    let (film_w, film_h) = piece
+        .as_ref()
+        .map_or((settings.width, settings.height), |p| {
+            (p.window.width().max(1), p.window.height().max(1))
+        });
+    memory::check_fits(triangles, film_w, film_h, memory::available_bytes())?;
     // Any aspect ratio: the vertical field of view is kept.
     scene.camera.aspect = settings.width as f32 / settings.height as f32;
     scene.validate().map_err(|e| match &args.scene {
         Some(p) => anyhow!("{}: invalid scene: {e}", p.display()),
         None => anyhow!("invalid scene: {e}"),
     })?;
+    let digest = piece
+        .as_ref()
+        .map(|_| sahara_render::digest::frame_digest(&scene, &settings));
+    if let (Some(p), Some(d)) = (&piece, &digest) {
+        settings.window = Some(p.window);
+        settings.samples = Some(p.samples.clone());
+        if args.skip_existing {
+            match part::existing_differs(&output, d, p) {
+                None => {
+                    eprintln!(
+                        "{}: already holds this part, complete: not rendered again",
+                        output.display()
+                    );
+                    return Ok(());
+                }
+                Some(why) => eprintln!("{}: rendering the part: {why}", output.display()),
+            }
+        }
+    }
 
     let cancel = settings.cancel.clone().expect("settings set a cancel flag");
     // SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature): a batch
@@ -92,6 +119,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .num_threads(threads)
         .build()
         .context("cannot start the render threads")?;
+    if let Some(p) = &piece {
+        eprintln!(
+            "part{}: pixels {} ({} of them), samples {}..{}",
+            if p.label.is_empty() {
+                String::new()
+            } else {
+                format!(" {}", p.label)
+            },
+            p.window,
+            p.window.pixels(),
+            p.samples.start,
+            p.samples.end
+        );
+    }
     eprintln!(
         "rendering {description} at {}x{}, {} ({sampler_name}), {} spp in passes of {}, {} threads",
         settings.width,
@@ -108,6 +149,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // Started after the line above, so that it does not draw over it.
     let bar = progress_bar(&settings);
     let on_progress = |p: Progress| {
+        if p.passes != u32::MAX {
+            bar.set_length(u64::from(p.passes) * u64::from(p.tiles));
+        }
         bar.set_position((p.pass as u64) * p.tiles as u64 + p.tiles_done as u64);
         let mrays = p.rays as f64 / p.elapsed.as_secs_f64().max(1e-9) / 1e6;
         let of = if p.passes == u32::MAX {
@@ -148,6 +192,36 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .cancel
             .as_ref()
             .is_some_and(|c| c.load(Ordering::SeqCst));
+    if let (Some(p), Some(d)) = (&piece, &digest) {
+        let record = part::PartRecord {
+            piece: p,
+            digest: d,
+            exposure,
+            tonemap,
+            interrupted: partial,
+        };
+        let done = part::write(&output, &record, &settings, &result)?;
+        eprintln!(
+            "{} {}: samples {}..{} of {}..{}, {:.2} s render (+{:.0} ms tree builds), {} rays",
+            if partial {
+                "wrote PARTIAL part"
+            } else {
+                "wrote part"
+            },
+            output.display(),
+            done.start,
+            done.end,
+            p.samples.start,
+            p.samples.end,
+            s.render_time.as_secs_f64(),
+            s.build_time.as_secs_f64() * 1e3,
+            s.rays()
+        );
+        if partial {
+            std::process::exit(130);
+        }
+        return Ok(());
+    }
     if s.passes == 0 && s.first_pass_pixels == 0 {
         bail!("stopped before the first pixel was finished: no image written");
     }
@@ -190,17 +264,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 }
 
 /// Where and how the image is written.
-struct Output<'a> {
-    path: &'a Path,
-    settings: &'a RenderSettings,
-    exposure: f32,
-    tonemap: ToneMap,
+pub(crate) struct Output<'a> {
+    pub(crate) path: &'a Path,
+    pub(crate) settings: &'a RenderSettings,
+    pub(crate) exposure: f32,
+    pub(crate) tonemap: ToneMap,
 }
 
 impl Output<'_> {
     /// Writes `result` (atomically), marked `partial` or not; `log` prints
     /// what a debug view's colours mean.
-    fn write(&self, result: &RenderResult, partial: bool, log: bool) -> Result<()> {
+    pub(crate) fn write(&self, result: &RenderResult, partial: bool, log: bool) -> Result<()> {
         let settings = self.settings;
         let s = &result.stats;
         let exr = is_exr(self.path);

@@ -219,3 +219,40 @@ fn previews_are_rewritten_while_rendering_and_marked_partial() {
     names.sort();
     assert_eq!(names, ["done.exr", "preview.exr"], "{names:?}");
 }
+
+#[test]
+fn sigterm_leaves_a_part_marked_partial_that_merge_refuses() {
+    let dir = temp_dir("part-sigterm");
+    let out = dir.join("part.exr");
+    // Many passes of one sample: far more than the wait.
+    let args = [
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "--spp",
+        "200000",
+        "--pass-spp",
+        "1",
+        "--part",
+        "1/2",
+    ];
+    let (code, log) = interrupt_render(&args, &out, "-TERM", Duration::from_millis(1500));
+    assert_eq!(code, Some(130), "{log}");
+    assert!(log.contains("wrote PARTIAL part"), "{log}");
+    assert_eq!(exr_text(&out, "sahara:complete").as_deref(), Some("false"));
+    let done = exr_text(&out, "sahara:samples_done").unwrap();
+    assert!(done.starts_with("0..") && done != "0..200000", "{done}");
+    let merged = dir.join("merged.exr");
+    let m = Command::new(SAHARA)
+        .args([
+            "merge",
+            out.to_str().unwrap(),
+            "-o",
+            merged.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&m.stderr);
+    assert!(!m.status.success() && e.contains("a partial part"), "{e}");
+}

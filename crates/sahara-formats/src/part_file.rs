@@ -1,0 +1,436 @@
+//! Render parts: a piece of a frame (a pixel window and a sample range) as
+//! an OpenEXR file holding its exact sums, for `sahara merge`.
+//!
+//! The file is a single-part scanline EXR the size of the window (1 x 1,
+//! all zero, for a window without pixels) with 16 `UINT` channels: each of
+//! the four 128-bit fixed-point sums of a pixel
+//! ([`sahara_render::PixelSum`]: R, G, B and the weight) as four 32-bit
+//! words, `sum.R.w0` (least significant) to `sum.R.w3`, then `sum.G.*`,
+//! `sum.B.*` and `weight.w*`. What the merge needs to know of it is in
+//! string attributes ([`PartInfo`]). It is written atomically.
+
+use std::io::{BufWriter, Read, Write};
+use std::ops::Range;
+use std::path::Path;
+
+use exr::meta::attribute::{AttributeValue, Text};
+use exr::prelude::{
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
+    WritableImage,
+};
+use sahara_render::{PixelSum, PixelWindow, SumBuffer};
+
+use crate::atomic::write_atomically;
+use crate::error::FormatError;
+
+/// The value of `sahara:format` in a part file.
+const FORMAT: &str = "sahara render part 1";
+
+/// Largest frame side a part may describe (as for `sahara render`).
+const MAX_SIDE: u32 = 65536;
+
+/// What a part file says about itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartInfo {
+    /// Digest of the scene and of the settings that change pixels
+    /// ([`sahara_render::digest::frame_digest`]).
+    pub digest: String,
+    /// Frame width in pixels.
+    pub width: u32,
+    /// Frame height in pixels.
+    pub height: u32,
+    /// Samples per pixel of the whole frame.
+    pub spp: u32,
+    /// The pixels this part holds.
+    pub window: PixelWindow,
+    /// The sample indices this part was asked to render.
+    pub samples: Range<u32>,
+    /// The sample indices its sums hold: `samples` when complete, a
+    /// prefix of it when interrupted.
+    pub samples_done: Range<u32>,
+    /// False if the render was interrupted: the part must not be taken for
+    /// a finished one.
+    pub complete: bool,
+    /// How the part was chosen, e.g. `3/8 tiles` (empty if by hand).
+    pub part: String,
+    /// The integrator's name (for the merged image's metadata).
+    pub integrator: String,
+    /// The seed (for the merged image's metadata).
+    pub seed: u64,
+    /// Exposure in stops for a PNG of the merged frame.
+    pub exposure: f32,
+    /// Tone map for a PNG of the merged frame (`clamp` or `filmic`).
+    pub tonemap: String,
+    /// Render statistics as (name, value) pairs, kept for people.
+    pub stats: Vec<(String, String)>,
+}
+
+impl PartInfo {
+    /// The attributes of the file.
+    fn attributes(&self) -> Vec<(String, String)> {
+        let w = &self.window;
+        let mut a = vec![
+            ("sahara:format", FORMAT.to_string()),
+            ("sahara:digest", self.digest.clone()),
+            ("sahara:frame", format!("{}x{}", self.width, self.height)),
+            ("sahara:spp", self.spp.to_string()),
+            (
+                "sahara:window",
+                format!("{},{},{},{}", w.x0, w.x1, w.y0, w.y1),
+            ),
+            ("sahara:samples", range(&self.samples)),
+            ("sahara:samples_done", range(&self.samples_done)),
+            ("sahara:complete", self.complete.to_string()),
+            ("sahara:partial", (!self.complete).to_string()),
+            ("sahara:part", self.part.clone()),
+            ("sahara:integrator", self.integrator.clone()),
+            ("sahara:seed", self.seed.to_string()),
+            ("sahara:exposure", self.exposure.to_string()),
+            ("sahara:tonemap", self.tonemap.clone()),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect::<Vec<_>>();
+        a.extend(
+            self.stats
+                .iter()
+                .map(|(k, v)| (format!("sahara:stats:{k}"), v.clone())),
+        );
+        a
+    }
+
+    /// Parses the attributes of the file `name`.
+    fn parse(name: &str, get: &dyn Fn(&str) -> Option<String>) -> Result<PartInfo, FormatError> {
+        let need = |key: &str| {
+            get(key).ok_or_else(|| {
+                FormatError::in_file(
+                    name,
+                    format!("not a Sahara render part: the header has no {key} attribute"),
+                )
+            })
+        };
+        let bad = |key: &str, v: &str| {
+            FormatError::in_file(name, format!("the header's {key} = {v:?} is not valid"))
+        };
+        let format = need("sahara:format")?;
+        if format != FORMAT {
+            return Err(FormatError::in_file(
+                name,
+                format!(
+                    "a render part of another format ({format:?}; this sahara reads {FORMAT:?})"
+                ),
+            ));
+        }
+        let number = |key: &str| -> Result<u32, FormatError> {
+            let v = need(key)?;
+            v.parse().map_err(|_| bad(key, &v))
+        };
+        let frame = need("sahara:frame")?;
+        let (width, height) = frame
+            .split_once('x')
+            .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
+            .filter(|&(w, h)| (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h))
+            .ok_or_else(|| bad("sahara:frame", &frame))?;
+        let spp = number("sahara:spp")?;
+        let win = need("sahara:window")?;
+        let v: Vec<u32> = win.split(',').filter_map(|p| p.parse().ok()).collect();
+        let window = match v[..] {
+            [x0, x1, y0, y1] if x0 <= x1 && x1 <= width && y0 <= y1 && y1 <= height => {
+                PixelWindow { x0, x1, y0, y1 }
+            }
+            _ => return Err(bad("sahara:window", &win)),
+        };
+        let parse_range = |key: &str| -> Result<Range<u32>, FormatError> {
+            let v = need(key)?;
+            v.split_once("..")
+                .and_then(|(a, b)| Some(a.parse::<u32>().ok()?..b.parse::<u32>().ok()?))
+                .filter(|r| r.start <= r.end && r.end <= spp)
+                .ok_or_else(|| bad(key, &v))
+        };
+        let samples = parse_range("sahara:samples")?;
+        let samples_done = parse_range("sahara:samples_done")?;
+        if samples_done.start != samples.start || samples_done.end > samples.end {
+            return Err(bad("sahara:samples_done", &range(&samples_done)));
+        }
+        let complete = match need("sahara:complete")?.as_str() {
+            "true" => true,
+            "false" => false,
+            v => return Err(bad("sahara:complete", v)),
+        };
+        if complete && samples_done != samples {
+            return Err(bad("sahara:samples_done", &range(&samples_done)));
+        }
+        let seed = need("sahara:seed")?;
+        let exposure = need("sahara:exposure")?;
+        Ok(PartInfo {
+            digest: need("sahara:digest")?,
+            width,
+            height,
+            spp,
+            window,
+            samples,
+            samples_done,
+            complete,
+            part: get("sahara:part").unwrap_or_default(),
+            integrator: need("sahara:integrator")?,
+            seed: seed.parse().map_err(|_| bad("sahara:seed", &seed))?,
+            exposure: exposure
+                .parse()
+                .ok()
+                .filter(|e: &f32| e.is_finite())
+                .ok_or_else(|| bad("sahara:exposure", &exposure))?,
+            tonemap: need("sahara:tonemap")?,
+            stats: Vec::new(),
+        })
+    }
+}
+
+fn range(r: &Range<u32>) -> String {
+    format!("{}..{}", r.start, r.end)
+}
+
+/// Channel names, in the order of the words of [`PixelSum`]'s sums.
+fn channel_names() -> Vec<String> {
+    let mut names = Vec::with_capacity(16);
+    for sum in ["sum.R", "sum.G", "sum.B", "weight"] {
+        for word in 0..4 {
+            names.push(format!("{sum}.w{word}"));
+        }
+    }
+    names
+}
+
+/// Writes a part: `sums` must cover exactly `info.window`.
+pub fn write_part(path: &Path, info: &PartInfo, sums: &SumBuffer) -> Result<(), FormatError> {
+    let name = path.display().to_string();
+    let w = &info.window;
+    if (sums.x0, sums.y0, sums.width, sums.height) != (w.x0, w.y0, w.width(), w.height())
+        && !(w.is_empty() && sums.sums.is_empty())
+    {
+        return Err(FormatError::in_file(
+            &name,
+            "the sums do not cover the part's window",
+        ));
+    }
+    let (fw, fh) = if w.is_empty() {
+        (1, 1)
+    } else {
+        (w.width() as usize, w.height() as usize)
+    };
+    let zero = [PixelSum::default()];
+    let pixels: &[PixelSum] = if w.is_empty() { &zero } else { &sums.sums };
+    let value = |p: &PixelSum, k: usize| if k < 3 { p.rgb[k] } else { p.weight };
+    let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    for (c, channel) in channel_names().into_iter().enumerate() {
+        let (sum, word) = (c / 4, c % 4);
+        let data: Vec<u32> = pixels
+            .iter()
+            .map(|p| (value(p, sum) as u128 >> (32 * word)) as u32)
+            .collect();
+        channels.push(AnyChannel::new(channel.as_str(), FlatSamples::U32(data)));
+    }
+    let mut attributes = LayerAttributes::default();
+    for (key, value) in info.attributes() {
+        let text = |s: &str| {
+            Text::new_or_none(s).ok_or_else(|| {
+                FormatError::in_file(&name, format!("{key} = {value:?} is not Latin-1 text"))
+            })
+        };
+        attributes
+            .other
+            .insert(text(&key)?, AttributeValue::Text(text(&value)?));
+    }
+    let layer = Layer::new(
+        (fw, fh),
+        attributes,
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(channels),
+    );
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| FormatError::in_file(&name, format!("cannot encode EXR: {e}")))?;
+    let mut bytes = bytes.into_inner();
+    crate::image_out::sort_exr_header(&mut bytes)
+        .map_err(|e| FormatError::in_file(&name, format!("cannot encode EXR: {e}")))?;
+    write_atomically(path, |out: &mut BufWriter<std::fs::File>| {
+        out.write_all(&bytes)
+            .and_then(|()| out.flush())
+            .map_err(|e| FormatError::write(path, e))
+    })
+}
+
+/// Reads a part file's header only (cheap: no pixels are read).
+pub fn read_part_info(path: &Path) -> Result<PartInfo, FormatError> {
+    let name = path.display().to_string();
+    let mut magic = [0u8; 4];
+    let mut file = std::fs::File::open(path).map_err(|e| FormatError::io(path, e))?;
+    if file.read_exact(&mut magic).is_err() || magic != [0x76, 0x2f, 0x31, 0x01] {
+        return Err(FormatError::in_file(
+            &name,
+            "not an OpenEXR file (it does not begin with the EXR magic number)",
+        ));
+    }
+    let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| {
+        FormatError::in_file(&name, format!("truncated or damaged OpenEXR header: {e}"))
+    })?;
+    let [header] = &meta.headers[..] else {
+        return Err(FormatError::in_file(
+            &name,
+            "not a Sahara render part: a multi-part EXR file",
+        ));
+    };
+    let attrs = &header.own_attributes.other;
+    let get = |key: &str| match attrs.get(&Text::from(key)) {
+        Some(AttributeValue::Text(t)) => Some(t.to_string()),
+        _ => None,
+    };
+    let mut info = PartInfo::parse(&name, &get)?;
+    let mut stats: Vec<(String, String)> = attrs
+        .iter()
+        .filter_map(|(k, v)| {
+            let k = k.to_string();
+            let stat = k.strip_prefix("sahara:stats:")?.to_string();
+            match v {
+                AttributeValue::Text(t) => Some((stat, t.to_string())),
+                _ => None,
+            }
+        })
+        .collect();
+    stats.sort();
+    info.stats = stats;
+    let w = &info.window;
+    let expected = if w.is_empty() {
+        (1, 1)
+    } else {
+        (w.width() as usize, w.height() as usize)
+    };
+    let size = (header.layer_size.x(), header.layer_size.y());
+    if size != expected {
+        return Err(FormatError::in_file(
+            &name,
+            format!(
+                "the image is {}x{} but its window {} is {}x{}",
+                size.0, size.1, w, expected.0, expected.1
+            ),
+        ));
+    }
+    let names: Vec<String> = header
+        .channels
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    let mut wanted = channel_names();
+    wanted.sort();
+    if names != wanted {
+        return Err(FormatError::in_file(
+            &name,
+            format!("not a Sahara render part: its channels are {names:?}"),
+        ));
+    }
+    Ok(info)
+}
+
+/// Reads a part: its header and its sums (over its window).
+pub fn read_part(path: &Path) -> Result<(PartInfo, SumBuffer), FormatError> {
+    let name = path.display().to_string();
+    let info = read_part_info(path)?;
+    let image = exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| {
+        FormatError::in_file(&name, format!("truncated or damaged OpenEXR file: {e}"))
+    })?;
+    let w = info.window;
+    let mut sums = SumBuffer::new(w.x0, w.y0, w.width(), w.height());
+    if w.is_empty() {
+        return Ok((info, sums));
+    }
+    let channels = &image.layer_data.channel_data.list;
+    for (c, channel) in channel_names().iter().enumerate() {
+        let data = channels
+            .iter()
+            .find(|ch| ch.name.to_string() == *channel)
+            .and_then(|ch| match &ch.sample_data {
+                FlatSamples::U32(d) if d.len() == sums.sums.len() => Some(d),
+                _ => None,
+            })
+            .ok_or_else(|| {
+                FormatError::in_file(
+                    &name,
+                    format!("channel {channel} is missing, not UINT or of the wrong size"),
+                )
+            })?;
+        let (sum, word) = (c / 4, c % 4);
+        for (p, &v) in sums.sums.iter_mut().zip(data) {
+            let slot = if sum < 3 {
+                &mut p.rgb[sum]
+            } else {
+                &mut p.weight
+            };
+            *slot = (*slot as u128 | (v as u128) << (32 * word)) as i128;
+        }
+    }
+    Ok((info, sums))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Vec2, Vec3};
+    use sahara_render::Filter;
+
+    fn info(window: PixelWindow) -> PartInfo {
+        PartInfo {
+            digest: "ab".repeat(32),
+            width: 9,
+            height: 7,
+            spp: 16,
+            window,
+            samples: 4..12,
+            samples_done: 4..12,
+            complete: true,
+            part: "1/2 tiles".into(),
+            integrator: "path".into(),
+            seed: 3,
+            exposure: -0.5,
+            tonemap: "filmic".into(),
+            stats: vec![("rays".into(), "123".into())],
+        }
+    }
+
+    #[test]
+    fn a_part_reads_back_bit_for_bit() {
+        let dir = std::env::temp_dir().join(format!("sahara-part-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let window = PixelWindow {
+            x0: 2,
+            x1: 6,
+            y0: 1,
+            y1: 4,
+        };
+        let mut sums = SumBuffer::new(2, 1, 4, 3);
+        let f = Filter::mitchell();
+        for k in 0..40 {
+            let (x, y) = (2 + k % 4, 1 + k % 3);
+            let pos = Vec2::new(x as f32 + 0.1 * (k % 7) as f32, y as f32 + 0.3);
+            sums.splat(&f, 2, x, y, pos, Vec3::new(1e6 * k as f32, 0.25, 1e-9));
+        }
+        let path = dir.join("p.exr");
+        write_part(&path, &info(window), &sums).unwrap();
+        let (back, back_sums) = read_part(&path).unwrap();
+        assert_eq!(back, info(window));
+        assert_eq!(back_sums, sums);
+        // A part without pixels.
+        let empty = PixelWindow {
+            x0: 3,
+            x1: 3,
+            y0: 0,
+            y1: 7,
+        };
+        write_part(&path, &info(empty), &SumBuffer::new(3, 0, 0, 7)).unwrap();
+        let (back, back_sums) = read_part(&path).unwrap();
+        assert_eq!(back.window, empty);
+        assert!(back_sums.sums.is_empty());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,236 @@
+//! Exact filter-weighted sums: the accumulation that makes an image
+//! independent of how its samples are grouped.
+//!
+//! A pixel's estimate is `sum w L / sum w` over the samples within the
+//! filter's reach. Floating-point addition is not associative, so summing
+//! the same contributions per tile, per pass, per thread or per process
+//! would give different bits depending on the grouping. Here every
+//! contribution (`w L` per channel, and `w`) is computed in `f64` (the
+//! product of two `f32` is exact there), converted to a signed fixed-point
+//! number with [`FRACTION_BITS`] fractional bits and added as an `i128`.
+//! Integer addition is associative and commutative, so a pixel's sums are
+//! the same bits however the samples are split into tiles, passes, sample
+//! ranges or processes, and in whatever order the pieces are added.
+//!
+//! The conversion rounds toward zero below `2^-64` (far below what an `f32`
+//! pixel can show) and clamps a contribution to `±2^60`, so that no sum of
+//! fewer than `2^66` contributions overflows.
+
+use glam::{Vec2, Vec3};
+
+use crate::filter::Filter;
+
+/// Fractional bits of the fixed-point sums.
+pub const FRACTION_BITS: i32 = 64;
+
+/// Largest magnitude of one contribution; larger ones are clamped.
+const MAX_CONTRIBUTION: f64 = (1u64 << 60) as f64;
+
+/// One contribution as a fixed-point number.
+#[inline]
+fn fixed(v: f64) -> i128 {
+    // Multiplying by a power of two is exact; the cast truncates.
+    (v.clamp(-MAX_CONTRIBUTION, MAX_CONTRIBUTION) * (2.0f64).powi(FRACTION_BITS)) as i128
+}
+
+/// A fixed-point sum as a float (rounded to nearest).
+#[inline]
+fn float(v: i128) -> f64 {
+    v as f64 * (2.0f64).powi(-FRACTION_BITS)
+}
+
+/// The sums of one pixel: filter-weighted radiance per channel and the
+/// filter weights, in fixed point ([`FRACTION_BITS`] fractional bits).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PixelSum {
+    /// `sum w L` for R, G and B.
+    pub rgb: [i128; 3],
+    /// `sum w`.
+    pub weight: i128,
+}
+
+impl PixelSum {
+    /// Adds one sample of radiance `l` with filter weight `w`.
+    #[inline]
+    pub fn add_sample(&mut self, l: Vec3, w: f32) {
+        let w64 = w as f64;
+        self.rgb[0] += fixed(l.x as f64 * w64);
+        self.rgb[1] += fixed(l.y as f64 * w64);
+        self.rgb[2] += fixed(l.z as f64 * w64);
+        self.weight += fixed(w64);
+    }
+
+    /// Adds another pixel's sums (exactly).
+    #[inline]
+    pub fn add(&mut self, other: &PixelSum) {
+        for c in 0..3 {
+            self.rgb[c] += other.rgb[c];
+        }
+        self.weight += other.weight;
+    }
+
+    /// The pixel's radiance: the weighted mean, zero where no weight
+    /// arrived; negative estimates (from the negative lobes of some
+    /// filters) become zero, since radiance is not negative.
+    pub fn value(&self) -> Vec3 {
+        if self.weight <= 0 {
+            return Vec3::ZERO;
+        }
+        let w = float(self.weight);
+        let v = Vec3::new(
+            (float(self.rgb[0]) / w) as f32,
+            (float(self.rgb[1]) / w) as f32,
+            (float(self.rgb[2]) / w) as f32,
+        );
+        v.max(Vec3::ZERO)
+    }
+}
+
+/// A rectangle of pixels `[x0, x0 + width) x [y0, y0 + height)` of an
+/// image, with each pixel's [`PixelSum`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SumBuffer {
+    /// Left column.
+    pub x0: u32,
+    /// Top row.
+    pub y0: u32,
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// `width * height` sums, row-major from `(x0, y0)`.
+    pub sums: Vec<PixelSum>,
+}
+
+impl SumBuffer {
+    /// Zero sums over `[x0, x0 + width) x [y0, y0 + height)`.
+    pub fn new(x0: u32, y0: u32, width: u32, height: u32) -> Self {
+        Self {
+            x0,
+            y0,
+            width,
+            height,
+            sums: vec![PixelSum::default(); width as usize * height as usize],
+        }
+    }
+
+    /// The sums of pixel `(x, y)` (image coordinates), if it is inside.
+    pub fn get(&self, x: u32, y: u32) -> Option<&PixelSum> {
+        self.index(x, y).map(|k| &self.sums[k])
+    }
+
+    fn index(&self, x: u32, y: u32) -> Option<usize> {
+        let (i, j) = (x.checked_sub(self.x0)?, y.checked_sub(self.y0)?);
+        (i < self.width && j < self.height).then(|| j as usize * self.width as usize + i as usize)
+    }
+
+    /// Splats a sample of pixel `(x, y)` at film position `pos` (pixel
+    /// units) with radiance `l` into every pixel of the buffer whose centre
+    /// lies within the filter's radius; `margin` is the filter's reach in
+    /// whole pixels ([`filter_margin`]).
+    #[inline]
+    pub fn splat(&mut self, filter: &Filter, margin: u32, x: u32, y: u32, pos: Vec2, l: Vec3) {
+        if self.width == 0 || self.height == 0 {
+            return;
+        }
+        let r = filter.radius();
+        let px0 = x.saturating_sub(margin).max(self.x0);
+        let px1 = (x.saturating_add(margin)).min(self.x0 + self.width - 1);
+        let py0 = y.saturating_sub(margin).max(self.y0);
+        let py1 = (y.saturating_add(margin)).min(self.y0 + self.height - 1);
+        for py in py0..=py1 {
+            let dy = pos.y - (py as f32 + 0.5);
+            if dy.abs() > r {
+                continue;
+            }
+            let wy = filter.eval_1d(dy);
+            let row = (py - self.y0) as usize * self.width as usize;
+            for px in px0..=px1 {
+                let wt = wy * filter.eval_1d(pos.x - (px as f32 + 0.5));
+                if wt != 0.0 {
+                    self.sums[row + (px - self.x0) as usize].add_sample(l, wt);
+                }
+            }
+        }
+    }
+
+    /// Adds `other`'s sums over the pixels both cover.
+    pub fn add(&mut self, other: &SumBuffer) {
+        let x0 = self.x0.max(other.x0);
+        let y0 = self.y0.max(other.y0);
+        let x1 = (self.x0 + self.width).min(other.x0 + other.width);
+        let y1 = (self.y0 + self.height).min(other.y0 + other.height);
+        for y in y0..y1.max(y0) {
+            for x in x0..x1.max(x0) {
+                let (Some(a), Some(b)) = (self.index(x, y), other.index(x, y)) else {
+                    continue;
+                };
+                let b = other.sums[b];
+                self.sums[a].add(&b);
+            }
+        }
+    }
+}
+
+/// Pixels beyond a pixel's own that its samples reach through the filter.
+pub fn filter_margin(f: &Filter) -> u32 {
+    (f.radius() - 0.5).ceil().max(0.0) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sums_do_not_depend_on_grouping() {
+        // Values whose float sums differ by grouping: (a + b) + c != a + (b + c).
+        let samples = [1e8f32, 1.0, -1e8, 3.3, 1e-7, 7.25];
+        let mut one = PixelSum::default();
+        for &v in &samples {
+            one.add_sample(Vec3::splat(v.abs()), 0.75);
+        }
+        let mut left = PixelSum::default();
+        let mut right = PixelSum::default();
+        for &v in &samples[..2] {
+            left.add_sample(Vec3::splat(v.abs()), 0.75);
+        }
+        for &v in samples[2..].iter().rev() {
+            right.add_sample(Vec3::splat(v.abs()), 0.75);
+        }
+        right.add(&left);
+        assert_eq!(one, right);
+        let exact: f64 = samples.iter().map(|v| v.abs() as f64).sum::<f64>() / 6.0;
+        assert!((one.value().x as f64 - exact).abs() <= 1e-6 * exact);
+    }
+
+    #[test]
+    fn negative_estimates_become_zero_and_empty_pixels_black() {
+        let mut p = PixelSum::default();
+        assert_eq!(p.value(), Vec3::ZERO);
+        p.add_sample(Vec3::ONE, 0.5);
+        assert_eq!(p.value(), Vec3::ONE);
+        // A negative lobe: sum w L = 0.5 - 1 < 0 with sum w = 0.25 > 0.
+        p.add_sample(Vec3::splat(4.0), -0.25);
+        assert_eq!(p.value(), Vec3::ZERO);
+        // No weight at all: black.
+        let mut q = PixelSum::default();
+        q.add_sample(Vec3::ONE, -0.5);
+        assert_eq!(q.value(), Vec3::ZERO);
+    }
+
+    #[test]
+    fn splat_reaches_the_filter_footprint_inside_the_buffer_only() {
+        let f = Filter::Box { radius: 1.0 };
+        let m = filter_margin(&f);
+        assert_eq!(m, 1);
+        let mut b = SumBuffer::new(2, 2, 2, 2);
+        // A sample in pixel (1, 1) near its lower right corner reaches (2, 2) only.
+        b.splat(&f, m, 1, 1, Vec2::new(1.9, 1.9), Vec3::ONE);
+        assert_eq!(b.get(2, 2).unwrap().value(), Vec3::ONE);
+        assert_eq!(b.get(3, 2).unwrap().weight, 0);
+        let mut c = SumBuffer::new(0, 0, 4, 4);
+        c.add(&b);
+        assert_eq!(c.get(2, 2), b.get(2, 2));
+        assert_eq!(c.get(1, 1).unwrap().weight, 0);
+    }
+}

@@ -1,0 +1,319 @@
+//! `sahara merge`: the parts of a frame assembled into its image.
+//!
+//! Every part's header is read and checked first (same frame, no overlap,
+//! nothing missing, nothing partial unless allowed), before any pixel is
+//! read. Then the parts are added up group by group: parts whose windows
+//! overlap (the sample ranges of one tile) form a group, which is summed
+//! into one buffer over the group's pixels, turned into the image's
+//! pixels, and dropped. At most one group's sums, one part and the image
+//! are in memory at once.
+
+use std::ops::Range;
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Context, Result};
+use sahara_formats::atomic::check_writable;
+use sahara_formats::image_out::ImageFormat;
+use sahara_formats::part_file::{read_part, read_part_info, PartInfo};
+use sahara_render::split::{tile, PixelWindow};
+use sahara_render::{
+    cost_maps, Film, Integrator, RenderResult, RenderSettings, RenderStats, SumBuffer, ToneMap,
+};
+
+use crate::cli::MergeArgs;
+use crate::render::Output;
+
+/// Entries of the list of what is missing shown in full.
+const MISSING_SHOWN: usize = 8;
+
+/// `sahara merge PARTS... -o OUT`.
+pub fn run(args: &MergeArgs) -> Result<()> {
+    ImageFormat::from_path(&args.output).map_err(|e| anyhow!("{e}"))?;
+    check_writable(&args.output)
+        .map_err(|e| anyhow!("{e}"))
+        .context("cannot write the merged image")?;
+    let mut parts: Vec<(PathBuf, PartInfo)> = Vec::with_capacity(args.parts.len());
+    for path in &args.parts {
+        let info = read_part_info(path).map_err(|e| anyhow!("{e}"))?;
+        parts.push((path.clone(), info));
+    }
+    let (first_path, first) = &parts[0];
+    for (path, info) in &parts[1..] {
+        let same = info.digest == first.digest
+            && (info.width, info.height, info.spp, info.seed)
+                == (first.width, first.height, first.spp, first.seed)
+            && info.integrator == first.integrator;
+        if !same {
+            bail!(
+                "{}: a part of another frame than {} (digest {} vs {}): another scene or other settings",
+                path.display(),
+                first_path.display(),
+                short(&info.digest),
+                short(&first.digest)
+            );
+        }
+    }
+    let partial: Vec<&(PathBuf, PartInfo)> = parts.iter().filter(|(_, i)| !i.complete).collect();
+    if let Some((path, info)) = partial.first().filter(|_| !args.allow_partial) {
+        bail!(
+            "{}: a partial part (interrupted: samples {} of {} rendered); render it again, \
+             or merge with --allow-partial",
+            path.display(),
+            range(&info.samples_done),
+            range(&info.samples)
+        );
+    }
+    let spp = check_coverage(&parts)?;
+    for (path, info) in &partial {
+        eprintln!(
+            "merging partial part {}: samples {} of {}, pixels {}",
+            path.display(),
+            range(&info.samples_done),
+            range(&info.samples),
+            info.window
+        );
+    }
+
+    let (w, h) = (first.width, first.height);
+    let mut film = Film::new(w, h);
+    for group in groups(&parts) {
+        let bounds = group
+            .iter()
+            .map(|&k| parts[k].1.window)
+            .reduce(|a, b| PixelWindow {
+                x0: a.x0.min(b.x0),
+                x1: a.x1.max(b.x1),
+                y0: a.y0.min(b.y0),
+                y1: a.y1.max(b.y1),
+            })
+            .expect("a group has a part");
+        let mut sums = SumBuffer::new(bounds.x0, bounds.y0, bounds.width(), bounds.height());
+        for &k in &group {
+            let (path, info) = &parts[k];
+            if info.samples_done.is_empty() {
+                continue;
+            }
+            let (again, part) = read_part(path).map_err(|e| anyhow!("{e}"))?;
+            if again != *info {
+                bail!("{}: the file changed while being merged", path.display());
+            }
+            sums.add(&part);
+        }
+        for &k in &group {
+            let win = parts[k].1.window;
+            for y in win.y0..win.y1 {
+                for x in win.x0..win.x1 {
+                    let value = sums.get(x, y).expect("inside the group").value();
+                    film.pixels[(y * w + x) as usize] = value;
+                }
+            }
+        }
+    }
+
+    let integrator = Integrator::from_name(&first.integrator).ok_or_else(|| {
+        anyhow!(
+            "{}: unknown integrator {:?}",
+            first_path.display(),
+            first.integrator
+        )
+    })?;
+    let cost = matches!(integrator, Integrator::Cost).then(|| cost_maps(&mut film, None));
+    let tonemap = match first.tonemap.as_str() {
+        "filmic" => ToneMap::Filmic,
+        _ => ToneMap::Clamp,
+    };
+    let settings = RenderSettings {
+        width: w,
+        height: h,
+        seed: first.seed,
+        integrator,
+        ..Default::default()
+    };
+    let result = RenderResult {
+        film,
+        sums: SumBuffer::new(0, 0, 0, 0),
+        stats: RenderStats {
+            passes: 1,
+            spp,
+            ..Default::default()
+        },
+        cost,
+    };
+    let out = Output {
+        path: &args.output,
+        settings: &settings,
+        exposure: first.exposure,
+        tonemap,
+    };
+    out.write(&result, !partial.is_empty(), true)?;
+    eprintln!(
+        "wrote {}{}: {} parts, {}x{}, {} spp",
+        if partial.is_empty() { "" } else { "PARTIAL " },
+        args.output.display(),
+        parts.len(),
+        w,
+        h,
+        spp
+    );
+    Ok(())
+}
+
+fn short(digest: &str) -> &str {
+    &digest[..digest.len().min(12)]
+}
+
+fn range(r: &Range<u32>) -> String {
+    format!("{}..{}", r.start, r.end)
+}
+
+/// Checks that every pixel's samples `0..spp` are held by exactly one part
+/// each; returns the fewest samples any pixel gets from the parts' sums
+/// (`spp` unless partial parts are merged).
+fn check_coverage(parts: &[(PathBuf, PartInfo)]) -> Result<u32> {
+    let first = &parts[0].1;
+    let (w, h, spp) = (first.width, first.height, first.spp);
+    // The frame cut along every part's window edges: each cell is held by
+    // the same parts throughout.
+    let cuts = |edges: &mut Vec<u32>| {
+        edges.sort_unstable();
+        edges.dedup();
+    };
+    let held: Vec<usize> = (0..parts.len())
+        .filter(|&k| !parts[k].1.window.is_empty() && !parts[k].1.samples.is_empty())
+        .collect();
+    let mut xs = vec![0, w];
+    let mut ys = vec![0, h];
+    for &k in &held {
+        let win = parts[k].1.window;
+        xs.extend([win.x0, win.x1]);
+        ys.extend([win.y0, win.y1]);
+    }
+    cuts(&mut xs);
+    cuts(&mut ys);
+    let (nx, ny) = (xs.len() - 1, ys.len() - 1);
+    let mut cells: Vec<Vec<usize>> = vec![Vec::new(); nx * ny];
+    for &k in &held {
+        let win = parts[k].1.window;
+        let ix0 = xs.binary_search(&win.x0).expect("an edge");
+        let ix1 = xs.binary_search(&win.x1).expect("an edge");
+        let iy0 = ys.binary_search(&win.y0).expect("an edge");
+        let iy1 = ys.binary_search(&win.y1).expect("an edge");
+        for iy in iy0..iy1 {
+            for ix in ix0..ix1 {
+                cells[iy * nx + ix].push(k);
+            }
+        }
+    }
+    // Tile grids the parts came from, to name a missing cell by its tile.
+    let mut grids: Vec<u32> = parts
+        .iter()
+        .filter_map(|(_, i)| {
+            let (_, rest) = i.part.split_once('/')?;
+            let (n, how) = rest.split_once(' ')?;
+            (how == "tiles").then(|| n.parse().ok()).flatten()
+        })
+        .collect();
+    grids.sort_unstable();
+    grids.dedup();
+    let full = PixelWindow::full(w, h);
+    let name_cell = |cell: &PixelWindow| {
+        for &n in &grids {
+            if let Some(i) = (0..n).find(|&i| tile(&full, i, n) == *cell) {
+                return format!("tile {i} of {n} (pixels {cell})");
+            }
+        }
+        format!("pixels {cell}")
+    };
+    let mut missing: Vec<String> = Vec::new();
+    let mut fewest = spp;
+    for iy in 0..ny {
+        for ix in 0..nx {
+            let cell = PixelWindow {
+                x0: xs[ix],
+                x1: xs[ix + 1],
+                y0: ys[iy],
+                y1: ys[iy + 1],
+            };
+            let mut here = cells[iy * nx + ix].clone();
+            here.sort_by_key(|&k| (parts[k].1.samples.start, parts[k].1.samples.end));
+            let mut at = 0;
+            let mut last: Option<usize> = None;
+            let mut done = 0;
+            for &k in &here {
+                let s = &parts[k].1.samples;
+                if s.start < at {
+                    let other = last.expect("a part ended there");
+                    bail!(
+                        "{} and {} overlap: both hold samples {}..{} of pixels {}",
+                        parts[other].0.display(),
+                        parts[k].0.display(),
+                        s.start,
+                        at.min(s.end),
+                        cell
+                    );
+                }
+                if s.start > at {
+                    missing.push(format!("samples {at}..{} of {}", s.start, name_cell(&cell)));
+                }
+                at = s.end;
+                last = Some(k);
+                done += parts[k].1.samples_done.len() as u32;
+            }
+            if at < spp {
+                missing.push(format!("samples {at}..{spp} of {}", name_cell(&cell)));
+            }
+            fewest = fewest.min(done);
+        }
+    }
+    if !missing.is_empty() {
+        let n = missing.len();
+        let mut list = missing[..n.min(MISSING_SHOWN)].join("; ");
+        if n > MISSING_SHOWN {
+            list += &format!("; and {} more", n - MISSING_SHOWN);
+        }
+        bail!(
+            "the parts do not make the whole frame ({w}x{h}, {spp} spp): missing {list} \
+             ({} part files given)",
+            parts.len()
+        );
+    }
+    Ok(fewest)
+}
+
+/// The parts in groups whose windows overlap (transitively); parts without
+/// pixels are left out.
+fn groups(parts: &[(PathBuf, PartInfo)]) -> Vec<Vec<usize>> {
+    let n = parts.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut k: usize) -> usize {
+        while parent[k] != k {
+            parent[k] = parent[parent[k]];
+            k = parent[k];
+        }
+        k
+    }
+    // Sorted by window, parts of one window are neighbours; overlapping
+    // windows of different shapes are joined by the pairwise test.
+    let mut order: Vec<usize> = (0..n).filter(|&k| !parts[k].1.window.is_empty()).collect();
+    order.sort_by_key(|&k| parts[k].1.window);
+    for (a, &i) in order.iter().enumerate() {
+        for &j in &order[a + 1..] {
+            let (wi, wj) = (parts[i].1.window, parts[j].1.window);
+            if wi == wj || !wi.intersect(&wj).is_empty() {
+                let (ri, rj) = (root(&mut parent, i), root(&mut parent, j));
+                parent[ri] = rj;
+            }
+        }
+    }
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    let mut index_of = vec![usize::MAX; n];
+    for &k in &order {
+        let r = root(&mut parent, k);
+        if index_of[r] == usize::MAX {
+            index_of[r] = out.len();
+            out.push(Vec::new());
+        }
+        out[index_of[r]].push(k);
+    }
+    out
+}

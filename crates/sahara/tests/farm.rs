@@ -1,0 +1,405 @@
+//! A frame rendered in parts (tiles, sample ranges, crop windows, or both)
+//! and merged is the whole frame's file byte for byte; `merge` refuses what
+//! would not make that frame, naming the file.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+mod common;
+
+use common::{sahara, temp_dir};
+use sahara_formats::part_file::{read_part, write_part};
+
+/// The frame of every test: small, a few passes, a filter wider than a pixel.
+const FRAME: &[&str] = &[
+    "--width",
+    "23",
+    "--height",
+    "17",
+    "--spp",
+    "10",
+    "--pass-spp",
+    "4",
+    "--filter",
+    "mitchell",
+];
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// `sahara render FRAME EXTRA -o OUT`, which must succeed.
+fn render(extra: &[&str], out: &Path) {
+    let o = out.to_str().unwrap();
+    let r = sahara(&[&["render"], FRAME, extra, &["--threads", "2", "-o", o]].concat());
+    assert!(r.status.success(), "{extra:?}: {}", stderr(&r));
+}
+
+/// `sahara merge PARTS -o OUT` and its result.
+fn merge(parts: &[PathBuf], out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["merge".to_string()];
+    args.extend(parts.iter().map(|p| p.display().to_string()));
+    args.extend(["-o".to_string(), out.display().to_string()]);
+    args.extend(extra.iter().map(|s| s.to_string()));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    sahara(&args)
+}
+
+/// Renders the parts given by `pieces` (extra options each) into `dir`.
+fn parts(dir: &Path, tag: &str, pieces: &[Vec<String>]) -> Vec<PathBuf> {
+    pieces
+        .iter()
+        .enumerate()
+        .map(|(k, extra)| {
+            let p = dir.join(format!("{tag}-{k}.exr"));
+            let extra: Vec<&str> = extra.iter().map(String::as_str).collect();
+            render(&extra, &p);
+            p
+        })
+        .collect()
+}
+
+fn split(n: u32, how: &str) -> Vec<Vec<String>> {
+    (0..n)
+        .map(|i| {
+            vec![
+                "--part".into(),
+                format!("{i}/{n}"),
+                "--split".into(),
+                how.into(),
+            ]
+        })
+        .collect()
+}
+
+#[test]
+fn tiles_sample_ranges_and_crops_merge_to_the_whole_frame_byte_for_byte() {
+    let dir = temp_dir("farm-merge");
+    let (whole_exr, whole_png) = (dir.join("whole.exr"), dir.join("whole.png"));
+    render(&[], &whole_exr);
+    render(&[], &whole_png);
+    // 5 tiles, one rendered with another tree builder (not part of the frame).
+    let mut tiles = split(5, "tiles");
+    tiles[2].extend(["--builder".into(), "binned".into()]);
+    // Tiles x sample ranges, with an empty range and a range across passes.
+    let mut both = Vec::new();
+    for i in 0..3 {
+        for r in ["0..0", "0..3", "3..9", "9..12"] {
+            both.push(vec![
+                "--part".into(),
+                format!("{i}/3"),
+                "--samples".into(),
+                r.into(),
+            ]);
+        }
+    }
+    // Hand-made crop windows, one of them split by samples.
+    let crops = vec![
+        vec!["--crop".into(), "0,0.4,0,1".into()],
+        vec!["--crop".into(), "0.4,1,0,0.5".into()],
+        vec![
+            "--crop".into(),
+            "0.4,1,0.5,1".into(),
+            "--part".into(),
+            "0/2".into(),
+            "--split".into(),
+            "samples".into(),
+        ],
+        vec![
+            "--crop".into(),
+            "0.4,1,0.5,1".into(),
+            "--part".into(),
+            "1/2".into(),
+            "--split".into(),
+            "samples".into(),
+        ],
+    ];
+    for (tag, pieces) in [
+        ("tiles", tiles),
+        ("samples", split(4, "samples")),
+        ("both", both),
+        ("crops", crops),
+    ] {
+        let files = parts(&dir, tag, &pieces);
+        for whole in [&whole_exr, &whole_png] {
+            let ext = whole.extension().unwrap().to_str().unwrap();
+            let out = dir.join(format!("merged-{tag}.{ext}"));
+            let m = merge(&files, &out, &[]);
+            assert!(m.status.success(), "{tag}: {}", stderr(&m));
+            assert!(
+                fs::read(&out).unwrap() == fs::read(whole).unwrap(),
+                "{tag}: the merged {ext} differs from the whole frame's"
+            );
+        }
+    }
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn merge_refuses_what_would_not_make_the_frame() {
+    let dir = temp_dir("farm-refusals");
+    let files = parts(&dir, "t", &split(2, "tiles"));
+    let out = dir.join("out.exr");
+    let refused = |parts: &[PathBuf], extra: &[&str], what: &[&str]| {
+        let m = merge(parts, &out, extra);
+        let e = stderr(&m);
+        assert!(!m.status.success(), "{what:?} was merged");
+        assert_eq!(e.trim_end().lines().count(), 1, "one line: {e}");
+        for w in what {
+            assert!(e.contains(w), "{w:?} not in: {e}");
+        }
+        assert!(!out.exists(), "an output was written");
+    };
+    // Missing: tile 1 of 2, every sample of it.
+    refused(
+        &files[..1],
+        &[],
+        &["missing samples 0..12 of tile 1 of 2 (pixels x 11..23, y 0..17)"],
+    );
+    // Missing samples of a tile.
+    let half = dir.join("half.exr");
+    render(&["--part", "1/2", "--samples", "0..8"], &half);
+    refused(
+        &[files[0].clone(), half.clone()],
+        &[],
+        &["missing samples 8..12 of tile 1 of 2"],
+    );
+    // Overlap: a part given twice, and a sample range inside another.
+    refused(
+        &[files[0].clone(), files[1].clone(), files[1].clone()],
+        &[],
+        &["overlap", "t-1.exr", "samples 0..12"],
+    );
+    refused(
+        &[files[0].clone(), files[1].clone(), half.clone()],
+        &[],
+        &["overlap", "half.exr", "samples 0..8"],
+    );
+    // Another frame: another seed.
+    let other = dir.join("other.exr");
+    render(&["--part", "1/2", "--seed", "7"], &other);
+    refused(
+        &[files[0].clone(), other.clone()],
+        &[],
+        &["other.exr: a part of another frame"],
+    );
+    // Not EXR, truncated, or an EXR image that is not a part.
+    let text = dir.join("text.exr");
+    fs::write(&text, "not an image\n").unwrap();
+    refused(
+        &[files[0].clone(), text.clone()],
+        &[],
+        &["text.exr: not an OpenEXR file"],
+    );
+    let bytes = fs::read(&files[1]).unwrap();
+    let cut = dir.join("cut.exr");
+    fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
+    refused(
+        &[files[0].clone(), cut.clone()],
+        &[],
+        &["cut.exr: truncated or damaged"],
+    );
+    fs::write(&cut, &bytes[..100]).unwrap();
+    refused(&[files[0].clone(), cut.clone()], &[], &["cut.exr:"]);
+    let image = dir.join("image.exr");
+    render(&[], &image);
+    refused(
+        &[files[0].clone(), image.clone()],
+        &[],
+        &["image.exr: not a Sahara render part"],
+    );
+    // Partial: refused unless allowed, and then said.
+    let (info, sums) = read_part(&files[1]).unwrap();
+    let partial = dir.join("partial.exr");
+    let mut cut_info = info.clone();
+    cut_info.complete = false;
+    cut_info.samples_done = 0..4;
+    write_part(&partial, &cut_info, &sums).unwrap();
+    refused(
+        &[files[0].clone(), partial.clone()],
+        &[],
+        &["partial.exr: a partial part", "samples 0..4 of 0..12"],
+    );
+    let m = merge(
+        &[files[0].clone(), partial.clone()],
+        &out,
+        &["--allow-partial"],
+    );
+    assert!(m.status.success(), "{}", stderr(&m));
+    assert!(
+        stderr(&m).contains("merging partial part"),
+        "{}",
+        stderr(&m)
+    );
+    let meta = exr::meta::MetaData::read_from_file(&out, false).unwrap();
+    let partial_flag = meta.headers[0]
+        .own_attributes
+        .other
+        .get(&exr::meta::attribute::Text::from("sahara:partial"))
+        .cloned();
+    assert_eq!(
+        partial_flag,
+        Some(exr::meta::attribute::AttributeValue::Text(
+            exr::meta::attribute::Text::from("true")
+        ))
+    );
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn skip_existing_keeps_a_complete_part_and_renders_any_other() {
+    let dir = temp_dir("farm-skip");
+    let p = dir.join("p.exr");
+    let args = |extra: &[&str]| {
+        let o = p.to_str().unwrap().to_string();
+        let mut a: Vec<String> = ["render"].iter().map(|s| s.to_string()).collect();
+        a.extend(FRAME.iter().map(|s| s.to_string()));
+        a.extend(["--part", "1/3", "--skip-existing", "-o"].map(String::from));
+        a.push(o);
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let run = |extra: &[&str]| {
+        let a = args(extra);
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        let r = sahara(&a);
+        assert!(r.status.success(), "{}", stderr(&r));
+        stderr(&r)
+    };
+    assert!(run(&[]).contains("does not exist"));
+    let first = fs::read(&p).unwrap();
+    assert!(run(&[]).contains("not rendered again"));
+    // The tree builder is not part of the frame: still the same part.
+    assert!(run(&["--builder", "binned"]).contains("not rendered again"));
+    assert_eq!(fs::read(&p).unwrap(), first);
+    // Another seed is another frame; a partial part is rendered again.
+    assert!(run(&["--seed", "5"]).contains("another frame"));
+    let (mut info, sums) = read_part(&p).unwrap();
+    info.complete = false;
+    info.samples_done = info.samples.start..info.samples.start;
+    write_part(&p, &info, &sums).unwrap();
+    assert!(run(&["--seed", "5"]).contains("it is partial"));
+    assert!(read_part(&p).unwrap().0.complete);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn part_options_are_checked() {
+    for (args, what) in [
+        (
+            &["render", "--part", "3/3", "-o", "x.exr"][..],
+            "is not a part I/N",
+        ),
+        (
+            &["render", "--crop", "0,2,0,1", "-o", "x.exr"],
+            "is not a crop window",
+        ),
+        (
+            &["render", "--samples", "5..2", "-o", "x.exr"],
+            "is not a sample range",
+        ),
+        (
+            &[
+                "render",
+                "--spp",
+                "4",
+                "--pass-spp",
+                "4",
+                "--samples",
+                "0..5",
+                "-o",
+                "x.exr",
+            ],
+            "reaches past the frame's 4 samples",
+        ),
+        (
+            &["render", "--part", "0/2", "-o", "x.png"],
+            "name a .exr file",
+        ),
+        (
+            &[
+                "render",
+                "--part",
+                "0/2",
+                "--time-limit",
+                "1",
+                "-o",
+                "x.exr",
+            ],
+            "--time-limit cannot make a part",
+        ),
+        (
+            &["render", "--skip-existing", "-o", "x.exr"],
+            "applies to parts",
+        ),
+    ] {
+        let r = sahara(args);
+        assert!(!r.status.success(), "{args:?}");
+        assert!(stderr(&r).contains(what), "{args:?}: {}", stderr(&r));
+    }
+}
+
+mod random_splits {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
+
+        /// Random frames and random splits (1-7 tiles x 1-5 sample ranges,
+        /// some without pixels or samples): the merged EXR and PNG are the
+        /// whole frame's bytes.
+        #[test]
+        fn random_splits_merge_to_the_whole_frame(
+            (w, h, spp, pass) in (1u32..=20, 1u32..=14, 1u32..=9, 1u32..=4),
+            (sampler, filter, integrator, seed) in (0usize..3, 0usize..4, 0usize..4, 0u64..100),
+            tiles in 1u32..=7,
+            cuts in proptest::collection::vec(0.0f64..=1.0, 0..=4),
+        ) {
+            let dir = temp_dir(&format!("farm-random-{w}-{h}-{spp}-{seed}-{tiles}"));
+            let pass = pass.min(spp);
+            let total = spp.div_ceil(pass) * pass;
+            let frame: Vec<String> = [
+                "render", "--width", &w.to_string(), "--height", &h.to_string(),
+                "--spp", &spp.to_string(), "--pass-spp", &pass.to_string(),
+                "--sampler", ["independent", "stratified", "sobol"][sampler],
+                "--filter", ["box", "tent", "gaussian", "mitchell"][filter],
+                "--integrator", ["path", "distribution", "ao", "normals"][integrator],
+                "--seed", &seed.to_string(), "--threads", "2",
+            ].iter().map(|s| s.to_string()).collect();
+            let run = |extra: &[String], out: &Path| {
+                let mut a = frame.clone();
+                a.extend(extra.iter().cloned());
+                a.extend(["-o".to_string(), out.display().to_string()]);
+                let a: Vec<&str> = a.iter().map(String::as_str).collect();
+                let r = sahara(&a);
+                assert!(r.status.success(), "{a:?}: {}", stderr(&r));
+            };
+            let mut bounds: Vec<u32> = cuts.iter().map(|c| (c * total as f64) as u32).collect();
+            bounds.extend([0, total]);
+            bounds.sort_unstable();
+            let mut files = Vec::new();
+            for i in 0..tiles {
+                for r in bounds.windows(2) {
+                    let p = dir.join(format!("p{i}-{}-{}.exr", r[0], r[1]));
+                    run(&[
+                        "--part".into(), format!("{i}/{tiles}"),
+                        "--samples".into(), format!("{}..{}", r[0], r[1]),
+                    ], &p);
+                    files.push(p);
+                }
+            }
+            for ext in ["exr", "png"] {
+                let whole = dir.join(format!("whole.{ext}"));
+                run(&[], &whole);
+                let merged = dir.join(format!("merged.{ext}"));
+                let m = merge(&files, &merged, &[]);
+                prop_assert!(m.status.success(), "{}", stderr(&m));
+                prop_assert!(fs::read(&merged).unwrap() == fs::read(&whole).unwrap(),
+                    "the merged {} differs", ext);
+            }
+            fs::remove_dir_all(&dir).unwrap();
+        }
+    }
+}
