@@ -561,9 +561,11 @@ impl Strip {
         self.pos.resize(n, Vec2::ZERO);
         self.radiance.clear();
         self.radiance.resize(n, Vec3::ZERO);
-        let sampler_at = |x: u32, y: u32, index: u32| {
+        // Sample `index` of pixel (x, y): its sampler, film position and
+        // camera ray.
+        let camera_sample = |x: u32, y: u32, index: u32| {
             let stream = hash2(s.seed, (y as u64) * w as u64 + x as u64);
-            PixelSampler::new(
+            let sampler = PixelSampler::new(
                 s.sampler,
                 SampleId {
                     stream,
@@ -571,7 +573,14 @@ impl Strip {
                     index,
                     count: spp,
                 },
-            )
+            );
+            let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
+            let (ray, time) = camera.generate_ray(
+                pos * inv,
+                sampler.get_2d(dims::LENS),
+                sampler.get_1d(dims::TIME),
+            );
+            (sampler, pos, ray, time)
         };
         let slot_of = |x: u32, y: u32, index: u32| {
             (((y - y0) * (x1 - x0) + (x - x0)) * per_pixel + index - indices.start) as usize
@@ -580,13 +589,7 @@ impl Strip {
             for y in y0..y1 {
                 for x in x0..x1 {
                     for index in indices.clone() {
-                        let sampler = sampler_at(x, y, index);
-                        let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
-                        let (ray, time) = camera.generate_ray(
-                            pos * inv,
-                            sampler.get_2d(dims::LENS),
-                            sampler.get_1d(dims::TIME),
-                        );
+                        let (sampler, pos, ray, time) = camera_sample(x, y, index);
                         let mut ctx = Context {
                             world,
                             sampler,
@@ -611,13 +614,7 @@ impl Strip {
             for index in indices.clone() {
                 for y in by..(by + 4).min(y1) {
                     for x in bx..(bx + 4).min(x1) {
-                        let sampler = sampler_at(x, y, index);
-                        let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
-                        let (ray, time) = camera.generate_ray(
-                            pos * inv,
-                            sampler.get_2d(dims::LENS),
-                            sampler.get_1d(dims::TIME),
-                        );
+                        let (sampler, pos, ray, time) = camera_sample(x, y, index);
                         let k = slot_of(x, y, index);
                         self.pos[k] = pos;
                         self.slot.push(k as u32);
