@@ -3,11 +3,15 @@
 //! be recognised as such before they are added up.
 
 use std::fmt::Write;
+use std::sync::Arc;
 
+use glam::Vec3;
 use sha2::{Digest, Sha256};
 
+use crate::light::Environment;
 use crate::render::RenderSettings;
 use crate::scene::Scene;
+use crate::texture::Texture;
 
 /// Feeds formatted text to the hash without building the whole string.
 struct HashWriter(Sha256);
@@ -19,16 +23,80 @@ impl Write for HashWriter {
     }
 }
 
+/// Hashes `tag`, the number of values and their bytes.
+fn bytes(h: &mut HashWriter, tag: &str, values: &mut dyn Iterator<Item = [u8; 4]>) {
+    h.0.update(tag.as_bytes());
+    let mut chunk = Vec::with_capacity(4096);
+    let mut n = 0u64;
+    for v in values {
+        chunk.extend_from_slice(&v);
+        n += 1;
+        if chunk.len() >= 4096 {
+            h.0.update(&chunk);
+            chunk.clear();
+        }
+    }
+    h.0.update(&chunk);
+    h.0.update(n.to_le_bytes());
+}
+
+/// The bytes of the floats of `v`.
+fn vec3s(v: &[Vec3]) -> impl Iterator<Item = [u8; 4]> + '_ {
+    v.iter().flat_map(|p| p.to_array()).map(f32::to_le_bytes)
+}
+
 /// SHA-256, in hex, of the scene and of the settings that change pixels:
 /// size, samples per pixel and per pass, seed, sampler, filter, integrator
 /// with its parameters, and the cost view's scale. The tree builder, tile
 /// size, threads, time limit, window and sample range are left out: they
 /// do not change a pixel of the frame.
 ///
-/// The scene enters through its `Debug` form, which prints every float so
-/// that it reads back to the same bits.
+/// The scene's large arrays (mesh vertices, triangles, normals, texture
+/// coordinates, material ids, texels) enter as their bytes; the rest of it
+/// through its `Debug` form, which prints every float so that it reads
+/// back to the same bits.
 pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
     let mut h = HashWriter(Sha256::new());
+    for m in &scene.meshes {
+        bytes(&mut h, "positions", &mut vec3s(&m.mesh.positions));
+        let mut idx = m.mesh.indices.iter().flatten().map(|i| i.to_le_bytes());
+        bytes(&mut h, "indices", &mut idx);
+        if let Some(n) = &m.normals {
+            bytes(&mut h, "normals", &mut vec3s(n));
+        }
+        if let Some(uv) = &m.uvs {
+            let mut it = uv.iter().flat_map(|p| p.to_array()).map(f32::to_le_bytes);
+            bytes(&mut h, "uvs", &mut it);
+        }
+        if let Some(ids) = &m.material_ids {
+            bytes(
+                &mut h,
+                "material ids",
+                &mut ids.iter().map(|i| i.to_le_bytes()),
+            );
+        }
+    }
+    // The rest of the scene, with each texture replaced by a placeholder
+    // once its texels are hashed (in order of first use).
+    let placeholder = Arc::new(Texture::new(1, 1, vec![Vec3::ZERO]));
+    let texture = |h: &mut HashWriter, t: &mut Arc<Texture>| {
+        let _ = write!(h, "texture {}x{}", t.width, t.height);
+        bytes(h, "texels", &mut vec3s(&t.texels));
+        *t = placeholder.clone();
+    };
+    let mut rest = Scene {
+        meshes: Vec::new(),
+        ..scene.clone()
+    };
+    for m in &mut rest.materials {
+        if let Some(t) = &mut m.texture {
+            texture(&mut h, t);
+        }
+    }
+    if let Some(Environment::Map { texture: t, .. }) = &mut rest.environment {
+        texture(&mut h, t);
+    }
+    let scene = &rest;
     // Writing to a hash cannot fail.
     let _ = write!(
         h,
@@ -97,5 +165,14 @@ mod tests {
         let mut moved = scene.clone();
         moved.camera.aspect *= 1.0 + f32::EPSILON;
         assert_ne!(frame_digest(&moved, &base), d);
+        let mut nudged = scene.clone();
+        nudged.meshes[0].mesh.positions[0].x += 1e-3;
+        assert_ne!(frame_digest(&nudged, &base), d);
+        let mut textured = scene.clone();
+        let texels = |v: f32| Arc::new(Texture::new(1, 2, vec![Vec3::ONE, Vec3::splat(v)]));
+        textured.materials[0].texture = Some(texels(0.5));
+        let t = frame_digest(&textured, &base);
+        textured.materials[0].texture = Some(texels(0.25));
+        assert_ne!(frame_digest(&textured, &base), t);
     }
 }

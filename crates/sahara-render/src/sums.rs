@@ -12,25 +12,31 @@
 //! the same bits however the samples are split into tiles, passes, sample
 //! ranges or processes, and in whatever order the pieces are added.
 //!
-//! The conversion rounds toward zero below `2^-64` (far below what an `f32`
-//! pixel can show) and clamps a contribution to `±2^60`, so that no sum of
-//! fewer than `2^66` contributions overflows.
+//! The conversion rounds toward zero below `2^-52` (far below what an `f32`
+//! pixel can show) and clamps a contribution to `±2^40`, so that no sum of
+//! fewer than `2^35` contributions overflows. It takes a handful of
+//! instructions: the integer part and the fraction are converted as two
+//! `i64`, which avoids the slow general `f64` to `i128` conversion.
 
 use glam::{Vec2, Vec3};
 
 use crate::filter::Filter;
 
 /// Fractional bits of the fixed-point sums.
-pub const FRACTION_BITS: i32 = 64;
+pub const FRACTION_BITS: i32 = 52;
 
 /// Largest magnitude of one contribution; larger ones are clamped.
-const MAX_CONTRIBUTION: f64 = (1u64 << 60) as f64;
+const MAX_CONTRIBUTION: f64 = (1u64 << 40) as f64;
 
-/// One contribution as a fixed-point number.
+/// One contribution as a fixed-point number, truncated toward zero.
 #[inline]
 fn fixed(v: f64) -> i128 {
-    // Multiplying by a power of two is exact; the cast truncates.
-    (v.clamp(-MAX_CONTRIBUTION, MAX_CONTRIBUTION) * (2.0f64).powi(FRACTION_BITS)) as i128
+    let v = v.clamp(-MAX_CONTRIBUTION, MAX_CONTRIBUTION);
+    let whole = v as i64;
+    // Exact (|v| < 2^52), with the sign of v; scaling by a power of two is
+    // exact too, and the cast truncates.
+    let fraction = ((v - whole as f64) * (2.0f64).powi(FRACTION_BITS)) as i64;
+    ((whole as i128) << FRACTION_BITS) + fraction as i128
 }
 
 /// A fixed-point sum as a float (rounded to nearest).
@@ -201,6 +207,19 @@ mod tests {
         assert_eq!(one, right);
         let exact: f64 = samples.iter().map(|v| v.abs() as f64).sum::<f64>() / 6.0;
         assert!((one.value().x as f64 - exact).abs() <= 1e-6 * exact);
+    }
+
+    #[test]
+    fn fixed_point_is_exact_down_to_its_resolution() {
+        for v in [0.0, 1.0, -1.0, 0.75, -3.5e-9, 123456.789, -1e12, 1e300] {
+            let f = fixed(v);
+            let back = float(f);
+            let v = v.clamp(-MAX_CONTRIBUTION, MAX_CONTRIBUTION);
+            assert!(back.abs() <= v.abs(), "{v}: truncated toward zero");
+            assert!((v - back).abs() < (2.0f64).powi(-FRACTION_BITS), "{v}");
+        }
+        assert_eq!(fixed(0.5), 1i128 << (FRACTION_BITS - 1));
+        assert_eq!(fixed(-2.25), -(9i128 << (FRACTION_BITS - 2)));
     }
 
     #[test]
