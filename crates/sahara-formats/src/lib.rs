@@ -26,6 +26,7 @@ pub mod mesh_library;
 pub mod mesh_scene;
 pub mod mtl;
 pub mod obj;
+pub mod pbrt;
 pub mod ply;
 pub mod scene_file;
 pub mod scene_load;
