@@ -68,7 +68,11 @@ pub fn load_pbrt(path: &Path) -> Result<PbrtScene, FormatError> {
     let mut w = warnings::Warnings::default();
     let desc = parser::parse_file(path, &mut w)?;
     let folder = path.parent().unwrap_or(Path::new(""));
-    finish(build::build(&desc, folder, &mut w)?, w)
+    finish(
+        build::build(&desc, folder, &mut w)?,
+        w,
+        &path.display().to_string(),
+    )
 }
 
 /// Parses and builds a pbrt file held in memory; `name` is used in
@@ -76,14 +80,14 @@ pub fn load_pbrt(path: &Path) -> Result<PbrtScene, FormatError> {
 pub fn parse_pbrt(text: &[u8], name: &str, folder: &Path) -> Result<PbrtScene, FormatError> {
     let mut w = warnings::Warnings::default();
     let desc = parser::parse_bytes(text.to_vec(), name, folder, &mut w)?;
-    finish(build::build(&desc, folder, &mut w)?, w)
+    finish(build::build(&desc, folder, &mut w)?, w, name)
 }
 
-fn finish(mut s: PbrtScene, w: warnings::Warnings) -> Result<PbrtScene, FormatError> {
+fn finish(mut s: PbrtScene, w: warnings::Warnings, name: &str) -> Result<PbrtScene, FormatError> {
     s.loaded.warnings = w.into_lines();
     s.loaded
         .scene
         .validate()
-        .map_err(|e| FormatError::in_file("pbrt scene", e))?;
+        .map_err(|e| FormatError::in_file(name, e))?;
     Ok(s)
 }

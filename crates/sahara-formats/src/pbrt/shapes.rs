@@ -27,7 +27,7 @@ use crate::fan::fan_triangulate;
 use crate::ply::parse_ply_with_attributes;
 
 /// Largest number of triangles a shape may make (subdivision, tessellation).
-const MAX_TRIANGLES: u64 = 1 << 27;
+const MAX_TRIANGLES: u64 = 1 << 24;
 
 /// Rim segments of a tessellated full circle.
 const SEGMENTS: u32 = 128;

@@ -372,3 +372,38 @@ fn pbrt_and_toml_scenes_render_the_same_instances_and_motion() {
     ) + "[[material]]\nname = \"half\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n";
     assert_same_image(pbrt, &toml, "instances", false);
 }
+
+#[test]
+fn the_fuzz_seed_with_every_directive_loads() {
+    let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds/pbrt/scene.pbrt");
+    let text = std::fs::read(&seed).unwrap();
+    let s = parse_pbrt(&text, "seed.pbrt", Path::new("/nonexistent")).unwrap();
+    let scene = &s.loaded.scene;
+    let w = &s.loaded.warnings;
+    assert_eq!(scene.lights.len(), 2, "spot and distant; {w:#?}");
+    assert!(matches!(
+        scene.environment,
+        Some(sahara_render::Environment::Constant(_))
+    ));
+    // The tetrahedron object, instanced twice (once moving), subdivided twice.
+    let tet = scene
+        .meshes
+        .iter()
+        .position(|m| m.mesh.indices.len() == 4 * 16)
+        .expect("the object mesh");
+    let uses: Vec<_> = scene
+        .instances
+        .iter()
+        .filter(|i| i.mesh as usize == tet)
+        .collect();
+    assert_eq!(uses.len(), 2);
+    assert!(uses[1].placement.is_moving());
+    assert!(scene
+        .materials
+        .iter()
+        .any(|m| m.is_emissive() && m.two_sided_emission));
+    assert_eq!(s.crop_window, Some([0.0, 1.0, 0.0, 1.0]));
+    assert!(w.iter().any(|l| l.contains("cropwindow")), "{w:#?}");
+    // The mix picks gold (amount 0.3 < 0.5): a conductor of gold's colour.
+    assert!(scene.materials.iter().any(|m| matches!(m.bsdf, sahara_render::Bsdf::Conductor { color, .. } if color.x > 0.9 && color.z < 0.45)));
+}
