@@ -473,8 +473,11 @@ fn settings(desc: &Description, folder: &Path, w: &mut Warnings) -> Result<Setti
         },
         Some(f) => {
             let mut radius = |d: f64| -> Result<f32, FormatError> {
-                let x = f.params.float("xradius", d)?;
-                let y = f.params.float("yradius", d)?;
+                // pbrt-v3 calls the radii xwidth and ywidth.
+                let x = f.params.float("xwidth", d)?;
+                let y = f.params.float("ywidth", d)?;
+                let x = f.params.float("xradius", x)?;
+                let y = f.params.float("yradius", y)?;
                 let r = f.params.float("radius", x.max(y))?;
                 if (x - y).abs() > 1e-9 {
                     w.add(
