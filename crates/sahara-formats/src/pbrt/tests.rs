@@ -407,3 +407,31 @@ fn the_fuzz_seed_with_every_directive_loads() {
     // The mix picks gold (amount 0.3 < 0.5): a conductor of gold's colour.
     assert!(scene.materials.iter().any(|m| matches!(m.bsdf, sahara_render::Bsdf::Conductor { color, .. } if color.x > 0.9 && color.z < 0.45)));
 }
+
+#[test]
+fn an_octahedral_environment_map_becomes_a_lat_long_map_through_the_light_transform() {
+    let dir = folder("envmap");
+    // A 2x2 equal-area map: the quadrant u > 1/2, v < 1/2 (directions with
+    // x > 0, y < 0 in light space) red, the rest black.
+    let texels: Vec<f32> = [[0.0; 3], [1.0, 0.0, 0.0], [0.0; 3], [0.0; 3]].concat();
+    crate::image_out::write_exr(&dir.join("sky.exr"), 2, 2, &texels, &[]).unwrap();
+    // Rotate 90 about z: light +x is world +y, light -y is world +x.
+    std::fs::write(
+        dir.join("s.pbrt"),
+        "WorldBegin\nRotate 90 0 0 1\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \"float scale\" 2\n",
+    )
+    .unwrap();
+    let s = load_pbrt(&dir.join("s.pbrt")).unwrap();
+    let Some(sahara_render::Environment::Map { texture, .. }) = &s.loaded.scene.environment else {
+        panic!("no map")
+    };
+    assert_eq!((texture.width, texture.height), (4, 2));
+    // World (1, 1, 0) normalised is light (1, -1, 0): red, at twice the value.
+    let at = |w: Vec3| {
+        let uv = sahara_render::light::environment::coordinates(w.normalize());
+        texture.texel((uv.x * 4.0) as i64, (uv.y * 2.0) as i64)
+    };
+    assert_eq!(at(Vec3::new(1.0, 0.3, 0.0)), Vec3::new(2.0, 0.0, 0.0));
+    assert_eq!(at(Vec3::new(-1.0, 0.3, 0.0)), Vec3::ZERO);
+    let _ = std::fs::remove_dir_all(&dir);
+}
