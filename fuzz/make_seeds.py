@@ -211,7 +211,7 @@ def hand_made():
 
 
 def main():
-    for target in ["obj", "ply", "scene_file", "gltf", "image", "kdtree"]:
+    for target in ["obj", "ply", "scene_file", "gltf", "image", "kdtree", "pbrt"]:
         (CORPUS / target).mkdir(parents=True, exist_ok=True)
     obj_seeds()
     ply_seeds()

@@ -28,6 +28,7 @@ pub mod mesh_scene;
 pub mod mtl;
 pub mod obj;
 pub mod part_file;
+pub mod pbrt;
 pub mod ply;
 pub mod scene_file;
 pub mod scene_load;

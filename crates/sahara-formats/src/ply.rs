@@ -18,7 +18,7 @@ mod reader;
 use std::fs;
 use std::path::Path;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use sahara_render::mesh::Mesh;
 
 use crate::error::FormatError;
@@ -34,6 +34,24 @@ pub fn load_ply(path: &Path) -> Result<Mesh, FormatError> {
 
 /// Parses a PLY file held in memory; `name` is used in error messages.
 pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, FormatError> {
+    parse_ply_with_attributes(bytes, name).map(|p| p.mesh)
+}
+
+/// A PLY mesh with the per-vertex attributes the file has.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlyMesh {
+    /// Positions and triangles.
+    pub mesh: Mesh,
+    /// Normals from `nx`, `ny`, `nz`, if the vertices have all three.
+    pub normals: Option<Vec<Vec3>>,
+    /// Texture coordinates from `u`, `v` (or `s`, `t`, `texture_u`,
+    /// `texture_v`, `texture_s`, `texture_t`), if the vertices have both.
+    pub uvs: Option<Vec<Vec2>>,
+}
+
+/// Parses a PLY file held in memory with its normals and texture
+/// coordinates; `name` is used in error messages.
+pub fn parse_ply_with_attributes(bytes: &[u8], name: &str) -> Result<PlyMesh, FormatError> {
     let header = parse_header(bytes, name)?;
     let layout = Layout::of(&header, name)?;
     match header.encoding {
@@ -55,9 +73,20 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, FormatError> {
     }
 }
 
+/// Names of the optional vertex attributes, by slot after x, y, z: the
+/// normal's three components, then u and v (each with its aliases).
+const ATTRIBUTE_NAMES: [&[&str]; 5] = [
+    &["nx"],
+    &["ny"],
+    &["nz"],
+    &["u", "s", "texture_u", "texture_s"],
+    &["v", "t", "texture_v", "texture_t"],
+];
+
 /// Where the mesh data sits among the header's elements and properties.
 struct Layout {
-    /// Index of the `vertex` element and, per property, which axis it is.
+    /// Index of the `vertex` element and, per property, which slot it
+    /// fills: 0..3 the position's axes, 3..6 the normal's, 6..8 u and v.
     vertex: Option<(usize, Vec<Option<usize>>)>,
     /// Index of the `face` element and of its index-list property.
     face: Option<(usize, usize)>,
@@ -95,6 +124,15 @@ impl Layout {
                             )));
                         }
                         axes[p] = Some(axis);
+                    }
+                    for (k, names) in ATTRIBUTE_NAMES.iter().enumerate() {
+                        if let Some(p) = element.properties.iter().position(|p| {
+                            names.contains(&p.name.as_str()) && matches!(p.kind, Kind::Scalar(_))
+                        }) {
+                            if axes[p].is_none() {
+                                axes[p] = Some(3 + k);
+                            }
+                        }
                     }
                     layout.vertex = Some((e, axes));
                     layout.vertex_count = element.count;
@@ -165,8 +203,12 @@ fn check_count<R: Reader>(r: &mut R, element: &Element) -> Result<(), FormatErro
 }
 
 /// Reads every element in order.
-fn read_body<R: Reader>(r: &mut R, header: &Header, layout: &Layout) -> Result<Mesh, FormatError> {
-    let mut mesh = Mesh::default();
+fn read_body<R: Reader>(
+    r: &mut R,
+    header: &Header,
+    layout: &Layout,
+) -> Result<PlyMesh, FormatError> {
+    let mut mesh = PlyMesh::default();
     for (e, element) in header.elements.iter().enumerate() {
         if element.properties.is_empty() {
             // Records of nothing: there is nothing to read, however many there are.
@@ -176,7 +218,7 @@ fn read_body<R: Reader>(r: &mut R, header: &Header, layout: &Layout) -> Result<M
         match (&layout.vertex, layout.face) {
             (Some((v, axes)), _) if *v == e => read_vertices(r, element, axes, &mut mesh)?,
             (_, Some((f, list))) if f == e => {
-                read_faces(r, element, list, layout.vertex_count, &mut mesh)?
+                read_faces(r, element, list, layout.vertex_count, &mut mesh.mesh)?
             }
             _ => skip_element(r, element)?,
         }
@@ -230,8 +272,11 @@ fn read_vertices<R: Reader>(
     r: &mut R,
     element: &Element,
     axes: &[Option<usize>],
-    mesh: &mut Mesh,
+    out: &mut PlyMesh,
 ) -> Result<(), FormatError> {
+    let has = |slots: std::ops::Range<usize>| slots.into_iter().all(|s| axes.contains(&Some(s)));
+    let (with_normals, with_uvs) = (has(3..6), has(6..8));
+    let mesh = &mut out.mesh;
     if element.count > u64::from(u32::MAX) {
         let at = r.here();
         return Err(r.error(
@@ -246,9 +291,17 @@ fn read_vertices<R: Reader>(
     }
     // `check_count` has bounded the count by the file size.
     mesh.positions.reserve_exact(element.count as usize);
+    let mut normals = Vec::new();
+    let mut uvs = Vec::new();
+    if with_normals {
+        normals.reserve_exact(element.count as usize);
+    }
+    if with_uvs {
+        uvs.reserve_exact(element.count as usize);
+    }
     for v in 0..element.count {
         r.begin_record(element.properties.len() as u64);
-        let mut p = [0.0f32; 3];
+        let mut p = [0.0f32; 8];
         for (property, axis) in element.properties.iter().zip(axes) {
             let ctx = |e| with_context(e, element, v, &property.name);
             match (property.kind, axis) {
@@ -261,8 +314,16 @@ fn read_vertices<R: Reader>(
             }
         }
         r.end_record()?;
-        mesh.positions.push(Vec3::from_array(p));
+        mesh.positions.push(Vec3::new(p[0], p[1], p[2]));
+        if with_normals {
+            normals.push(Vec3::new(p[3], p[4], p[5]));
+        }
+        if with_uvs {
+            uvs.push(Vec2::new(p[6], p[7]));
+        }
     }
+    out.normals = with_normals.then_some(normals);
+    out.uvs = with_uvs.then_some(uvs);
     Ok(())
 }
 

@@ -69,7 +69,7 @@ pub struct MergeArgs {
 /// brackets apply when neither gives one.
 #[derive(Debug, Args, Clone, PartialEq, Default)]
 pub struct RenderArgs {
-    /// What to render: a scene file (.toml), or a mesh (.obj, .ply, .gltf,
+    /// What to render: a scene file (.toml, .pbrt, .pbrt.gz), or a mesh (.obj, .ply, .gltf,
     /// .glb) with its own materials, framed by its camera sidecar or
     /// automatically and lit by a default sky and sun unless it emits
     /// light; none for the built-in Cornell box.

@@ -431,7 +431,8 @@ fn load_input(path: Option<&Path>, camera: Option<&Path>) -> Result<Input> {
             warnings: Vec::new(),
         });
     };
-    const EXPECTED: &str = "expected a scene file (.toml) or a mesh (.obj, .ply, .gltf, .glb)";
+    const EXPECTED: &str =
+        "expected a scene file (.toml, .pbrt, .pbrt.gz) or a mesh (.obj, .ply, .gltf, .glb)";
     if path.is_dir() {
         bail!("{}: is a folder; {EXPECTED}", path.display());
     }
@@ -440,7 +441,16 @@ fn load_input(path: Option<&Path>, camera: Option<&Path>) -> Result<Input> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     // A `FormatError`'s message already names the file and place.
+    let pbrt = sahara_formats::pbrt::is_pbrt_path(path);
     let (scene, file, warnings) = match ext.as_str() {
+        _ if pbrt && camera.is_some() => bail!(
+            "{}: --camera applies to meshes and the built-in scene; a pbrt file has its own Camera",
+            path.display()
+        ),
+        _ if pbrt => {
+            let p = sahara_formats::pbrt::load_pbrt(path).map_err(flat)?;
+            (p.loaded.scene, Some(p.loaded.settings), p.loaded.warnings)
+        }
         "toml" if camera.is_some() => bail!(
             "{}: --camera applies to meshes and the built-in scene; a scene file has its own [camera]",
             path.display()
@@ -478,8 +488,14 @@ fn load_input(path: Option<&Path>, camera: Option<&Path>) -> Result<Input> {
 }
 
 fn stem(path: &Path) -> String {
-    path.file_stem()
-        .map_or("render".into(), |s| s.to_string_lossy().into_owned())
+    let stem = path
+        .file_stem()
+        .map_or("render".into(), |s| s.to_string_lossy().into_owned());
+    // `scene.pbrt.gz` is the scene `scene`.
+    match stem.strip_suffix(".pbrt") {
+        Some(s) if !s.is_empty() => s.to_owned(),
+        _ => stem,
+    }
 }
 
 fn is_exr(path: &Path) -> bool {

@@ -356,7 +356,7 @@ fn a_path_without_a_usable_extension_says_what_it_is() {
         );
         assert!(!err.contains("cannot render . files"), "{err}");
         assert!(
-            err.contains("expected a scene file (.toml) or a mesh"),
+            err.contains("expected a scene file (.toml, .pbrt, .pbrt.gz) or a mesh"),
             "{err}"
         );
     }
@@ -610,4 +610,55 @@ fn render_mean_8x8(scene: &Path, out: &Path) -> f32 {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     checked_mean(out, 8, 8)
+}
+
+#[test]
+fn a_pbrt_scene_renders_with_its_film_and_its_warnings_counted() {
+    let dir = temp_dir("pbrt");
+    let scene = dir.join("s.pbrt");
+    fs::write(
+        &scene,
+        "LookAt 0 0 3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\n\
+         Film \"rgb\" \"integer xresolution\" 12 \"integer yresolution\" 6 \"string filename\" \"from_file.png\"\n\
+         Sampler \"halton\" \"integer pixelsamples\" 2\nWorldBegin\n\
+         LightSource \"infinite\" \"rgb L\" [1 1 1]\n\
+         Material \"coateddiffuse\" Shape \"sphere\"\nShape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\n\
+         Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\n",
+    )
+    .unwrap();
+    let out = sahara(&["render", scene.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("shape 'curve' is not supported; skipped (2 times"),
+        "{err}"
+    );
+    let mean = checked_mean(&dir.join("from_file.png"), 12, 6);
+    assert!(mean > 0.1, "a lit sphere on a white sky: {mean}");
+    // Compressed, and with the size overridden.
+    let text = fs::read(&scene).unwrap();
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    std::io::Write::write_all(&mut gz, &text).unwrap();
+    fs::write(dir.join("z.pbrt.gz"), gz.finish().unwrap()).unwrap();
+    let png = dir.join("cli.png");
+    let out = sahara(&[
+        "render",
+        dir.join("z.pbrt.gz").to_str().unwrap(),
+        "--width",
+        "5",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    checked_mean(&png, 5, 6);
+    // An error names the file, line and column.
+    fs::write(dir.join("bad.pbrt"), "WorldBegin\n  Shapee \"sphere\"\n").unwrap();
+    let out = sahara(&["render", dir.join("bad.pbrt").to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("bad.pbrt: line 2: column 3: unknown directive 'Shapee'"),
+        "{}",
+        stderr(&out)
+    );
+    let _ = fs::remove_dir_all(&dir);
 }

@@ -1,0 +1,437 @@
+//! Tests of the pbrt reader as a whole: directives, transforms, includes,
+//! instancing, compressed files, errors, and pbrt scenes rendering as the
+//! same scenes written in Sahara's TOML.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use glam::{DVec3, Vec3};
+use sahara_render::{render, Placement, RenderSettings, Scene};
+
+use super::description::Description;
+use super::parser::parse_bytes;
+use super::warnings::Warnings;
+use super::{load_pbrt, parse_pbrt};
+use crate::scene_load::load_scene;
+
+fn parse(text: &str) -> Result<(Description, Warnings), crate::FormatError> {
+    let mut w = Warnings::default();
+    let d = parse_bytes(
+        text.as_bytes().to_vec(),
+        "t.pbrt",
+        Path::new("/nonexistent"),
+        &mut w,
+    )?;
+    Ok((d, w))
+}
+
+fn err(text: &str) -> String {
+    match parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent")) {
+        Ok(_) => panic!("expected an error for {text:?}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// A fresh folder for a test's files.
+fn folder(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("sahara-pbrt-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn a_known_point_goes_through_the_transform_stack() {
+    let (d, _) = parse(
+        "AttributeBegin\n Translate 1 2 3\n Rotate 90 0 0 1\n Scale 2 2 2\n CoordinateSystem \"mine\"\n Shape \"sphere\"\nAttributeEnd\n\
+         Shape \"sphere\"\n\
+         CoordSysTransform \"mine\" ConcatTransform [1 0 0 0 0 1 0 0 0 0 1 0 0 0 1 1] Shape \"sphere\"\n\
+         Transform 1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1 Shape \"sphere\"\n\
+         Identity LookAt 0 0 0  0 0 1  0 1 0 Shape \"sphere\"\n\
+         Identity LookAt 0 0 0  1 0 0  0 1 0 Shape \"sphere\"",
+    )
+    .unwrap();
+    let p = |i: usize, v: [f64; 3]| d.shapes[i].xform.m[0].transform_point3(DVec3::from_array(v));
+    let close = |a: DVec3, b: [f64; 3]| (a - DVec3::from_array(b)).length() < 1e-12;
+    // Scale, then rotate about z, then translate.
+    assert!(
+        close(p(0, [1.0, 0.0, 0.0]), [1.0, 4.0, 3.0]),
+        "{}",
+        p(0, [1.0, 0.0, 0.0])
+    );
+    // AttributeEnd restored the identity.
+    assert!(close(p(1, [1.0, 0.0, 0.0]), [1.0, 0.0, 0.0]));
+    // The named system, then a translation of 1 along its z (scaled by 2).
+    assert!(
+        close(p(2, [0.0, 0.0, 0.0]), [1.0, 2.0, 5.0]),
+        "{}",
+        p(2, [0.0; 3])
+    );
+    // Transform replaces: columns, translation last.
+    assert!(close(p(3, [0.0, 0.0, 0.0]), [5.0, 6.0, 7.0]));
+    // LookAt is world to camera, +x = up x forward.
+    assert!(close(p(4, [1.0, 0.0, 0.0]), [1.0, 0.0, 0.0]));
+    // Looking down +x with y up: camera +z is world +x, camera +x (up x
+    // forward) is world -z, so world +x is at camera (0, 0, 1).
+    assert!(
+        close(p(5, [1.0, 0.0, 0.0]), [0.0, 0.0, 1.0]),
+        "{}",
+        p(5, [1.0, 0.0, 0.0])
+    );
+    assert!(close(p(5, [0.0, 0.0, -1.0]), [1.0, 0.0, 0.0]));
+}
+
+#[test]
+fn motion_orientation_and_blocks() {
+    let (d, w) = parse(
+        "TransformTimes 0 2\nActiveTransform EndTime\nTranslate 4 0 0\nActiveTransform All\nReverseOrientation\n\
+         AttributeBegin ReverseOrientation Shape \"disk\" AttributeEnd\nShape \"disk\"\nTransformBegin Translate 1 1 1 TransformEnd\n\
+         AttributeBegin",
+    )
+    .unwrap();
+    assert_eq!(d.transform_times, (0.0, 2.0));
+    let s = &d.shapes[1];
+    assert!(s.xform.is_animated());
+    assert_eq!(s.xform.m[0].transform_point3(DVec3::ZERO), DVec3::ZERO);
+    assert_eq!(
+        s.xform.m[1].transform_point3(DVec3::ZERO),
+        DVec3::new(4.0, 0.0, 0.0)
+    );
+    assert!(s.reverse && !d.shapes[0].reverse);
+    assert_eq!(w.count("AttributeBegin without AttributeEnd"), 1);
+}
+
+#[test]
+fn every_error_names_file_line_and_column() {
+    assert_eq!(
+        err("WorldBegin\n  Shapee \"sphere\""),
+        "t.pbrt: line 2: column 3: unknown directive 'Shapee'"
+    );
+    assert_eq!(
+        err("Shape \"sphere\" \"string radius\" \"x\""),
+        "t.pbrt: line 1: column 16: parameter \"string radius\": expected type float"
+    );
+    assert_eq!(
+        err("Shape \"sphere\"\n\"float radius\" [1 2]"),
+        "t.pbrt: line 2: column 1: parameter \"float radius\": expected one value, found 2"
+    );
+    assert_eq!(
+        err("Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"integer indices\" [0 1 4]"),
+        "t.pbrt: line 1: column 59: parameter \"integer indices\": index 4 is out of range (4 vertices)"
+    );
+    assert_eq!(
+        err("Translate 1 2"),
+        "t.pbrt: line 1: column 1: the file ends where 3 numbers is expected"
+    );
+    assert_eq!(
+        err("Translate 1 2 x"),
+        "t.pbrt: line 1: column 15: expected a number, found 'x'"
+    );
+    assert_eq!(
+        err("AttributeEnd"),
+        "t.pbrt: line 1: column 1: AttributeEnd without a block to close"
+    );
+    let e = err("\n Include \"missing.pbrt\"");
+    assert!(
+        e.starts_with("t.pbrt: line 2: column 2: Include: /nonexistent/missing.pbrt: cannot read"),
+        "{e}"
+    );
+    assert_eq!(
+        err("NamedMaterial \"nope\" Shape \"sphere\""),
+        "t.pbrt: line 1: column 1: unknown named material \"nope\""
+    );
+    assert_eq!(
+        err("ObjectInstance \"nope\""),
+        "t.pbrt: line 1: column 1: ObjectInstance of unknown object \"nope\""
+    );
+    assert_eq!(
+        err("Camera \"orthographic\""),
+        "t.pbrt: line 1: column 1: the 'orthographic' camera is not supported (Sahara has perspective cameras only)"
+    );
+    assert!(err("Shape \"sphere\" \"rgb\" [1 2 3]").contains("expected a parameter declaration"));
+    assert!(err("Film \"rgb\" \"integer xresolution\" [0]").contains("must be in 1..=65536"));
+}
+
+#[test]
+fn unknown_parameters_and_unsupported_features_are_counted_warnings() {
+    let text = "Shape \"sphere\" \"float radius\" 1 \"float wobble\" 3\nShape \"sphere\" \"float wobble\" 2\n\
+                Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\nShape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\n\
+                Material \"coateddiffuse\" Shape \"sphere\"\nLightSource \"point\"";
+    let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent")).unwrap();
+    let w = &s.loaded.warnings;
+    assert!(w.contains(&"t.pbrt:1:33: shape 'sphere': unknown parameter \"float wobble\", ignored (2 times; the first here)".to_owned()), "{w:#?}");
+    assert!(
+        w.contains(
+            &"t.pbrt:3:1: shape 'curve' is not supported; skipped (2 times; the first here)"
+                .to_owned()
+        ),
+        "{w:#?}"
+    );
+    assert!(
+        w.iter()
+            .any(|l| l.contains("material 'coateddiffuse': the coating")),
+        "{w:#?}"
+    );
+    assert_eq!(s.loaded.scene.lights.len(), 1);
+}
+
+#[test]
+fn includes_resolve_from_the_main_folder_then_the_including_file() {
+    let dir = folder("include");
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    std::fs::write(
+        dir.join("main.pbrt"),
+        "Include \"sub/a.pbrt\"\nImport \"sub/b.pbrt\"\n",
+    )
+    .unwrap();
+    // a.pbrt names c.pbrt relative to itself, b.pbrt names sub/ply relative to the main file.
+    std::fs::write(dir.join("sub/a.pbrt"), "Include \"c.pbrt\"\n").unwrap();
+    std::fs::write(dir.join("sub/c.pbrt"), "LightSource \"point\"\n").unwrap();
+    let ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+               0 0 0 0 0 1 0 0\n1 0 0 0 0 1 1 0\n1 1 0 0 0 1 1 1\n0 1 0 0 0 1 0 1\n4 0 1 2 3\n";
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    gz.write_all(ply.as_bytes()).unwrap();
+    std::fs::write(dir.join("sub/quad.ply.gz"), gz.finish().unwrap()).unwrap();
+    std::fs::write(
+        dir.join("sub/b.pbrt"),
+        "Shape \"plymesh\" \"string filename\" \"sub/quad.ply.gz\"\n",
+    )
+    .unwrap();
+    let s = load_pbrt(&dir.join("main.pbrt")).unwrap();
+    let scene = &s.loaded.scene;
+    assert_eq!(scene.lights.len(), 1);
+    assert_eq!(scene.meshes.len(), 1);
+    let m = &scene.meshes[0];
+    assert_eq!(m.mesh.indices.len(), 2, "the quad is two triangles");
+    assert_eq!(m.normals.as_ref().unwrap()[2], Vec3::Z);
+    assert_eq!(m.uvs.as_ref().unwrap()[2], glam::Vec2::ONE);
+    // The whole file compressed reads the same.
+    let text = std::fs::read(dir.join("main.pbrt")).unwrap();
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    gz.write_all(&text).unwrap();
+    std::fs::write(dir.join("main.pbrt.gz"), gz.finish().unwrap()).unwrap();
+    let z = load_pbrt(&dir.join("main.pbrt.gz")).unwrap();
+    assert_eq!(z.loaded.scene, s.loaded.scene);
+    // A file that includes itself is an error, not a hang.
+    std::fs::write(dir.join("loop.pbrt"), "Include \"loop.pbrt\"\n").unwrap();
+    let e = load_pbrt(&dir.join("loop.pbrt")).unwrap_err().to_string();
+    assert!(e.contains("nested more than"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn object_instances_share_one_mesh() {
+    let text = "Material \"diffuse\" \"rgb reflectance\" [0.1 0.2 0.3]\nObjectBegin \"tri\"\n\
+                Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\n\
+                Material \"conductor\" Shape \"sphere\"\nObjectEnd\n\
+                AttributeBegin Translate 5 0 0 ObjectInstance \"tri\" AttributeEnd\n\
+                AttributeBegin Scale 2 2 2 ObjectInstance \"tri\" AttributeEnd\n\
+                ActiveTransform EndTime Translate 0 1 0 ActiveTransform All ObjectInstance \"tri\"";
+    let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent")).unwrap();
+    let scene = &s.loaded.scene;
+    assert_eq!(scene.meshes.len(), 1, "one mesh for the object");
+    assert_eq!(scene.instances.len(), 3);
+    assert!(scene
+        .instances
+        .iter()
+        .all(|i| i.mesh == 0 && i.material.is_none()));
+    let ids = scene.meshes[0].material_ids.as_ref().unwrap();
+    assert_ne!(
+        ids[0],
+        *ids.last().unwrap(),
+        "the triangle and the sphere keep their materials"
+    );
+    assert_eq!(
+        scene.materials[ids[0] as usize].bsdf,
+        sahara_render::Bsdf::Diffuse {
+            albedo: Vec3::new(0.1, 0.2, 0.3)
+        }
+    );
+    match scene.instances[0].placement {
+        Placement::Static(a) => {
+            assert_eq!(a.transform_point3(Vec3::ZERO), Vec3::new(5.0, 0.0, 0.0))
+        }
+        other => panic!("{other:?}"),
+    }
+    match scene.instances[2].placement {
+        Placement::Moving { open, close } => {
+            assert_eq!(open.translation, Vec3::ZERO);
+            assert_eq!(close.translation, Vec3::Y);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn camera_fov_is_the_shorter_axis_and_settings_map() {
+    let text = "Film \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 200 \"string filename\" \"out.exr\"\n\
+                Sampler \"halton\" \"integer pixelsamples\" 8\nIntegrator \"volpath\" \"integer maxdepth\" 7\n\
+                PixelFilter \"box\"\nLookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 60 \"float lensradius\" 0.1 \"float focaldistance\" 5\nWorldBegin";
+    let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/scenes")).unwrap();
+    let st = &s.loaded.settings;
+    assert_eq!((st.width, st.height, st.spp), (100, 200, 8));
+    assert_eq!(
+        st.integrator,
+        sahara_render::Integrator::Path {
+            max_depth: 7,
+            rr_depth: 3
+        }
+    );
+    assert_eq!(st.filter, sahara_render::Filter::Box { radius: 0.5 });
+    assert_eq!(st.output.as_deref(), Some(Path::new("/scenes/out.exr")));
+    let c = &s.loaded.scene.camera;
+    // Portrait: the 60 degrees span the width; tan(v/2) = tan(30) * 2.
+    let expect = (2.0 * (30f64.to_radians().tan() * 2.0).atan()).to_degrees() as f32;
+    assert!((c.vfov_deg - expect).abs() < 1e-4, "{}", c.vfov_deg);
+    assert_eq!((c.lens_radius, c.focus_distance), (0.1, 5.0));
+    assert!((c.eye - Vec3::new(0.0, 0.0, -5.0)).length() < 1e-6);
+    // pbrt's image right is up x forward: +x here, looking down +z.
+    assert!((c.right - Vec3::X).length() < 1e-6, "{}", c.right);
+}
+
+/// Renders a scene small and fast.
+fn image(scene: &Scene, spp: u32) -> Vec<Vec3> {
+    let settings = RenderSettings {
+        width: 24,
+        height: 24,
+        spp,
+        passes: 1,
+        ..RenderSettings::default()
+    };
+    let mut scene = scene.clone();
+    scene.camera.aspect = 1.0;
+    render(&scene, &settings, &|_| {}).film.pixels
+}
+
+/// The same scene in pbrt and TOML renders the same image.
+fn assert_same_image(pbrt: &str, toml: &str, name: &str, exact: bool) {
+    let dir = folder(name);
+    std::fs::write(dir.join("s.pbrt"), pbrt).unwrap();
+    std::fs::write(dir.join("s.toml"), toml).unwrap();
+    std::fs::write(
+        dir.join("tri.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+    )
+    .unwrap();
+    let p = load_pbrt(&dir.join("s.pbrt")).unwrap();
+    let t = load_scene(&dir.join("s.toml")).unwrap();
+    let (a, b) = (image(&p.loaded.scene, 4), image(&t.scene, 4));
+    assert!(
+        b.iter().any(|v| v.max_element() > 0.0),
+        "the reference image is black"
+    );
+    if exact {
+        assert!(a == b, "{name}: the images differ");
+    } else {
+        let worst = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (*x - *y).abs().max_element())
+            .fold(0.0, f32::max);
+        assert!(worst < 1e-3, "{name}: images differ by up to {worst}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn pbrt_and_toml_scenes_render_the_same_spheres_disc_light_and_camera() {
+    let pbrt = "Scale -1 1 1\nLookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n\
+                LightSource \"point\" \"rgb I\" [5 5 5] \"point3 from\" [1 2 0]\n\
+                AttributeBegin Material \"diffuse\" \"rgb reflectance\" [0.5 0.2 0.2] Translate 0 0 5 Shape \"sphere\" AttributeEnd\n\
+                AttributeBegin Material \"conductor\" \"rgb reflectance\" [0.9 0.8 0.3] \"float roughness\" 0.0625 Translate 1.25 -0.5 4 Shape \"sphere\" \"float radius\" 0.5 AttributeEnd\n\
+                AttributeBegin Material \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource \"diffuse\" \"rgb L\" [4 4 4]\n\
+                Transform [1 0 0 0  0 0 1 0  0 -1 0 0  0 3 5 1] Shape \"disk\" \"float radius\" 1 AttributeEnd\n";
+    let toml = "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, 1]\nvfov = 40\n\
+                [[material]]\nname = \"red\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.2, 0.2]\n\
+                [[material]]\nname = \"gold\"\ntype = \"conductor\"\ncolor = [0.9, 0.8, 0.3]\nroughness = 0.5\n\
+                [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 5]\nradius = 1\nmaterial = \"red\"\n\
+                [[object]]\ntype = \"sphere\"\ncenter = [1.25, -0.5, 4]\nradius = 0.5\nmaterial = \"gold\"\n\
+                [[light]]\ntype = \"area\"\nshape = \"disc\"\ncenter = [0, 3, 5]\nnormal = [0, -1, 0]\nradius = 1\nradiance = [4, 4, 4]\n\
+                [[light]]\ntype = \"point\"\nposition = [1, 2, 0]\nintensity = [5, 5, 5]\n\
+                [film]\nwidth = 24\nheight = 24\n";
+    assert_same_image(pbrt, toml, "spheres", true);
+}
+
+#[test]
+fn pbrt_and_toml_scenes_render_the_same_instances_and_motion() {
+    let pbrt = "Scale -1 1 1\nLookAt 0 1 -6  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 50\nWorldBegin\n\
+                LightSource \"point\" \"rgb I\" [20 20 20] \"point3 from\" [0 4 -4]\n\
+                ObjectBegin \"tet\"\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 0 0 1] \"integer indices\" [0 2 1 0 1 3 0 3 2 1 2 3]\nObjectEnd\n\
+                AttributeBegin Translate -1.5 0 0 Rotate 30 0 1 0 Scale 1.5 1.5 1.5 ObjectInstance \"tet\" AttributeEnd\n\
+                AttributeBegin Translate 1 0 0 ActiveTransform EndTime Translate 0 1 0 ActiveTransform All ObjectInstance \"tet\" AttributeEnd\n";
+    let toml = "[camera]\neye = [0, 1, -6]\ntarget = [0, 0, 0]\nvfov = 50\nshutter_open = 0\nshutter_close = 1\n\
+                [[object]]\ntype = \"mesh\"\nfile = \"tri.obj\"\ntransform = { translate = [-1.5, 0, 0], rotate = { axis = [0, 1, 0], degrees = 30 }, scale = 1.5 }\n\
+                [[object]]\ntype = \"mesh\"\nfile = \"tri.obj\"\nmotion = { open = { translate = [1, 0, 0] }, close = { translate = [1, 1, 0] } }\n\
+                [[light]]\ntype = \"point\"\nposition = [0, 4, -4]\nintensity = [20, 20, 20]\n\
+                [film]\nwidth = 24\nheight = 24\n";
+    // pbrt's default material is diffuse 0.5, the OBJ's (no MTL) Sahara's grey 0.8:
+    // give the TOML objects pbrt's.
+    let toml = toml.replace(
+        "[[object]]\ntype = \"mesh\"\nfile = \"tri.obj\"\n",
+        "[[object]]\ntype = \"mesh\"\nfile = \"tri.obj\"\nmaterial = \"half\"\n",
+    ) + "[[material]]\nname = \"half\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n";
+    assert_same_image(pbrt, &toml, "instances", false);
+}
+
+#[test]
+fn the_fuzz_seed_with_every_directive_loads() {
+    let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds/pbrt/scene.pbrt");
+    let text = std::fs::read(&seed).unwrap();
+    let s = parse_pbrt(&text, "seed.pbrt", Path::new("/nonexistent")).unwrap();
+    let scene = &s.loaded.scene;
+    let w = &s.loaded.warnings;
+    assert_eq!(scene.lights.len(), 2, "spot and distant; {w:#?}");
+    assert!(matches!(
+        scene.environment,
+        Some(sahara_render::Environment::Constant(_))
+    ));
+    // The tetrahedron object, instanced twice (once moving), subdivided twice.
+    let tet = scene
+        .meshes
+        .iter()
+        .position(|m| m.mesh.indices.len() == 4 * 16)
+        .expect("the object mesh");
+    let uses: Vec<_> = scene
+        .instances
+        .iter()
+        .filter(|i| i.mesh as usize == tet)
+        .collect();
+    assert_eq!(uses.len(), 2);
+    assert!(uses[1].placement.is_moving());
+    assert!(scene
+        .materials
+        .iter()
+        .any(|m| m.is_emissive() && m.two_sided_emission));
+    assert_eq!(s.crop_window, Some([0.0, 1.0, 0.0, 1.0]));
+    assert!(w.iter().any(|l| l.contains("cropwindow")), "{w:#?}");
+    // The mix picks gold (amount 0.3 < 0.5): a conductor of gold's colour.
+    assert!(scene.materials.iter().any(|m| matches!(m.bsdf, sahara_render::Bsdf::Conductor { color, .. } if color.x > 0.9 && color.z < 0.45)));
+}
+
+#[test]
+fn an_octahedral_environment_map_becomes_a_lat_long_map_through_the_light_transform() {
+    let dir = folder("envmap");
+    // A 2x2 equal-area map: the quadrant u > 1/2, v < 1/2 (directions with
+    // x > 0, y < 0 in light space) red, the rest black.
+    let texels: Vec<f32> = [[0.0; 3], [1.0, 0.0, 0.0], [0.0; 3], [0.0; 3]].concat();
+    crate::image_out::write_exr(&dir.join("sky.exr"), 2, 2, &texels, &[]).unwrap();
+    // Rotate 90 about z: light +x is world +y, light -y is world +x.
+    std::fs::write(
+        dir.join("s.pbrt"),
+        "WorldBegin\nRotate 90 0 0 1\nLightSource \"infinite\" \"string filename\" \"sky.exr\" \"float scale\" 2\n",
+    )
+    .unwrap();
+    let s = load_pbrt(&dir.join("s.pbrt")).unwrap();
+    let Some(sahara_render::Environment::Map { texture, .. }) = &s.loaded.scene.environment else {
+        panic!("no map")
+    };
+    assert_eq!((texture.width, texture.height), (4, 2));
+    // World (1, 1, 0) normalised is light (1, -1, 0): red, at twice the value.
+    let at = |w: Vec3| {
+        let uv = sahara_render::light::environment::coordinates(w.normalize());
+        texture.texel((uv.x * 4.0) as i64, (uv.y * 2.0) as i64)
+    };
+    assert_eq!(at(Vec3::new(1.0, 0.3, 0.0)), Vec3::new(2.0, 0.0, 0.0));
+    assert_eq!(at(Vec3::new(-1.0, 0.3, 0.0)), Vec3::ZERO);
+    let _ = std::fs::remove_dir_all(&dir);
+}
