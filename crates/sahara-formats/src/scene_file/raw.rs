@@ -55,6 +55,9 @@ pub(super) enum MaterialType {
     Mirror,
     Dielectric,
     RoughDielectric,
+    ThinDielectric,
+    MetallicRoughness,
+    CoatedDiffuse,
     Emission,
 }
 
@@ -72,6 +75,13 @@ pub(super) struct RawMaterial {
     pub ior: Opt<f32>,
     pub radiance: Opt<V3>,
     pub two_sided: Opt<bool>,
+    pub metal: Opt<String>,
+    pub eta: Opt<V3>,
+    pub k: Opt<V3>,
+    pub base_color: Opt<V3>,
+    pub metallic: Opt<f32>,
+    pub specular: Opt<f32>,
+    pub specular_color: Opt<V3>,
 }
 
 /// Shape kinds (`type` of an `[[object]]`, `shape` of an area light).

@@ -223,6 +223,8 @@ pub(crate) struct Shading<'m> {
     pub wo: Vec3,
     pub material: &'m Material,
     pub tint: Vec3,
+    /// The back of a one-sided material: it scatters nothing.
+    pub blind: bool,
 }
 
 impl<'m> Shading<'m> {
@@ -238,6 +240,7 @@ impl<'m> Shading<'m> {
             wo: frame.to_local(wo_world),
             material,
             tint: material.tint(hit.uv),
+            blind: material.is_blind_side(wo_world.dot(hit.ng)),
         }
     }
 
@@ -280,6 +283,9 @@ impl Shading<'_> {
         hit: &SurfaceHit,
         depth: u32,
     ) -> Option<(BsdfSample, Ray)> {
+        if self.blind {
+            return None;
+        }
         let u_lobe = ctx.sampler.get_1d(dims::bounce(depth, dims::BSDF_LOBE));
         let u = ctx.sampler.get_2d(dims::bounce(depth, dims::BSDF_DIR));
         let s = self.material.bsdf.sample(self.tint, self.wo, u_lobe, u)?;
@@ -299,7 +305,7 @@ pub(crate) fn light_contribution(
     ls: &LightSample,
     time: f32,
 ) -> Option<(Vec3, f32, ShadowQuery)> {
-    if !sh.side_ok(hit, ls.wi) {
+    if sh.blind || !sh.side_ok(hit, ls.wi) {
         return None;
     }
     let wi = sh.frame.to_local(ls.wi);
@@ -313,4 +319,66 @@ pub(crate) fn light_contribution(
         .world
         .shadow_query(hit.spawn_origin(ls.wi), ls.wi, ls.dist, time, ls.ignore);
     Some((c, e.pdf, shadow))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+    use crate::light::Light;
+    use crate::sampler::{SampleId, SamplerKind};
+    use crate::scene::Scene;
+    use crate::shape::Shape;
+    use sahara_kd::BuildParams;
+
+    /// Radiance seen at the centre of a quad whose back faces the camera
+    /// and a point light beside the camera.
+    fn back_radiance(material: Material) -> Vec3 {
+        let cam = Camera::look_at(Vec3::new(0.0, 0.0, -3.0), Vec3::ZERO, Vec3::Y, 40.0, 1.0);
+        let mut scene = Scene::new(cam);
+        let m = scene.add_material(material);
+        scene.add_shape(
+            Shape::Quad {
+                corner: Vec3::new(-1.0, -1.0, 0.0),
+                edge_u: Vec3::new(2.0, 0.0, 0.0),
+                edge_v: Vec3::new(0.0, 2.0, 0.0),
+            },
+            m,
+        );
+        scene.add_light(Light::point(Vec3::new(0.3, 0.0, -2.0), Vec3::splat(4.0)));
+        let world = World::new(&scene, &BuildParams::default());
+        let mut stats = TraceStats::default();
+        let mut sum = Vec3::ZERO;
+        for index in 0..16 {
+            let sampler = PixelSampler::new(
+                SamplerKind::Sobol,
+                SampleId {
+                    stream: 0,
+                    pass: 0,
+                    index,
+                    count: 16,
+                },
+            );
+            let mut ctx = Context {
+                world: &world,
+                sampler,
+                stats: &mut stats,
+            };
+            let ray = Ray::new(Vec3::new(0.0, 0.0, -3.0), Vec3::Z);
+            sum += Integrator::default().li(&mut ctx, &ray, 0.0);
+        }
+        sum / 16.0
+    }
+
+    #[test]
+    fn one_sided_materials_are_black_from_behind() {
+        let two = back_radiance(Material::diffuse(Vec3::splat(0.8)));
+        assert!(two.min_element() > 0.1, "{two}");
+        let one = back_radiance(Material::diffuse(Vec3::splat(0.8)).with_two_sided(false));
+        assert_eq!(one, Vec3::ZERO);
+        // Glass has two sides whatever the flag says.
+        let glass = back_radiance(Material::glass(1.5).with_two_sided(false));
+        let glass_two = back_radiance(Material::glass(1.5));
+        assert_eq!(glass, glass_two);
+    }
 }

@@ -279,6 +279,10 @@ pub struct Material {
     /// Emit from both faces (default: only the front face, the side of the
     /// winding-order normal `(v1 - v0) x (v2 - v0)`).
     pub two_sided_emission: bool,
+    /// Scatter light on both faces (the default). When false, a reflector
+    /// seen from its back face (against the winding-order normal) is
+    /// black. Glass has two sides by nature and ignores this.
+    pub two_sided: bool,
 }
 
 impl Material {
@@ -289,6 +293,7 @@ impl Material {
             texture: None,
             emission: Vec3::ZERO,
             two_sided_emission: false,
+            two_sided: true,
         }
     }
 
@@ -326,6 +331,21 @@ impl Material {
     pub fn with_emission(mut self, radiance: Vec3) -> Self {
         self.emission = radiance;
         self
+    }
+
+    /// This material scattering on both faces (`true`) or the front face
+    /// only.
+    pub fn with_two_sided(mut self, two_sided: bool) -> Self {
+        self.two_sided = two_sided;
+        self
+    }
+
+    /// True if light arriving from `wo_dot_ng`'s side (the cosine of the
+    /// outgoing direction to the front face's normal) is not scattered:
+    /// the back of a one-sided reflector.
+    #[inline]
+    pub fn is_blind_side(&self, wo_dot_ng: f32) -> bool {
+        !self.two_sided && wo_dot_ng < 0.0 && self.bsdf.is_reflective_only()
     }
 
     /// This material with an albedo texture.
