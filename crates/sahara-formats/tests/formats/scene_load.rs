@@ -89,24 +89,51 @@ fn mtl_parameters_choose_the_bsdf() {
 }
 
 #[test]
-fn gltf_metallic_roughness_chooses_conductor_or_diffuse() {
+fn gltf_materials_become_the_metallic_roughness_bsdf_or_glass() {
     let mut m = GltfMaterial::default_material();
     m.base_color = [0.9, 0.5, 0.2, 1.0];
     m.roughness = 0.3;
+    m.metallic = 0.25;
+    m.ior = 1.4;
+    m.specular = 0.5;
+    m.specular_color = [1.0, 0.0, 0.0];
     assert_eq!(
         gltf_bsdf(&m),
-        Bsdf::Conductor {
-            color: Vec3::new(0.9, 0.5, 0.2),
+        Bsdf::MetallicRoughness {
+            base_color: Vec3::new(0.9, 0.5, 0.2),
+            metallic: 0.25,
+            roughness: 0.3,
+            ior: 1.4,
+            specular: 0.5,
+            specular_color: Vec3::X,
+        }
+    );
+    // Out-of-range factors are clamped, an ior below 1 is the default.
+    m.metallic = 7.0;
+    m.ior = 0.0;
+    assert!(matches!(
+        gltf_bsdf(&m),
+        Bsdf::MetallicRoughness {
+            metallic: 1.0,
+            ior: 1.5,
+            ..
+        }
+    ));
+    // Transmission: a thin wall unless the material has a volume.
+    m.metallic = 0.0;
+    m.ior = 1.5;
+    m.transmission = 1.0;
+    assert_eq!(gltf_bsdf(&m), Bsdf::ThinDielectric { ior: 1.5 });
+    m.thickness = 0.1;
+    assert_eq!(
+        gltf_bsdf(&m),
+        Bsdf::RoughDielectric {
+            ior: 1.5,
             roughness: 0.3
         }
     );
-    m.metallic = 0.1;
-    assert_eq!(
-        gltf_bsdf(&m),
-        Bsdf::Diffuse {
-            albedo: Vec3::new(0.9, 0.5, 0.2)
-        }
-    );
+    m.roughness = 0.0;
+    assert_eq!(gltf_bsdf(&m), Bsdf::Dielectric { ior: 1.5 });
 }
 
 #[test]
@@ -284,12 +311,10 @@ fn gltf_nodes_become_instances_of_one_mesh_placed_by_the_object() {
         .abs_diff_eq(Vec3::new(0.0, 1.0, 10.0), 1e-6));
     let m = &scene.materials[scene.material_of(0, 0) as usize];
     assert_eq!(m.emission, Vec3::splat(2.0));
-    assert_eq!(
+    assert!(matches!(
         m.bsdf,
-        Bsdf::Diffuse {
-            albedo: Vec3::splat(0.5)
-        }
-    );
+        Bsdf::MetallicRoughness { base_color, metallic: 0.0, .. } if base_color == Vec3::splat(0.5)
+    ));
     // glTF's v runs downwards; the scene's upwards.
     let uvs = scene.meshes[0].uvs.as_ref().unwrap();
     assert_eq!(uvs[1], glam::Vec2::new(1.0, 1.0));
