@@ -95,6 +95,9 @@ pub struct GltfMaterial {
     /// Thickness of the volume the surface bounds (`KHR_materials_volume`;
     /// 0, a thin wall, without it).
     pub thickness: f32,
+    /// How the base colour's alpha cuts the surface (`alphaMode`, with
+    /// `alphaCutoff` for `MASK`).
+    pub alpha_mode: sahara_render::AlphaMode,
 }
 
 impl GltfMaterial {
@@ -113,6 +116,7 @@ impl GltfMaterial {
             specular_color: [1.0; 3],
             transmission: 0.0,
             thickness: 0.0,
+            alpha_mode: sahara_render::AlphaMode::Opaque,
         }
     }
 }
@@ -549,6 +553,13 @@ impl Loader<'_> {
                 .transmission()
                 .map_or(0.0, |t| t.transmission_factor()),
             thickness: material.volume().map_or(0.0, |v| v.thickness_factor()),
+            alpha_mode: match material.alpha_mode() {
+                ::gltf::material::AlphaMode::Opaque => sahara_render::AlphaMode::Opaque,
+                ::gltf::material::AlphaMode::Mask => sahara_render::AlphaMode::Mask {
+                    cutoff: material.alpha_cutoff().unwrap_or(0.5),
+                },
+                ::gltf::material::AlphaMode::Blend => sahara_render::AlphaMode::Blend,
+            },
         };
         let id = self.scene.materials.len() as u32;
         self.scene.materials.push(converted);

@@ -29,8 +29,10 @@
 //! thickness (glTF's thin-walled default), else a solid of the material's
 //! index, rough when its roughness is. `emissive` is emitted (from both
 //! faces when the material is double-sided), and a material that is not
-//! double-sided is black from behind. Alpha, metallic / roughness
-//! textures, normal maps and occlusion are ignored.
+//! double-sided is black from behind. `alphaMode` `MASK` (with
+//! `alphaCutoff`) and `BLEND` cut the surface by the base colour's alpha
+//! factor times the base colour texture's alpha channel (PNG). Metallic /
+//! roughness textures, normal maps and occlusion are ignored.
 //!
 //! A texture that cannot be read is a warning and the material is
 //! untextured. Each texture file is decoded once ([`TextureCache`]).
@@ -43,7 +45,7 @@ use glam::Vec3;
 use sahara_render::{Bsdf, Material, Texture};
 
 use crate::gltf::{GltfImage, GltfMaterial};
-use crate::image_in::{decode_rgb_f32, load_rgb_f32, RgbF32Image};
+use crate::image_in::{decode_png_alpha, decode_rgb_f32, load_rgb_f32, RgbF32Image};
 use crate::mtl::MtlMaterial;
 
 /// IOR used for MTL glass that gives none (`Ni` <= 1).
@@ -210,7 +212,8 @@ pub fn gltf_material(
 ) -> Material {
     let mut out = Material::new(gltf_bsdf(m))
         .with_emission(emission(m.emissive))
-        .with_two_sided(m.double_sided);
+        .with_two_sided(m.double_sided)
+        .with_alpha(m.alpha_mode, m.base_color[3].clamp(0.0, 1.0));
     out.two_sided_emission = m.double_sided;
     if let Some(t) = &m.base_color_texture {
         if t.tex_coord != 0 {
@@ -227,6 +230,19 @@ pub fn gltf_material(
                     warnings,
                 ),
             };
+            // Cut-outs and transparency read the texture's alpha channel.
+            if out.has_holes() {
+                let bytes = match &t.image {
+                    GltfImage::File(path) => std::fs::read(path).ok(),
+                    GltfImage::Embedded { bytes, .. } => Some(bytes.clone()),
+                };
+                let alpha = bytes.as_deref().and_then(decode_png_alpha);
+                if let (Some(tex), Some(alpha)) = (&out.texture, alpha) {
+                    if alpha.len() == tex.texels.len() {
+                        out.texture = Some(Arc::new((**tex).clone().with_alpha(alpha)));
+                    }
+                }
+            }
         }
     }
     out

@@ -8,7 +8,7 @@ use sahara_formats::mesh_scene::load_mesh_scene;
 use sahara_formats::mtl::MtlMaterial;
 use sahara_formats::scene_load::load_scene;
 use sahara_formats::scenes_dir;
-use sahara_render::{Bsdf, Integrator, Light, Placement, Shape};
+use sahara_render::{AlphaMode, Bsdf, Integrator, Light, Placement, Shape};
 
 use crate::common::TempDir;
 use crate::gltf::{base64, triangle_buffer, triangle_json};
@@ -290,8 +290,10 @@ fn gltf_nodes_become_instances_of_one_mesh_placed_by_the_object() {
         r#""uri": "data:application/octet-stream;base64,{}","#,
         base64(&bin)
     );
-    let extra = r#""materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1],
-      "metallicFactor": 0}, "emissiveFactor": [2, 2, 2]}],
+    let extra = r#""materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 0.8],
+      "metallicFactor": 0}, "emissiveFactor": [2, 2, 2], "alphaMode": "MASK", "alphaCutoff": 0.3,
+      "extensions": {"KHR_materials_ior": {"ior": 1.7}}}],
+  "extensionsUsed": ["KHR_materials_ior"],
   "nodes": [{"mesh": 0, "translation": [1, 0, 0]}, {"mesh": 0, "translation": [0, 1, 0]}],
   "scenes": [{"nodes": [0, 1]}], "scene": 0"#;
     dir.write("two.gltf", triangle_json(&uri, bin.len(), extra));
@@ -313,8 +315,11 @@ fn gltf_nodes_become_instances_of_one_mesh_placed_by_the_object() {
     assert_eq!(m.emission, Vec3::splat(2.0));
     assert!(matches!(
         m.bsdf,
-        Bsdf::MetallicRoughness { base_color, metallic: 0.0, .. } if base_color == Vec3::splat(0.5)
+        Bsdf::MetallicRoughness { base_color, metallic: 0.0, ior: 1.7, .. } if base_color == Vec3::splat(0.5)
     ));
+    assert_eq!(m.alpha_mode, AlphaMode::Mask { cutoff: 0.3 });
+    assert_eq!(m.alpha, 0.8);
+    assert!(!m.two_sided, "glTF materials are single-sided by default");
     // glTF's v runs downwards; the scene's upwards.
     let uvs = scene.meshes[0].uvs.as_ref().unwrap();
     assert_eq!(uvs[1], glam::Vec2::new(1.0, 1.0));

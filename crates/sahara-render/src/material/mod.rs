@@ -267,6 +267,24 @@ impl Bsdf {
     }
 }
 
+/// How a material's opacity (`alpha`: its factor times the texture's
+/// alpha channel) cuts its surface.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum AlphaMode {
+    /// The surface is there everywhere; opacity is ignored.
+    #[default]
+    Opaque,
+    /// Cut-out: the surface is absent where the opacity is below `cutoff`
+    /// (for camera rays, bounces and shadow rays alike).
+    Mask {
+        /// Opacity threshold.
+        cutoff: f32,
+    },
+    /// Stochastic transparency: each ray meets the surface with
+    /// probability equal to the opacity, and passes through otherwise.
+    Blend,
+}
+
 /// A surface material.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -283,6 +301,10 @@ pub struct Material {
     /// seen from its back face (against the winding-order normal) is
     /// black. Glass has two sides by nature and ignores this.
     pub two_sided: bool,
+    /// How opacity cuts the surface.
+    pub alpha_mode: AlphaMode,
+    /// Opacity factor in `[0, 1]`, times the texture's alpha channel.
+    pub alpha: f32,
 }
 
 impl Material {
@@ -294,6 +316,8 @@ impl Material {
             emission: Vec3::ZERO,
             two_sided_emission: false,
             two_sided: true,
+            alpha_mode: AlphaMode::Opaque,
+            alpha: 1.0,
         }
     }
 
@@ -346,6 +370,30 @@ impl Material {
     #[inline]
     pub fn is_blind_side(&self, wo_dot_ng: f32) -> bool {
         !self.two_sided && wo_dot_ng < 0.0 && self.bsdf.is_reflective_only()
+    }
+
+    /// This material with an opacity `alpha` applied by `mode`.
+    pub fn with_alpha(mut self, mode: AlphaMode, alpha: f32) -> Self {
+        self.alpha_mode = mode;
+        self.alpha = alpha;
+        self
+    }
+
+    /// True if rays may pass through the surface somewhere.
+    pub fn has_holes(&self) -> bool {
+        self.alpha_mode != AlphaMode::Opaque
+    }
+
+    /// True if a ray meeting the surface at `uv` passes through it, `u`
+    /// uniform in `[0, 1)` deciding for stochastic transparency.
+    #[inline]
+    pub fn passes(&self, uv: Vec2, u: f32) -> bool {
+        let opacity = || self.alpha * self.texture.as_ref().map_or(1.0, |t| t.alpha(uv));
+        match self.alpha_mode {
+            AlphaMode::Opaque => false,
+            AlphaMode::Mask { cutoff } => opacity() < cutoff,
+            AlphaMode::Blend => u >= opacity(),
+        }
     }
 
     /// This material with an albedo texture.
