@@ -118,6 +118,12 @@ pub struct MaterialSpec {
     /// default true; for `emission`, which uses the key for its emission,
     /// always true).
     pub two_sided: bool,
+    /// How opacity cuts the surface (`alpha_mode` `opaque`, `mask` with
+    /// `alpha_cutoff`, or `blend`; default opaque).
+    pub alpha_mode: sahara_render::AlphaMode,
+    /// Opacity in [0, 1], times the texture's alpha channel (`alpha`,
+    /// default 1).
+    pub alpha: f32,
 }
 
 /// The kinds of material and their parameters.

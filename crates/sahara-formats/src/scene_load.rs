@@ -152,7 +152,25 @@ pub fn camera_of(c: &CameraSpec, aspect: f32) -> Camera {
 
 /// The renderer material of a `[[material]]` (a texture that cannot be read is a warning).
 fn material_of(m: &MaterialSpec, warnings: &mut Vec<String>, name: &str) -> Material {
-    material_kind_of(m, warnings, name).with_two_sided(m.two_sided)
+    let mut out = material_kind_of(m, warnings, name)
+        .with_two_sided(m.two_sided)
+        .with_alpha(m.alpha_mode, m.alpha);
+    // Cut-outs and transparency read a PNG texture's alpha channel.
+    let file = match &m.kind {
+        MaterialKind::Diffuse { texture, .. }
+        | MaterialKind::MetallicRoughness { texture, .. }
+        | MaterialKind::CoatedDiffuse { texture, .. } => texture.as_deref(),
+        _ => None,
+    };
+    if let (true, Some(path), Some(tex)) = (out.has_holes(), file, &out.texture) {
+        let alpha = std::fs::read(path)
+            .ok()
+            .and_then(|b| crate::image_in::decode_png_alpha(&b));
+        if let Some(alpha) = alpha.filter(|a| a.len() == tex.texels.len()) {
+            out.texture = Some(Arc::new((**tex).clone().with_alpha(alpha)));
+        }
+    }
+    out
 }
 
 /// The texture of a `[[material]]` (a warning and none if it cannot be read).

@@ -82,6 +82,18 @@ pub(super) struct RawMaterial {
     pub metallic: Opt<f32>,
     pub specular: Opt<f32>,
     pub specular_color: Opt<V3>,
+    pub alpha: Opt<f32>,
+    pub alpha_mode: Opt<AlphaModeName>,
+    pub alpha_cutoff: Opt<f32>,
+}
+
+/// `alpha_mode` of a `[[material]]`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum AlphaModeName {
+    Opaque,
+    Mask,
+    Blend,
 }
 
 /// Shape kinds (`type` of an `[[object]]`, `shape` of an area light).

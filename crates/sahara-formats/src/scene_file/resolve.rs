@@ -351,6 +351,9 @@ impl Ctx<'_> {
             ("metallic", span(&m.metallic)),
             ("specular", span(&m.specular)),
             ("specular_color", span(&m.specular_color)),
+            ("alpha", span(&m.alpha)),
+            ("alpha_mode", span(&m.alpha_mode)),
+            ("alpha_cutoff", span(&m.alpha_cutoff)),
         ];
         let allowed: &[&str] = match kind {
             MaterialType::Diffuse => &["albedo", "texture", "two_sided"],
@@ -371,6 +374,24 @@ impl Ctx<'_> {
             ],
             MaterialType::CoatedDiffuse => &["albedo", "texture", "ior", "roughness", "two_sided"],
             MaterialType::Emission => &["radiance", "two_sided", "albedo"],
+        };
+        let with_alpha: Vec<&str>;
+        let allowed = if matches!(
+            kind,
+            MaterialType::Diffuse
+                | MaterialType::Conductor
+                | MaterialType::Mirror
+                | MaterialType::MetallicRoughness
+                | MaterialType::CoatedDiffuse
+        ) {
+            with_alpha = allowed
+                .iter()
+                .copied()
+                .chain(["alpha", "alpha_mode", "alpha_cutoff"])
+                .collect();
+            &with_alpha[..]
+        } else {
+            allowed
         };
         self.only(&present, allowed, &what)?;
         if m.name.get_ref().is_empty() {
@@ -444,10 +465,40 @@ impl Ctx<'_> {
             .then(|| m.two_sided.as_ref().map(|b| *b.get_ref()))
             .flatten()
             .unwrap_or(true);
+        let alpha = self.number(
+            &m.alpha,
+            "alpha",
+            1.0,
+            |a| (0.0..=1.0).contains(&a),
+            "between 0 and 1",
+        )?;
+        let cutoff = self.number(
+            &m.alpha_cutoff,
+            "alpha_cutoff",
+            0.5,
+            |a| (0.0..=1.0).contains(&a),
+            "between 0 and 1",
+        )?;
+        let alpha_mode = match m.alpha_mode.as_ref().map(|a| *a.get_ref()) {
+            None | Some(AlphaModeName::Opaque) => sahara_render::AlphaMode::Opaque,
+            Some(AlphaModeName::Mask) => sahara_render::AlphaMode::Mask { cutoff },
+            Some(AlphaModeName::Blend) => sahara_render::AlphaMode::Blend,
+        };
+        if let (Some(c), false) = (
+            &m.alpha_cutoff,
+            matches!(alpha_mode, sahara_render::AlphaMode::Mask { .. }),
+        ) {
+            return Err(self.at(
+                c.span(),
+                "`alpha_cutoff` applies to `alpha_mode = \"mask\"` only",
+            ));
+        }
         Ok(MaterialSpec {
             name: m.name.get_ref().clone(),
             kind,
             two_sided,
+            alpha_mode,
+            alpha,
         })
     }
 

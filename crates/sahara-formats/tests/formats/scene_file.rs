@@ -176,7 +176,9 @@ fn a_complete_scene_parses_into_the_expected_values() {
                     albedo: Vec3::new(0.6, 0.4, 0.2),
                     texture: Some(at("wood.png"))
                 },
-                two_sided: true
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
             MaterialSpec {
                 name: "gold".into(),
@@ -184,17 +186,23 @@ fn a_complete_scene_parses_into_the_expected_values() {
                     color: Vec3::new(1.0, 0.8, 0.3),
                     roughness: 0.1
                 },
-                two_sided: true
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
             MaterialSpec {
                 name: "mirror".into(),
                 kind: MaterialKind::Mirror { color: Vec3::ONE },
-                two_sided: true
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
             MaterialSpec {
                 name: "glass".into(),
                 kind: MaterialKind::Dielectric { ior: 1.33 },
-                two_sided: true
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
             MaterialSpec {
                 name: "frosted".into(),
@@ -202,7 +210,9 @@ fn a_complete_scene_parses_into_the_expected_values() {
                     ior: 1.5,
                     roughness: 0.4
                 },
-                two_sided: true
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
             MaterialSpec {
                 name: "lamp".into(),
@@ -211,7 +221,9 @@ fn a_complete_scene_parses_into_the_expected_values() {
                     two_sided: true,
                     albedo: Vec3::ZERO
                 },
-                two_sided: true
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
         ]
     );
@@ -664,6 +676,8 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
         }
     );
     assert!(!m[1].two_sided);
+    assert_eq!(m[0].alpha_mode, sahara_render::AlphaMode::Opaque);
+    assert_eq!(m[0].alpha, 1.0);
     assert_eq!(
         m[2].kind,
         MaterialKind::CoatedDiffuse {
@@ -727,5 +741,34 @@ fn bad_conductor_and_layered_keys_are_errors_at_the_value() {
     assert!(
         m.contains("line 10:") && m.contains("greater than 1"),
         "{m}"
+    );
+}
+
+#[test]
+fn alpha_keys_parse_and_apply_to_reflectors_only() {
+    let m = materials_of(
+        "[[material]]\nname = \"leaf\"\ntype = \"diffuse\"\nalpha_mode = \"mask\"\nalpha_cutoff = 0.3\n\
+         [[material]]\nname = \"veil\"\ntype = \"metallic_roughness\"\nalpha_mode = \"blend\"\nalpha = 0.25\n",
+    );
+    assert_eq!(
+        m[0].alpha_mode,
+        sahara_render::AlphaMode::Mask { cutoff: 0.3 }
+    );
+    assert_eq!(m[1].alpha_mode, sahara_render::AlphaMode::Blend);
+    assert_eq!(m[1].alpha, 0.25);
+    let e = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"dielectric\"\nalpha = 0.5\n",
+    ));
+    assert!(e.contains("line 10:") && e.contains("`alpha`"), "{e}");
+    let e = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"diffuse\"\nalpha_cutoff = 0.5\n",
+    ));
+    assert!(e.contains("line 10:") && e.contains("mask"), "{e}");
+    let e = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"diffuse\"\nalpha = 2\n",
+    ));
+    assert!(
+        e.contains("line 10:") && e.contains("between 0 and 1"),
+        "{e}"
     );
 }
