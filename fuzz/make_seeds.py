@@ -183,6 +183,26 @@ def gltf_seeds():
     chunk += b" " * (-len(chunk) % 4)
     body = struct.pack("<II", len(chunk), 0x4E4F534A) + chunk + struct.pack("<II", len(blob), 0x004E4942) + blob
     put("gltf", "triangle.glb", struct.pack("<III", 0x46546C67, 2, 12 + len(body)) + body)
+    # The material extensions and alpha modes the loader reads.
+    ext = dict(text)
+    ext["extensionsUsed"] = ["KHR_materials_ior", "KHR_materials_specular",
+                             "KHR_materials_transmission", "KHR_materials_volume",
+                             "KHR_materials_emissive_strength"]
+    ext["materials"] = [
+        {"pbrMetallicRoughness": {"baseColorFactor": [1, 0.5, 0.2, 0.4], "metallicFactor": 0.3,
+                                  "roughnessFactor": 0.2},
+         "alphaMode": "MASK", "alphaCutoff": 0.3, "doubleSided": True,
+         "extensions": {"KHR_materials_ior": {"ior": 1.7},
+                        "KHR_materials_specular": {"specularFactor": 0.5,
+                                                   "specularColorFactor": [1, 0.8, 0.6]},
+                        "KHR_materials_emissive_strength": {"emissiveStrength": 4}}},
+        {"alphaMode": "BLEND",
+         "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                        "KHR_materials_volume": {"thicknessFactor": 0.1}}},
+    ]
+    ext["meshes"] = [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0},
+                                     {"attributes": {"POSITION": 0}, "indices": 1, "material": 1}]}]
+    put("gltf", "materials.gltf", json.dumps(ext, indent=1))
 
 
 def png(width, height, colour_type, depth, rows):

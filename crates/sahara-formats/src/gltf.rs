@@ -80,6 +80,24 @@ pub struct GltfMaterial {
     pub emissive: [f32; 3],
     /// Whether back faces are visible.
     pub double_sided: bool,
+    /// Index of refraction of the dielectric part (`KHR_materials_ior`;
+    /// 1.5 without it).
+    pub ior: f32,
+    /// Strength of the dielectric's specular layer
+    /// (`KHR_materials_specular`; 1 without it).
+    pub specular: f32,
+    /// Colour of the dielectric's specular layer (`KHR_materials_specular`;
+    /// white without it).
+    pub specular_color: [f32; 3],
+    /// Fraction of light transmitted through the surface
+    /// (`KHR_materials_transmission`; 0 without it).
+    pub transmission: f32,
+    /// Thickness of the volume the surface bounds (`KHR_materials_volume`;
+    /// 0, a thin wall, without it).
+    pub thickness: f32,
+    /// How the base colour's alpha cuts the surface (`alphaMode`, with
+    /// `alphaCutoff` for `MASK`).
+    pub alpha_mode: sahara_render::AlphaMode,
 }
 
 impl GltfMaterial {
@@ -93,6 +111,12 @@ impl GltfMaterial {
             roughness: 1.0,
             emissive: [0.0; 3],
             double_sided: false,
+            ior: 1.5,
+            specular: 1.0,
+            specular_color: [1.0; 3],
+            transmission: 0.0,
+            thickness: 0.0,
+            alpha_mode: sahara_render::AlphaMode::Opaque,
         }
     }
 }
@@ -520,6 +544,22 @@ impl Loader<'_> {
             roughness: pbr.roughness_factor(),
             emissive: material.emissive_factor().map(|e| e * strength),
             double_sided: material.double_sided(),
+            ior: material.ior().unwrap_or(1.5),
+            specular: material.specular().map_or(1.0, |s| s.specular_factor()),
+            specular_color: material
+                .specular()
+                .map_or([1.0; 3], |s| s.specular_color_factor()),
+            transmission: material
+                .transmission()
+                .map_or(0.0, |t| t.transmission_factor()),
+            thickness: material.volume().map_or(0.0, |v| v.thickness_factor()),
+            alpha_mode: match material.alpha_mode() {
+                ::gltf::material::AlphaMode::Opaque => sahara_render::AlphaMode::Opaque,
+                ::gltf::material::AlphaMode::Mask => sahara_render::AlphaMode::Mask {
+                    cutoff: material.alpha_cutoff().unwrap_or(0.5),
+                },
+                ::gltf::material::AlphaMode::Blend => sahara_render::AlphaMode::Blend,
+            },
         };
         let id = self.scene.materials.len() as u32;
         self.scene.materials.push(converted);

@@ -91,6 +91,18 @@ fn decode(bytes: &[u8], name: &str) -> Result<RgbF32Image, FormatError> {
     Ok((width, height, rgb))
 }
 
+/// The alpha channel of a PNG image held in memory (values in `[0, 1]`,
+/// row-major from the top left), or `None` if it has none or is not a PNG.
+/// Call it on bytes that [`decode_rgb_f32`] accepted (which checked the
+/// size).
+pub fn decode_png_alpha(bytes: &[u8]) -> Option<Vec<f32>> {
+    let image = image::load_from_memory_with_format(bytes, image::ImageFormat::Png).ok()?;
+    if !image.color().has_alpha() {
+        return None;
+    }
+    Some(image.into_rgba32f().pixels().map(|p| p.0[3]).collect())
+}
+
 /// Rejects empty images and images beyond the size limits.
 fn check_size(name: &str, width: u32, height: u32) -> Result<(), FormatError> {
     if width == 0 || height == 0 {

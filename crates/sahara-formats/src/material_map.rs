@@ -20,10 +20,18 @@
 //! `map_Kd` multiplies the diffuse or conductor colour (sRGB images are
 //! linearised). Colours are clamped to [0, 1].
 //!
-//! **glTF** metallic-roughness: `metallic` >= 0.5 gives a conductor of the
-//! base colour with the material's roughness, else Lambertian with the base
-//! colour; the base colour texture multiplies either; `emissive` is emitted
-//! (from both faces when the material is double-sided). Alpha, metallic /
+//! **glTF**: the metallic-roughness BSDF (`Bsdf::MetallicRoughness`) with
+//! the material's base colour, metallic and roughness factors, its
+//! `KHR_materials_ior` index and `KHR_materials_specular` strength and
+//! colour; the base colour texture multiplies the base colour. A material
+//! with `KHR_materials_transmission` of at least 0.5 is glass instead: a
+//! thin pane (`ThinDielectric`) when it has no `KHR_materials_volume`
+//! thickness (glTF's thin-walled default), else a solid of the material's
+//! index, rough when its roughness is. `emissive` is emitted (from both
+//! faces when the material is double-sided), and a material that is not
+//! double-sided is black from behind. `alphaMode` `MASK` (with
+//! `alphaCutoff`) and `BLEND` cut the surface by the base colour's alpha
+//! factor times the base colour texture's alpha channel (PNG). Metallic /
 //! roughness textures, normal maps and occlusion are ignored.
 //!
 //! A texture that cannot be read is a warning and the material is
@@ -37,7 +45,7 @@ use glam::Vec3;
 use sahara_render::{Bsdf, Material, Texture};
 
 use crate::gltf::{GltfImage, GltfMaterial};
-use crate::image_in::{decode_rgb_f32, load_rgb_f32, RgbF32Image};
+use crate::image_in::{decode_png_alpha, decode_rgb_f32, load_rgb_f32, RgbF32Image};
 use crate::mtl::MtlMaterial;
 
 /// IOR used for MTL glass that gives none (`Ni` <= 1).
@@ -161,13 +169,37 @@ fn emission(c: [f32; 3]) -> Vec3 {
 /// The BSDF a glTF material stands for (rules in the module documentation).
 pub fn gltf_bsdf(m: &GltfMaterial) -> Bsdf {
     let base = unit([m.base_color[0], m.base_color[1], m.base_color[2]]);
-    if m.metallic >= 0.5 {
-        Bsdf::Conductor {
-            color: base,
-            roughness: m.roughness.clamp(0.0, 1.0),
+    let factor = |x: f32, default: f32| {
+        if x.is_finite() {
+            x.clamp(0.0, 1.0)
+        } else {
+            default
         }
+    };
+    let roughness = factor(m.roughness, 1.0);
+    // glTF allows an ior of 0 to mean "infinitely dense"; anything below 1
+    // is taken as the default.
+    let ior = if m.ior.is_finite() && m.ior >= 1.0 {
+        m.ior
     } else {
-        Bsdf::Diffuse { albedo: base }
+        1.5
+    };
+    if factor(m.transmission, 0.0) >= 0.5 && factor(m.metallic, 1.0) < 0.5 {
+        return if m.thickness.is_nan() || m.thickness <= 0.0 {
+            Bsdf::ThinDielectric { ior }
+        } else if roughness > 0.0 {
+            Bsdf::RoughDielectric { ior, roughness }
+        } else {
+            Bsdf::Dielectric { ior }
+        };
+    }
+    Bsdf::MetallicRoughness {
+        base_color: base,
+        metallic: factor(m.metallic, 1.0),
+        roughness,
+        ior,
+        specular: factor(m.specular, 1.0),
+        specular_color: unit(m.specular_color),
     }
 }
 
@@ -178,7 +210,10 @@ pub fn gltf_material(
     textures: &mut TextureCache,
     warnings: &mut Vec<String>,
 ) -> Material {
-    let mut out = Material::new(gltf_bsdf(m)).with_emission(emission(m.emissive));
+    let mut out = Material::new(gltf_bsdf(m))
+        .with_emission(emission(m.emissive))
+        .with_two_sided(m.double_sided)
+        .with_alpha(m.alpha_mode, m.base_color[3].clamp(0.0, 1.0));
     out.two_sided_emission = m.double_sided;
     if let Some(t) = &m.base_color_texture {
         if t.tex_coord != 0 {
@@ -195,6 +230,19 @@ pub fn gltf_material(
                     warnings,
                 ),
             };
+            // Cut-outs and transparency read the texture's alpha channel.
+            if out.has_holes() {
+                let bytes = match &t.image {
+                    GltfImage::File(path) => std::fs::read(path).ok(),
+                    GltfImage::Embedded { bytes, .. } => Some(bytes.clone()),
+                };
+                let alpha = bytes.as_deref().and_then(decode_png_alpha);
+                if let (Some(tex), Some(alpha)) = (&out.texture, alpha) {
+                    if alpha.len() == tex.texels.len() {
+                        out.texture = Some(Arc::new((**tex).clone().with_alpha(alpha)));
+                    }
+                }
+            }
         }
     }
     out

@@ -114,6 +114,16 @@ pub struct MaterialSpec {
     pub name: String,
     /// What kind of material, with its parameters.
     pub kind: MaterialKind,
+    /// Whether a reflector scatters light on both faces (`two_sided`,
+    /// default true; for `emission`, which uses the key for its emission,
+    /// always true).
+    pub two_sided: bool,
+    /// How opacity cuts the surface (`alpha_mode` `opaque`, `mask` with
+    /// `alpha_cutoff`, or `blend`; default opaque).
+    pub alpha_mode: sahara_render::AlphaMode,
+    /// Opacity in [0, 1], times the texture's alpha channel (`alpha`,
+    /// default 1).
+    pub alpha: f32,
 }
 
 /// The kinds of material and their parameters.
@@ -132,6 +142,50 @@ pub enum MaterialKind {
         color: Vec3,
         /// Perceptual roughness in [0, 1].
         roughness: f32,
+    },
+    /// A metal given by its complex index of refraction (`type =
+    /// "conductor"` with `metal = "gold"` or `eta` and `k`): GGX with the
+    /// exact conductor Fresnel term.
+    ComplexConductor {
+        /// Real part of the index per RGB channel (> 0).
+        eta: Vec3,
+        /// Extinction coefficient per RGB channel (>= 0).
+        k: Vec3,
+        /// Perceptual roughness in [0, 1].
+        roughness: f32,
+    },
+    /// The glTF metallic-roughness model.
+    MetallicRoughness {
+        /// Base colour in [0, 1] (default 0.8 grey).
+        base_color: Vec3,
+        /// Texture file multiplying `base_color` (resolved; exists).
+        texture: Option<PathBuf>,
+        /// Metalness in [0, 1] (default 0).
+        metallic: f32,
+        /// Perceptual roughness in [0, 1] (default 0.5).
+        roughness: f32,
+        /// Index of refraction of the specular layer (>= 1, default 1.5).
+        ior: f32,
+        /// Strength of the specular layer in [0, 1] (default 1).
+        specular: f32,
+        /// Colour of the specular layer at normal incidence (default white).
+        specular_color: Vec3,
+    },
+    /// A diffuse base under a clear coat.
+    CoatedDiffuse {
+        /// Reflectance of the base in [0, 1] (default 0.5 grey).
+        albedo: Vec3,
+        /// Texture file multiplying `albedo` (resolved; exists).
+        texture: Option<PathBuf>,
+        /// Index of refraction of the coat (> 1, default 1.5).
+        ior: f32,
+        /// Perceptual roughness of the coat in [0, 1] (default 0.1).
+        roughness: f32,
+    },
+    /// A thin pane of glass.
+    ThinDielectric {
+        /// Index of refraction (> 0, default 1.5).
+        ior: f32,
     },
     /// A perfect mirror.
     Mirror {

@@ -25,7 +25,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
-use sahara_render::{Camera, Environment, Instance, Light, Material, Scene, Texture};
+use sahara_render::{Bsdf, Camera, Environment, Instance, Light, Material, Scene, Texture};
 
 use crate::error::FormatError;
 use crate::image_in::load_rgb_f32;
@@ -152,26 +152,110 @@ pub fn camera_of(c: &CameraSpec, aspect: f32) -> Camera {
 
 /// The renderer material of a `[[material]]` (a texture that cannot be read is a warning).
 fn material_of(m: &MaterialSpec, warnings: &mut Vec<String>, name: &str) -> Material {
+    let mut out = material_kind_of(m, warnings, name)
+        .with_two_sided(m.two_sided)
+        .with_alpha(m.alpha_mode, m.alpha);
+    // Cut-outs and transparency read a PNG texture's alpha channel.
+    let file = match &m.kind {
+        MaterialKind::Diffuse { texture, .. }
+        | MaterialKind::MetallicRoughness { texture, .. }
+        | MaterialKind::CoatedDiffuse { texture, .. } => texture.as_deref(),
+        _ => None,
+    };
+    if let (true, Some(path), Some(tex)) = (out.has_holes(), file, &out.texture) {
+        let alpha = std::fs::read(path)
+            .ok()
+            .and_then(|b| crate::image_in::decode_png_alpha(&b));
+        if let Some(alpha) = alpha.filter(|a| a.len() == tex.texels.len()) {
+            out.texture = Some(Arc::new((**tex).clone().with_alpha(alpha)));
+        }
+    }
+    out
+}
+
+/// The texture of a `[[material]]` (a warning and none if it cannot be read).
+fn texture_of(
+    m: &MaterialSpec,
+    path: &Path,
+    warnings: &mut Vec<String>,
+    name: &str,
+) -> Option<Arc<Texture>> {
+    match load_rgb_f32(path) {
+        Ok((w, h, rgb)) if w > 0 && h > 0 => {
+            let texels = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
+            Some(Arc::new(Texture::new(w, h, texels)))
+        }
+        Ok(_) => {
+            warnings.push(format!(
+                "{name}: material '{}': texture {} is empty; the material is untextured",
+                m.name,
+                path.display()
+            ));
+            None
+        }
+        Err(e) => {
+            warnings.push(format!(
+                "{name}: material '{}': {e}; the material is untextured",
+                m.name
+            ));
+            None
+        }
+    }
+}
+
+fn material_kind_of(m: &MaterialSpec, warnings: &mut Vec<String>, name: &str) -> Material {
     match &m.kind {
+        MaterialKind::ComplexConductor { eta, k, roughness } => {
+            Material::new(Bsdf::ComplexConductor {
+                eta: *eta,
+                k: *k,
+                roughness: *roughness,
+            })
+        }
+        MaterialKind::MetallicRoughness {
+            base_color,
+            texture,
+            metallic,
+            roughness,
+            ior,
+            specular,
+            specular_color,
+        } => {
+            let mut out = Material::new(Bsdf::MetallicRoughness {
+                base_color: *base_color,
+                metallic: *metallic,
+                roughness: *roughness,
+                ior: *ior,
+                specular: *specular,
+                specular_color: *specular_color,
+            });
+            out.texture = texture
+                .as_deref()
+                .and_then(|p| texture_of(m, p, warnings, name));
+            out
+        }
+        MaterialKind::CoatedDiffuse {
+            albedo,
+            texture,
+            ior,
+            roughness,
+        } => {
+            let mut out = Material::new(Bsdf::CoatedDiffuse {
+                albedo: *albedo,
+                ior: *ior,
+                roughness: *roughness,
+            });
+            out.texture = texture
+                .as_deref()
+                .and_then(|p| texture_of(m, p, warnings, name));
+            out
+        }
+        MaterialKind::ThinDielectric { ior } => Material::new(Bsdf::ThinDielectric { ior: *ior }),
         MaterialKind::Diffuse { albedo, texture } => {
             let mut out = Material::diffuse(*albedo);
-            if let Some(path) = texture {
-                match load_rgb_f32(path) {
-                    Ok((w, h, rgb)) if w > 0 && h > 0 => {
-                        let texels = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
-                        out.texture = Some(Arc::new(Texture::new(w, h, texels)));
-                    }
-                    Ok(_) => warnings.push(format!(
-                        "{name}: material '{}': texture {} is empty; the material is untextured",
-                        m.name,
-                        path.display()
-                    )),
-                    Err(e) => warnings.push(format!(
-                        "{name}: material '{}': {e}; the material is untextured",
-                        m.name
-                    )),
-                }
-            }
+            out.texture = texture
+                .as_deref()
+                .and_then(|p| texture_of(m, p, warnings, name));
             out
         }
         MaterialKind::Conductor { color, roughness } => Material::conductor(*color, *roughness),

@@ -44,7 +44,7 @@ pub use filter::Filter;
 pub use instance::{Instance, Placement, Srt};
 pub use integrator::Integrator;
 pub use light::{Environment, Light};
-pub use material::{Bsdf, Material};
+pub use material::{AlphaMode, Bsdf, Material};
 pub use mesh::{Mesh, SceneMesh};
 pub use render::{
     cost_maps, render, render_watched, CostMaps, Preview, Progress, RenderResult, RenderSettings,

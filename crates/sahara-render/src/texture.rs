@@ -14,6 +14,8 @@ pub struct Texture {
     pub height: u32,
     /// Texels, row-major from the top-left corner.
     pub texels: Vec<Vec3>,
+    /// Opacity per texel (same layout), if the image has an alpha channel.
+    pub alpha: Option<Vec<f32>>,
 }
 
 impl Texture {
@@ -29,7 +31,36 @@ impl Texture {
             width,
             height,
             texels,
+            alpha: None,
         }
+    }
+
+    /// This texture with an opacity channel (`width * height` values in
+    /// `[0, 1]`).
+    pub fn with_alpha(mut self, alpha: Vec<f32>) -> Self {
+        assert_eq!(alpha.len(), self.texels.len(), "alpha count");
+        self.alpha = Some(alpha);
+        self
+    }
+
+    /// Bilinear lookup of the opacity at `uv` (1 without an alpha channel).
+    pub fn alpha(&self, uv: Vec2) -> f32 {
+        let Some(a) = &self.alpha else {
+            return 1.0;
+        };
+        if !uv.is_finite() {
+            return a[0];
+        }
+        let (w, h) = (self.width as i64, self.height as i64);
+        let at = |x: i64, y: i64| a[(y.rem_euclid(h) * w + x.rem_euclid(w)) as usize];
+        let x = uv.x.rem_euclid(1.0) * self.width as f32 - 0.5;
+        let y = (1.0 - uv.y).rem_euclid(1.0) * self.height as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let top = at(x0, y0) + (at(x0 + 1, y0) - at(x0, y0)) * fx;
+        let bottom = at(x0, y0 + 1) + (at(x0 + 1, y0 + 1) - at(x0, y0 + 1)) * fx;
+        top + (bottom - top) * fy
     }
 
     /// The texel at integer coordinates, wrapped.

@@ -90,6 +90,9 @@ pub struct World<'a> {
     instance_light: Vec<Option<u32>>,
     env: Option<u32>,
     default_material: Material,
+    /// Whether any material has holes (alpha): shadow rays then look at
+    /// what they meet.
+    has_holes: bool,
     /// Centre of the scene's bounds.
     pub center: Vec3,
     /// Radius of the scene's bounding sphere.
@@ -190,6 +193,7 @@ impl<'a> World<'a> {
             instance_light,
             env,
             default_material: Scene::default_material(),
+            has_holes: scene.materials.iter().any(Material::has_holes),
             center,
             radius,
         }
@@ -348,9 +352,40 @@ impl<'a> World<'a> {
     /// True if nothing blocks the segment of `q`.
     #[inline]
     pub(crate) fn visible(&self, q: &ShadowQuery) -> bool {
+        if self.has_holes {
+            return self.visible_through_holes(q);
+        }
         !self
             .accel
             .occluded(&q.ray, self.shutter_fraction(q.time), q.ignore)
+    }
+
+    /// [`World::visible`] in a scene with cut-out or stochastic surfaces:
+    /// the closest surfaces along the segment in turn, until one is
+    /// there (blocked) or none is left (visible). After
+    /// [`MAX_PASS_THROUGHS`] surfaces the segment counts as blocked.
+    fn visible_through_holes(&self, q: &ShadowQuery) -> bool {
+        let s = self.shutter_fraction(q.time);
+        let mut ray = q.ray;
+        for k in 0..MAX_PASS_THROUGHS {
+            let Some(h) = self.accel.closest(&ray, s, &mut NoCounters) else {
+                return true;
+            };
+            let hit = self.surface(&h, s);
+            if Some(h.instance) != q.ignore {
+                let u = pass_through_draw(&ray, &hit, k);
+                if !self.material(hit.material).passes(hit.uv, u) {
+                    return false;
+                }
+            }
+            let origin = hit.spawn_origin(ray.dir);
+            let travelled = (origin - ray.origin).dot(ray.dir) / ray.dir.length_squared();
+            ray = Ray::with_interval(origin, ray.dir, 0.0, ray.tmax - travelled);
+            if ray.tmax.is_nan() || ray.tmax <= 0.0 {
+                return true;
+            }
+        }
+        false
     }
 
     /// True if the scene has any light to sample.
@@ -421,3 +456,20 @@ impl<'a> World<'a> {
 
 /// Relative shortening of shadow rays towards points on lights.
 pub const SHADOW_EPS: f32 = 1.0 / 4096.0;
+
+/// Most surfaces with holes a ray passes through before it stops there.
+pub const MAX_PASS_THROUGHS: u32 = 64;
+
+/// The uniform number deciding whether the `k`-th surface a shadow ray
+/// meets lets it through (stochastic transparency): a hash of the ray and
+/// the hit, so a render is the same every time.
+#[inline]
+fn pass_through_draw(ray: &Ray, hit: &SurfaceHit, k: u32) -> f32 {
+    let o = ray.origin.to_array().map(f32::to_bits);
+    let d = ray.dir.to_array().map(f32::to_bits);
+    let a = (o[0] as u64) << 32 | o[1] as u64;
+    let b = (o[2] as u64) << 32 | d[0] as u64;
+    let c = (d[1] as u64) << 32 | d[2] as u64;
+    let e = (hit.instance as u64) << 32 | hit.tri as u64;
+    crate::hash::unit_f32(crate::hash::hash3(a ^ e, b, c.wrapping_add(k as u64)))
+}

@@ -55,6 +55,9 @@ pub(super) enum MaterialType {
     Mirror,
     Dielectric,
     RoughDielectric,
+    ThinDielectric,
+    MetallicRoughness,
+    CoatedDiffuse,
     Emission,
 }
 
@@ -72,6 +75,25 @@ pub(super) struct RawMaterial {
     pub ior: Opt<f32>,
     pub radiance: Opt<V3>,
     pub two_sided: Opt<bool>,
+    pub metal: Opt<String>,
+    pub eta: Opt<V3>,
+    pub k: Opt<V3>,
+    pub base_color: Opt<V3>,
+    pub metallic: Opt<f32>,
+    pub specular: Opt<f32>,
+    pub specular_color: Opt<V3>,
+    pub alpha: Opt<f32>,
+    pub alpha_mode: Opt<AlphaModeName>,
+    pub alpha_cutoff: Opt<f32>,
+}
+
+/// `alpha_mode` of a `[[material]]`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum AlphaModeName {
+    Opaque,
+    Mask,
+    Blend,
 }
 
 /// Shape kinds (`type` of an `[[object]]`, `shape` of an area light).

@@ -344,14 +344,54 @@ impl Ctx<'_> {
             ("ior", span(&m.ior)),
             ("radiance", span(&m.radiance)),
             ("two_sided", span(&m.two_sided)),
+            ("metal", span(&m.metal)),
+            ("eta", span(&m.eta)),
+            ("k", span(&m.k)),
+            ("base_color", span(&m.base_color)),
+            ("metallic", span(&m.metallic)),
+            ("specular", span(&m.specular)),
+            ("specular_color", span(&m.specular_color)),
+            ("alpha", span(&m.alpha)),
+            ("alpha_mode", span(&m.alpha_mode)),
+            ("alpha_cutoff", span(&m.alpha_cutoff)),
         ];
         let allowed: &[&str] = match kind {
-            MaterialType::Diffuse => &["albedo", "texture"],
-            MaterialType::Conductor => &["color", "roughness"],
-            MaterialType::Mirror => &["color"],
+            MaterialType::Diffuse => &["albedo", "texture", "two_sided"],
+            MaterialType::Conductor => &["color", "metal", "eta", "k", "roughness", "two_sided"],
+            MaterialType::Mirror => &["color", "two_sided"],
             MaterialType::Dielectric => &["ior"],
             MaterialType::RoughDielectric => &["ior", "roughness"],
+            MaterialType::ThinDielectric => &["ior"],
+            MaterialType::MetallicRoughness => &[
+                "base_color",
+                "texture",
+                "metallic",
+                "roughness",
+                "ior",
+                "specular",
+                "specular_color",
+                "two_sided",
+            ],
+            MaterialType::CoatedDiffuse => &["albedo", "texture", "ior", "roughness", "two_sided"],
             MaterialType::Emission => &["radiance", "two_sided", "albedo"],
+        };
+        let with_alpha: Vec<&str>;
+        let allowed = if matches!(
+            kind,
+            MaterialType::Diffuse
+                | MaterialType::Conductor
+                | MaterialType::Mirror
+                | MaterialType::MetallicRoughness
+                | MaterialType::CoatedDiffuse
+        ) {
+            with_alpha = allowed
+                .iter()
+                .copied()
+                .chain(["alpha", "alpha_mode", "alpha_cutoff"])
+                .collect();
+            &with_alpha[..]
+        } else {
+            allowed
         };
         self.only(&present, allowed, &what)?;
         if m.name.get_ref().is_empty() {
@@ -367,19 +407,27 @@ impl Ctx<'_> {
             )
         };
         let ior = || self.number(&m.ior, "ior", 1.5, |n| n > 0.0, "greater than 0");
+        let texture = || {
+            m.texture
+                .as_ref()
+                .map(|t| self.file(t, "texture"))
+                .transpose()
+        };
+        let unit = |value: &Opt<f32>, key: &str, default: f32| {
+            self.number(
+                value,
+                key,
+                default,
+                |x| (0.0..=1.0).contains(&x),
+                "between 0 and 1",
+            )
+        };
         let kind = match kind {
             MaterialType::Diffuse => MaterialKind::Diffuse {
                 albedo: self.reflectance(&m.albedo, "albedo", Vec3::splat(0.5))?,
-                texture: m
-                    .texture
-                    .as_ref()
-                    .map(|t| self.file(t, "texture"))
-                    .transpose()?,
+                texture: texture()?,
             },
-            MaterialType::Conductor => MaterialKind::Conductor {
-                color: self.reflectance(&m.color, "color", Vec3::splat(0.9))?,
-                roughness: roughness(0.2)?,
-            },
+            MaterialType::Conductor => self.conductor(m, roughness(0.2)?)?,
             MaterialType::Mirror => MaterialKind::Mirror {
                 color: self.reflectance(&m.color, "color", Vec3::ONE)?,
             },
@@ -387,6 +435,22 @@ impl Ctx<'_> {
             MaterialType::RoughDielectric => MaterialKind::RoughDielectric {
                 ior: ior()?,
                 roughness: roughness(0.2)?,
+            },
+            MaterialType::ThinDielectric => MaterialKind::ThinDielectric { ior: ior()? },
+            MaterialType::MetallicRoughness => MaterialKind::MetallicRoughness {
+                base_color: self.reflectance(&m.base_color, "base_color", Vec3::splat(0.8))?,
+                texture: texture()?,
+                metallic: unit(&m.metallic, "metallic", 0.0)?,
+                roughness: roughness(0.5)?,
+                ior: self.number(&m.ior, "ior", 1.5, |n| n >= 1.0, "at least 1")?,
+                specular: unit(&m.specular, "specular", 1.0)?,
+                specular_color: self.reflectance(&m.specular_color, "specular_color", Vec3::ONE)?,
+            },
+            MaterialType::CoatedDiffuse => MaterialKind::CoatedDiffuse {
+                albedo: self.reflectance(&m.albedo, "albedo", Vec3::splat(0.5))?,
+                texture: texture()?,
+                ior: self.number(&m.ior, "ior", 1.5, |n| n > 1.0, "greater than 1")?,
+                roughness: roughness(0.1)?,
             },
             MaterialType::Emission => MaterialKind::Emission {
                 radiance: self.power(
@@ -397,9 +461,97 @@ impl Ctx<'_> {
                 albedo: self.reflectance(&m.albedo, "albedo", Vec3::ZERO)?,
             },
         };
+        let two_sided = kind_uses_two_sided_for_scattering(&kind)
+            .then(|| m.two_sided.as_ref().map(|b| *b.get_ref()))
+            .flatten()
+            .unwrap_or(true);
+        let alpha = self.number(
+            &m.alpha,
+            "alpha",
+            1.0,
+            |a| (0.0..=1.0).contains(&a),
+            "between 0 and 1",
+        )?;
+        let cutoff = self.number(
+            &m.alpha_cutoff,
+            "alpha_cutoff",
+            0.5,
+            |a| (0.0..=1.0).contains(&a),
+            "between 0 and 1",
+        )?;
+        let alpha_mode = match m.alpha_mode.as_ref().map(|a| *a.get_ref()) {
+            None | Some(AlphaModeName::Opaque) => sahara_render::AlphaMode::Opaque,
+            Some(AlphaModeName::Mask) => sahara_render::AlphaMode::Mask { cutoff },
+            Some(AlphaModeName::Blend) => sahara_render::AlphaMode::Blend,
+        };
+        if let (Some(c), false) = (
+            &m.alpha_cutoff,
+            matches!(alpha_mode, sahara_render::AlphaMode::Mask { .. }),
+        ) {
+            return Err(self.at(
+                c.span(),
+                "`alpha_cutoff` applies to `alpha_mode = \"mask\"` only",
+            ));
+        }
         Ok(MaterialSpec {
             name: m.name.get_ref().clone(),
             kind,
+            two_sided,
+            alpha_mode,
+            alpha,
+        })
+    }
+
+    /// A `conductor`: by `color` (Schlick), by a `metal` preset, or by
+    /// `eta` and `k`; one of the three at most (default: `color`).
+    fn conductor(&self, m: &RawMaterial, roughness: f32) -> Result<MaterialKind, FormatError> {
+        let given = [
+            ("color", span(&m.color)),
+            ("metal", span(&m.metal)),
+            ("eta", span(&m.eta).or(span(&m.k))),
+        ];
+        let mut seen = given.iter().filter_map(|(k, s)| s.clone().map(|s| (*k, s)));
+        if let (Some((a, _)), Some((b, at))) = (seen.next(), seen.next()) {
+            return Err(self.at(
+                at,
+                format!("a conductor has `{a}` or `{b}`, not both (`eta` and `k` go together)"),
+            ));
+        }
+        if let Some(name) = &m.metal {
+            let Some((eta, k)) = sahara_render::material::metals::preset(name.get_ref()) else {
+                return Err(self.at(
+                    name.span(),
+                    format!(
+                        "no metal is named '{}' (known: {})",
+                        name.get_ref(),
+                        sahara_render::material::metals::PRESETS.join(", ")
+                    ),
+                ));
+            };
+            return Ok(MaterialKind::ComplexConductor { eta, k, roughness });
+        }
+        if m.eta.is_some() || m.k.is_some() {
+            let what = "a conductor given by its index";
+            let entry = m.kind.span();
+            let eta = self.vec(self.required(&m.eta, "eta", &entry, what)?, "eta")?;
+            let k = self.vec(self.required(&m.k, "k", &entry, what)?, "k")?;
+            if eta.min_element() <= 0.0 {
+                return Err(self.at(
+                    span(&m.eta).unwrap_or(entry),
+                    format!("`eta` {eta} must be greater than 0"),
+                ));
+            }
+            if k.min_element() < 0.0 {
+                return Err(self.at(
+                    span(&m.k).unwrap_or(entry),
+                    format!("`k` {k} must not be negative"),
+                ));
+            }
+            return Ok(MaterialKind::ComplexConductor { eta, k, roughness });
+        }
+        Ok(MaterialKind::Conductor {
+            color: self.reflectance(&m.color, "color", Vec3::splat(0.9))?,
+            roughness,
         })
     }
 
@@ -903,6 +1055,12 @@ struct ShapeKeys<'r> {
 }
 
 /// The snake_case name of a `type`/`name` value, as written in the file.
+/// True for the kinds whose `two_sided` key means "scatter on both
+/// faces" (emission uses it for its emission).
+fn kind_uses_two_sided_for_scattering(kind: &MaterialKind) -> bool {
+    !matches!(kind, MaterialKind::Emission { .. })
+}
+
 fn type_name<T: std::fmt::Debug>(value: &Spanned<T>) -> String {
     let debug = format!("{:?}", value.get_ref());
     let mut out = String::new();

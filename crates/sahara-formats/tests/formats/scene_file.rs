@@ -175,29 +175,44 @@ fn a_complete_scene_parses_into_the_expected_values() {
                 kind: MaterialKind::Diffuse {
                     albedo: Vec3::new(0.6, 0.4, 0.2),
                     texture: Some(at("wood.png"))
-                }
+                },
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
             MaterialSpec {
                 name: "gold".into(),
                 kind: MaterialKind::Conductor {
                     color: Vec3::new(1.0, 0.8, 0.3),
                     roughness: 0.1
-                }
+                },
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
             MaterialSpec {
                 name: "mirror".into(),
-                kind: MaterialKind::Mirror { color: Vec3::ONE }
+                kind: MaterialKind::Mirror { color: Vec3::ONE },
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
             MaterialSpec {
                 name: "glass".into(),
-                kind: MaterialKind::Dielectric { ior: 1.33 }
+                kind: MaterialKind::Dielectric { ior: 1.33 },
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
             MaterialSpec {
                 name: "frosted".into(),
                 kind: MaterialKind::RoughDielectric {
                     ior: 1.5,
                     roughness: 0.4
-                }
+                },
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
             MaterialSpec {
                 name: "lamp".into(),
@@ -205,7 +220,10 @@ fn a_complete_scene_parses_into_the_expected_values() {
                     radiance: Vec3::new(5., 5., 4.),
                     two_sided: true,
                     albedo: Vec3::ZERO
-                }
+                },
+                two_sided: true,
+                alpha_mode: sahara_render::AlphaMode::Opaque,
+                alpha: 1.0
             },
         ]
     );
@@ -613,4 +631,144 @@ fn every_example_scene_loads() {
         .objects
         .iter()
         .any(|o| matches!(o.placement, Placement::Motion { .. })));
+}
+
+/// The materials of `rest` (after `HEAD`).
+fn materials_of(rest: &str) -> Vec<MaterialSpec> {
+    let dir = assets();
+    let path = dir.write("m.toml", with_head(rest));
+    load_scene_file(&path).unwrap().materials
+}
+
+#[test]
+fn layered_conductor_and_thin_materials_parse_with_defaults() {
+    let m = materials_of(
+        "[[material]]\nname = \"a\"\ntype = \"metallic_roughness\"\n\
+         [[material]]\nname = \"b\"\ntype = \"metallic_roughness\"\nbase_color = [1, 0, 0]\nmetallic = 1\nroughness = 0.3\nior = 1.4\nspecular = 0.5\nspecular_color = [0, 1, 0]\ntwo_sided = false\n\
+         [[material]]\nname = \"c\"\ntype = \"coated_diffuse\"\n\
+         [[material]]\nname = \"d\"\ntype = \"thin_dielectric\"\nior = 1.52\n\
+         [[material]]\nname = \"e\"\ntype = \"conductor\"\nmetal = \"gold\"\nroughness = 0.1\n\
+         [[material]]\nname = \"f\"\ntype = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.1]\n",
+    );
+    assert_eq!(
+        m[0].kind,
+        MaterialKind::MetallicRoughness {
+            base_color: Vec3::splat(0.8),
+            texture: None,
+            metallic: 0.0,
+            roughness: 0.5,
+            ior: 1.5,
+            specular: 1.0,
+            specular_color: Vec3::ONE,
+        }
+    );
+    assert!(m[0].two_sided);
+    assert_eq!(
+        m[1].kind,
+        MaterialKind::MetallicRoughness {
+            base_color: Vec3::X,
+            texture: None,
+            metallic: 1.0,
+            roughness: 0.3,
+            ior: 1.4,
+            specular: 0.5,
+            specular_color: Vec3::Y,
+        }
+    );
+    assert!(!m[1].two_sided);
+    assert_eq!(m[0].alpha_mode, sahara_render::AlphaMode::Opaque);
+    assert_eq!(m[0].alpha, 1.0);
+    assert_eq!(
+        m[2].kind,
+        MaterialKind::CoatedDiffuse {
+            albedo: Vec3::splat(0.5),
+            texture: None,
+            ior: 1.5,
+            roughness: 0.1,
+        }
+    );
+    assert_eq!(m[3].kind, MaterialKind::ThinDielectric { ior: 1.52 });
+    let (eta, k) = sahara_render::material::metals::preset("gold").unwrap();
+    assert_eq!(
+        m[4].kind,
+        MaterialKind::ComplexConductor {
+            eta,
+            k,
+            roughness: 0.1
+        }
+    );
+    assert_eq!(
+        m[5].kind,
+        MaterialKind::ComplexConductor {
+            eta: Vec3::new(0.2, 0.9, 1.1),
+            k: Vec3::new(3.9, 2.4, 2.1),
+            roughness: 0.2
+        }
+    );
+}
+
+#[test]
+fn bad_conductor_and_layered_keys_are_errors_at_the_value() {
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"conductor\"\nmetal = \"brass\"\n",
+    ));
+    assert!(
+        m.contains("line 10: column 9:") && m.contains("'brass'") && m.contains("gold"),
+        "{m}"
+    );
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"conductor\"\ncolor = [1, 1, 1]\nmetal = \"gold\"\n",
+    ));
+    assert!(m.contains("line 11:") && m.contains("not both"), "{m}");
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"conductor\"\neta = [1, 1, 1]\n",
+    ));
+    assert!(m.contains("`k`"), "{m}");
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"metallic_roughness\"\nmetallic = 2\n",
+    ));
+    assert!(m.contains("line 10:") && m.contains("metallic"), "{m}");
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"thin_dielectric\"\nroughness = 0.2\n",
+    ));
+    assert!(
+        m.contains("line 10:") && m.contains("thin_dielectric"),
+        "{m}"
+    );
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"coated_diffuse\"\nior = 1\n",
+    ));
+    assert!(
+        m.contains("line 10:") && m.contains("greater than 1"),
+        "{m}"
+    );
+}
+
+#[test]
+fn alpha_keys_parse_and_apply_to_reflectors_only() {
+    let m = materials_of(
+        "[[material]]\nname = \"leaf\"\ntype = \"diffuse\"\nalpha_mode = \"mask\"\nalpha_cutoff = 0.3\n\
+         [[material]]\nname = \"veil\"\ntype = \"metallic_roughness\"\nalpha_mode = \"blend\"\nalpha = 0.25\n",
+    );
+    assert_eq!(
+        m[0].alpha_mode,
+        sahara_render::AlphaMode::Mask { cutoff: 0.3 }
+    );
+    assert_eq!(m[1].alpha_mode, sahara_render::AlphaMode::Blend);
+    assert_eq!(m[1].alpha, 0.25);
+    let e = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"dielectric\"\nalpha = 0.5\n",
+    ));
+    assert!(e.contains("line 10:") && e.contains("`alpha`"), "{e}");
+    let e = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"diffuse\"\nalpha_cutoff = 0.5\n",
+    ));
+    assert!(e.contains("line 10:") && e.contains("mask"), "{e}");
+    let e = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"diffuse\"\nalpha = 2\n",
+    ));
+    assert!(
+        e.contains("line 10:") && e.contains("between 0 and 1"),
+        "{e}"
+    );
 }

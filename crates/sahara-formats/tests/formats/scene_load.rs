@@ -8,7 +8,7 @@ use sahara_formats::mesh_scene::load_mesh_scene;
 use sahara_formats::mtl::MtlMaterial;
 use sahara_formats::scene_load::load_scene;
 use sahara_formats::scenes_dir;
-use sahara_render::{Bsdf, Integrator, Light, Placement, Shape};
+use sahara_render::{AlphaMode, Bsdf, Integrator, Light, Placement, Shape};
 
 use crate::common::TempDir;
 use crate::gltf::{base64, triangle_buffer, triangle_json};
@@ -89,24 +89,51 @@ fn mtl_parameters_choose_the_bsdf() {
 }
 
 #[test]
-fn gltf_metallic_roughness_chooses_conductor_or_diffuse() {
+fn gltf_materials_become_the_metallic_roughness_bsdf_or_glass() {
     let mut m = GltfMaterial::default_material();
     m.base_color = [0.9, 0.5, 0.2, 1.0];
     m.roughness = 0.3;
+    m.metallic = 0.25;
+    m.ior = 1.4;
+    m.specular = 0.5;
+    m.specular_color = [1.0, 0.0, 0.0];
     assert_eq!(
         gltf_bsdf(&m),
-        Bsdf::Conductor {
-            color: Vec3::new(0.9, 0.5, 0.2),
+        Bsdf::MetallicRoughness {
+            base_color: Vec3::new(0.9, 0.5, 0.2),
+            metallic: 0.25,
+            roughness: 0.3,
+            ior: 1.4,
+            specular: 0.5,
+            specular_color: Vec3::X,
+        }
+    );
+    // Out-of-range factors are clamped, an ior below 1 is the default.
+    m.metallic = 7.0;
+    m.ior = 0.0;
+    assert!(matches!(
+        gltf_bsdf(&m),
+        Bsdf::MetallicRoughness {
+            metallic: 1.0,
+            ior: 1.5,
+            ..
+        }
+    ));
+    // Transmission: a thin wall unless the material has a volume.
+    m.metallic = 0.0;
+    m.ior = 1.5;
+    m.transmission = 1.0;
+    assert_eq!(gltf_bsdf(&m), Bsdf::ThinDielectric { ior: 1.5 });
+    m.thickness = 0.1;
+    assert_eq!(
+        gltf_bsdf(&m),
+        Bsdf::RoughDielectric {
+            ior: 1.5,
             roughness: 0.3
         }
     );
-    m.metallic = 0.1;
-    assert_eq!(
-        gltf_bsdf(&m),
-        Bsdf::Diffuse {
-            albedo: Vec3::new(0.9, 0.5, 0.2)
-        }
-    );
+    m.roughness = 0.0;
+    assert_eq!(gltf_bsdf(&m), Bsdf::Dielectric { ior: 1.5 });
 }
 
 #[test]
@@ -263,8 +290,10 @@ fn gltf_nodes_become_instances_of_one_mesh_placed_by_the_object() {
         r#""uri": "data:application/octet-stream;base64,{}","#,
         base64(&bin)
     );
-    let extra = r#""materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 1],
-      "metallicFactor": 0}, "emissiveFactor": [2, 2, 2]}],
+    let extra = r#""materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 0.5, 0.8],
+      "metallicFactor": 0}, "emissiveFactor": [2, 2, 2], "alphaMode": "MASK", "alphaCutoff": 0.3,
+      "extensions": {"KHR_materials_ior": {"ior": 1.7}}}],
+  "extensionsUsed": ["KHR_materials_ior"],
   "nodes": [{"mesh": 0, "translation": [1, 0, 0]}, {"mesh": 0, "translation": [0, 1, 0]}],
   "scenes": [{"nodes": [0, 1]}], "scene": 0"#;
     dir.write("two.gltf", triangle_json(&uri, bin.len(), extra));
@@ -284,12 +313,13 @@ fn gltf_nodes_become_instances_of_one_mesh_placed_by_the_object() {
         .abs_diff_eq(Vec3::new(0.0, 1.0, 10.0), 1e-6));
     let m = &scene.materials[scene.material_of(0, 0) as usize];
     assert_eq!(m.emission, Vec3::splat(2.0));
-    assert_eq!(
+    assert!(matches!(
         m.bsdf,
-        Bsdf::Diffuse {
-            albedo: Vec3::splat(0.5)
-        }
-    );
+        Bsdf::MetallicRoughness { base_color, metallic: 0.0, ior: 1.7, .. } if base_color == Vec3::splat(0.5)
+    ));
+    assert_eq!(m.alpha_mode, AlphaMode::Mask { cutoff: 0.3 });
+    assert_eq!(m.alpha, 0.8);
+    assert!(!m.two_sided, "glTF materials are single-sided by default");
     // glTF's v runs downwards; the scene's upwards.
     let uvs = scene.meshes[0].uvs.as_ref().unwrap();
     assert_eq!(uvs[1], glam::Vec2::new(1.0, 1.0));

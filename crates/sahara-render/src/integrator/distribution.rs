@@ -33,6 +33,9 @@ pub(crate) fn step(
         }
         return false;
     };
+    if super::pass_through(ctx, st, &hit) {
+        return true;
+    }
     let sh = Shading::new(world, &hit, ray.dir);
     let mat = sh.material;
     if st.prev_delta {

@@ -223,6 +223,8 @@ pub(crate) struct Shading<'m> {
     pub wo: Vec3,
     pub material: &'m Material,
     pub tint: Vec3,
+    /// The back of a one-sided material: it scatters nothing.
+    pub blind: bool,
 }
 
 impl<'m> Shading<'m> {
@@ -238,6 +240,7 @@ impl<'m> Shading<'m> {
             wo: frame.to_local(wo_world),
             material,
             tint: material.tint(hit.uv),
+            blind: material.is_blind_side(wo_world.dot(hit.ng)),
         }
     }
 
@@ -280,6 +283,9 @@ impl Shading<'_> {
         hit: &SurfaceHit,
         depth: u32,
     ) -> Option<(BsdfSample, Ray)> {
+        if self.blind {
+            return None;
+        }
         let u_lobe = ctx.sampler.get_1d(dims::bounce(depth, dims::BSDF_LOBE));
         let u = ctx.sampler.get_2d(dims::bounce(depth, dims::BSDF_DIR));
         let s = self.material.bsdf.sample(self.tint, self.wo, u_lobe, u)?;
@@ -287,6 +293,29 @@ impl Shading<'_> {
         ctx.stats.bounce_rays += 1;
         Some((s, Ray::new(hit.spawn_origin(wi), wi)))
     }
+}
+
+/// The `light` field of [`dims::extra`] whose dimensions decide stochastic
+/// transparency.
+const PASS_THROUGH_DIMS: u32 = 0xfff;
+
+/// If the surface of `hit` has a hole where `st`'s ray meets it, moves the
+/// ray past it (same direction, same path vertex) and returns true.
+pub(crate) fn pass_through(ctx: &Context, st: &mut PathState, hit: &SurfaceHit) -> bool {
+    let m = ctx.world.material(hit.material);
+    if !m.has_holes() || st.pass_throughs >= crate::world::MAX_PASS_THROUGHS {
+        return false;
+    }
+    let u = ctx
+        .sampler
+        .get_1d(dims::extra(st.depth, PASS_THROUGH_DIMS, st.pass_throughs));
+    if !m.passes(hit.uv, u) {
+        return false;
+    }
+    st.pass_throughs += 1;
+    let dir = st.ray.dir;
+    st.ray = Ray::new(hit.spawn_origin(dir), dir);
+    true
 }
 
 /// Light from a light sample if nothing blocks it: `f |cos| Li` (not
@@ -299,7 +328,7 @@ pub(crate) fn light_contribution(
     ls: &LightSample,
     time: f32,
 ) -> Option<(Vec3, f32, ShadowQuery)> {
-    if !sh.side_ok(hit, ls.wi) {
+    if sh.blind || !sh.side_ok(hit, ls.wi) {
         return None;
     }
     let wi = sh.frame.to_local(ls.wi);
@@ -313,4 +342,175 @@ pub(crate) fn light_contribution(
         .world
         .shadow_query(hit.spawn_origin(ls.wi), ls.wi, ls.dist, time, ls.ignore);
     Some((c, e.pdf, shadow))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Camera;
+    use crate::light::Light;
+    use crate::sampler::{SampleId, SamplerKind};
+    use crate::scene::Scene;
+    use crate::shape::Shape;
+    use sahara_kd::BuildParams;
+
+    /// Radiance seen at the centre of a quad whose back faces the camera
+    /// and a point light beside the camera.
+    fn back_radiance(material: Material) -> Vec3 {
+        let cam = Camera::look_at(Vec3::new(0.0, 0.0, -3.0), Vec3::ZERO, Vec3::Y, 40.0, 1.0);
+        let mut scene = Scene::new(cam);
+        let m = scene.add_material(material);
+        scene.add_shape(
+            Shape::Quad {
+                corner: Vec3::new(-1.0, -1.0, 0.0),
+                edge_u: Vec3::new(2.0, 0.0, 0.0),
+                edge_v: Vec3::new(0.0, 2.0, 0.0),
+            },
+            m,
+        );
+        scene.add_light(Light::point(Vec3::new(0.3, 0.0, -2.0), Vec3::splat(4.0)));
+        let world = World::new(&scene, &BuildParams::default());
+        let mut stats = TraceStats::default();
+        let mut sum = Vec3::ZERO;
+        for index in 0..16 {
+            let sampler = PixelSampler::new(
+                SamplerKind::Sobol,
+                SampleId {
+                    stream: 0,
+                    pass: 0,
+                    index,
+                    count: 16,
+                },
+            );
+            let mut ctx = Context {
+                world: &world,
+                sampler,
+                stats: &mut stats,
+            };
+            let ray = Ray::new(Vec3::new(0.0, 0.0, -3.0), Vec3::Z);
+            sum += Integrator::default().li(&mut ctx, &ray, 0.0);
+        }
+        sum / 16.0
+    }
+
+    #[test]
+    fn one_sided_materials_are_black_from_behind() {
+        let two = back_radiance(Material::diffuse(Vec3::splat(0.8)));
+        assert!(two.min_element() > 0.1, "{two}");
+        let one = back_radiance(Material::diffuse(Vec3::splat(0.8)).with_two_sided(false));
+        assert_eq!(one, Vec3::ZERO);
+        // Glass has two sides whatever the flag says.
+        let glass = back_radiance(Material::glass(1.5).with_two_sided(false));
+        let glass_two = back_radiance(Material::glass(1.5));
+        assert_eq!(glass, glass_two);
+    }
+
+    /// A floor under a square whose left half is opaque and right half a
+    /// hole (alpha 0 in its texture), lit from straight above; the world
+    /// and radiance seen looking down at `x` on the floor.
+    fn cut_out_scene(mode: crate::material::AlphaMode) -> Scene {
+        use crate::texture::Texture;
+        let cam = Camera::look_at(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 40.0, 1.0);
+        let mut scene = Scene::new(cam);
+        let floor = scene.add_material(Material::diffuse(Vec3::ONE));
+        let texture = Texture::new(2, 1, vec![Vec3::ONE; 2]).with_alpha(vec![1.0, 0.0]);
+        let leaf = scene.add_material(
+            Material::diffuse(Vec3::ZERO)
+                .with_texture(std::sync::Arc::new(texture))
+                .with_alpha(mode, 1.0),
+        );
+        scene.add_shape(
+            Shape::Quad {
+                corner: Vec3::new(-2.0, 0.0, -2.0),
+                edge_u: Vec3::new(0.0, 0.0, 4.0),
+                edge_v: Vec3::new(4.0, 0.0, 0.0),
+            },
+            floor,
+        );
+        scene.add_shape(
+            Shape::Quad {
+                corner: Vec3::new(-1.0, 1.0, -1.0),
+                edge_u: Vec3::new(2.0, 0.0, 0.0),
+                edge_v: Vec3::new(0.0, 0.0, 2.0),
+            },
+            leaf,
+        );
+        scene.add_light(Light::directional(Vec3::new(0.0, -1.0, 0.0), Vec3::ONE));
+        scene
+    }
+
+    fn radiance_down(world: &World, x: f32) -> Vec3 {
+        let mut stats = TraceStats::default();
+        let sampler = PixelSampler::new(
+            SamplerKind::Sobol,
+            SampleId {
+                stream: 0,
+                pass: 0,
+                index: 0,
+                count: 1,
+            },
+        );
+        let mut ctx = Context {
+            world,
+            sampler,
+            stats: &mut stats,
+        };
+        let ray = Ray::new(Vec3::new(x, 3.0, 0.0), -Vec3::Y);
+        Integrator::from_name("path")
+            .unwrap()
+            .li(&mut ctx, &ray, 0.0)
+    }
+
+    #[test]
+    fn a_cut_out_casts_the_cut_outs_shadow() {
+        use crate::material::AlphaMode;
+        let up = Vec3::Y;
+        let on_floor = |x: f32| Vec3::new(x, 1e-3, 0.0);
+        let opaque = cut_out_scene(AlphaMode::Opaque);
+        let world = World::new(&opaque, &BuildParams::default());
+        assert!(!world.unoccluded(on_floor(-0.5), up, f32::INFINITY, 0.0, None));
+        assert!(!world.unoccluded(on_floor(0.5), up, f32::INFINITY, 0.0, None));
+        assert_eq!(radiance_down(&world, 0.5), Vec3::ZERO);
+
+        let mask = cut_out_scene(AlphaMode::Mask { cutoff: 0.5 });
+        let world = World::new(&mask, &BuildParams::default());
+        // The opaque half shadows the floor, the hole lets the light by.
+        assert!(!world.unoccluded(on_floor(-0.5), up, f32::INFINITY, 0.0, None));
+        assert!(world.unoccluded(on_floor(0.5), up, f32::INFINITY, 0.0, None));
+        // Outside the square the floor is lit either way.
+        assert!(world.unoccluded(on_floor(1.5), up, f32::INFINITY, 0.0, None));
+        // Looking down: the black opaque half, the lit floor through the
+        // hole (white Lambertian under unit irradiance: 1 / pi).
+        assert_eq!(radiance_down(&world, -0.5), Vec3::ZERO);
+        let through = radiance_down(&world, 0.5);
+        assert!(
+            (through - Vec3::splat(std::f32::consts::FRAC_1_PI))
+                .abs()
+                .max_element()
+                < 1e-3,
+            "{through}"
+        );
+
+        // Blend at opacity 1 on the left, 0 on the right: the same answers.
+        let blend = cut_out_scene(AlphaMode::Blend);
+        let world = World::new(&blend, &BuildParams::default());
+        assert!(!world.unoccluded(on_floor(-0.5), up, f32::INFINITY, 0.0, None));
+        assert!(world.unoccluded(on_floor(0.5), up, f32::INFINITY, 0.0, None));
+
+        // Blend at a uniform opacity of 0.3: about 70 % of shadow rays
+        // pass.
+        let mut half = cut_out_scene(AlphaMode::Blend);
+        half.materials[1].texture = None;
+        half.materials[1].alpha = 0.3;
+        let world = World::new(&half, &BuildParams::default());
+        let n = 4000;
+        let open = (0..n)
+            .filter(|&i| {
+                let x = -0.9 + 1.8 * (i as f32 + 0.5) / n as f32;
+                world.unoccluded(on_floor(x), up, f32::INFINITY, 0.0, None)
+            })
+            .count();
+        let f = open as f32 / n as f32;
+        assert!((f - 0.7).abs() < 0.03, "{f}");
+    }
 }

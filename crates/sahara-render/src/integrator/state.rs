@@ -41,6 +41,8 @@ pub(crate) struct PathState {
     pub prev_p: Vec3,
     /// Running sum of one light's samples (the distribution tracer).
     pub light_sum: Vec3,
+    /// Surfaces with holes the path has passed through.
+    pub pass_throughs: u32,
 }
 
 impl PathState {
@@ -58,6 +60,7 @@ impl PathState {
             prev_pdf: 0.0,
             prev_p: ray.origin,
             light_sum: Vec3::ZERO,
+            pass_throughs: 0,
         }
     }
 

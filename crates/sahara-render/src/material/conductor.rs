@@ -1,10 +1,10 @@
-//! Metals: the rough GGX conductor and the perfect mirror, both with a
-//! Schlick Fresnel term tinted by the base colour (the reflectance at
-//! normal incidence).
+//! Metals: the rough GGX conductor and the perfect mirror, with any
+//! Fresnel term (Schlick's tinted by a colour, or the exact one of a
+//! complex index of refraction).
 
 use glam::{Vec2, Vec3};
 
-use super::fresnel::{reflect, schlick};
+use super::fresnel::reflect;
 use super::microfacet::Ggx;
 use super::{BsdfEval, BsdfSample};
 
@@ -19,8 +19,9 @@ fn upper(w: Vec3, flip: bool) -> Vec3 {
     }
 }
 
-/// Value and density of the rough conductor.
-pub fn eval(color: Vec3, ggx: &Ggx, wo: Vec3, wi: Vec3) -> BsdfEval {
+/// Value and density of the rough conductor whose Fresnel reflectance at
+/// the microfacet cosine `c` is `fresnel(c)`.
+pub fn eval(fresnel: impl Fn(f32) -> Vec3, ggx: &Ggx, wo: Vec3, wi: Vec3) -> BsdfEval {
     if wo.z * wi.z <= 0.0 {
         return BsdfEval::ZERO;
     }
@@ -31,7 +32,7 @@ pub fn eval(color: Vec3, ggx: &Ggx, wo: Vec3, wi: Vec3) -> BsdfEval {
     if oh <= 0.0 {
         return BsdfEval::ZERO;
     }
-    let f = schlick(color, oh) * (ggx.d(h) * ggx.g(wo, wi) / (4.0 * wo.z * wi.z));
+    let f = fresnel(oh) * (ggx.d(h) * ggx.g(wo, wi) / (4.0 * wo.z * wi.z));
     BsdfEval {
         f,
         pdf: ggx.pdf_visible(wo, h) / (4.0 * oh),
@@ -39,7 +40,7 @@ pub fn eval(color: Vec3, ggx: &Ggx, wo: Vec3, wi: Vec3) -> BsdfEval {
 }
 
 /// A direction reflected about a visible microfacet normal.
-pub fn sample(color: Vec3, ggx: &Ggx, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+pub fn sample(fresnel: impl Fn(f32) -> Vec3, ggx: &Ggx, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
     if wo.z == 0.0 {
         return None;
     }
@@ -54,7 +55,7 @@ pub fn sample(color: Vec3, ggx: &Ggx, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
     let pdf = ggx.pdf_visible(wo, m) / (4.0 * om);
     // f cos / pdf = F D G / (4 wo.z) / (G1 D (wo.m) / wo.z / (4 wo.m))
     //             = F G / G1: D and the Jacobian cancel.
-    let weight = schlick(color, om) * (ggx.g(wo, wi) / ggx.g1(wo));
+    let weight = fresnel(om) * (ggx.g(wo, wi) / ggx.g1(wo));
     Some(BsdfSample {
         wi: upper(wi, flip),
         weight,
@@ -64,13 +65,13 @@ pub fn sample(color: Vec3, ggx: &Ggx, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
 }
 
 /// The perfect mirror direction (a delta lobe).
-pub fn sample_mirror(color: Vec3, wo: Vec3) -> Option<BsdfSample> {
+pub fn sample_mirror(fresnel: impl Fn(f32) -> Vec3, wo: Vec3) -> Option<BsdfSample> {
     if wo.z == 0.0 {
         return None;
     }
     Some(BsdfSample {
         wi: Vec3::new(-wo.x, -wo.y, wo.z),
-        weight: schlick(color, wo.z.abs()),
+        weight: fresnel(wo.z.abs()),
         pdf: 1.0,
         delta: true,
     })

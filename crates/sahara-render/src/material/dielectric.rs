@@ -58,6 +58,32 @@ pub fn sample_smooth(ior: f32, wo: Vec3, u_lobe: f32) -> Option<BsdfSample> {
     })
 }
 
+/// A thin pane of index `ior` (both faces parallel, nothing in between
+/// absorbs): light is reflected, with the reflectance `R' = 2R / (1 + R)`
+/// of the two faces and every bounce between them, or passes straight
+/// through, undeviated.
+pub fn sample_thin(ior: f32, wo: Vec3, u_lobe: f32) -> Option<BsdfSample> {
+    if wo.z == 0.0 {
+        return None;
+    }
+    let r = fresnel(wo.z.abs(), ior);
+    let r = if r < 1.0 { 2.0 * r / (1.0 + r) } else { 1.0 };
+    if u_lobe < r {
+        return Some(BsdfSample {
+            wi: Vec3::new(-wo.x, -wo.y, wo.z),
+            weight: Vec3::ONE,
+            pdf: r,
+            delta: true,
+        });
+    }
+    Some(BsdfSample {
+        wi: -wo,
+        weight: Vec3::ONE,
+        pdf: 1.0 - r,
+        delta: true,
+    })
+}
+
 /// The generalised half vector of `wo` (z > 0) and `wi`, facing +z, and
 /// whether the pair is a reflection.
 #[inline]

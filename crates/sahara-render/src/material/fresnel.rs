@@ -25,6 +25,42 @@ pub fn schlick(f0: Vec3, cos: f32) -> Vec3 {
     f0 + (Vec3::ONE - f0) * m
 }
 
+/// Schlick's form with reflectance `f0` at normal incidence and `f90` at
+/// grazing incidence (`KHR_materials_specular` scales the latter).
+#[inline]
+pub fn schlick_f90(f0: Vec3, f90: Vec3, cos: f32) -> Vec3 {
+    let m = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
+    f0 + (f90 - f0) * m
+}
+
+/// Exact unpolarised Fresnel reflectance of a conductor of complex index
+/// `eta + i k` (per channel, relative to the outside medium) for light
+/// arriving at `cos_i` (clamped to `[0, 1]`).
+///
+/// With `a^2 + b^2 = sqrt((eta^2 - k^2 - sin^2)^2 + 4 eta^2 k^2)` and
+/// `a^2 = (that + eta^2 - k^2 - sin^2) / 2`, the s and p reflectances are
+/// `Rs = (a^2 + b^2 - 2a cos + cos^2) / (a^2 + b^2 + 2a cos + cos^2)` and
+/// `Rp = Rs (cos^2 (a^2 + b^2) - 2a cos sin^2 + sin^4) /
+/// (cos^2 (a^2 + b^2) + 2a cos sin^2 + sin^4)`.
+#[inline]
+pub fn conductor(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
+    let c = cos_i.clamp(0.0, 1.0);
+    let c2 = c * c;
+    let s2 = 1.0 - c2;
+    let t0 = eta * eta - k * k - Vec3::splat(s2);
+    let a2b2 = (t0 * t0 + 4.0 * eta * eta * k * k)
+        .max(Vec3::ZERO)
+        .powf(0.5);
+    let a = (0.5 * (a2b2 + t0)).max(Vec3::ZERO).powf(0.5);
+    let t1 = a2b2 + Vec3::splat(c2);
+    let t2 = 2.0 * c * a;
+    let rs = (t1 - t2) / (t1 + t2).max(Vec3::splat(1e-30));
+    let t3 = c2 * a2b2 + Vec3::splat(s2 * s2);
+    let t4 = t2 * s2;
+    let rp = rs * (t3 - t4) / (t3 + t4).max(Vec3::splat(1e-30));
+    (0.5 * (rs + rp)).clamp(Vec3::ZERO, Vec3::ONE)
+}
+
 /// The refraction of `w` (pointing away from the surface, on the side `n`
 /// points to) into the other side, `eta = n_t / n_i`; `None` under total
 /// internal reflection.
@@ -60,5 +96,22 @@ mod tests {
         assert!((t.length() - 1.0).abs() < 1e-5);
         // n_i sin_i = n_t sin_t.
         assert!((0.6 - 1.5 * t.x.abs()).abs() < 1e-5 && t.z < 0.0);
+    }
+
+    #[test]
+    fn conductor_fresnel_limits() {
+        let (eta, k) = (Vec3::new(0.2, 1.0, 1.4), Vec3::new(3.6, 2.6, 1.9));
+        // Normal incidence: ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2).
+        let f0 = conductor(1.0, eta, k);
+        let want = ((eta - 1.0) * (eta - 1.0) + k * k) / ((eta + 1.0) * (eta + 1.0) + k * k);
+        assert!((f0 - want).abs().max_element() < 1e-5, "{f0} vs {want}");
+        // Grazing incidence reflects everything.
+        assert!((conductor(0.0, eta, k) - Vec3::ONE).abs().max_element() < 1e-5);
+        // Without absorption it is the dielectric formula.
+        for c in [0.1f32, 0.5, 0.9] {
+            let d = dielectric(c, 1.5);
+            let m = conductor(c, Vec3::splat(1.5), Vec3::ZERO);
+            assert!((m.x - d).abs() < 1e-5, "cos {c}: {} vs {d}", m.x);
+        }
     }
 }
