@@ -479,48 +479,56 @@ fn render_tile(
     };
     let stepped = s.integrator.is_stepped();
     let rows = if stepped { STRIP_ROWS } else { 1 };
-    let mut strip = Strip::default();
-    for y0 in (t.y0..t.y1).step_by(rows as usize) {
-        if stop() {
-            return out;
-        }
-        let y1 = (y0 + rows).min(t.y1);
-        strip.render(
-            world,
-            s,
-            t.x0,
-            t.x1,
-            y0,
-            y1,
-            pass,
-            indices.clone(),
-            &mut out.stats,
-        );
-        let mut k = 0;
-        for y in y0..y1 {
-            for x in t.x0..t.x1 {
-                for _ in indices.clone() {
-                    let pos = strip.pos[k];
-                    let mut l = strip.radiance[k];
-                    k += 1;
-                    // Guard, count, never hide: a NaN or infinite sample is
-                    // a bug somewhere; it is zeroed so one cannot ruin a
-                    // pixel, and reported in the statistics.
-                    if !l.is_finite() {
-                        out.nan += 1;
-                        l = Vec3::ZERO;
+    // The strip's buffers, kept by the thread from tile to tile.
+    STRIP.with_borrow_mut(|strip| {
+        for y0 in (t.y0..t.y1).step_by(rows as usize) {
+            if stop() {
+                return;
+            }
+            let y1 = (y0 + rows).min(t.y1);
+            strip.render(
+                world,
+                s,
+                t.x0,
+                t.x1,
+                y0,
+                y1,
+                pass,
+                indices.clone(),
+                &mut out.stats,
+            );
+            let mut k = 0;
+            for y in y0..y1 {
+                for x in t.x0..t.x1 {
+                    for _ in indices.clone() {
+                        let pos = strip.pos[k];
+                        let mut l = strip.radiance[k];
+                        k += 1;
+                        // Guard, count, never hide: a NaN or infinite sample is
+                        // a bug somewhere; it is zeroed so one cannot ruin a
+                        // pixel, and reported in the statistics.
+                        if !l.is_finite() {
+                            out.nan += 1;
+                            l = Vec3::ZERO;
+                        }
+                        if l.min_element() < 0.0 {
+                            out.negative += 1;
+                            l = l.max(Vec3::ZERO);
+                        }
+                        out.sums.splat(&s.filter, m, x, y, pos, l);
                     }
-                    if l.min_element() < 0.0 {
-                        out.negative += 1;
-                        l = l.max(Vec3::ZERO);
-                    }
-                    out.sums.splat(&s.filter, m, x, y, pos, l);
                 }
             }
+            out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
         }
-        out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
-    }
+    });
     out
+}
+
+thread_local! {
+    /// This thread's strip buffers, reused by every tile it renders (fresh
+    /// ones per tile cost page faults of their own).
+    static STRIP: std::cell::RefCell<Strip> = std::cell::RefCell::new(Strip::default());
 }
 
 /// The samples of a strip of a tile's rows: film positions and radiance,

@@ -39,6 +39,9 @@ fn fixed(v: f64) -> i128 {
     ((whole as i128) << FRACTION_BITS) + fraction as i128
 }
 
+/// Filter taps per row whose weights a splat computes once per sample.
+const MAX_TAPS: usize = 16;
+
 /// A fixed-point sum as a float (rounded to nearest).
 #[inline]
 fn float(v: i128) -> f64 {
@@ -144,6 +147,15 @@ impl SumBuffer {
         let px1 = (x.saturating_add(margin)).min(self.x0 + self.width - 1);
         let py0 = y.saturating_sub(margin).max(self.y0);
         let py1 = (y.saturating_add(margin)).min(self.y0 + self.height - 1);
+        // The columns' weights, once per sample rather than once per row.
+        let mut wx = [0.0f32; MAX_TAPS];
+        let taps = (px1 + 1).saturating_sub(px0) as usize;
+        let cached = taps <= MAX_TAPS;
+        if cached {
+            for (k, w) in wx[..taps].iter_mut().enumerate() {
+                *w = filter.eval_1d(pos.x - ((px0 + k as u32) as f32 + 0.5));
+            }
+        }
         for py in py0..=py1 {
             let dy = pos.y - (py as f32 + 0.5);
             if dy.abs() > r {
@@ -152,7 +164,12 @@ impl SumBuffer {
             let wy = filter.eval_1d(dy);
             let row = (py - self.y0) as usize * self.width as usize;
             for px in px0..=px1 {
-                let wt = wy * filter.eval_1d(pos.x - (px as f32 + 0.5));
+                let w = if cached {
+                    wx[(px - px0) as usize]
+                } else {
+                    filter.eval_1d(pos.x - (px as f32 + 0.5))
+                };
+                let wt = wy * w;
                 if wt != 0.0 {
                     self.sums[row + (px - self.x0) as usize].add_sample(l, wt);
                 }
