@@ -568,14 +568,7 @@ fn settings(desc: &Description, folder: &Path, w: &mut Warnings) -> Result<Setti
                         ),
                         &i.loc,
                     );
-                    for p in i
-                        .params
-                        .unused()
-                        .map(|p| p.name.clone())
-                        .collect::<Vec<_>>()
-                    {
-                        i.params.get(&p);
-                    }
+                    i.params.mark_all_used();
                     Integrator::Path {
                         max_depth,
                         rr_depth: 3,

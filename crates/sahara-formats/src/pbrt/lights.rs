@@ -180,14 +180,7 @@ pub(crate) fn add_light(
                 format!("light '{}' is not supported; skipped", e.kind),
                 &e.loc,
             );
-            for p in e
-                .params
-                .unused()
-                .map(|p| p.name.clone())
-                .collect::<Vec<_>>()
-            {
-                e.params.get(&p);
-            }
+            e.params.mark_all_used();
         }
         other => return Err(e.loc.error(format!("unknown light type '{other}'"))),
     }

@@ -344,14 +344,7 @@ pub(crate) fn map_material(
                 "Kd"
             };
             let base = tex.spectrum(e, name, grey(0.5), Use::Reflectance, w)?;
-            for p in e
-                .params
-                .unused()
-                .map(|p| p.name.clone())
-                .collect::<Vec<_>>()
-            {
-                e.params.get(&p);
-            }
+            e.params.mark_all_used();
             approx(w, "not supported; replaced by a diffuse material");
             diffuse(base)
         }
@@ -360,14 +353,7 @@ pub(crate) fn map_material(
                 format!("unknown material type '{other}'; replaced by diffuse grey 0.5"),
                 &e.loc,
             );
-            for p in e
-                .params
-                .unused()
-                .map(|p| p.name.clone())
-                .collect::<Vec<_>>()
-            {
-                e.params.get(&p);
-            }
+            e.params.mark_all_used();
             diffuse(Tint::constant(grey(0.5)))
         }
     };

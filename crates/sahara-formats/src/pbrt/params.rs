@@ -191,6 +191,14 @@ impl ParamList {
         self.params.iter().any(|p| p.name == name)
     }
 
+    /// Marks every parameter as read (for a directive that is skipped or
+    /// replaced as a whole and warned about once).
+    pub(crate) fn mark_all_used(&self) {
+        for p in &self.params {
+            p.used.set(true);
+        }
+    }
+
     /// Parameters no lookup asked for.
     pub(crate) fn unused(&self) -> impl Iterator<Item = &Param> {
         self.params.iter().filter(|p| !p.used.get())

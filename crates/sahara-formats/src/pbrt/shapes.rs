@@ -352,14 +352,7 @@ pub(crate) fn shape_geometry(
                 format!("shape '{}' is not supported; skipped", e.kind),
                 &e.loc,
             );
-            for p in e
-                .params
-                .unused()
-                .map(|p| p.name.clone())
-                .collect::<Vec<_>>()
-            {
-                e.params.get(&p);
-            }
+            e.params.mark_all_used();
             return Ok(None);
         }
         other => return Err(e.loc.error(format!("unknown shape type '{other}'"))),

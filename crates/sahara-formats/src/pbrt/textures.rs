@@ -359,9 +359,7 @@ impl<'a> Textures<'a> {
                     format!("texture '{other}' is not supported; replaced by grey 0.5"),
                     &e.loc,
                 );
-                for p in e.params.unused().map(|p| p.name.clone()).collect::<Vec<_>>() {
-                    e.params.get(&p);
-                }
+                e.params.mark_all_used();
                 return Ok(Tint::constant(Vec3::splat(0.5)));
             }
         })
