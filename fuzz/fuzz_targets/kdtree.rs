@@ -7,7 +7,8 @@
 //! (sometimes aimed at a vertex, an edge or an inside point of a triangle). For each builder, with arbitrary
 //! depth and leaf limits: `validate` passes, closest hit equals
 //! `sahara_kd::brute::closest_hit` bit for bit (t, triangle, u, v), any
-//! hit equals `sahara_kd::brute::any_hit` and "closest hit exists", and the
+//! hit equals `sahara_kd::brute::any_hit` and "closest hit exists", so do
+//! batches (interleaved over the wide nodes and one by one), and the
 //! rays traced in packets of eight (grouped by direction signs) give the
 //! closest hits too.
 #![no_main]
@@ -15,6 +16,7 @@
 use arbitrary::Arbitrary;
 use glam::Vec3;
 use libfuzzer_sys::fuzz_target;
+use sahara_kd::internals::BatchWalk;
 use sahara_kd::PACKET;
 use sahara_kd::validate;
 use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
@@ -185,6 +187,28 @@ fuzz_target!(|input: Input| {
                 "{}: any hit {got_any} but brute force gives {any} for {ray:?}",
                 builder.name()
             );
+        }
+        // Batches, interleaved over the wide nodes and one by one over the
+        // binary ones.
+        for walk in [BatchWalk::Wide, BatchWalk::Binary] {
+            let mut hits = vec![None; rays.len()];
+            tree.closest_hits_walked(&rays, &mut hits, walk);
+            let mut occluded = vec![false; rays.len()];
+            tree.any_hits_walked(&rays, &mut occluded, walk);
+            for (k, (ray, &(closest, any))) in rays.iter().zip(&expected).enumerate() {
+                assert!(
+                    same(hits[k], closest),
+                    "{} {walk:?} batch: closest hit {:?} but brute force gives {closest:?} for {ray:?}",
+                    builder.name(),
+                    hits[k]
+                );
+                assert_eq!(
+                    occluded[k],
+                    any,
+                    "{} {walk:?} batch: any hit disagrees with brute force for {ray:?}",
+                    builder.name()
+                );
+            }
         }
         // Packets: the rays grouped by direction signs (so that most packets
         // take the packet path; mixed ones fall back to single rays) and

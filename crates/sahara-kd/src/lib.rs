@@ -63,5 +63,6 @@ pub struct ReadmeExample;
 #[doc(hidden)]
 pub mod internals {
     pub use crate::isect::RayShear;
+    pub use crate::kd::BatchWalk;
     pub use crate::leaf::{Frustum, IndexedBlocks, PacketShear, BLOCK_WIDTH};
 }

@@ -2,13 +2,15 @@
 //!
 //! Closest hit: the same `t` to the bit, the same triangle (ties go to the
 //! smallest index), the same barycentrics. Any hit: the same answer as brute
-//! force and as "closest hit exists". And every tree passes the structural
-//! validator.
+//! force and as "closest hit exists". Both for single rays (the binary
+//! nodes) and for batches walked over the wide nodes, interleaved, and over
+//! the binary ones. And every tree passes the structural validator.
 
 mod common;
 
 use glam::Vec3;
 use proptest::prelude::*;
+use sahara_kd::internals::BatchWalk;
 use sahara_kd::validate;
 use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
 
@@ -216,6 +218,11 @@ fn builders() -> Vec<BuildParams> {
     let mut serial = BuildParams::new(Builder::Sah);
     serial.parallel = false;
     out.push(serial);
+    // Without wide nodes: batches walk the binary nodes.
+    out.push(BuildParams {
+        wide_nodes: false,
+        ..deep
+    });
     // The compact leaf layout, with the default tree and a deep one.
     for base in [BuildParams::new(Builder::Sah), deep] {
         out.push(BuildParams {
@@ -224,6 +231,16 @@ fn builders() -> Vec<BuildParams> {
         });
     }
     out
+}
+
+fn same_hit(a: Option<sahara_kd::Hit>, b: Option<sahara_kd::Hit>) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some(a), Some(b)) => {
+            a.t.to_bits() == b.t.to_bits() && a.tri == b.tri && a.u == b.u && a.v == b.v
+        }
+        _ => false,
+    }
 }
 
 fn check(tris: Vec<Triangle>, rays: &[RaySpec]) -> Result<(), TestCaseError> {
@@ -235,25 +252,46 @@ fn check(tris: Vec<Triangle>, rays: &[RaySpec]) -> Result<(), TestCaseError> {
                 params.builder.name()
             )));
         }
-        for spec in rays {
+        let batch: Vec<Ray> = rays.iter().map(|s| make_ray(s, &tris)).collect();
+        let mut walked = Vec::new();
+        for walk in [BatchWalk::Wide, BatchWalk::Binary] {
+            let mut hits = vec![None; batch.len()];
+            tree.closest_hits_walked(&batch, &mut hits, walk);
+            let mut occluded = vec![false; batch.len()];
+            tree.any_hits_walked(&batch, &mut occluded, walk);
+            walked.push((walk, hits, occluded));
+        }
+        for (i, spec) in rays.iter().enumerate() {
             let ray = make_ray(spec, &tris);
             let want = brute::closest_hit(&tris, &ray);
             let got = tree.closest_hit(&ray);
-            let same = match (want, got) {
-                (None, None) => true,
-                (Some(a), Some(b)) => {
-                    a.t.to_bits() == b.t.to_bits() && a.tri == b.tri && a.u == b.u && a.v == b.v
-                }
-                _ => false,
-            };
             prop_assert!(
-                same,
+                same_hit(want, got),
                 "{}: ray {:?}: brute {:?} tree {:?}",
                 params.builder.name(),
                 ray,
                 want,
                 got
             );
+            for (walk, hits, occluded) in &walked {
+                prop_assert!(
+                    same_hit(want, hits[i]),
+                    "{}: batch walk {:?}, ray {:?}: brute {:?} tree {:?}",
+                    params.builder.name(),
+                    walk,
+                    ray,
+                    want,
+                    hits[i]
+                );
+                prop_assert_eq!(
+                    occluded[i],
+                    want.is_some(),
+                    "{}: batch walk {:?}, any-hit disagrees, ray {:?}",
+                    params.builder.name(),
+                    walk,
+                    ray
+                );
+            }
             let any = tree.any_hit(&ray);
             prop_assert_eq!(
                 any,

@@ -387,6 +387,10 @@ pub struct TreeOptions {
     /// the tree's memory, tracing some 3-13% slower.
     #[arg(long)]
     pub compact_leaves: bool,
+    /// Walk single rays over the binary 8-byte nodes only, without the
+    /// wide nodes derived from them (for comparisons).
+    #[arg(long)]
+    pub binary_nodes: bool,
     /// Use only the first FRACTION of the triangles, in file order (0 < F
     /// <= 1; for build-scaling measurements).
     #[arg(long, value_name = "FRACTION", value_parser = parse_subset)]
@@ -406,6 +410,7 @@ impl Default for TreeOptions {
             lane_cost: None,
             exact_below: None,
             compact_leaves: false,
+            binary_nodes: false,
             subset: None,
         }
     }
@@ -424,6 +429,7 @@ impl TreeOptions {
         p.lane_cost = self.lane_cost.unwrap_or(p.lane_cost);
         p.exact_below = self.exact_below.unwrap_or(p.exact_below);
         p.compact_leaves = self.compact_leaves;
+        p.wide_nodes = !self.binary_nodes;
         p
     }
 

@@ -151,6 +151,11 @@ pub struct BuildParams {
     /// tracing some 3-13% slower (figures in `docs/performance.md`).
     /// Default false.
     pub compact_leaves: bool,
+    /// Derive wide nodes (three binary levels in one 64-byte node, walked
+    /// with SIMD) for the single-ray queries and batches. The binary nodes
+    /// stay the reference form; the wide ones add about as many bytes
+    /// again (figures in `docs/performance.md`). Default true.
+    pub wide_nodes: bool,
 }
 
 impl Default for BuildParams {
@@ -197,6 +202,7 @@ impl BuildParams {
                 _ => 0,
             },
             compact_leaves: false,
+            wide_nodes: true,
         }
     }
 

@@ -2,9 +2,13 @@
 
 use rayon::prelude::*;
 
+use super::query::{AnyLeaf, ClosestLeaf};
 use super::KdTree;
 use crate::isect::Hit;
+use crate::leaf::layout::{Indexed, Layout, Whole};
+use crate::leaf::TriangleLeaves;
 use crate::math::{Ray, Triangle};
+use crate::simd::{dispatch, level, Kernel};
 
 /// Rays per work item of [`KdTree::closest_hits`] and [`KdTree::any_hits`].
 pub(crate) const BATCH: usize = 256;
@@ -12,12 +16,175 @@ pub(crate) const BATCH: usize = 256;
 impl KdTree<Triangle> {
     /// Closest hits of many rays, in parallel; `out[i]` answers `rays[i]`.
     pub fn closest_hits(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        in_parallel(rays, out, |r| self.closest_hit(r));
+        in_parallel(rays, out, |rs, os| self.closest_hits_serial(rs, os));
     }
 
     /// Occlusion of many rays, in parallel; `out[i]` answers `rays[i]`.
     pub fn any_hits(&self, rays: &[Ray], out: &mut [bool]) {
-        in_parallel(rays, out, |r| self.any_hit(r));
+        in_parallel(rays, out, |rs, os| self.any_hits_serial(rs, os));
+    }
+
+    /// Closest hits of many rays on the calling thread (for callers that
+    /// run their own threads, such as a renderer's tiles); `out[i]`
+    /// answers `rays[i]`. Several rays are walked at once, interleaved, so
+    /// that their memory loads overlap: faster than one ray at a time on
+    /// incoherent rays (see `docs/performance.md`), the same answers.
+    pub fn closest_hits_serial(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
+        self.closest_hits_walked(rays, out, BatchWalk::Auto);
+    }
+
+    /// [`KdTree::closest_hits_serial`] with the walk chosen by `walk`
+    /// (for tests and measurements).
+    #[doc(hidden)]
+    pub fn closest_hits_walked(&self, rays: &[Ray], out: &mut [Option<Hit>], walk: BatchWalk) {
+        assert_eq!(rays.len(), out.len(), "one output slot per ray");
+        if self.interleaves(rays, walk) {
+            dispatch(
+                level::AVX512,
+                ClosestBatch {
+                    tree: self,
+                    rays,
+                    out,
+                },
+            );
+        } else {
+            for (r, o) in rays.iter().zip(out) {
+                *o = self.closest_hit(r);
+            }
+        }
+    }
+
+    /// Occlusion of many rays on the calling thread, as
+    /// [`KdTree::closest_hits_serial`]; `out[i]` answers `rays[i]`.
+    pub fn any_hits_serial(&self, rays: &[Ray], out: &mut [bool]) {
+        self.any_hits_walked(rays, out, BatchWalk::Auto);
+    }
+
+    /// [`KdTree::any_hits_serial`] with the walk chosen by `walk` (for
+    /// tests and measurements).
+    #[doc(hidden)]
+    pub fn any_hits_walked(&self, rays: &[Ray], out: &mut [bool], walk: BatchWalk) {
+        assert_eq!(rays.len(), out.len(), "one output slot per ray");
+        if self.interleaves(rays, walk) {
+            dispatch(
+                level::AVX512,
+                AnyBatch {
+                    tree: self,
+                    rays,
+                    out,
+                },
+            );
+        } else {
+            for (r, o) in rays.iter().zip(out) {
+                *o = self.any_hit(r);
+            }
+        }
+    }
+
+    /// Whether a batch of `rays` takes the interleaved wide walk.
+    fn interleaves(&self, rays: &[Ray], walk: BatchWalk) -> bool {
+        !self.wide.is_empty()
+            && match walk {
+                BatchWalk::Auto => !coherent(rays),
+                BatchWalk::Binary => false,
+                BatchWalk::Wide => true,
+            }
+    }
+}
+
+/// How a batch query walks its rays.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BatchWalk {
+    /// Ray by ray over the binary nodes when the rays are coherent, else
+    /// interleaved over the wide nodes.
+    Auto,
+    /// Ray by ray over the binary nodes.
+    Binary,
+    /// Interleaved over the wide nodes (when the tree has them).
+    Wide,
+}
+
+/// Rays sampled to judge a batch's coherence.
+const SAMPLE: usize = 32;
+
+/// True when most neighbouring rays of the batch point within about 25
+/// degrees of each other (camera rays, shadow rays towards one light):
+/// the binary walk's branches are then predictable, and one ray at a time
+/// over the binary nodes beats the wide walk, whose every step computes
+/// all seven planes. Incoherent rays (bounces off diffuse surfaces,
+/// random rays) take the interleaved wide walk (figures in
+/// `docs/performance.md`).
+fn coherent(rays: &[Ray]) -> bool {
+    let step = (rays.len() / SAMPLE).max(1);
+    let (mut pairs, mut close) = (0, 0);
+    for i in (1..rays.len()).step_by(step).take(SAMPLE) {
+        let (a, b) = (rays[i - 1].dir, rays[i].dir);
+        let d = a.dot(b);
+        // cos > 0.9, without the square roots.
+        close += (d > 0.0 && d * d > 0.81 * a.length_squared() * b.length_squared()) as usize;
+        pairs += 1;
+    }
+    4 * close >= 3 * pairs
+}
+
+/// [`KdTree::closest_hits_serial`] as a kernel for [`dispatch`].
+struct ClosestBatch<'a> {
+    tree: &'a KdTree<Triangle>,
+    rays: &'a [Ray],
+    out: &'a mut [Option<Hit>],
+}
+
+impl ClosestBatch<'_> {
+    #[inline(always)]
+    fn over<L: Layout, const SIMD: u8>(self, layout: L) {
+        let Self { tree, rays, out } = self;
+        tree.walk_interleaved::<_, SIMD>(
+            rays,
+            |i| ClosestLeaf::<L, SIMD>::new(tree, layout, &rays[i]),
+            |i, v| out[i] = v.hit(),
+        );
+    }
+}
+
+impl Kernel for ClosestBatch<'_> {
+    type Output = ();
+    #[inline(always)]
+    unsafe fn run<const LEVEL: u8>(self) {
+        match &self.tree.leaf_data {
+            TriangleLeaves::Whole(v) => self.over::<_, LEVEL>(Whole(v)),
+            TriangleLeaves::Indexed(p) => self.over::<_, LEVEL>(Indexed(p)),
+        }
+    }
+}
+
+/// [`KdTree::any_hits_serial`] as a kernel for [`dispatch`].
+struct AnyBatch<'a> {
+    tree: &'a KdTree<Triangle>,
+    rays: &'a [Ray],
+    out: &'a mut [bool],
+}
+
+impl AnyBatch<'_> {
+    #[inline(always)]
+    fn over<L: Layout, const SIMD: u8>(self, layout: L) {
+        let Self { tree, rays, out } = self;
+        tree.walk_interleaved::<_, SIMD>(
+            rays,
+            |i| AnyLeaf::<L, SIMD>::new(layout, &rays[i]),
+            |i, v| out[i] = v.found(),
+        );
+    }
+}
+
+impl Kernel for AnyBatch<'_> {
+    type Output = ();
+    #[inline(always)]
+    unsafe fn run<const LEVEL: u8>(self) {
+        match &self.tree.leaf_data {
+            TriangleLeaves::Whole(v) => self.over::<_, LEVEL>(Whole(v)),
+            TriangleLeaves::Indexed(p) => self.over::<_, LEVEL>(Indexed(p)),
+        }
     }
 }
 
@@ -26,24 +193,95 @@ impl KdTree<Triangle> {
 /// a range only a few times unless a thief steals, so a costly quarter of
 /// an image could hold one thread while the other idles (see
 /// `docs/performance.md`).
-fn in_parallel<T: Send>(rays: &[Ray], out: &mut [T], query: impl Fn(&Ray) -> T + Sync) {
+fn in_parallel<T: Send>(rays: &[Ray], out: &mut [T], query: impl Fn(&[Ray], &mut [T]) + Sync) {
     assert_eq!(rays.len(), out.len(), "one output slot per ray");
     rays.par_chunks(BATCH)
         .zip(out.par_chunks_mut(BATCH))
         .with_max_len(1)
-        .for_each(|(rs, os)| {
-            for (r, o) in rs.iter().zip(os) {
-                *o = query(r);
-            }
-        });
+        .for_each(|(rs, os)| query(rs, os));
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::brute;
     use crate::build::BuildParams;
     use crate::test_support::{floats, soup};
     use glam::Vec3;
+
+    /// Every level's build of the interleaved wide walk (the portable one
+    /// is what a CPU without AVX2 runs) answers as brute force, in both
+    /// leaf layouts, with rays that miss the root cell or are invalid
+    /// among them.
+    #[test]
+    fn every_level_of_the_interleaved_walk_agrees_with_brute_force() {
+        let mut f = floats(41);
+        let tris = soup(&mut f, 3000, 0.4);
+        let mut rays: Vec<Ray> = (0..2000)
+            .map(|_| Ray::new(Vec3::new(f(), f(), f()) * 5.0, Vec3::new(f(), f(), f())))
+            .collect();
+        rays.push(Ray::new(Vec3::splat(100.0), Vec3::X));
+        rays.push(Ray::new(Vec3::ZERO, Vec3::ZERO));
+        rays.push(Ray::with_interval(Vec3::ZERO, Vec3::X, 2.0, 1.0));
+        let want: Vec<Option<Hit>> = rays.iter().map(|r| brute::closest_hit(&tris, r)).collect();
+        for compact_leaves in [false, true] {
+            let params = BuildParams {
+                compact_leaves,
+                ..BuildParams::default()
+            };
+            let tree = KdTree::build(tris.clone(), &params);
+            assert!(!tree.wide.is_empty());
+            for top in [level::PORTABLE, level::AVX2, level::AVX512] {
+                let mut out = vec![None; rays.len()];
+                let out_ref = &mut out;
+                dispatch(
+                    top,
+                    ClosestBatch {
+                        tree: &tree,
+                        rays: &rays,
+                        out: out_ref,
+                    },
+                );
+                assert_eq!(out, want, "level {top}, compact {compact_leaves}");
+                let mut occluded = vec![false; rays.len()];
+                let o = &mut occluded;
+                dispatch(
+                    top,
+                    AnyBatch {
+                        tree: &tree,
+                        rays: &rays,
+                        out: o,
+                    },
+                );
+                let any: Vec<bool> = want.iter().map(|h| h.is_some()).collect();
+                assert_eq!(occluded, any, "level {top}, compact {compact_leaves}");
+            }
+        }
+    }
+
+    /// Camera-like rays count as coherent, bounce-like and random ones do
+    /// not.
+    #[test]
+    fn coherence_is_judged_by_neighbouring_directions() {
+        let camera: Vec<Ray> = (0..256)
+            .map(|i| {
+                let (x, y) = ((i % 16) as f32 / 16.0 - 0.5, (i / 16) as f32 / 16.0 - 0.5);
+                Ray::new(Vec3::ZERO, Vec3::new(x, y, 1.0))
+            })
+            .collect();
+        assert!(coherent(&camera));
+        let mut f = floats(3);
+        let random: Vec<Ray> = (0..256)
+            .map(|_| Ray::new(Vec3::ZERO, Vec3::new(f(), f(), f())))
+            .collect();
+        assert!(!coherent(&random));
+        // Bounces off one plane: cosine-like directions about +z.
+        let bounces: Vec<Ray> = (0..256)
+            .map(|_| Ray::new(Vec3::ZERO, Vec3::new(f(), f(), f().abs() + 0.1)))
+            .collect();
+        assert!(!coherent(&bounces));
+        assert!(coherent(&camera[..1]));
+    }
 
     /// The batch queries put each ray's own answer in its own slot, across
     /// the parallel work items (more rays than one item holds, and a

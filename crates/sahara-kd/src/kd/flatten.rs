@@ -13,6 +13,11 @@ impl<P: LeafStorage> KdTree<P> {
         let (sub, bounds) = build::build(&prims, params);
         let (mut nodes, indices) = flatten(&sub.nodes, &sub.indices, P::LEAF_WIDTH);
         let leaf_data = P::leaf_data(&prims, &indices, &mut nodes, params);
+        let wide_shift = P::LEAF_WIDTH.trailing_zeros();
+        let wide = match params.wide_nodes && P::WIDE_NODES {
+            true => super::wide::derive(&nodes, wide_shift).unwrap_or_default(),
+            false => Vec::new(),
+        };
         KdTree {
             nodes,
             indices,
@@ -20,6 +25,8 @@ impl<P: LeafStorage> KdTree<P> {
             leaf_data,
             bounds,
             params: *params,
+            wide,
+            wide_shift,
         }
     }
 }

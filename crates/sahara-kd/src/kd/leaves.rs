@@ -13,6 +13,9 @@ pub trait LeafStorage: Primitive {
     type LeafData: Clone + std::fmt::Debug + Default + Send + Sync;
     /// Leaf index runs start at and are padded to a multiple of this.
     const LEAF_WIDTH: usize;
+    /// Whether the tree derives wide nodes for its walks (when
+    /// [`BuildParams::wide_nodes`] asks for them).
+    const WIDE_NODES: bool;
     /// The leaf data for a padded index array (`u32::MAX` marks padding);
     /// it may re-point the non-empty leaves of `nodes` (whose offsets are
     /// into that array) at itself.
@@ -36,6 +39,7 @@ impl LeafStorage for Triangle {
     /// block.
     type LeafData = TriangleLeaves;
     const LEAF_WIDTH: usize = BLOCK_WIDTH;
+    const WIDE_NODES: bool = true;
     fn leaf_data(
         prims: &[Self],
         padded_indices: &[u32],
@@ -72,6 +76,9 @@ impl LeafStorage for Triangle {
 impl LeafStorage for Aabb {
     type LeafData = ();
     const LEAF_WIDTH: usize = 1;
+    /// The top levels of a scene walk their boxes with the caller's
+    /// closures, outside the instruction-set dispatch: binary nodes.
+    const WIDE_NODES: bool = false;
     fn leaf_data(_: &[Self], _: &[u32], _: &mut [Node], _: &BuildParams) {}
     fn leaf_run(_: &(), offset: u32) -> usize {
         offset as usize

@@ -11,7 +11,9 @@ mod node;
 pub(crate) mod packet;
 mod query;
 mod walk;
+mod wide;
 
+pub use batch::BatchWalk;
 pub use counters::{Counters, NoCounters, TraversalCounters};
 pub use leaves::LeafStorage;
 pub use node::{Node, MAX_NODE_FIELD};
@@ -37,6 +39,11 @@ pub struct KdTree<P: LeafStorage = Triangle> {
     pub(crate) leaf_data: P::LeafData,
     pub(crate) bounds: Aabb,
     pub(crate) params: BuildParams,
+    /// The wide nodes derived from `nodes` for single-ray walks (empty
+    /// when not derived; see `wide`).
+    pub(crate) wide: Vec<wide::WideNode>,
+    /// Leaf offsets in `wide`'s leaf words are shifted down by this.
+    pub(crate) wide_shift: u32,
 }
 
 impl<P: LeafStorage> KdTree<P> {

@@ -12,13 +12,39 @@ use crate::simd::{dispatch, level, Kernel};
 /// The closest-hit leaf visit of one ray, a named type rather than a
 /// closure so that `#[inline(always)]` can put it into the walk's loop
 /// (LLVM kept the closure out of line: a call per leaf).
-struct ClosestLeaf<'a, L: Layout, const SIMD: u8> {
+pub(crate) struct ClosestLeaf<'a, L: Layout, const SIMD: u8> {
     tree: &'a KdTree<Triangle>,
     layout: L,
-    shear: &'a RayShear,
+    shear: RayShear,
     tmin: f32,
     best_t: f32,
     best: Hit,
+}
+
+impl<'a, L: Layout, const SIMD: u8> ClosestLeaf<'a, L, SIMD> {
+    /// The leaf visit of `ray` before any hit.
+    #[inline(always)]
+    pub(crate) fn new(tree: &'a KdTree<Triangle>, layout: L, ray: &Ray) -> Self {
+        Self {
+            tree,
+            layout,
+            shear: RayShear::from_ray(ray),
+            tmin: ray.tmin,
+            best_t: ray.tmax,
+            best: Hit {
+                t: f32::INFINITY,
+                tri: u32::MAX,
+                u: 0.0,
+                v: 0.0,
+            },
+        }
+    }
+
+    /// The closest hit found.
+    #[inline(always)]
+    pub(crate) fn hit(&self) -> Option<Hit> {
+        (self.best.tri != u32::MAX).then_some(self.best)
+    }
 }
 
 impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for ClosestLeaf<'_, L, SIMD> {
@@ -29,7 +55,7 @@ impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for ClosestLeaf<'_, L,
         let blocks = unsafe { self.layout.blocks(offset, count) };
         self.tree.leaf_closest::<C, SIMD, _>(
             blocks,
-            self.shear,
+            &self.shear,
             self.tmin,
             count,
             &mut self.best_t,
@@ -41,19 +67,47 @@ impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for ClosestLeaf<'_, L,
         }
         LeafResult::Continue
     }
+
+    #[inline(always)]
+    fn prefetch(&self, offset: usize) {
+        self.layout.prefetch(offset);
+        // The hit's triangle index is read from the index array.
+        let run = self.tree.indices.as_ptr().wrapping_add(offset);
+        crate::leaf::layout::prefetch_lines(run.cast(), 1);
+    }
 }
 
 /// The any-hit leaf visit of one ray (a named type for the reason given at
 /// [`ClosestLeaf`]).
-struct AnyLeaf<'a, L: Layout, const SIMD: u8> {
+pub(crate) struct AnyLeaf<L: Layout, const SIMD: u8> {
     layout: L,
-    shear: &'a RayShear,
+    shear: RayShear,
     tmin: f32,
     tmax: f32,
     found: bool,
 }
 
-impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for AnyLeaf<'_, L, SIMD> {
+impl<L: Layout, const SIMD: u8> AnyLeaf<L, SIMD> {
+    /// The leaf visit of `ray` before any hit.
+    #[inline(always)]
+    pub(crate) fn new(layout: L, ray: &Ray) -> Self {
+        Self {
+            layout,
+            shear: RayShear::from_ray(ray),
+            tmin: ray.tmin,
+            tmax: ray.tmax,
+            found: false,
+        }
+    }
+
+    /// Whether a hit was found.
+    #[inline(always)]
+    pub(crate) fn found(&self) -> bool {
+        self.found
+    }
+}
+
+impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for AnyLeaf<L, SIMD> {
     #[inline(always)]
     fn visit(&mut self, offset: usize, count: usize, c: &mut C, _: &mut f32) -> LeafResult {
         // SAFETY: as in `ClosestLeaf::visit`.
@@ -65,9 +119,14 @@ impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for AnyLeaf<'_, L, SIM
             LeafResult::Continue
         }
     }
+
+    #[inline(always)]
+    fn prefetch(&self, offset: usize) {
+        self.layout.prefetch(offset);
+    }
 }
 
-impl<L: Layout, const SIMD: u8> AnyLeaf<'_, L, SIMD> {
+impl<L: Layout, const SIMD: u8> AnyLeaf<L, SIMD> {
     /// True if a triangle of `blocks` (a leaf of `count`) is hit.
     #[inline(always)]
     fn any_hit_among<C: Counters, B: LeafBlock>(
@@ -80,7 +139,7 @@ impl<L: Layout, const SIMD: u8> AnyLeaf<'_, L, SIMD> {
             let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
             (0..lanes).for_each(|_| c.triangle());
             // SAFETY: `SIMD` is the level the traversal is compiled for.
-            let (mut m, e) = unsafe { block.edges::<SIMD>(self.shear, lanes) };
+            let (mut m, e) = unsafe { block.edges::<SIMD>(&self.shear, lanes) };
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
@@ -102,7 +161,7 @@ impl KdTree<Triangle> {
     #[inline(always)]
     fn single_ray_level(&self) -> u8 {
         match self.leaf_data {
-            TriangleLeaves::Whole(_) => level::AVX2,
+            TriangleLeaves::Whole(_) => level::AVX512,
             TriangleLeaves::Indexed(_) => level::AVX512,
         }
     }
@@ -147,23 +206,9 @@ impl KdTree<Triangle> {
         ray: &Ray,
         counters: &mut C,
     ) -> Option<Hit> {
-        let shear = RayShear::from_ray(ray);
-        let mut leaf = ClosestLeaf::<L, SIMD> {
-            tree: self,
-            layout,
-            shear: &shear,
-            tmin: ray.tmin,
-            best_t: ray.tmax,
-            best: Hit {
-                t: f32::INFINITY,
-                tri: u32::MAX,
-                u: 0.0,
-                v: 0.0,
-            },
-        };
+        let mut leaf = ClosestLeaf::<L, SIMD>::new(self, layout, ray);
         self.walk(ray, counters, &mut leaf);
-        let best = leaf.best;
-        (best.tri != u32::MAX).then_some(best)
+        leaf.hit()
     }
 
     /// The any-hit walk over the leaf layout `layout`, at level `SIMD`.
@@ -174,16 +219,9 @@ impl KdTree<Triangle> {
         ray: &Ray,
         counters: &mut C,
     ) -> bool {
-        let shear = RayShear::from_ray(ray);
-        let mut leaf = AnyLeaf::<L, SIMD> {
-            layout,
-            shear: &shear,
-            tmin: ray.tmin,
-            tmax: ray.tmax,
-            found: false,
-        };
+        let mut leaf = AnyLeaf::<L, SIMD>::new(layout, ray);
         self.walk(ray, counters, &mut leaf);
-        leaf.found
+        leaf.found()
     }
 
     /// The closest-hit test of one leaf, whose `count` triangles are in

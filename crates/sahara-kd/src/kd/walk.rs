@@ -39,6 +39,13 @@ pub(crate) trait LeafVisit<C> {
         counters: &mut C,
         closest: &mut f32,
     ) -> LeafResult;
+
+    /// Asks the cache for the leaf whose index run starts at `offset` (a
+    /// hint for walks that visit it later).
+    #[inline(always)]
+    fn prefetch(&self, offset: usize) {
+        let _ = offset;
+    }
 }
 
 impl<C, F: FnMut(usize, usize, &mut C, &mut f32) -> LeafResult> LeafVisit<C> for F {

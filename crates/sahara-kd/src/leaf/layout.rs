@@ -211,6 +211,30 @@ pub(crate) trait Layout: Copy {
     /// `offset` and `count` must be those of a non-empty leaf of the tree
     /// these blocks belong to.
     unsafe fn blocks(&self, offset: usize, count: usize) -> impl Iterator<Item = Self::Block<'_>>;
+
+    /// Asks the cache for the first block of the leaf with offset field
+    /// `offset` (a hint: any offset is safe).
+    #[inline(always)]
+    fn prefetch(&self, offset: usize) {
+        let _ = offset;
+    }
+}
+
+/// Asks the cache for the `lines` 64-byte lines from `p` (a hint: any
+/// address is safe, nothing is read).
+#[inline(always)]
+pub(crate) fn prefetch_lines(p: *const u8, lines: usize) {
+    #[cfg(target_arch = "x86_64")]
+    for l in 0..lines {
+        // SAFETY: a prefetch neither faults nor reads.
+        unsafe {
+            std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+                p.wrapping_add(64 * l).cast(),
+            )
+        };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (p, lines);
 }
 
 /// The whole layout's blocks.
@@ -235,6 +259,15 @@ impl Layout for Whole<'_> {
             block,
             run: offset + b * BLOCK_WIDTH,
         })
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, offset: usize) {
+        let block = self.0.as_ptr().wrapping_add(offset / BLOCK_WIDTH);
+        prefetch_lines(
+            block.cast(),
+            std::mem::size_of::<TriangleBlock>().div_ceil(64),
+        );
     }
 }
 
