@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 use sahara_kd::gamma;
 use sahara_kd::{BuildParams, Counters, NoCounters, Ray};
 
-use crate::accel::{Accel, RawHit};
+use crate::accel::{Accel, BatchBuffers, RawHit};
 use crate::distribution::Distribution1D;
 use crate::light::area::Emitter;
 use crate::light::{AreaLight, EnvLight, LightSample, LightSource};
@@ -68,6 +68,17 @@ pub(crate) struct ShadowQuery {
     pub time: f32,
     /// An instance that cannot block (the light's own surface).
     pub ignore: Option<u32>,
+}
+
+/// The buffers of the world's batch queries, kept from one call to the
+/// next.
+#[derive(Debug, Default)]
+pub struct WorldBuffers {
+    s: Vec<f32>,
+    raw: Vec<Option<RawHit>>,
+    rays: Vec<Ray>,
+    ignore: Vec<Option<u32>>,
+    accel: BatchBuffers,
 }
 
 /// Safety factor on the pbrt-style error bound (it is a first-order bound;
@@ -246,6 +257,56 @@ impl<'a> World<'a> {
         self.accel.closest_packet(rays, &s[..n], &mut raw[..n]);
         for ((o, h), &s) in out.iter_mut().zip(&raw[..n]).zip(&s[..n]) {
             *o = h.map(|h| self.surface(&h, s));
+        }
+    }
+
+    /// The closest surfaces along many rays, `rays[i]` at `times[i]`, in
+    /// one batch (see [`Accel::closest_batch`]); the same hits as
+    /// [`World::intersect`] ray by ray. `buf` holds buffers between calls.
+    pub fn intersect_batch(
+        &self,
+        rays: &[Ray],
+        times: &[f32],
+        out: &mut [Option<SurfaceHit>],
+        buf: &mut WorldBuffers,
+    ) {
+        buf.s.clear();
+        buf.s
+            .extend(times.iter().map(|&t| self.shutter_fraction(t)));
+        buf.raw.clear();
+        buf.raw.resize(rays.len(), None);
+        self.accel
+            .closest_batch(rays, &buf.s, &mut buf.raw, &mut buf.accel);
+        for ((o, h), &s) in out.iter_mut().zip(&buf.raw).zip(&buf.s) {
+            *o = h.map(|h| self.surface(&h, s));
+        }
+    }
+
+    /// [`World::visible`] of many queries, into `out[i]`, in one batch
+    /// (see [`Accel::occluded_batch`]).
+    pub(crate) fn visible_batch(
+        &self,
+        queries: &[ShadowQuery],
+        out: &mut [bool],
+        buf: &mut WorldBuffers,
+    ) {
+        if self.has_holes {
+            for (q, o) in queries.iter().zip(out) {
+                *o = self.visible_through_holes(q);
+            }
+            return;
+        }
+        buf.rays.clear();
+        buf.rays.extend(queries.iter().map(|q| q.ray));
+        buf.s.clear();
+        buf.s
+            .extend(queries.iter().map(|q| self.shutter_fraction(q.time)));
+        buf.ignore.clear();
+        buf.ignore.extend(queries.iter().map(|q| q.ignore));
+        self.accel
+            .occluded_batch(&buf.rays, &buf.s, &buf.ignore, out, &mut buf.accel);
+        for o in out.iter_mut() {
+            *o = !*o;
         }
     }
 

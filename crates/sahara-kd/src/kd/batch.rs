@@ -7,7 +7,7 @@ use super::KdTree;
 use crate::isect::Hit;
 use crate::leaf::layout::{Indexed, Layout, Whole};
 use crate::leaf::TriangleLeaves;
-use crate::math::{Ray, Triangle};
+use crate::math::{Aabb, Ray, Triangle};
 use crate::simd::{dispatch, level, Kernel};
 
 /// Rays per work item of [`KdTree::closest_hits`] and [`KdTree::any_hits`].
@@ -85,7 +85,7 @@ impl KdTree<Triangle> {
     fn interleaves(&self, rays: &[Ray], walk: BatchWalk) -> bool {
         !self.wide.is_empty()
             && match walk {
-                BatchWalk::Auto => !coherent(rays),
+                BatchWalk::Auto => self.nodes.len() >= SMALL_TREE && !coherent(rays, self.bounds),
                 BatchWalk::Binary => false,
                 BatchWalk::Wide => true,
             }
@@ -108,21 +108,29 @@ pub enum BatchWalk {
 /// Rays sampled to judge a batch's coherence.
 const SAMPLE: usize = 32;
 
-/// True when most neighbouring rays of the batch point within about 25
-/// degrees of each other (camera rays, shadow rays towards one light):
-/// the binary walk's branches are then predictable, and one ray at a time
-/// over the binary nodes beats the wide walk, whose every step computes
-/// all seven planes. Incoherent rays (bounces off diffuse surfaces,
-/// random rays) take the interleaved wide walk (figures in
-/// `docs/performance.md`).
-fn coherent(rays: &[Ray]) -> bool {
+/// Trees of fewer binary nodes take the binary walk: a walk of a few
+/// nodes costs less than the wide walk's set-up.
+const SMALL_TREE: usize = 64;
+
+/// True when most neighbouring rays of the batch start close together
+/// (within a hundredth of the tree's diagonal) and point within about 25
+/// degrees of each other (camera rays, shadow rays from neighbouring
+/// pixels towards one light): they walk the same cells, the binary
+/// walk's branches are predictable, and one ray at a time over the binary
+/// nodes beats the wide walk, whose every step computes all seven planes.
+/// Incoherent rays (bounces off diffuse surfaces, shadow rays from
+/// scattered points, random rays) take the interleaved wide walk (figures
+/// in `docs/performance.md`).
+fn coherent(rays: &[Ray], bounds: Aabb) -> bool {
+    let near = (bounds.max - bounds.min).length_squared() * 1e-4;
     let step = (rays.len() / SAMPLE).max(1);
     let (mut pairs, mut close) = (0, 0);
     for i in (1..rays.len()).step_by(step).take(SAMPLE) {
-        let (a, b) = (rays[i - 1].dir, rays[i].dir);
-        let d = a.dot(b);
+        let (a, b) = (&rays[i - 1], &rays[i]);
+        let d = a.dir.dot(b.dir);
         // cos > 0.9, without the square roots.
-        close += (d > 0.0 && d * d > 0.81 * a.length_squared() * b.length_squared()) as usize;
+        let aligned = d > 0.0 && d * d > 0.81 * a.dir.length_squared() * b.dir.length_squared();
+        close += (aligned && a.origin.distance_squared(b.origin) <= near) as usize;
         pairs += 1;
     }
     4 * close >= 3 * pairs
@@ -259,8 +267,8 @@ mod tests {
         }
     }
 
-    /// Camera-like rays count as coherent, bounce-like and random ones do
-    /// not.
+    /// Camera-like rays count as coherent; bounce-like, random ones and
+    /// parallel rays from scattered points do not.
     #[test]
     fn coherence_is_judged_by_neighbouring_directions() {
         let camera: Vec<Ray> = (0..256)
@@ -269,18 +277,24 @@ mod tests {
                 Ray::new(Vec3::ZERO, Vec3::new(x, y, 1.0))
             })
             .collect();
-        assert!(coherent(&camera));
+        let bounds = Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0));
+        assert!(coherent(&camera, bounds));
         let mut f = floats(3);
         let random: Vec<Ray> = (0..256)
             .map(|_| Ray::new(Vec3::ZERO, Vec3::new(f(), f(), f())))
             .collect();
-        assert!(!coherent(&random));
+        assert!(!coherent(&random, bounds));
         // Bounces off one plane: cosine-like directions about +z.
         let bounces: Vec<Ray> = (0..256)
             .map(|_| Ray::new(Vec3::ZERO, Vec3::new(f(), f(), f().abs() + 0.1)))
             .collect();
-        assert!(!coherent(&bounces));
-        assert!(coherent(&camera[..1]));
+        assert!(!coherent(&bounces, bounds));
+        assert!(coherent(&camera[..1], bounds));
+        // One direction from scattered points (shadow rays towards the sun).
+        let sun: Vec<Ray> = (0..256)
+            .map(|_| Ray::new(Vec3::new(f(), f(), f()) * 10.0, Vec3::new(0.3, 1.0, 0.2)))
+            .collect();
+        assert!(!coherent(&sun, bounds));
     }
 
     /// The batch queries put each ray's own answer in its own slot, across

@@ -17,6 +17,16 @@ use top_level::InstanceList;
 /// through one after another, without the top level.
 const PACKET_INSTANCES: usize = 8;
 
+/// The buffers of [`Accel::closest_batch`] and [`Accel::occluded_batch`],
+/// kept from one call to the next.
+#[derive(Debug, Default)]
+pub struct BatchBuffers {
+    rays: Vec<Ray>,
+    hits: Vec<Option<Hit>>,
+    blocked: Vec<bool>,
+    index: Vec<u32>,
+}
+
 /// A hit before shading: which instance and triangle, where.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RawHit {
@@ -181,6 +191,97 @@ impl Accel {
                     u: h.u,
                     v: h.v,
                 });
+            }
+        }
+    }
+
+    /// Closest hits of many rays, `rays[i]` at shutter fraction `s[i]`,
+    /// exactly as [`Accel::closest`] finds them: a scene of a few instances
+    /// traces all the rays through each instance's tree in turn as one
+    /// batch ([`KdTree::closest_hits_serial`], which walks incoherent rays
+    /// interleaved over the wide nodes), each ray's interval cut at its
+    /// closest hit so far; a scene of more instances, ray by ray through
+    /// the top level. `buf` holds the object-space rays between calls.
+    pub fn closest_batch(
+        &self,
+        rays: &[Ray],
+        s: &[f32],
+        out: &mut [Option<RawHit>],
+        buf: &mut BatchBuffers,
+    ) {
+        let n = rays.len();
+        assert!(s.len() == n && out.len() == n);
+        if self.placed.len() > PACKET_INSTANCES {
+            for ((r, &s), o) in rays.iter().zip(s).zip(out.iter_mut()) {
+                *o = self.closest(r, s, &mut NoCounters);
+            }
+            return;
+        }
+        out.fill(None);
+        for (i, p) in self.placed.iter().enumerate() {
+            let i = i as u32;
+            buf.rays.clear();
+            for k in 0..n {
+                let tmax = out[k].map_or(rays[k].tmax, |b| b.t);
+                buf.rays.push(Self::object_ray(p, &rays[k], s[k], tmax));
+            }
+            buf.hits.clear();
+            buf.hits.resize(n, None);
+            self.trees[p.mesh as usize].closest_hits_serial(&buf.rays, &mut buf.hits);
+            for (o, h) in out.iter_mut().zip(&buf.hits) {
+                let Some(h) = *h else { continue };
+                // The tie rule of `closest`: the lower instance index wins.
+                if o.is_some_and(|b| b.t < h.t || (b.t == h.t && b.instance <= i)) {
+                    continue;
+                }
+                *o = Some(RawHit {
+                    t: h.t,
+                    instance: i,
+                    tri: h.tri,
+                    u: h.u,
+                    v: h.v,
+                });
+            }
+        }
+    }
+
+    /// [`Accel::occluded`] of many rays, `rays[i]` at shutter fraction
+    /// `s[i]` ignoring instance `ignore[i]`, into `out[i]`: through each
+    /// instance's tree in turn as one batch of the rays not yet blocked
+    /// (see [`Accel::closest_batch`]).
+    pub fn occluded_batch(
+        &self,
+        rays: &[Ray],
+        s: &[f32],
+        ignore: &[Option<u32>],
+        out: &mut [bool],
+        buf: &mut BatchBuffers,
+    ) {
+        let n = rays.len();
+        assert!(s.len() == n && ignore.len() == n && out.len() == n);
+        if self.placed.len() > PACKET_INSTANCES {
+            for (k, o) in out.iter_mut().enumerate() {
+                *o = self.occluded(&rays[k], s[k], ignore[k]);
+            }
+            return;
+        }
+        out.fill(false);
+        for (i, p) in self.placed.iter().enumerate() {
+            let i = i as u32;
+            buf.rays.clear();
+            buf.index.clear();
+            for k in 0..n {
+                if !out[k] && ignore[k] != Some(i) {
+                    buf.index.push(k as u32);
+                    buf.rays
+                        .push(Self::object_ray(p, &rays[k], s[k], rays[k].tmax));
+                }
+            }
+            buf.blocked.clear();
+            buf.blocked.resize(buf.rays.len(), false);
+            self.trees[p.mesh as usize].any_hits_serial(&buf.rays, &mut buf.blocked);
+            for (&k, &b) in buf.index.iter().zip(&buf.blocked) {
+                out[k as usize] |= b;
             }
         }
     }

@@ -12,7 +12,7 @@ use sahara_kd::{Ray, PACKET16};
 
 use super::state::{Deferred, PathState};
 use super::{Context, Integrator, TraceStats};
-use crate::world::{SurfaceHit, World};
+use crate::world::{ShadowQuery, SurfaceHit, World, WorldBuffers};
 
 /// The buffers of a batch, kept from one batch to the next.
 #[derive(Default)]
@@ -31,6 +31,14 @@ pub(crate) struct Wavefront {
     visible: Vec<bool>,
     /// The order in which to trace a batch's rays.
     order: Vec<u32>,
+    /// A batch's rays, times and hits in that order.
+    ordered_rays: Vec<Ray>,
+    ordered_times: Vec<f32>,
+    ordered_hits: Vec<Option<SurfaceHit>>,
+    /// The round's shadow queries in that order, and their answers.
+    queries: Vec<ShadowQuery>,
+    answers: Vec<bool>,
+    world: WorldBuffers,
 }
 
 /// A stand-in ray for the ordering of contributions without a shadow ray.
@@ -103,14 +111,26 @@ impl Wavefront {
                 }
                 first = false;
             } else {
-                // Ray by ray, grouped by direction octant: rays that share
-                // their signs walk the tree's cells in the same order, which
-                // the branch predictor follows (figures in
-                // docs/performance.md).
+                // One batch, grouped by direction octant: the rays that
+                // share their signs walk the cells in the same order
+                // (figures in docs/performance.md).
                 octant_order(&self.rays, &mut self.order);
+                self.ordered_rays.clear();
+                self.ordered_times.clear();
                 for &j in &self.order {
-                    let j = j as usize;
-                    self.hits[j] = world.intersect(&self.rays[j], self.times[j]);
+                    self.ordered_rays.push(self.rays[j as usize]);
+                    self.ordered_times.push(self.times[j as usize]);
+                }
+                self.ordered_hits.clear();
+                self.ordered_hits.resize(self.order.len(), None);
+                world.intersect_batch(
+                    &self.ordered_rays,
+                    &self.ordered_times,
+                    &mut self.ordered_hits,
+                    &mut self.world,
+                );
+                for (&j, h) in self.order.iter().zip(&self.ordered_hits) {
+                    self.hits[j as usize] = *h;
                 }
             }
             // Every live path's step.
@@ -141,10 +161,19 @@ impl Wavefront {
                 self.rays.push(d.shadow.map_or(NO_RAY, |q| q.ray));
             }
             octant_order(&self.rays, &mut self.order);
+            self.queries.clear();
+            self.order
+                .retain(|&j| self.deferred[j as usize].shadow.is_some());
             for &j in &self.order {
                 if let Some(q) = &self.deferred[j as usize].shadow {
-                    self.visible[j as usize] = world.visible(q);
+                    self.queries.push(*q);
                 }
+            }
+            self.answers.clear();
+            self.answers.resize(self.queries.len(), true);
+            world.visible_batch(&self.queries, &mut self.answers, &mut self.world);
+            for (&j, &v) in self.order.iter().zip(&self.answers) {
+                self.visible[j as usize] = v;
             }
             for ((d, &i), &v) in self.deferred.iter().zip(&self.owner).zip(&self.visible) {
                 paths[i as usize].apply(&d.op, v);

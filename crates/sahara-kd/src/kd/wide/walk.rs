@@ -312,6 +312,27 @@ mod vector {
         t
     };
 
+    /// Per combination of plane signs, per level: the slots that lie
+    /// beyond their plane at that level (bit `c` for slot `c`).
+    static BEYOND: [[u8; 3]; 1 << PLANES] = {
+        let mut t = [[0u8; 3]; 1 << PLANES];
+        let mut neg = 0;
+        while neg < 1 << PLANES {
+            let mut c = 0;
+            while c < WIDTH {
+                let r = rank(neg, c);
+                let mut level = 0;
+                while level < 3 {
+                    t[neg][level] |= (((r >> (2 - level)) & 1) << c) as u8;
+                    level += 1;
+                }
+                c += 1;
+            }
+            neg += 1;
+        }
+        t
+    };
+
     /// For each mask of lanes, the lanes set, packed to the front
     /// (`vpcompressd` as a permutation, for AVX2).
     static PACK: [[u8; WIDTH]; 256] = {
@@ -354,6 +375,10 @@ mod vector {
         stack: &mut Stack,
         sp: usize,
     ) -> (usize, u32) {
+        if SIMD >= level::AVX512 {
+            // SAFETY: the caller's contract.
+            return unsafe { step512(n, r, t0, t1, closest, stack, sp) };
+        }
         unsafe {
             let planes = _mm256_load_ps(n.planes.as_ptr());
             let meta = _mm256_set1_epi32(n.meta() as i32);
@@ -437,6 +462,86 @@ mod vector {
                 _mm256_permutevar8x32_epi32(children, pick)
             };
             _mm256_storeu_si256(node_p, packed);
+            let top = _mm256_permutevar8x32_epi32(packed, _mm256_set1_epi32(k as i32 - 1));
+            (k, _mm256_cvtsi256_si32(top) as u32)
+        }
+    }
+
+    /// [`step`] with AVX-512's masked minimum and maximum, mask registers
+    /// and `vpcompressd` (the same values).
+    ///
+    /// # Safety
+    /// AVX-512 F + VL and the caller compiled for them; `sp + 8` entries
+    /// fit the stack.
+    #[inline(always)]
+    unsafe fn step512(
+        n: &WideNode,
+        r: &WideRay,
+        t0: f32,
+        t1: f32,
+        closest: f32,
+        stack: &mut Stack,
+        sp: usize,
+    ) -> (usize, u32) {
+        unsafe {
+            let planes = _mm256_load_ps(n.planes.as_ptr());
+            let meta = n.meta();
+            let axes = _mm256_and_si256(
+                _mm256_srlv_epi32(
+                    _mm256_set1_epi32(meta as i32),
+                    _mm256_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14),
+                ),
+                _mm256_set1_epi32(3),
+            );
+            let inv = _mm256_permutevar8x32_ps(_mm256_loadu_ps(r.inv.as_ptr()), axes);
+            let org = _mm256_permutevar8x32_ps(_mm256_loadu_ps(r.origin.as_ptr()), axes);
+            let tp = _mm256_mul_ps(_mm256_sub_ps(planes, org), inv);
+            let neg = (_mm256_movemask_ps(inv) & 0x7f) as usize;
+            let [b0, b1, b2] = BEYOND[neg];
+            let d0 = _mm256_permutevar8x32_ps(tp, _mm256_setzero_si256());
+            let d1 = _mm256_permutevar8x32_ps(tp, _mm256_setr_epi32(1, 1, 1, 1, 2, 2, 2, 2));
+            let d2 = _mm256_permutevar8x32_ps(tp, _mm256_setr_epi32(3, 3, 4, 4, 5, 5, 6, 6));
+            // Where the slot lies beyond the plane its entry may grow,
+            // elsewhere its exit may shrink; `max(d, bound)` and
+            // `min(d, bound)` return `bound` when `d` is NaN.
+            let mut lo = _mm256_set1_ps(t0);
+            let mut hi = _mm256_set1_ps(t1);
+            lo = _mm256_mask_max_ps(lo, b0, d0, lo);
+            hi = _mm256_mask_min_ps(hi, !b0, d0, hi);
+            lo = _mm256_mask_max_ps(lo, b1, d1, lo);
+            hi = _mm256_mask_min_ps(hi, !b1, d1, hi);
+            lo = _mm256_mask_max_ps(lo, b2, d2, lo);
+            hi = _mm256_mask_min_ps(hi, !b2, d2, hi);
+            // The widened interval of `kd::interval`: `lo >= 0` (it is at
+            // least the ray's `tmin`), so `lo - |lo| M` is `lo (1 - M)`,
+            // and `hi + |hi| M` compares as `hi (1 + M)` (for `hi < 0` both
+            // say the slot is behind the ray).
+            let wlo = _mm256_mul_ps(lo, _mm256_set1_ps(1.0 - MARGIN));
+            let whi = _mm256_mul_ps(hi, _mm256_set1_ps(1.0 + MARGIN));
+            let limit = _mm256_set1_ps(closest * (1.0 + MARGIN));
+            let visit = _mm256_cmp_ps_mask::<_CMP_LE_OQ>(wlo, whi)
+                & _mm256_cmp_ps_mask::<_CMP_LE_OQ>(lo, limit)
+                & (meta >> 16) as u8;
+            // Into front-to-back order, farthest first.
+            let order = lanes_of(&FAR_FIRST[neg]);
+            let flags = _mm256_maskz_mov_epi32(visit, _mm256_set1_epi32(-1));
+            let flags = _mm256_permutevar8x32_epi32(flags, order);
+            let m = _mm256_test_epi32_mask(flags, flags);
+            let children = _mm256_load_si256(n.children.as_ptr().cast());
+            let children = _mm256_permutevar8x32_epi32(children, order);
+            let lo = _mm256_permutevar8x32_ps(lo, order);
+            let hi = _mm256_permutevar8x32_ps(hi, order);
+            let packed = _mm256_maskz_compress_epi32(m, children);
+            _mm256_storeu_si256(stack.node.as_mut_ptr().add(sp).cast(), packed);
+            _mm256_storeu_ps(
+                stack.t0.as_mut_ptr().add(sp).cast(),
+                _mm256_maskz_compress_ps(m, lo),
+            );
+            _mm256_storeu_ps(
+                stack.t1.as_mut_ptr().add(sp).cast(),
+                _mm256_maskz_compress_ps(m, hi),
+            );
+            let k = m.count_ones() as usize;
             let top = _mm256_permutevar8x32_epi32(packed, _mm256_set1_epi32(k as i32 - 1));
             (k, _mm256_cvtsi256_si32(top) as u32)
         }
