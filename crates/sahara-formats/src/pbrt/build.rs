@@ -25,7 +25,7 @@ use sahara_render::{
 
 use super::description::{Description, Entity, MaterialRef, ShapeDecl, Xform};
 use super::lights::{add_light, area_emission};
-use super::materials::{map_material, Mapped};
+use super::materials::{blend, map_material, Mapped};
 use super::shapes::shape_geometry;
 use super::subdivision::smooth_normals;
 use super::textures::Textures;
@@ -130,8 +130,22 @@ impl Materials<'_> {
                 if depth >= MAX_MIX_DEPTH {
                     return Err(e.loc.error("mix materials nest too deep (a cycle?)"));
                 }
-                let pick = if amount < 0.5 { &names[0] } else { &names[1] };
-                self.named(scene, pick, &e.loc, w, depth + 1)
+                let a = self.named(scene, &names[0], &e.loc, w, depth + 1)?;
+                let b = self.named(scene, &names[1], &e.loc, w, depth + 1)?;
+                let t = amount.clamp(0.0, 1.0) as f32;
+                if let (Some(a), Some(b)) = (a, b) {
+                    let (ma, mb) = (&scene.materials[a as usize], &scene.materials[b as usize]);
+                    if let Some(m) = blend(ma, mb, t) {
+                        return Ok(Some(scene.add_material(m)));
+                    }
+                }
+                if t > 0.0 && t < 1.0 && a != b {
+                    w.add(
+                        "material 'mix': the blend is replaced by the material with the larger weight",
+                        &e.loc,
+                    );
+                }
+                Ok(if t < 0.5 { a } else { b })
             }
         }
     }

@@ -156,7 +156,7 @@ fn every_error_names_file_line_and_column() {
 fn unknown_parameters_and_unsupported_features_are_counted_warnings() {
     let text = "Shape \"sphere\" \"float radius\" 1 \"float wobble\" 3\nShape \"sphere\" \"float wobble\" 2\n\
                 Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\nShape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\n\
-                Material \"coateddiffuse\" Shape \"sphere\"\nLightSource \"point\"";
+                Material \"hair\" Shape \"sphere\"\nLightSource \"point\"";
     let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent")).unwrap();
     let w = &s.loaded.warnings;
     assert!(w.contains(&"t.pbrt:1:33: shape 'sphere': unknown parameter \"float wobble\", ignored (2 times; the first here)".to_owned()), "{w:#?}");
@@ -169,7 +169,7 @@ fn unknown_parameters_and_unsupported_features_are_counted_warnings() {
     );
     assert!(
         w.iter()
-            .any(|l| l.contains("material 'coateddiffuse': the coating")),
+            .any(|l| l.contains("material 'hair': not supported; replaced by a diffuse material")),
         "{w:#?}"
     );
     assert_eq!(s.loaded.scene.lights.len(), 1);
@@ -338,12 +338,12 @@ fn pbrt_and_toml_scenes_render_the_same_spheres_disc_light_and_camera() {
     let pbrt = "Scale -1 1 1\nLookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n\
                 LightSource \"point\" \"rgb I\" [5 5 5] \"point3 from\" [1 2 0]\n\
                 AttributeBegin Material \"diffuse\" \"rgb reflectance\" [0.5 0.2 0.2] Translate 0 0 5 Shape \"sphere\" AttributeEnd\n\
-                AttributeBegin Material \"conductor\" \"rgb reflectance\" [0.9 0.8 0.3] \"float roughness\" 0.0625 Translate 1.25 -0.5 4 Shape \"sphere\" \"float radius\" 0.5 AttributeEnd\n\
+                AttributeBegin Material \"conductor\" \"rgb eta\" [0.2 0.9 1.1] \"rgb k\" [3.9 2.4 2.1] \"float roughness\" 0.0625 Translate 1.25 -0.5 4 Shape \"sphere\" \"float radius\" 0.5 AttributeEnd\n\
                 AttributeBegin Material \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource \"diffuse\" \"rgb L\" [4 4 4]\n\
                 Transform [1 0 0 0  0 0 1 0  0 -1 0 0  0 3 5 1] Shape \"disk\" \"float radius\" 1 AttributeEnd\n";
     let toml = "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, 1]\nvfov = 40\n\
                 [[material]]\nname = \"red\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.2, 0.2]\n\
-                [[material]]\nname = \"gold\"\ntype = \"conductor\"\ncolor = [0.9, 0.8, 0.3]\nroughness = 0.5\n\
+                [[material]]\nname = \"gold\"\ntype = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.1]\nroughness = 0.5\n\
                 [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 5]\nradius = 1\nmaterial = \"red\"\n\
                 [[object]]\ntype = \"sphere\"\ncenter = [1.25, -0.5, 4]\nradius = 0.5\nmaterial = \"gold\"\n\
                 [[light]]\ntype = \"area\"\nshape = \"disc\"\ncenter = [0, 3, 5]\nnormal = [0, -1, 0]\nradius = 1\nradiance = [4, 4, 4]\n\
@@ -404,8 +404,19 @@ fn the_fuzz_seed_with_every_directive_loads() {
         .any(|m| m.is_emissive() && m.two_sided_emission));
     assert_eq!(s.crop_window, Some([0.0, 1.0, 0.0, 1.0]));
     assert!(w.iter().any(|l| l.contains("cropwindow")), "{w:#?}");
-    // The mix picks gold (amount 0.3 < 0.5): a conductor of gold's colour.
-    assert!(scene.materials.iter().any(|m| matches!(m.bsdf, sahara_render::Bsdf::Conductor { color, .. } if color.x > 0.9 && color.z < 0.45)));
+    // The mix picks gold (amount 0.3 < 0.5): the conductor of gold's
+    // named spectra, and says so.
+    let (eta, k) = (
+        Vec3::new(0.3267, 0.4015, 1.5758),
+        Vec3::new(36.1267, 2.3372, 1.7213),
+    );
+    assert!(scene.materials.iter().any(|m| matches!(m.bsdf,
+        sahara_render::Bsdf::ComplexConductor { eta: e, k: kk, roughness } if e == eta && kk == k && roughness == 0.1f32.sqrt().sqrt())));
+    assert!(
+        w.iter()
+            .any(|l| l.contains("material 'mix': the blend is replaced")),
+        "{w:#?}"
+    );
 }
 
 #[test]

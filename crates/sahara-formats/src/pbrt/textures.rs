@@ -45,6 +45,23 @@ impl Tint {
         }
     }
 
+    /// The texture a Sahara material holds for this tint: the image with
+    /// the colour multiplied in, a 1 x 1 image of a colour other than
+    /// white, or none for white.
+    pub(crate) fn baked(&self) -> Option<Arc<Texture>> {
+        match &self.image {
+            Some(t) if self.color == Vec3::ONE => Some(t.clone()),
+            Some(t) => {
+                let texels = t.texels.iter().map(|&v| v * self.color).collect();
+                let mut out = Texture::new(t.width, t.height, texels);
+                out.alpha = t.alpha.clone();
+                Some(Arc::new(out))
+            }
+            None if self.color == Vec3::ONE => None,
+            None => Some(Arc::new(Texture::new(1, 1, vec![self.color]))),
+        }
+    }
+
     /// The mean value (the image's mean texel times the colour).
     pub(crate) fn mean(&self) -> Vec3 {
         match &self.image {
@@ -108,6 +125,22 @@ pub(crate) fn rgb_of(
         SpectrumParam::Texture(_) => unreachable!("textures are looked up by the caller"),
     };
     Ok(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
+}
+
+/// The samples of a spectrum given as wavelength-value pairs or as a
+/// file, `None` for the other kinds (and for an unreadable file, which
+/// [`rgb_of`] reports).
+pub(crate) fn spectral_samples(
+    p: &SpectrumParam,
+    folders: &[std::path::PathBuf],
+) -> Option<Vec<(f64, f64)>> {
+    match p {
+        SpectrumParam::Sampled(pairs) => Some(pairs.clone()),
+        SpectrumParam::Named(name, _) if spectrum::named(name).is_none() => {
+            read_spectrum_file(&super::parser::resolve(folders, name))
+        }
+        _ => None,
+    }
 }
 
 /// A spectrum file: wavelength-value pairs, `#` comments.
