@@ -32,7 +32,7 @@ use super::textures::Textures;
 use super::warnings::Warnings;
 use super::PbrtScene;
 use crate::error::FormatError;
-use crate::scene_load::{shapes::add_placed_shape, FileSettings, LoadedScene};
+use crate::scene_load::{shapes::add_placed_shape, FileCrop, FileSettings, LoadedScene};
 
 /// Deepest chain of `mix` materials followed.
 const MAX_MIX_DEPTH: usize = 16;
@@ -351,18 +351,92 @@ fn camera(
     Ok((c, (open, close)))
 }
 
-/// Render settings, crop window and pixel bounds.
-type Settings = (FileSettings, Option<[f64; 4]>, Option<[i64; 4]>);
+/// The part of the image a film renders: its `cropwindow` (clamped to
+/// [0, 1], each pair in either order) or else its `pixelbounds` (clipped
+/// to the image), as pbrt-v4 decides; an empty one is an error.
+fn film_crop(
+    f: &Entity,
+    width: i64,
+    height: i64,
+    w: &mut Warnings,
+) -> Result<Option<FileCrop>, FormatError> {
+    let crop = match f.params.floats("cropwindow")? {
+        Some(&[a, b, c, d]) => {
+            if f.params.has("pixelbounds") {
+                w.add(
+                    "film: both 'cropwindow' and 'pixelbounds' given; the crop window is used",
+                    &f.loc,
+                );
+                f.params.get("pixelbounds");
+            }
+            let outside = [a, b, c, d].iter().any(|v| !(0.0..=1.0).contains(v));
+            if outside {
+                w.add("film 'cropwindow' reaches outside [0, 1]; clamped", &f.loc);
+            }
+            let c01 = |v: f64| v.clamp(0.0, 1.0);
+            Some(FileCrop::Fractions([
+                c01(a.min(b)),
+                c01(a.max(b)),
+                c01(c.min(d)),
+                c01(c.max(d)),
+            ]))
+        }
+        Some(v) => {
+            return Err(f
+                .params
+                .get("cropwindow")
+                .expect("present")
+                .error(format!("expected 4 values, found {}", v.len())))
+        }
+        None => match f.params.ints("pixelbounds")? {
+            Some(&[x0, x1, y0, y1]) => {
+                let b = [x0 as i64, x1 as i64, y0 as i64, y1 as i64];
+                if b[0] < 0 || b[2] < 0 || b[1] > width || b[3] > height {
+                    w.add(
+                        "film 'pixelbounds' reach outside the image; clipped",
+                        &f.loc,
+                    );
+                }
+                Some(FileCrop::Pixels(b))
+            }
+            Some(v) => {
+                return Err(f
+                    .params
+                    .get("pixelbounds")
+                    .expect("present")
+                    .error(format!("expected 4 values, found {}", v.len())))
+            }
+            None => None,
+        },
+    };
+    if let Some(c) = crop {
+        if c.window(width as u32, height as u32).is_empty() {
+            let name = if matches!(c, FileCrop::Fractions(_)) {
+                "cropwindow"
+            } else {
+                "pixelbounds"
+            };
+            return Err(f
+                .params
+                .get(name)
+                .expect("present")
+                .error(format!("holds no pixel of the {width}x{height} image")));
+        }
+    }
+    Ok(crop)
+}
 
-/// The render settings of `Film`, `Sampler`, `PixelFilter` and `Integrator`,
-/// and the crop window and pixel bounds the film asks for.
-fn settings(desc: &Description, folder: &Path, w: &mut Warnings) -> Result<Settings, FormatError> {
+/// The render settings of `Film`, `Sampler`, `PixelFilter` and `Integrator`.
+fn settings(
+    desc: &Description,
+    folder: &Path,
+    w: &mut Warnings,
+) -> Result<FileSettings, FormatError> {
     let mut width = 1280i64;
     let mut height = 720i64;
     let mut output = None;
     let mut exposure = 0.0f32;
     let mut crop = None;
-    let mut bounds = None;
     if let Some(f) = &desc.film {
         if !["rgb", "gbuffer", "spectral", "image"].contains(&f.kind.as_str()) {
             return Err(f.loc.error(format!("unknown film type '{}'", f.kind)));
@@ -392,34 +466,7 @@ fn settings(desc: &Description, folder: &Path, w: &mut Warnings) -> Result<Setti
             }
             output = Some(p);
         }
-        if let Some(c) = f.params.floats("cropwindow")? {
-            let [x0, x1, y0, y1] = c else {
-                return Err(f
-                    .params
-                    .get("cropwindow")
-                    .expect("present")
-                    .error("expected 4 values"));
-            };
-            crop = Some([*x0, *x1, *y0, *y1]);
-            w.add(
-                "film 'cropwindow' is recorded, but the whole image is rendered",
-                &f.loc,
-            );
-        }
-        if let Some(b) = f.params.ints("pixelbounds")? {
-            let [x0, x1, y0, y1] = b else {
-                return Err(f
-                    .params
-                    .get("pixelbounds")
-                    .expect("present")
-                    .error("expected 4 values"));
-            };
-            bounds = Some([*x0 as i64, *x1 as i64, *y0 as i64, *y1 as i64]);
-            w.add(
-                "film 'pixelbounds' is recorded, but the whole image is rendered",
-                &f.loc,
-            );
-        }
+        crop = film_crop(f, width, height, w)?;
         let iso = f.params.float("iso", 100.0)?;
         if iso > 0.0 {
             exposure = (iso / 100.0).log2() as f32;
@@ -610,22 +657,19 @@ fn settings(desc: &Description, folder: &Path, w: &mut Warnings) -> Result<Setti
             out
         }
     };
-    Ok((
-        FileSettings {
-            integrator,
-            sampler,
-            spp: spp as u32,
-            seed,
-            filter,
-            width: width as u32,
-            height: height as u32,
-            exposure,
-            tonemap: ToneMap::Clamp,
-            output,
-        },
+    Ok(FileSettings {
+        integrator,
+        sampler,
+        spp: spp as u32,
+        seed,
+        filter,
+        width: width as u32,
+        height: height as u32,
+        exposure,
+        tonemap: ToneMap::Clamp,
+        output,
         crop,
-        bounds,
-    ))
+    })
 }
 
 /// One shape's mesh in object space, oriented, or `None` if it is not rendered.
@@ -665,7 +709,7 @@ pub(crate) fn build(
     folder: &Path,
     w: &mut Warnings,
 ) -> Result<PbrtScene, FormatError> {
-    let (settings, crop_window, pixel_bounds) = settings(desc, folder, w)?;
+    let settings = settings(desc, folder, w)?;
     let aspect = f64::from(settings.width) / f64::from(settings.height);
     let (camera, shutter) = camera(desc, aspect, w)?;
     let mut scene = Scene::new(camera);
@@ -766,8 +810,6 @@ pub(crate) fn build(
             settings,
             warnings: Vec::new(),
         },
-        crop_window,
-        pixel_bounds,
     })
 }
 

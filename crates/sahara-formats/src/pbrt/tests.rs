@@ -263,6 +263,63 @@ fn object_instances_share_one_mesh() {
 }
 
 #[test]
+fn film_crop_windows_and_pixel_bounds_follow_pbrt_v4() {
+    use crate::scene_load::FileCrop;
+    use sahara_render::PixelWindow;
+    let film = |extra: &str| {
+        let text = format!(
+            "Film \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 50 {extra}\nWorldBegin"
+        );
+        parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent"))
+    };
+    let window = |extra: &str| {
+        let s = film(extra).unwrap();
+        let c = s.loaded.settings.crop.expect("a crop");
+        (c, c.window(100, 50), s.loaded.warnings)
+    };
+    // Pairs in either order; pixels from ceil(f * size).
+    let (c, win, w) = window("\"float cropwindow\" [0.5 0.25 0.1 0.3]");
+    assert_eq!(c, FileCrop::Fractions([0.25, 0.5, 0.1, 0.3]));
+    assert_eq!(
+        win,
+        PixelWindow {
+            x0: 25,
+            x1: 50,
+            y0: 5,
+            y1: 15
+        }
+    );
+    assert!(w.is_empty(), "{w:?}");
+    // Pixel bounds are clipped to the image, with a warning.
+    let (_, win, w) = window("\"integer pixelbounds\" [10 120 -3 20]");
+    assert_eq!(
+        win,
+        PixelWindow {
+            x0: 10,
+            x1: 100,
+            y0: 0,
+            y1: 20
+        }
+    );
+    assert!(
+        w[0].contains("film 'pixelbounds' reach outside the image; clipped"),
+        "{w:?}"
+    );
+    // Both: the crop window wins, as in pbrt-v4.
+    let (c, _, w) = window("\"float cropwindow\" [0 1 0 0.5] \"integer pixelbounds\" [0 10 0 10]");
+    assert_eq!(c, FileCrop::Fractions([0.0, 1.0, 0.0, 0.5]));
+    assert!(
+        w[0].contains("both 'cropwindow' and 'pixelbounds' given"),
+        "{w:?}"
+    );
+    // Empty: an error at the parameter.
+    let e = film("\"float cropwindow\" [0.2 0.2 0 1]")
+        .unwrap_err()
+        .to_string();
+    assert_eq!(e, "t.pbrt: line 1: column 63: parameter \"float cropwindow\": holds no pixel of the 100x50 image");
+}
+
+#[test]
 fn camera_fov_is_the_shorter_axis_and_settings_map() {
     let text = "Film \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 200 \"string filename\" \"out.exr\"\n\
                 Sampler \"halton\" \"integer pixelsamples\" 8\nIntegrator \"volpath\" \"integer maxdepth\" 7\n\
@@ -402,8 +459,10 @@ fn the_fuzz_seed_with_every_directive_loads() {
         .materials
         .iter()
         .any(|m| m.is_emissive() && m.two_sided_emission));
-    assert_eq!(s.crop_window, Some([0.0, 1.0, 0.0, 1.0]));
-    assert!(w.iter().any(|l| l.contains("cropwindow")), "{w:#?}");
+    assert_eq!(
+        s.loaded.settings.crop,
+        Some(crate::scene_load::FileCrop::Fractions([0.0, 1.0, 0.0, 1.0]))
+    );
     // The mix picks gold (amount 0.3 < 0.5): the conductor of gold's
     // named spectra, and says so.
     let (eta, k) = (
