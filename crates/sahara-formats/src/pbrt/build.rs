@@ -19,8 +19,8 @@ use std::path::Path;
 use glam::{Affine3A, DMat3, DMat4, DVec3, Mat4, Vec3};
 use sahara_render::mesh::SceneMesh;
 use sahara_render::{
-    Camera, Filter, Instance, Integrator, Material, Placement, SamplerKind, Scene, Shape, Srt,
-    ToneMap,
+    AlphaMode, Camera, Filter, Instance, Integrator, Material, Placement, SamplerKind, Scene,
+    Shape, Srt, ToneMap,
 };
 
 use super::description::{Description, Entity, MaterialRef, ShapeDecl, Xform};
@@ -28,7 +28,7 @@ use super::lights::{add_light, area_emission};
 use super::materials::{blend, map_material, Mapped};
 use super::shapes::shape_geometry;
 use super::subdivision::smooth_normals;
-use super::textures::Textures;
+use super::textures::{with_opacity, Textures};
 use super::warnings::Warnings;
 use super::PbrtScene;
 use crate::error::FormatError;
@@ -57,9 +57,46 @@ struct Materials<'a> {
     anonymous: HashMap<usize, Option<u32>>,
     named: HashMap<String, Option<u32>>,
     default: Option<u32>,
+    /// Materials cut by a shape's `alpha`: (material, alpha) to the cut one.
+    cut: HashMap<(u32, String), u32>,
 }
 
 impl Materials<'_> {
+    /// `material` cut by shape `e`'s `alpha`, pbrt-v4's stochastic
+    /// transparency (a ray meets the surface with probability `alpha`);
+    /// `None` if the shape is not there at all (alpha 0).
+    fn cut(
+        &mut self,
+        scene: &mut Scene,
+        material: u32,
+        e: &Entity,
+        w: &mut Warnings,
+    ) -> Result<Option<u32>, FormatError> {
+        let Some(p) = e.params.get("alpha") else {
+            return Ok(Some(material));
+        };
+        let key = (material, format!("{:?}", p.values));
+        if let Some(&m) = self.cut.get(&key) {
+            e.params.get("alpha");
+            return Ok(Some(m));
+        }
+        let alpha = self.textures.float_tint(e, "alpha", 1.0, w)?;
+        let factor = alpha.color.x.clamp(0.0, 1.0);
+        if alpha.image.is_none() && factor >= 1.0 {
+            return Ok(Some(material));
+        }
+        if alpha.image.is_none() && factor <= 0.0 {
+            return Ok(None);
+        }
+        let mut m = scene.materials[material as usize].clone();
+        if let Some(img) = &alpha.image {
+            m.texture = Some(with_opacity(m.texture.as_ref(), img));
+        }
+        let id = scene.add_material(m.with_alpha(AlphaMode::Blend, factor));
+        self.cut.insert(key, id);
+        Ok(Some(id))
+    }
+
     /// The Sahara material of `r`, or `None` for pbrt's `interface`.
     fn resolve(
         &mut self,
@@ -719,6 +756,7 @@ pub(crate) fn build(
         anonymous: HashMap::new(),
         named: HashMap::new(),
         default: None,
+        cut: HashMap::new(),
     };
     for (what, loc) in &desc.ignored {
         w.add(format!("{what} is not supported; ignored"), loc);
@@ -731,6 +769,10 @@ pub(crate) fn build(
                 "shapes with an 'interface' material (no surface) are not rendered",
                 &s.entity.loc,
             );
+            shape_geometry(&s.entity, w)?;
+            continue;
+        };
+        let Some(material) = materials.cut(&mut scene, material, &s.entity, w)? else {
             shape_geometry(&s.entity, w)?;
             continue;
         };
@@ -842,6 +884,10 @@ fn object_mesh(
                 "shapes with an 'interface' material (no surface) are not rendered",
                 &s.entity.loc,
             );
+            shape_geometry(&s.entity, w)?;
+            continue;
+        };
+        let Some(material) = materials.cut(scene, material, &s.entity, w)? else {
             shape_geometry(&s.entity, w)?;
             continue;
         };

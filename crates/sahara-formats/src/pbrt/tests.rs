@@ -505,3 +505,110 @@ fn an_octahedral_environment_map_becomes_a_lat_long_map_through_the_light_transf
     assert_eq!(at(Vec3::new(-1.0, 0.3, 0.0)), Vec3::ZERO);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A little-endian PFM of `w x h` RGB texels given from the top row.
+fn write_pfm(path: &Path, w: u32, h: u32, rgb_top_down: &[[f32; 3]]) {
+    let mut b = format!("PF\n{w} {h}\n-1\n").into_bytes();
+    for y in (0..h as usize).rev() {
+        for px in &rgb_top_down[y * w as usize..(y + 1) * w as usize] {
+            px.iter().for_each(|v| b.extend(v.to_le_bytes()));
+        }
+    }
+    std::fs::write(path, b).unwrap();
+}
+
+/// The texture of the material of the one shape of `text`.
+fn shape_material(dir: &Path, text: &str) -> (sahara_render::Material, Vec<String>) {
+    std::fs::write(dir.join("s.pbrt"), text).unwrap();
+    let s = load_pbrt(&dir.join("s.pbrt")).unwrap();
+    let id = s.loaded.scene.instances[0].material.unwrap();
+    (
+        s.loaded.scene.materials[id as usize].clone(),
+        s.loaded.warnings,
+    )
+}
+
+#[test]
+fn tga_and_pfm_imagemaps_load_and_textures_combine_texel_by_texel() {
+    let dir = folder("imagemaps");
+    // A 2x1 TGA, 24-bit, top-down: red, then grey 128.
+    let mut tga = vec![0u8, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 1, 0, 24, 0x20];
+    tga.extend([0, 0, 255, 128, 128, 128]);
+    std::fs::write(dir.join("a.tga"), &tga).unwrap();
+    write_pfm(
+        &dir.join("b.pfm"),
+        2,
+        1,
+        &[[0.0, 0.0, 1.0], [4.0, 4.0, 4.0]],
+    );
+    let quad = "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"point2 uv\" [0 0 1 0 0 1 1 1]";
+    let srgb = crate::srgb::srgb8_to_linear;
+    let (m, w) = shape_material(
+        &dir,
+        &format!("Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"a.tga\"\n\
+                  Texture \"b\" \"spectrum\" \"imagemap\" \"string filename\" \"b.pfm\"\n\
+                  Texture \"m\" \"spectrum\" \"mix\" \"texture tex1\" \"a\" \"texture tex2\" \"b\" \"float amount\" 0.25\n\
+                  Material \"diffuse\" \"texture reflectance\" \"m\"\n{quad}"),
+    );
+    assert!(w.is_empty(), "{w:?}");
+    let t = m.texture.expect("the mixed image");
+    assert_eq!((t.width, t.height), (2, 1));
+    assert_eq!(t.texels[0], Vec3::new(0.75, 0.0, 0.25));
+    assert_eq!(t.texels[1], Vec3::splat(0.75 * srgb(128) + 1.0));
+    // "linear": the 8-bit values as they are stored.
+    let (m, _) = shape_material(
+        &dir,
+        &format!("Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"a.tga\" \"string encoding\" \"linear\"\n\
+                  Material \"diffuse\" \"texture reflectance\" \"a\"\n{quad}"),
+    );
+    assert_eq!(m.texture.unwrap().texels[1], Vec3::splat(128.0 / 255.0));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn alpha_textures_cut_shapes_out() {
+    let dir = folder("alpha");
+    let quad = "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"point2 uv\" [0 0 1 0 0 1 1 1]";
+    // A float checkerboard of 2 x 1 checks: opaque in u < 1/2 (tex1 = 1).
+    let (m, w) = shape_material(
+        &dir,
+        &format!("Texture \"c\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 1\n\
+                  Material \"diffuse\" \"rgb reflectance\" [0.2 0.4 0.6]\n\
+                  AttributeBegin {quad} \"texture alpha\" \"c\" AttributeEnd\n"),
+    );
+    assert!(w.is_empty(), "{w:?}");
+    assert_eq!(m.alpha_mode, sahara_render::AlphaMode::Blend);
+    for u in [0.0, 0.5, 0.999] {
+        let at = glam::Vec2::new(0.1, 0.5);
+        assert!(!m.passes(at, u), "opaque check");
+        let hole = glam::Vec2::new(0.9, 0.5);
+        assert!(m.passes(hole, u), "the hole");
+    }
+    assert_eq!(m.tint(glam::Vec2::new(0.9, 0.5)), Vec3::ONE);
+    // An RGBA TGA as a float texture is its alpha; the colour texture keeps its texels.
+    let mut tga = vec![0u8, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 1, 0, 32, 0x28];
+    tga.extend([0, 0, 255, 255, 0, 255, 0, 0]);
+    std::fs::write(dir.join("leaf.tga"), &tga).unwrap();
+    let (m, _) = shape_material(
+        &dir,
+        &format!(
+            "Texture \"leaf\" \"spectrum\" \"imagemap\" \"string filename\" \"leaf.tga\"\n\
+                  Texture \"cut\" \"float\" \"imagemap\" \"string filename\" \"leaf.tga\"\n\
+                  Material \"diffuse\" \"texture reflectance\" \"leaf\"\n\
+                  AttributeBegin {quad} \"texture alpha\" \"cut\" AttributeEnd\n"
+        ),
+    );
+    let t = m.texture.as_ref().unwrap();
+    assert_eq!(t.alpha.as_deref(), Some(&[1.0, 0.0][..]));
+    assert_eq!(t.texels[0], Vec3::new(1.0, 0.0, 0.0));
+    // A constant alpha of 0 removes the shape; 0.5 is half transparent.
+    std::fs::write(dir.join("s.pbrt"), format!("AttributeBegin {quad} \"float alpha\" 0 AttributeEnd\nAttributeBegin {quad} \"float alpha\" 0.5 AttributeEnd\n")).unwrap();
+    let s = load_pbrt(&dir.join("s.pbrt")).unwrap();
+    assert_eq!(s.loaded.scene.instances.len(), 1);
+    let m = &s.loaded.scene.materials[s.loaded.scene.instances[0].material.unwrap() as usize];
+    assert_eq!(
+        (m.alpha_mode, m.alpha),
+        (sahara_render::AlphaMode::Blend, 0.5)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
