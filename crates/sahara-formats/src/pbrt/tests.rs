@@ -572,9 +572,11 @@ fn alpha_textures_cut_shapes_out() {
     // A float checkerboard of 2 x 1 checks: opaque in u < 1/2 (tex1 = 1).
     let (m, w) = shape_material(
         &dir,
-        &format!("Texture \"c\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 1\n\
+        &format!(
+            "Texture \"c\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 1\n\
                   Material \"diffuse\" \"rgb reflectance\" [0.2 0.4 0.6]\n\
-                  AttributeBegin {quad} \"texture alpha\" \"c\" AttributeEnd\n"),
+                  AttributeBegin {quad} \"texture alpha\" \"c\" AttributeEnd\n"
+        ),
     );
     assert!(w.is_empty(), "{w:?}");
     assert_eq!(m.alpha_mode, sahara_render::AlphaMode::Blend);
