@@ -388,6 +388,12 @@ fn camera(
     Ok((c, (open, close)))
 }
 
+/// The error of film parameter `name` holding `found` values, not 4.
+fn not_four(f: &Entity, name: &str, found: usize) -> FormatError {
+    let p = f.params.get(name).expect("present");
+    p.error(format!("expected 4 values, found {found}"))
+}
+
 /// The part of the image a film renders: its `cropwindow` (clamped to
 /// [0, 1], each pair in either order) or else its `pixelbounds` (clipped
 /// to the image), as pbrt-v4 decides; an empty one is an error.
@@ -418,13 +424,7 @@ fn film_crop(
                 c01(c.max(d)),
             ]))
         }
-        Some(v) => {
-            return Err(f
-                .params
-                .get("cropwindow")
-                .expect("present")
-                .error(format!("expected 4 values, found {}", v.len())))
-        }
+        Some(v) => return Err(not_four(f, "cropwindow", v.len())),
         None => match f.params.ints("pixelbounds")? {
             Some(&[x0, x1, y0, y1]) => {
                 let b = [x0 as i64, x1 as i64, y0 as i64, y1 as i64];
@@ -436,13 +436,7 @@ fn film_crop(
                 }
                 Some(FileCrop::Pixels(b))
             }
-            Some(v) => {
-                return Err(f
-                    .params
-                    .get("pixelbounds")
-                    .expect("present")
-                    .error(format!("expected 4 values, found {}", v.len())))
-            }
+            Some(v) => return Err(not_four(f, "pixelbounds", v.len())),
             None => None,
         },
     };

@@ -614,3 +614,49 @@ fn alpha_textures_cut_shapes_out() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_fuzz_seed_with_every_material_warns_only_of_what_it_approximates() {
+    use sahara_render::Bsdf;
+    let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds/pbrt/materials.pbrt");
+    let text = std::fs::read(&seed).unwrap();
+    let s = parse_pbrt(&text, "seed.pbrt", Path::new("/nonexistent")).unwrap();
+    let w = &s.loaded.warnings;
+    // The approximations, one line each: nothing else is lost.
+    let kinds: Vec<&str> = w
+        .iter()
+        .map(|l| l.split(": ").nth(1).unwrap_or(""))
+        .collect();
+    assert_eq!(
+        kinds,
+        [
+            "material 'coatedconductor'",
+            "material 'plastic'",
+            "material 'substrate'",
+            "material 'uber'",
+            "material 'translucent'",
+            "material 'dielectric'"
+        ],
+        "{w:#?}"
+    );
+    let m = &s.loaded.scene.materials;
+    let has = |f: &dyn Fn(&sahara_render::Material) -> bool| m.iter().any(f);
+    assert!(has(
+        &|m| matches!(m.bsdf, Bsdf::CoatedDiffuse { ior, .. } if ior == 1.4)
+            && m.alpha_mode == sahara_render::AlphaMode::Blend
+    ));
+    assert!(has(&|m| matches!(m.bsdf, Bsdf::ThinDielectric { .. })));
+    assert!(has(
+        &|m| matches!(m.bsdf, Bsdf::Dielectric { ior } if ior == 1.6727)
+    ));
+    assert!(has(
+        &|m| matches!(m.bsdf, Bsdf::Diffuse { albedo } if albedo == Vec3::new(0.75, 0.0, 0.25))
+    ));
+    // The sampled conductor spectra were fitted: eta between the samples' extremes.
+    assert!(has(
+        &|m| matches!(m.bsdf, Bsdf::ComplexConductor { eta, roughness, .. }
+        if eta.min_element() >= 0.2 && eta.max_element() <= 0.5 && roughness > 0.4)
+    ));
+    // 13 shapes: the sphere of alpha 0 is not there.
+    assert_eq!(s.loaded.scene.instances.len(), 12);
+}
