@@ -213,7 +213,23 @@ def png(width, height, colour_type, depth, rows):
     return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
 
 
+def tga(kind, width, height, depth, descriptor, data, cmap=b"", cmap_bits=0, footer=True):
+    header = struct.pack("<BBBHHBHHHHBB", 0, 1 if cmap else 0, kind, 0, len(cmap) // max(cmap_bits // 8, 1),
+                         cmap_bits, 0, 0, width, height, depth, descriptor)
+    tail = b"\0" * 8 + b"TRUEVISION-XFILE.\0" if footer else b""
+    return header + cmap + data + tail
+
+
 def image_seeds():
+    # TGA: 24-bit raw bottom-up, 32-bit run-length top-down with alpha,
+    # colour-mapped, 16-bit grey with alpha.
+    put("image", "rgb24.tga", tga(2, 2, 2, 24, 0, bytes(range(12))))
+    put("image", "rle32.tga", tga(10, 3, 2, 32, 0x28, bytes([0x82, 1, 2, 3, 128, 0x02, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0, 0, 0])))
+    put("image", "mapped.tga", tga(1, 2, 1, 8, 0, bytes([0, 1]), cmap=bytes([255, 0, 0, 0, 255, 0]), cmap_bits=24))
+    put("image", "grey16.tga", tga(3, 1, 2, 16, 0, bytes([10, 255, 200, 0])))
+    # PFM: colour little-endian, grey big-endian with a scale.
+    put("image", "rgb.pfm", b"PF\n2 1\n-1.0\n" + struct.pack("<6f", 0.5, 1, 2, 0, 0.25, 8))
+    put("image", "grey.pfm", b"Pf\n1 2\n2.0\n" + struct.pack(">2f", 0.5, 3))
     put("image", "rgb.png", png(2, 2, 2, 8, [bytes([255, 0, 0, 0, 255, 0]), bytes([0, 0, 255, 9, 9, 9])]))
     put("image", "grey16.png", png(3, 1, 0, 16, [struct.pack(">3H", 0, 30000, 65535)]))
     put("image", "rgba.png", png(1, 2, 6, 8, [bytes([1, 2, 3, 4]), bytes([5, 6, 7, 8])]))

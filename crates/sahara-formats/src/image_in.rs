@@ -1,10 +1,15 @@
 //! Image readers for textures and environment maps: linear float RGB out.
 //!
-//! PNG and JPEG are taken as sRGB-encoded and converted to linear; Radiance
-//! HDR and OpenEXR are linear already. The format is recognised by the file's
-//! first bytes, not its extension. Grey images are expanded to RGB, alpha is
-//! dropped. The size in the header is checked against [`MAX_IMAGE_SIDE`] and
-//! [`MAX_IMAGE_PIXELS`] before any pixel memory is allocated.
+//! PNG, JPEG and 8-bit TGA are taken as sRGB-encoded and converted to
+//! linear; Radiance HDR, OpenEXR and PFM are linear already. The format is
+//! recognised by the file's first bytes (TGA, which has no signature, by
+//! its footer or a `.tga` name). Grey images are expanded to RGB; alpha is
+//! kept by [`decode_image`] for PNG and TGA. The size in the header is
+//! checked against [`MAX_IMAGE_SIDE`] and [`MAX_IMAGE_PIXELS`] before any
+//! pixel memory is allocated.
+
+mod pfm;
+mod tga;
 
 use std::fs;
 use std::io::Cursor;
@@ -22,15 +27,57 @@ pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
 /// An image as linear float RGB: width, height, `width * height * 3` values row-major from the top left.
 pub type RgbF32Image = (u32, u32, Vec<f32>);
 
-/// Loads a PNG, JPEG, HDR or EXR file as linear float RGB (`(width, height, rgb)`).
+/// A decoded image: linear float RGB and, if it has one, its alpha channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width * height * 3` values, row-major from the top left.
+    pub rgb: Vec<f32>,
+    /// `width * height` opacities in `[0, 1]`, if the file has alpha.
+    pub alpha: Option<Vec<f32>>,
+}
+
+/// Loads a PNG, JPEG, HDR, EXR, TGA or PFM file as linear float RGB (`(width, height, rgb)`).
 pub fn load_rgb_f32(path: &Path) -> Result<RgbF32Image, FormatError> {
+    let i = load_image(path)?;
+    Ok((i.width, i.height, i.rgb))
+}
+
+/// Loads an image file with its alpha channel (PNG and TGA have one).
+pub fn load_image(path: &Path) -> Result<Image, FormatError> {
     let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
-    decode_rgb_f32(&bytes, &path.display().to_string())
+    decode_image(&bytes, &path.display().to_string())
 }
 
 /// Decodes an image held in memory as linear float RGB; `name` is used in error messages.
 pub fn decode_rgb_f32(bytes: &[u8], name: &str) -> Result<RgbF32Image, FormatError> {
-    decode(bytes, name).map_err(crate::scene_file::one_line)
+    let i = decode_image(bytes, name)?;
+    Ok((i.width, i.height, i.rgb))
+}
+
+/// Decodes an image held in memory with its alpha channel; `name` is used
+/// in error messages (and recognises a TGA file by its extension).
+pub fn decode_image(bytes: &[u8], name: &str) -> Result<Image, FormatError> {
+    let image = if pfm::is_pfm(bytes) {
+        pfm::decode(bytes, name)
+    } else if tga::is_tga(bytes, name) {
+        tga::decode(bytes, name)
+    } else {
+        decode(bytes, name).map(|(width, height, rgb)| Image {
+            width,
+            height,
+            rgb,
+            alpha: None,
+        })
+    };
+    let mut image = image.map_err(crate::scene_file::one_line)?;
+    if image.alpha.is_none() && bytes.starts_with(b"\x89PNG") {
+        image.alpha = decode_png_alpha(bytes);
+    }
+    Ok(image)
 }
 
 fn decode(bytes: &[u8], name: &str) -> Result<RgbF32Image, FormatError> {
@@ -43,7 +90,7 @@ fn decode(bytes: &[u8], name: &str) -> Result<RgbF32Image, FormatError> {
     let format = reader.format().ok_or_else(|| {
         FormatError::in_file(
             name,
-            "not a PNG, JPEG, Radiance HDR or OpenEXR image (unrecognised first bytes)",
+            "not a PNG, JPEG, Radiance HDR, OpenEXR, TGA or PFM image (unrecognised first bytes)",
         )
     })?;
     let (width, height) = image::ImageReader::with_format(Cursor::new(bytes), format)
@@ -104,7 +151,7 @@ pub fn decode_png_alpha(bytes: &[u8]) -> Option<Vec<f32>> {
 }
 
 /// Rejects empty images and images beyond the size limits.
-fn check_size(name: &str, width: u32, height: u32) -> Result<(), FormatError> {
+pub(crate) fn check_size(name: &str, width: u32, height: u32) -> Result<(), FormatError> {
     if width == 0 || height == 0 {
         return Err(FormatError::in_file(
             name,

@@ -36,7 +36,7 @@ use crate::scene_file::{
 };
 
 pub use placement::{placement, srt};
-pub use settings::FileSettings;
+pub use settings::{FileCrop, FileSettings};
 
 /// A scene ready to render, with how its file asks for it to be rendered.
 #[derive(Clone, Debug)]

@@ -22,8 +22,14 @@ pub struct Piece {
     pub label: String,
 }
 
-/// The piece the options ask for (None: the whole frame, a plain image).
-pub fn plan(args: &RenderArgs, settings: &RenderSettings) -> Result<Option<Piece>> {
+/// The piece the options ask for (None: a plain image). `file_window` is
+/// the crop the scene file asks for: the pixels `--part` divides unless
+/// `--crop` names others.
+pub fn plan(
+    args: &RenderArgs,
+    settings: &RenderSettings,
+    file_window: Option<PixelWindow>,
+) -> Result<Option<Piece>> {
     if args.part.is_none() && args.crop.is_none() && args.samples.is_none() {
         if args.skip_existing {
             bail!("--skip-existing applies to parts (--part, --crop or --samples)");
@@ -40,7 +46,7 @@ pub fn plan(args: &RenderArgs, settings: &RenderSettings) -> Result<Option<Piece
     let total = settings.spp * settings.passes;
     let mut window = match args.crop {
         Some(f) => crop(w, h, f),
-        None => PixelWindow::full(w, h),
+        None => file_window.unwrap_or_else(|| PixelWindow::full(w, h)),
     };
     let mut samples = match &args.samples {
         Some(r) if r.end > total => bail!(

@@ -54,7 +54,23 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         tonemap,
         output,
     } = resolve(args, file.as_ref(), &name)?;
-    let piece = part::plan(args, &settings)?;
+    // The scene file's crop (pbrt's film `cropwindow` / `pixelbounds`):
+    // a plain render is an image of those pixels, as pbrt writes it.
+    let file_window = file
+        .as_ref()
+        .and_then(|f| f.crop)
+        .map(|c| c.window(settings.width, settings.height));
+    if file_window.is_some_and(|w| w.is_empty()) {
+        bail!(
+            "the scene file's crop window holds no pixel of the {}x{} image",
+            settings.width,
+            settings.height
+        );
+    }
+    let piece = part::plan(args, &settings, file_window)?;
+    if piece.is_none() {
+        settings.window = file_window;
+    }
     if piece.is_some() && !is_exr(&output) {
         bail!(
             "{}: a part (--part, --crop, --samples) is written as OpenEXR: name a .exr file",
@@ -71,11 +87,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .iter()
         .map(|m| m.mesh.indices.len() as u64)
         .sum();
-    let (film_w, film_h) = piece
-        .as_ref()
-        .map_or((settings.width, settings.height), |p| {
-            (p.window.width().max(1), p.window.height().max(1))
-        });
+    let (film_w, film_h) = match (&piece, settings.window) {
+        (Some(p), _) => (p.window.width().max(1), p.window.height().max(1)),
+        (None, Some(w)) => (w.width(), w.height()),
+        (None, None) => (settings.width, settings.height),
+    };
     memory::check_fits(triangles, film_w, film_h, memory::available_bytes())?;
     // Any aspect ratio: the vertical field of view is kept.
     scene.camera.aspect = settings.width as f32 / settings.height as f32;
@@ -131,6 +147,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             p.window.pixels(),
             p.samples.start,
             p.samples.end
+        );
+    }
+    if let (None, Some(w)) = (&piece, settings.window) {
+        eprintln!(
+            "crop window of the scene file: pixels {w}, written as a {}x{} image",
+            w.width(),
+            w.height()
         );
     }
     eprintln!(
@@ -227,7 +250,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     output_settings.write(&result, partial, true)?;
     let secs = s.render_time.as_secs_f64();
-    let pixels = u64::from(settings.width) * u64::from(settings.height);
+    let pixels = u64::from(result.film.width) * u64::from(result.film.height);
     eprintln!(
         "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {:.3} CPU s, {} rays, {:.2} Mrays/s{}",
         if partial {
@@ -284,7 +307,7 @@ impl Output<'_> {
         } else if matches!(settings.integrator, Integrator::Depth) {
             // Raw distances would be a flat white or grey: map the nearest
             // to the farthest hit onto white to dark grey (EXR keeps them raw).
-            let range = depth_range(&rgb, settings.width, settings.height);
+            let range = depth_range(&rgb, result.film.width, result.film.height);
             if log {
                 match range {
                     Some((near, far)) => eprintln!(
@@ -303,10 +326,12 @@ impl Output<'_> {
         } else {
             Pixels::Rgb8(&rgb8)
         };
+        // The film is the window's when the scene file crops the image.
+        let (width, height) = (result.film.width, result.film.height);
         let finished = if s.passes == 0 {
             s.first_pass_pixels
         } else {
-            u64::from(settings.width) * u64::from(settings.height)
+            u64::from(width) * u64::from(height)
         };
         let metadata = vec![
             (
@@ -318,15 +343,9 @@ impl Output<'_> {
             ("sahara:partial".to_string(), partial.to_string()),
             ("sahara:finished_pixels".to_string(), finished.to_string()),
         ];
-        write_image(
-            self.path,
-            settings.width,
-            settings.height,
-            pixels,
-            &metadata,
-        )
-        .map_err(|e| anyhow!("{e}"))
-        .context("cannot write the output image")
+        write_image(self.path, width, height, pixels, &metadata)
+            .map_err(|e| anyhow!("{e}"))
+            .context("cannot write the output image")
     }
 }
 

@@ -182,6 +182,7 @@ mod tests {
             exposure: 1.5,
             tonemap: ToneMap::Filmic,
             output: Some(PathBuf::from("out/x.exr")),
+            crop: None,
         }
     }
 

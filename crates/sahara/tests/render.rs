@@ -662,3 +662,50 @@ fn a_pbrt_scene_renders_with_its_film_and_its_warnings_counted() {
     );
     let _ = fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_pbrt_crop_window_renders_those_pixels_of_the_whole_frame() {
+    let dir = temp_dir("pbrt-crop");
+    let frame = "LookAt 0 0 3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\n\
+                 Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 12 CROP\n\
+                 Sampler \"independent\" \"integer pixelsamples\" 4\nWorldBegin\n\
+                 LightSource \"infinite\" \"rgb L\" [1 1 1]\n\
+                 Material \"diffuse\" \"rgb reflectance\" [0.7 0.3 0.2] Shape \"sphere\"\n";
+    let render = |name: &str, crop: &str| {
+        let scene = dir.join(format!("{name}.pbrt"));
+        fs::write(&scene, frame.replace("CROP", crop)).unwrap();
+        let exr = dir.join(format!("{name}.exr"));
+        let out = sahara(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            exr.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        (load_rgb_f32(&exr).unwrap(), stderr(&out))
+    };
+    let ((w, h, whole), _) = render("whole", "");
+    assert_eq!((w, h), (16, 12));
+    // pbrt-v4's rule: x from ceil(0.3 * 16) = 5 to ceil(0.8 * 16) = 13,
+    // y from ceil(0.25 * 12) = 3 to ceil(0.6 * 12) = 8.
+    for (name, crop) in [
+        ("crop", "\"float cropwindow\" [0.3 0.8 0.25 0.6]"),
+        ("bounds", "\"integer pixelbounds\" [5 13 3 8]"),
+    ] {
+        let ((cw, ch, part), err) = render(name, crop);
+        assert_eq!((cw, ch), (8, 5), "{name}");
+        assert!(
+            err.contains(
+                "crop window of the scene file: pixels x 5..13, y 3..8, written as a 8x5 image"
+            ),
+            "{err}"
+        );
+        for y in 0..5usize {
+            for x in 0..8usize {
+                let (i, j) = (3 * (y * 8 + x), 3 * ((y + 3) * 16 + x + 5));
+                assert_eq!(part[i..i + 3], whole[j..j + 3], "{name}: pixel {x}, {y}");
+            }
+        }
+    }
+    let _ = fs::remove_dir_all(&dir);
+}

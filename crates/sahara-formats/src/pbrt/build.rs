@@ -19,20 +19,20 @@ use std::path::Path;
 use glam::{Affine3A, DMat3, DMat4, DVec3, Mat4, Vec3};
 use sahara_render::mesh::SceneMesh;
 use sahara_render::{
-    Camera, Filter, Instance, Integrator, Material, Placement, SamplerKind, Scene, Shape, Srt,
-    ToneMap,
+    AlphaMode, Camera, Filter, Instance, Integrator, Material, Placement, SamplerKind, Scene,
+    Shape, Srt, ToneMap,
 };
 
 use super::description::{Description, Entity, MaterialRef, ShapeDecl, Xform};
 use super::lights::{add_light, area_emission};
-use super::materials::{map_material, Mapped};
+use super::materials::{blend, map_material, Mapped};
 use super::shapes::shape_geometry;
 use super::subdivision::smooth_normals;
-use super::textures::Textures;
+use super::textures::{with_opacity, Textures};
 use super::warnings::Warnings;
 use super::PbrtScene;
 use crate::error::FormatError;
-use crate::scene_load::{shapes::add_placed_shape, FileSettings, LoadedScene};
+use crate::scene_load::{shapes::add_placed_shape, FileCrop, FileSettings, LoadedScene};
 
 /// Deepest chain of `mix` materials followed.
 const MAX_MIX_DEPTH: usize = 16;
@@ -57,9 +57,46 @@ struct Materials<'a> {
     anonymous: HashMap<usize, Option<u32>>,
     named: HashMap<String, Option<u32>>,
     default: Option<u32>,
+    /// Materials cut by a shape's `alpha`: (material, alpha) to the cut one.
+    cut: HashMap<(u32, String), u32>,
 }
 
 impl Materials<'_> {
+    /// `material` cut by shape `e`'s `alpha`, pbrt-v4's stochastic
+    /// transparency (a ray meets the surface with probability `alpha`);
+    /// `None` if the shape is not there at all (alpha 0).
+    fn cut(
+        &mut self,
+        scene: &mut Scene,
+        material: u32,
+        e: &Entity,
+        w: &mut Warnings,
+    ) -> Result<Option<u32>, FormatError> {
+        let Some(p) = e.params.get("alpha") else {
+            return Ok(Some(material));
+        };
+        let key = (material, format!("{:?}", p.values));
+        if let Some(&m) = self.cut.get(&key) {
+            e.params.get("alpha");
+            return Ok(Some(m));
+        }
+        let alpha = self.textures.float_tint(e, "alpha", 1.0, w)?;
+        let factor = alpha.color.x.clamp(0.0, 1.0);
+        if alpha.image.is_none() && factor >= 1.0 {
+            return Ok(Some(material));
+        }
+        if alpha.image.is_none() && factor <= 0.0 {
+            return Ok(None);
+        }
+        let mut m = scene.materials[material as usize].clone();
+        if let Some(img) = &alpha.image {
+            m.texture = Some(with_opacity(m.texture.as_ref(), img));
+        }
+        let id = scene.add_material(m.with_alpha(AlphaMode::Blend, factor));
+        self.cut.insert(key, id);
+        Ok(Some(id))
+    }
+
     /// The Sahara material of `r`, or `None` for pbrt's `interface`.
     fn resolve(
         &mut self,
@@ -130,8 +167,22 @@ impl Materials<'_> {
                 if depth >= MAX_MIX_DEPTH {
                     return Err(e.loc.error("mix materials nest too deep (a cycle?)"));
                 }
-                let pick = if amount < 0.5 { &names[0] } else { &names[1] };
-                self.named(scene, pick, &e.loc, w, depth + 1)
+                let a = self.named(scene, &names[0], &e.loc, w, depth + 1)?;
+                let b = self.named(scene, &names[1], &e.loc, w, depth + 1)?;
+                let t = amount.clamp(0.0, 1.0) as f32;
+                if let (Some(a), Some(b)) = (a, b) {
+                    let (ma, mb) = (&scene.materials[a as usize], &scene.materials[b as usize]);
+                    if let Some(m) = blend(ma, mb, t) {
+                        return Ok(Some(scene.add_material(m)));
+                    }
+                }
+                if t > 0.0 && t < 1.0 && a != b {
+                    w.add(
+                        "material 'mix': the blend is replaced by the material with the larger weight",
+                        &e.loc,
+                    );
+                }
+                Ok(if t < 0.5 { a } else { b })
             }
         }
     }
@@ -337,18 +388,86 @@ fn camera(
     Ok((c, (open, close)))
 }
 
-/// Render settings, crop window and pixel bounds.
-type Settings = (FileSettings, Option<[f64; 4]>, Option<[i64; 4]>);
+/// The error of film parameter `name` holding `found` values, not 4.
+fn not_four(f: &Entity, name: &str, found: usize) -> FormatError {
+    let p = f.params.get(name).expect("present");
+    p.error(format!("expected 4 values, found {found}"))
+}
 
-/// The render settings of `Film`, `Sampler`, `PixelFilter` and `Integrator`,
-/// and the crop window and pixel bounds the film asks for.
-fn settings(desc: &Description, folder: &Path, w: &mut Warnings) -> Result<Settings, FormatError> {
+/// The part of the image a film renders: its `cropwindow` (clamped to
+/// [0, 1], each pair in either order) or else its `pixelbounds` (clipped
+/// to the image), as pbrt-v4 decides; an empty one is an error.
+fn film_crop(
+    f: &Entity,
+    width: i64,
+    height: i64,
+    w: &mut Warnings,
+) -> Result<Option<FileCrop>, FormatError> {
+    let crop = match f.params.floats("cropwindow")? {
+        Some(&[a, b, c, d]) => {
+            if f.params.has("pixelbounds") {
+                w.add(
+                    "film: both 'cropwindow' and 'pixelbounds' given; the crop window is used",
+                    &f.loc,
+                );
+                f.params.get("pixelbounds");
+            }
+            let outside = [a, b, c, d].iter().any(|v| !(0.0..=1.0).contains(v));
+            if outside {
+                w.add("film 'cropwindow' reaches outside [0, 1]; clamped", &f.loc);
+            }
+            let c01 = |v: f64| v.clamp(0.0, 1.0);
+            Some(FileCrop::Fractions([
+                c01(a.min(b)),
+                c01(a.max(b)),
+                c01(c.min(d)),
+                c01(c.max(d)),
+            ]))
+        }
+        Some(v) => return Err(not_four(f, "cropwindow", v.len())),
+        None => match f.params.ints("pixelbounds")? {
+            Some(&[x0, x1, y0, y1]) => {
+                let b = [x0 as i64, x1 as i64, y0 as i64, y1 as i64];
+                if b[0] < 0 || b[2] < 0 || b[1] > width || b[3] > height {
+                    w.add(
+                        "film 'pixelbounds' reach outside the image; clipped",
+                        &f.loc,
+                    );
+                }
+                Some(FileCrop::Pixels(b))
+            }
+            Some(v) => return Err(not_four(f, "pixelbounds", v.len())),
+            None => None,
+        },
+    };
+    if let Some(c) = crop {
+        if c.window(width as u32, height as u32).is_empty() {
+            let name = if matches!(c, FileCrop::Fractions(_)) {
+                "cropwindow"
+            } else {
+                "pixelbounds"
+            };
+            return Err(f
+                .params
+                .get(name)
+                .expect("present")
+                .error(format!("holds no pixel of the {width}x{height} image")));
+        }
+    }
+    Ok(crop)
+}
+
+/// The render settings of `Film`, `Sampler`, `PixelFilter` and `Integrator`.
+fn settings(
+    desc: &Description,
+    folder: &Path,
+    w: &mut Warnings,
+) -> Result<FileSettings, FormatError> {
     let mut width = 1280i64;
     let mut height = 720i64;
     let mut output = None;
     let mut exposure = 0.0f32;
     let mut crop = None;
-    let mut bounds = None;
     if let Some(f) = &desc.film {
         if !["rgb", "gbuffer", "spectral", "image"].contains(&f.kind.as_str()) {
             return Err(f.loc.error(format!("unknown film type '{}'", f.kind)));
@@ -378,34 +497,7 @@ fn settings(desc: &Description, folder: &Path, w: &mut Warnings) -> Result<Setti
             }
             output = Some(p);
         }
-        if let Some(c) = f.params.floats("cropwindow")? {
-            let [x0, x1, y0, y1] = c else {
-                return Err(f
-                    .params
-                    .get("cropwindow")
-                    .expect("present")
-                    .error("expected 4 values"));
-            };
-            crop = Some([*x0, *x1, *y0, *y1]);
-            w.add(
-                "film 'cropwindow' is recorded, but the whole image is rendered",
-                &f.loc,
-            );
-        }
-        if let Some(b) = f.params.ints("pixelbounds")? {
-            let [x0, x1, y0, y1] = b else {
-                return Err(f
-                    .params
-                    .get("pixelbounds")
-                    .expect("present")
-                    .error("expected 4 values"));
-            };
-            bounds = Some([*x0 as i64, *x1 as i64, *y0 as i64, *y1 as i64]);
-            w.add(
-                "film 'pixelbounds' is recorded, but the whole image is rendered",
-                &f.loc,
-            );
-        }
+        crop = film_crop(f, width, height, w)?;
         let iso = f.params.float("iso", 100.0)?;
         if iso > 0.0 {
             exposure = (iso / 100.0).log2() as f32;
@@ -596,22 +688,19 @@ fn settings(desc: &Description, folder: &Path, w: &mut Warnings) -> Result<Setti
             out
         }
     };
-    Ok((
-        FileSettings {
-            integrator,
-            sampler,
-            spp: spp as u32,
-            seed,
-            filter,
-            width: width as u32,
-            height: height as u32,
-            exposure,
-            tonemap: ToneMap::Clamp,
-            output,
-        },
+    Ok(FileSettings {
+        integrator,
+        sampler,
+        spp: spp as u32,
+        seed,
+        filter,
+        width: width as u32,
+        height: height as u32,
+        exposure,
+        tonemap: ToneMap::Clamp,
+        output,
         crop,
-        bounds,
-    ))
+    })
 }
 
 /// One shape's mesh in object space, oriented, or `None` if it is not rendered.
@@ -651,7 +740,7 @@ pub(crate) fn build(
     folder: &Path,
     w: &mut Warnings,
 ) -> Result<PbrtScene, FormatError> {
-    let (settings, crop_window, pixel_bounds) = settings(desc, folder, w)?;
+    let settings = settings(desc, folder, w)?;
     let aspect = f64::from(settings.width) / f64::from(settings.height);
     let (camera, shutter) = camera(desc, aspect, w)?;
     let mut scene = Scene::new(camera);
@@ -661,6 +750,7 @@ pub(crate) fn build(
         anonymous: HashMap::new(),
         named: HashMap::new(),
         default: None,
+        cut: HashMap::new(),
     };
     for (what, loc) in &desc.ignored {
         w.add(format!("{what} is not supported; ignored"), loc);
@@ -673,6 +763,10 @@ pub(crate) fn build(
                 "shapes with an 'interface' material (no surface) are not rendered",
                 &s.entity.loc,
             );
+            shape_geometry(&s.entity, w)?;
+            continue;
+        };
+        let Some(material) = materials.cut(&mut scene, material, &s.entity, w)? else {
             shape_geometry(&s.entity, w)?;
             continue;
         };
@@ -752,8 +846,6 @@ pub(crate) fn build(
             settings,
             warnings: Vec::new(),
         },
-        crop_window,
-        pixel_bounds,
     })
 }
 
@@ -786,6 +878,10 @@ fn object_mesh(
                 "shapes with an 'interface' material (no surface) are not rendered",
                 &s.entity.loc,
             );
+            shape_geometry(&s.entity, w)?;
+            continue;
+        };
+        let Some(material) = materials.cut(scene, material, &s.entity, w)? else {
             shape_geometry(&s.entity, w)?;
             continue;
         };

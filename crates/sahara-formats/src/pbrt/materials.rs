@@ -4,27 +4,32 @@
 //! | pbrt | Sahara | lost (warned) |
 //! |---|---|---|
 //! | `diffuse`, v3 `matte` | diffuse | v3 `sigma` (Oren-Nayar) |
-//! | `conductor`, v3 `metal` | conductor of colour F0 from eta, k (or `reflectance`); mirror when smooth | complex Fresnel (Schlick from F0), anisotropy |
-//! | `coatedconductor` | conductor (the base) | the coating |
+//! | `conductor`, v3 `metal` (`eta`, `k`) | complex-IOR conductor, exact Fresnel | anisotropy; textured `eta` / `k` (their means) |
+//! | `conductor` with `reflectance` | complex-IOR conductor of `eta = 1`, `k = 2 sqrt(r / (1 - r))` (pbrt-v4's own conversion) | for a textured reflectance: Schlick's Fresnel from it |
+//! | `coatedconductor` | the conductor with `eta / eta_coat`, `k / eta_coat` (as pbrt-v4 sees it through the coat) | the coat's own reflection |
+//! | `coateddiffuse` | coated diffuse | an absorbing coat (`albedo`, `thickness`, `g`) |
 //! | `dielectric`, v3 `glass` | glass / rough glass | dispersion, v3 `Kr`/`Kt` tints |
-//! | `thindielectric` | glass | thinness (refracts as a solid) |
-//! | v3 `mirror` | mirror | |
-//! | `coateddiffuse`, v3 `plastic`, `substrate`, `uber` | diffuse (the base) | the coating / specular lobe |
-//! | `diffusetransmission`, v3 `translucent` | diffuse (reflectance) | transmission |
-//! | `mix` | the material with the larger weight | the blend |
+//! | `thindielectric` | thin dielectric | |
+//! | v3 `mirror` | a smooth conductor reflecting `Kr` at every angle | |
+//! | v3 `plastic`, `uber` | glTF-style specular layer (`Ks`, index 1.5) over a diffuse base (`Kd`) | the base loses what the layer reflects; `uber`'s `Kr`, `Kt` |
+//! | v3 `substrate` | the same, the layer's normal reflectance `Ks` | Ashikhmin-Shirley's coupling |
+//! | `diffusetransmission`, v3 `translucent` | diffuse (or layered) reflection | transmission |
+//! | `mix` | the blend when exact (two diffuse colours, or the same material), else the material of larger weight | the blend |
 //! | `measured`, `hair`, `subsurface`, v3 `kdsubsurface`, `fourier`, `disney` | diffuse | the model |
 //! | `interface`, `""`, `none` | no surface (the shape is skipped) | |
 //!
 //! Roughness: Sahara's is perceptual (`alpha = roughness^2`). pbrt-v4 maps
 //! `roughness` r to `alpha = sqrt(r)` with `remaproughness` (the default)
 //! and `alpha = r` without; pbrt-v3 remaps with its polynomial in `ln r`.
+//! pbrt-v3's `opacity` (uber) becomes stochastic transparency.
 
 use glam::Vec3;
-use sahara_render::Material;
+use sahara_render::{AlphaMode, Bsdf, Material};
 
 use super::description::Entity;
+use super::params::SpectrumParam;
 use super::spectrum::{self, Use};
-use super::textures::{Textures, Tint};
+use super::textures::{rgb_of, spectral_samples, Textures, Tint};
 use super::warnings::Warnings;
 use crate::error::FormatError;
 
@@ -89,67 +94,195 @@ fn diffuse(tint: Tint) -> Material {
     m
 }
 
-/// The conductor colour: `reflectance` if given, else F0 of `eta`, `k`
-/// (default copper).
-fn conductor_color(
+/// A material of `bsdf` whose base colour is multiplied by `tint`.
+fn tinted(bsdf: Bsdf, tint: &Tint) -> Material {
+    let mut m = Material::new(bsdf);
+    m.texture = tint.baked();
+    m
+}
+
+/// Copper: pbrt's default conductor.
+fn copper() -> (Vec3, Vec3) {
+    let part = |p: &str| match spectrum::named(&format!("metal-Cu-{p}")) {
+        Some(spectrum::Named::Rgb(c)) => v3(c),
+        _ => unreachable!("copper is tabulated"),
+    };
+    (part("eta"), part("k"))
+}
+
+fn v3(c: [f64; 3]) -> Vec3 {
+    Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32)
+}
+
+/// What a conductor's colour is given as.
+enum Metal {
+    /// Complex index per channel.
+    Index(Vec3, Vec3),
+    /// A textured reflectance (Schlick's Fresnel from it).
+    Reflectance(Tint),
+}
+
+/// `eta` and `k` for a normal reflectance `r` (pbrt-v4's conversion of a
+/// conductor's `reflectance`: `eta = 1`, whose normal reflectance is
+/// `k^2 / (4 + k^2)`).
+fn k_of_reflectance(r: Vec3) -> Vec3 {
+    let r = r.clamp(Vec3::ZERO, Vec3::splat(0.9999));
+    2.0 * (r / (Vec3::ONE - r)).powf(0.5)
+}
+
+/// The colour of a conductor (`prefix` is `conductor.` in a
+/// `coatedconductor`): `reflectance` if given, else `eta` and `k`
+/// (default copper). Two spectra are fitted together
+/// ([`spectrum::fit_conductor`]); a texture gives its mean.
+fn conductor_metal(
     e: &Entity,
     prefix: &str,
     tex: &mut Textures,
     w: &mut Warnings,
-) -> Result<Tint, FormatError> {
+) -> Result<Metal, FormatError> {
     let refl = format!("{prefix}reflectance");
-    if e.params.has(&refl) || e.params.has("reflectance") {
-        let name = if e.params.has(&refl) {
-            refl
-        } else {
-            "reflectance".into()
-        };
-        return tex.spectrum(e, &name, Vec3::ONE, Use::Reflectance, w);
-    }
-    let cu_eta = match spectrum::named("metal-Cu-eta") {
-        Some(spectrum::Named::Rgb(c)) => c,
-        _ => unreachable!("copper is tabulated"),
-    };
-    let cu_k = match spectrum::named("metal-Cu-k") {
-        Some(spectrum::Named::Rgb(c)) => c,
-        _ => unreachable!("copper is tabulated"),
-    };
-    let v = |c: [f64; 3]| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32);
-    let eta = tex.spectrum(e, &format!("{prefix}eta"), v(cu_eta), Use::Unbounded, w)?;
-    let k = tex.spectrum(e, &format!("{prefix}k"), v(cu_k), Use::Unbounded, w)?;
-    if eta.image.is_some() || k.image.is_some() {
-        w.add("conductor eta / k textures replaced by their means", &e.loc);
-    }
-    let (eta, k) = (eta.mean(), k.mean());
-    let f0 = Vec3::from_array(std::array::from_fn(|i| {
-        spectrum::conductor_f0(f64::from(eta[i]), f64::from(k[i])) as f32
-    }));
-    Ok(Tint::constant(f0))
-}
-
-/// The index of refraction of a dielectric (`eta`, pbrt-v3 `index`; a
-/// spectrum is taken at 532 nm, green).
-fn ior(e: &Entity, tex: &mut Textures, w: &mut Warnings) -> Result<f32, FormatError> {
-    let name = if e.params.has("index") {
-        "index"
-    } else {
-        "eta"
-    };
-    let eta = match e.params.get(name).map(|p| p.ty) {
-        Some("float") => e.params.float(name, 1.5)? as f32,
-        Some(_) => {
-            let t = tex.spectrum(e, name, Vec3::splat(1.5), Use::Unbounded, w)?;
-            if (t.color.x - t.color.z).abs() > 1e-4 {
+    if e.params.has(&refl) {
+        let r = tex.spectrum(e, &refl, Vec3::ONE, Use::Reflectance, w)?;
+        return Ok(match r.image {
+            None => Metal::Index(Vec3::ONE, k_of_reflectance(r.color)),
+            Some(_) => {
                 w.add(
-                    "dielectric: dispersion is lost (the index at 532 nm is used)",
+                    format!(
+                        "material '{}': a textured 'reflectance' uses Schlick's Fresnel from it",
+                        e.kind
+                    ),
                     &e.loc,
                 );
+                Metal::Reflectance(r)
             }
-            t.mean().y
+        });
+    }
+    let (eta_name, k_name) = (format!("{prefix}eta"), format!("{prefix}k"));
+    let (pe, pk) = (
+        e.params.spectrum(&eta_name, true)?,
+        e.params.spectrum(&k_name, true)?,
+    );
+    if let (Some(se), Some(sk)) = (&pe, &pk) {
+        if let (Some(a), Some(b)) = (
+            spectral_samples(se, &e.folders),
+            spectral_samples(sk, &e.folders),
+        ) {
+            let (fe, fk) = spectrum::fit_conductor(
+                |l| spectrum::piecewise_linear(&a, l),
+                |l| spectrum::piecewise_linear(&b, l),
+            );
+            return Ok(Metal::Index(v3(fe), v3(fk)));
         }
-        None => 1.5,
+    }
+    let (cu_eta, cu_k) = copper();
+    let mut part = |p: &Option<SpectrumParam>, name: &str, default: Vec3| match p {
+        None => Ok(default),
+        Some(SpectrumParam::Texture(_)) => {
+            let t = tex.spectrum(e, name, default, Use::Unbounded, w)?;
+            w.add(
+                format!(
+                    "material '{}': textured 'eta' / 'k' replaced by their means",
+                    e.kind
+                ),
+                &e.loc,
+            );
+            Ok(t.mean())
+        }
+        Some(p) => rgb_of(p, Use::Unbounded, &e.folders, w),
     };
+    let eta = part(&pe, &eta_name, cu_eta)?;
+    let k = part(&pk, &k_name, cu_k)?;
+    Ok(Metal::Index(eta, k))
+}
+
+/// A conductor of colour `metal` and `roughness`.
+fn conductor(metal: Metal, roughness: f32) -> Material {
+    match metal {
+        Metal::Index(eta, k) => Material::new(Bsdf::ComplexConductor {
+            eta: eta.max(Vec3::ZERO),
+            k: k.max(Vec3::ZERO),
+            roughness,
+        }),
+        Metal::Reflectance(r) => tinted(
+            Bsdf::Conductor {
+                color: Vec3::ONE,
+                roughness,
+            },
+            &r,
+        ),
+    }
+}
+
+/// The index of refraction of a dielectric (`eta`, pbrt-v3 `index`): a
+/// spectrum is taken at the d line (a named glass is its `n_d`).
+fn ior(
+    e: &Entity,
+    names: &[&str],
+    tex: &mut Textures,
+    w: &mut Warnings,
+) -> Result<f32, FormatError> {
+    let Some(name) = names.iter().copied().find(|n| e.params.has(n)) else {
+        return Ok(1.5);
+    };
+    if e.params.get(name).map(|p| p.ty) == Some("float") {
+        return Ok(e.params.float(name, 1.5)? as f32);
+    }
+    let p = e.params.spectrum(name, true)?.expect("present");
+    let eta = match &p {
+        SpectrumParam::Texture(_) => {
+            tex.spectrum(e, name, Vec3::splat(1.5), Use::Unbounded, w)?
+                .mean()
+                .y
+        }
+        other => match spectral_samples(other, &e.folders) {
+            Some(s) => spectrum::piecewise_linear(&s, spectrum::D_LINE) as f32,
+            None => rgb_of(other, Use::Unbounded, &e.folders, w)?.y,
+        },
+    };
+    let dispersive = match &p {
+        SpectrumParam::Named(n, _) => n.starts_with("glass-"),
+        SpectrumParam::Sampled(s) => s.windows(2).any(|p| p[0].1 != p[1].1),
+        _ => false,
+    };
+    if dispersive {
+        w.add(
+            format!(
+                "material '{}': dispersion is lost (the index n_d at 587.56 nm is used)",
+                e.kind
+            ),
+            &e.loc,
+        );
+    }
     Ok(eta)
+}
+
+/// The glTF-style layered reflector Sahara gives pbrt-v3's `plastic`,
+/// `uber`, `substrate` and `translucent`: a specular layer of roughness `r`
+/// whose reflectance at normal incidence is `f0` (grazing: `f90`, grey)
+/// over a diffuse base `kd`.
+fn layered(kd: &Tint, f0: Vec3, f90: f32, r: f32) -> Material {
+    // glTF's dielectric layer: f0 = min(0.04 specular_color, 1) specular,
+    // f90 = specular (index 1.5).
+    let specular = f90.max(0.0);
+    let specular_color = if specular > 0.0 {
+        f0 / (0.04 * specular)
+    } else {
+        Vec3::ZERO
+    };
+    tinted(
+        Bsdf::MetallicRoughness {
+            base_color: kd.color.clamp(Vec3::ZERO, Vec3::ONE),
+            metallic: 0.0,
+            roughness: r,
+            ior: 1.5,
+            specular,
+            specular_color,
+        },
+        &Tint {
+            color: Vec3::ONE,
+            image: kd.image.clone(),
+        },
+    )
 }
 
 /// The one mapping from a pbrt material to Sahara's: see the module's table.
@@ -174,6 +307,20 @@ pub(crate) fn map_material(
         }
     }
     let grey = |v: f32| Vec3::splat(v);
+    // A texture's mean for a colour that Sahara holds as a constant.
+    let constant = |tex: &mut Textures, w: &mut Warnings, name: &str, default: f32| {
+        let t = tex.spectrum(e, name, grey(default), Use::Reflectance, w)?;
+        if t.image.is_some() {
+            w.add(
+                format!(
+                    "material '{}': a textured '{name}' is replaced by its mean",
+                    e.kind
+                ),
+                &e.loc,
+            );
+        }
+        Ok::<_, FormatError>(t.mean())
+    };
     let m = match e.kind.as_str() {
         "diffuse" => diffuse(tex.spectrum(e, "reflectance", grey(0.5), Use::Reflectance, w)?),
         "matte" => {
@@ -182,140 +329,168 @@ pub(crate) fn map_material(
             }
             diffuse(tex.spectrum(e, "Kd", grey(0.5), Use::Reflectance, w)?)
         }
-        "conductor" | "metal" | "coatedconductor" => {
+        "conductor" | "metal" => {
             let v3 = e.kind == "metal";
-            let prefix = if e.kind == "coatedconductor" {
-                "conductor."
-            } else {
-                ""
-            };
-            let color = conductor_color(e, prefix, tex, w)?;
-            let r = roughness(e, prefix, if v3 { 0.01 } else { 0.0 }, v3, tex, w)?;
-            if e.kind == "coatedconductor" {
-                approx(
-                    w,
-                    "the dielectric coating is left out (the conductor alone)",
-                );
-                for p in [
-                    "interface.roughness",
-                    "interface.uroughness",
-                    "interface.vroughness",
-                    "interface.eta",
-                    "thickness",
-                    "albedo",
-                    "g",
-                    "maxdepth",
-                    "nsamples",
-                ] {
-                    e.params.get(p);
-                }
+            let metal = conductor_metal(e, "", tex, w)?;
+            let r = roughness(e, "", if v3 { 0.01 } else { 0.0 }, v3, tex, w)?;
+            conductor(metal, r)
+        }
+        "coatedconductor" => {
+            let metal = conductor_metal(e, "conductor.", tex, w)?;
+            let r = roughness(e, "conductor.", 0.0, false, tex, w)?;
+            let coat = ior(e, &["interface.eta"], tex, w)?.max(1e-3);
+            roughness(e, "interface.", 0.0, false, tex, w)?;
+            for p in ["thickness", "albedo", "g", "maxdepth", "nsamples"] {
+                e.params.get(p);
             }
             approx(
                 w,
-                "complex Fresnel approximated by Schlick's from the normal reflectance",
+                "the coat's own reflection is left out (the conductor as seen through the coat)",
             );
-            let mut m = if r <= 1e-3 {
-                Material::mirror(color.color)
-            } else {
-                Material::conductor(color.color, r)
-            };
-            m.texture = color.image;
-            m
+            conductor(
+                match metal {
+                    Metal::Index(eta, k) => Metal::Index(eta / coat, k / coat),
+                    other => other,
+                },
+                r,
+            )
         }
         "dielectric" | "glass" | "thindielectric" => {
             let v3 = e.kind == "glass";
-            let eta = ior(e, tex, w)?;
+            let eta = ior(e, &["index", "eta"], tex, w)?;
             if v3 {
-                let kr = tex
-                    .spectrum(e, "Kr", Vec3::ONE, Use::Reflectance, w)?
-                    .mean();
-                let kt = tex
-                    .spectrum(e, "Kt", Vec3::ONE, Use::Reflectance, w)?
-                    .mean();
+                let kr = constant(tex, w, "Kr", 1.0)?;
+                let kt = constant(tex, w, "Kt", 1.0)?;
                 if kr != Vec3::ONE || kt != Vec3::ONE {
                     approx(w, "'Kr' / 'Kt' tints are not supported; clear glass");
                 }
-            }
-            if e.kind == "thindielectric" {
-                approx(w, "rendered as solid glass (refracting), not a thin sheet");
             }
             if (eta - 1.0).abs() < 1e-6 {
                 // Index-matched: pbrt lets light pass straight through.
                 return Ok(Mapped::Interface);
             }
-            let r = if e.kind == "thindielectric" {
-                0.0
+            if e.kind == "thindielectric" {
+                Material::new(Bsdf::ThinDielectric { ior: eta })
             } else {
-                roughness(e, "", 0.0, v3, tex, w)?
-            };
-            if r <= 1e-3 {
-                Material::glass(eta)
-            } else {
-                Material::rough_glass(eta, r)
+                let r = roughness(e, "", 0.0, v3, tex, w)?;
+                if r <= 1e-3 {
+                    Material::glass(eta)
+                } else {
+                    Material::rough_glass(eta, r)
+                }
             }
         }
         "mirror" => {
+            // pbrt-v3's mirror reflects Kr at every angle: a conductor whose
+            // Fresnel term is 1 (eta = 1, k large), tinted by Kr.
             let kr = tex.spectrum(e, "Kr", grey(0.9), Use::Reflectance, w)?;
-            let mut m = Material::mirror(kr.color);
-            m.texture = kr.image;
-            m
+            tinted(
+                Bsdf::ComplexConductor {
+                    eta: Vec3::ONE,
+                    k: Vec3::splat(1e4),
+                    roughness: 0.0,
+                },
+                &kr,
+            )
         }
-        "coateddiffuse" | "plastic" | "substrate" | "uber" => {
-            let name = if e.kind == "coateddiffuse" {
-                "reflectance"
-            } else {
-                "Kd"
-            };
-            let default = match e.kind.as_str() {
-                "plastic" | "uber" => 0.25,
-                _ => 0.5,
-            };
-            let base = tex.spectrum(e, name, grey(default), Use::Reflectance, w)?;
-            for p in [
-                "roughness",
-                "uroughness",
-                "vroughness",
-                "thickness",
-                "eta",
-                "albedo",
-                "g",
-                "maxdepth",
-                "nsamples",
-                "Ks",
-                "Kr",
-                "Kt",
-                "opacity",
-                "index",
-                "remaproughness",
-            ] {
+        "coateddiffuse" => {
+            let base = tex.spectrum(e, "reflectance", grey(0.5), Use::Reflectance, w)?;
+            let r = roughness(e, "", 0.0, false, tex, w)?;
+            let eta = ior(e, &["eta"], tex, w)?;
+            let albedo = constant(tex, w, "albedo", 0.0)?;
+            tex.float(e, "thickness", 0.01, w)?;
+            tex.float(e, "g", 0.0, w)?;
+            for p in ["maxdepth", "nsamples"] {
                 e.params.get(p);
             }
+            if albedo != Vec3::ZERO {
+                approx(
+                    w,
+                    "a scattering coat ('albedo') is not supported; a clear coat",
+                );
+            }
+            tinted(
+                Bsdf::CoatedDiffuse {
+                    albedo: base.color.clamp(Vec3::ZERO, Vec3::ONE),
+                    ior: eta.max(1.0),
+                    roughness: r,
+                },
+                &Tint {
+                    color: Vec3::ONE,
+                    image: base.image,
+                },
+            )
+        }
+        "plastic" | "uber" => {
+            let kd = tex.spectrum(e, "Kd", grey(0.25), Use::Reflectance, w)?;
+            let ks = constant(tex, w, "Ks", 0.25)?;
+            let r = roughness(e, "", 0.1, true, tex, w)?;
+            let eta = if e.kind == "uber" {
+                ior(e, &["index", "eta"], tex, w)?
+            } else {
+                1.5
+            };
+            let r0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+            let f90 = ks.max_element();
+            let mut m = layered(&kd, ks * r0, f90, r);
             approx(
                 w,
-                "the coating / specular layer is left out (the diffuse base alone)",
+                "the diffuse base loses the light the specular layer reflects (an energy-conserving layering)",
             );
-            diffuse(base)
-        }
-        "diffusetransmission" | "translucent" => {
-            let name = if e.kind == "translucent" {
-                "Kd"
-            } else {
-                "reflectance"
-            };
-            let base = tex.spectrum(e, name, grey(0.25), Use::Reflectance, w)?;
-            for p in [
-                "transmittance",
-                "Ks",
-                "reflect",
-                "transmit",
-                "roughness",
-                "remaproughness",
-                "scale",
-            ] {
-                e.params.get(p);
+            if e.kind == "uber" {
+                let kr = constant(tex, w, "Kr", 0.0)?;
+                let kt = constant(tex, w, "Kt", 0.0)?;
+                if kr != Vec3::ZERO || kt != Vec3::ZERO {
+                    approx(
+                        w,
+                        "its specular reflection 'Kr' and transmission 'Kt' are left out",
+                    );
+                }
+                let opacity = constant(tex, w, "opacity", 1.0)?;
+                let a = opacity.min_element().clamp(0.0, 1.0);
+                if a < 1.0 {
+                    m = m.with_alpha(AlphaMode::Blend, a);
+                }
             }
-            approx(w, "transmission is left out (diffuse reflection alone)");
-            diffuse(base)
+            m
+        }
+        "substrate" => {
+            let kd = tex.spectrum(e, "Kd", grey(0.5), Use::Reflectance, w)?;
+            let ks = constant(tex, w, "Ks", 0.5)?;
+            let r = roughness(e, "", 0.1, true, tex, w)?;
+            approx(
+                w,
+                "Ashikhmin-Shirley's coupling of the layers is replaced by an energy-conserving layering",
+            );
+            layered(&kd, ks, 1.0, r)
+        }
+        "diffusetransmission" => {
+            let base = tex.spectrum(e, "reflectance", grey(0.25), Use::Reflectance, w)?;
+            let t = constant(tex, w, "transmittance", 0.25)?;
+            let scale = tex.float(e, "scale", 1.0, w)? as f32;
+            if t != Vec3::ZERO {
+                approx(w, "transmission is left out (diffuse reflection alone)");
+            }
+            diffuse(Tint {
+                color: base.color * scale,
+                image: base.image,
+            })
+        }
+        "translucent" => {
+            let kd = tex.spectrum(e, "Kd", grey(0.25), Use::Reflectance, w)?;
+            let ks = constant(tex, w, "Ks", 0.25)?;
+            let reflect = constant(tex, w, "reflect", 0.5)?;
+            let transmit = constant(tex, w, "transmit", 0.5)?;
+            let r = roughness(e, "", 0.1, true, tex, w)?;
+            if transmit != Vec3::ZERO {
+                approx(w, "transmission is left out (reflection alone)");
+            }
+            let kd = Tint {
+                color: kd.color * reflect,
+                image: kd.image,
+            };
+            let ks = ks * reflect;
+            layered(&kd, ks * 0.04, ks.max_element(), r)
         }
         "mix" => {
             let Some(names) = e.params.strings("materials")? else {
@@ -330,10 +505,6 @@ pub(crate) fn map_material(
                 )));
             };
             let amount = tex.float(e, "amount", 0.5, w)?;
-            approx(
-                w,
-                "the blend is replaced by the material with the larger weight",
-            );
             return Ok(Mapped::Mix([a.clone(), b.clone()], amount));
         }
         "interface" | "" | "none" => return Ok(Mapped::Interface),
@@ -360,6 +531,32 @@ pub(crate) fn map_material(
     Ok(Mapped::Surface(m))
 }
 
+/// pbrt's `mix` of materials `a` and `b` with weight `t` of `b`, when
+/// Sahara can blend them exactly: the same material, or two diffuse
+/// colours without textures (a Lambertian BSDF is linear in its colour).
+pub(crate) fn blend(a: &Material, b: &Material, t: f32) -> Option<Material> {
+    if a == b {
+        return Some(a.clone());
+    }
+    match (a.bsdf, b.bsdf) {
+        (Bsdf::Diffuse { albedo: x }, Bsdf::Diffuse { albedo: y })
+            if a.texture.is_none()
+                && b.texture.is_none()
+                && Material {
+                    bsdf: a.bsdf,
+                    ..b.clone()
+                } == *a =>
+        {
+            let mut m = a.clone();
+            m.bsdf = Bsdf::Diffuse {
+                albedo: x.lerp(y, t),
+            };
+            Some(m)
+        }
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -372,5 +569,172 @@ mod tests {
         // pbrt-v3 at r = 1: alpha = 1.62142.. clamps to 1.
         assert_eq!(sahara_roughness(1.0, true, true), 1.0);
         assert!(sahara_roughness(0.01, true, true) < sahara_roughness(0.1, true, true));
+    }
+
+    /// The material of the one sphere of a scene made of `decl`, and the
+    /// warnings.
+    fn material_of(decl: &str) -> (Material, Vec<String>) {
+        let text = format!("{decl}\nShape \"sphere\"\n");
+        let s = crate::pbrt::parse_pbrt(
+            text.as_bytes(),
+            "m.pbrt",
+            std::path::Path::new("/nonexistent"),
+        )
+        .unwrap_or_else(|e| panic!("{decl}: {e}"));
+        let scene = &s.loaded.scene;
+        let id = scene.instances[0].material.expect("a material") as usize;
+        (scene.materials[id].clone(), s.loaded.warnings)
+    }
+
+    /// Reflectance (mean sample weight) from `cos` to the normal, seen by
+    /// a smooth (delta) BSDF.
+    fn delta_reflectance(m: &Material, cos: f32) -> Vec3 {
+        let wo = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
+        let tint = m.tint(glam::Vec2::splat(0.5));
+        let s = m
+            .bsdf
+            .sample(tint, wo, 0.0, glam::Vec2::splat(0.5))
+            .expect("a sample");
+        assert!(s.delta);
+        s.weight
+    }
+
+    #[test]
+    fn a_conductor_of_given_reflectance_has_it_at_normal_incidence() {
+        let (m, w) = material_of("Material \"conductor\" \"rgb reflectance\" [0.9 0.5 0.1]");
+        assert!(w.is_empty(), "{w:?}");
+        let Bsdf::ComplexConductor { eta, k, roughness } = m.bsdf else {
+            panic!("{:?}", m.bsdf)
+        };
+        assert_eq!((eta, roughness), (Vec3::ONE, 0.0));
+        let f0 = sahara_render::material::fresnel::conductor(1.0, eta, k);
+        assert!(
+            (f0 - Vec3::new(0.9, 0.5, 0.1)).abs().max_element() < 1e-5,
+            "{f0}"
+        );
+        // Brighter at grazing angles, as every conductor.
+        assert!(delta_reflectance(&m, 0.1).min_element() > 0.3);
+    }
+
+    #[test]
+    fn the_v4_layered_and_thin_materials_are_sahara_s() {
+        let (m, w) = material_of(
+            "Material \"coateddiffuse\" \"rgb reflectance\" [0.6 0.3 0.2] \"float roughness\" 0.0625 \"float eta\" 1.4",
+        );
+        assert!(w.is_empty(), "{w:?}");
+        assert_eq!(
+            m.bsdf,
+            Bsdf::CoatedDiffuse {
+                albedo: Vec3::new(0.6, 0.3, 0.2),
+                ior: 1.4,
+                roughness: 0.5
+            }
+        );
+        let (m, _) = material_of("Material \"thindielectric\" \"float eta\" 1.33");
+        assert_eq!(m.bsdf, Bsdf::ThinDielectric { ior: 1.33 });
+        let (m, w) = material_of(
+            "Material \"coatedconductor\" \"float interface.eta\" 2 \"rgb conductor.eta\" [0.4 0.6 0.8] \"rgb conductor.k\" [4 3 2]",
+        );
+        assert_eq!(
+            m.bsdf,
+            Bsdf::ComplexConductor {
+                eta: Vec3::new(0.2, 0.3, 0.4),
+                k: Vec3::new(2.0, 1.5, 1.0),
+                roughness: 0.0
+            }
+        );
+        assert!(
+            w.iter()
+                .any(|l| l.contains("the coat's own reflection is left out")),
+            "{w:?}"
+        );
+    }
+
+    #[test]
+    fn the_v3_mirror_reflects_kr_at_every_angle() {
+        let (m, w) = material_of("Material \"mirror\" \"rgb Kr\" [0.8 0.5 0.25]");
+        assert!(w.is_empty(), "{w:?}");
+        for cos in [1.0, 0.5, 0.05] {
+            let r = delta_reflectance(&m, cos);
+            assert!(
+                (r - Vec3::new(0.8, 0.5, 0.25)).abs().max_element() < 1e-4,
+                "cos {cos}: {r}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_v3_plastics_are_a_specular_layer_over_their_kd() {
+        let (m, w) = material_of("Material \"plastic\" \"rgb Kd\" [0.5 0.4 0.3] \"rgb Ks\" [0.5 0.5 0.5] \"float roughness\" 0.1");
+        let Bsdf::MetallicRoughness {
+            base_color,
+            metallic,
+            ior,
+            specular,
+            specular_color,
+            ..
+        } = m.bsdf
+        else {
+            panic!("{:?}", m.bsdf)
+        };
+        assert_eq!(
+            (base_color, metallic, ior),
+            (Vec3::new(0.5, 0.4, 0.3), 0.0, 1.5)
+        );
+        // Normal reflectance 0.04 Ks, grazing Ks.
+        assert_eq!(specular, 0.5);
+        assert!(
+            (specular_color * 0.04 * specular - Vec3::splat(0.02))
+                .abs()
+                .max_element()
+                < 1e-7
+        );
+        assert!(w
+            .iter()
+            .any(|l| l.contains("material 'plastic': the diffuse base loses")));
+        // substrate: the layer's normal reflectance is Ks.
+        let (m, _) = material_of("Material \"substrate\" \"rgb Ks\" [0.1 0.2 0.3]");
+        let Bsdf::MetallicRoughness {
+            specular,
+            specular_color,
+            ..
+        } = m.bsdf
+        else {
+            panic!()
+        };
+        assert_eq!(specular, 1.0);
+        assert!(
+            (specular_color * 0.04 - Vec3::new(0.1, 0.2, 0.3))
+                .abs()
+                .max_element()
+                < 1e-7
+        );
+        // uber's opacity is stochastic transparency.
+        let (m, _) = material_of("Material \"uber\" \"rgb opacity\" [0.25 0.25 0.25]");
+        assert_eq!((m.alpha_mode, m.alpha), (AlphaMode::Blend, 0.25));
+    }
+
+    #[test]
+    fn a_mix_of_diffuse_colours_is_their_blend_else_the_heavier_material() {
+        let named = "MakeNamedMaterial \"a\" \"string type\" \"diffuse\" \"rgb reflectance\" [1 0 0]\n\
+                     MakeNamedMaterial \"b\" \"string type\" \"diffuse\" \"rgb reflectance\" [0 0 1]\n\
+                     MakeNamedMaterial \"c\" \"string type\" \"dielectric\"\n";
+        let (m, w) = material_of(&format!(
+            "{named}MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"a\" \"b\"] \"float amount\" 0.25\nNamedMaterial \"m\""
+        ));
+        assert!(w.is_empty(), "{w:?}");
+        assert_eq!(
+            m.bsdf,
+            Bsdf::Diffuse {
+                albedo: Vec3::new(0.75, 0.0, 0.25)
+            }
+        );
+        let (m, w) = material_of(&format!(
+            "{named}MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"a\" \"c\"] \"float amount\" 0.75\nNamedMaterial \"m\""
+        ));
+        assert_eq!(m.bsdf, Bsdf::Dielectric { ior: 1.5 });
+        assert!(w
+            .iter()
+            .any(|l| l.contains("the blend is replaced by the material with the larger weight")));
     }
 }

@@ -41,16 +41,12 @@ use std::path::Path;
 use crate::error::FormatError;
 use crate::scene_load::LoadedScene;
 
-/// A pbrt scene ready to render, with what its film asks for beyond
-/// Sahara's settings.
+/// A pbrt scene ready to render (the film's `cropwindow` or
+/// `pixelbounds` is in its settings' `crop`).
 #[derive(Clone, Debug)]
 pub struct PbrtScene {
     /// The scene, its render settings and the loading warnings.
     pub loaded: LoadedScene,
-    /// The film's `cropwindow` (x0, x1, y0, y1 as fractions of the image), if given.
-    pub crop_window: Option<[f64; 4]>,
-    /// The film's `pixelbounds` (x0, x1, y0, y1 in pixels), if given.
-    pub pixel_bounds: Option<[i64; 4]>,
 }
 
 /// True if `path` names a pbrt file (`.pbrt` or `.pbrt.gz`, any case).

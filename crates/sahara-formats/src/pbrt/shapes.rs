@@ -137,10 +137,10 @@ pub(crate) fn shape_geometry(
     e: &Entity,
     w: &mut Warnings,
 ) -> Result<Option<Geometry>, FormatError> {
-    // Parameters every shape may have that Sahara does not use.
-    if e.params.get("alpha").is_some() {
+    // `alpha` (cut-outs) is read by the caller.
+    if e.params.get("shadowalpha").is_some() {
         w.add(
-            "shape 'alpha' (cut-outs) is not supported; shapes are opaque",
+            "shape 'shadowalpha' is not supported; the shape's 'alpha' cuts its shadows too",
             &e.loc,
         );
     }

@@ -156,7 +156,7 @@ fn every_error_names_file_line_and_column() {
 fn unknown_parameters_and_unsupported_features_are_counted_warnings() {
     let text = "Shape \"sphere\" \"float radius\" 1 \"float wobble\" 3\nShape \"sphere\" \"float wobble\" 2\n\
                 Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\nShape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\n\
-                Material \"coateddiffuse\" Shape \"sphere\"\nLightSource \"point\"";
+                Material \"hair\" Shape \"sphere\"\nLightSource \"point\"";
     let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent")).unwrap();
     let w = &s.loaded.warnings;
     assert!(w.contains(&"t.pbrt:1:33: shape 'sphere': unknown parameter \"float wobble\", ignored (2 times; the first here)".to_owned()), "{w:#?}");
@@ -169,7 +169,7 @@ fn unknown_parameters_and_unsupported_features_are_counted_warnings() {
     );
     assert!(
         w.iter()
-            .any(|l| l.contains("material 'coateddiffuse': the coating")),
+            .any(|l| l.contains("material 'hair': not supported; replaced by a diffuse material")),
         "{w:#?}"
     );
     assert_eq!(s.loaded.scene.lights.len(), 1);
@@ -263,6 +263,63 @@ fn object_instances_share_one_mesh() {
 }
 
 #[test]
+fn film_crop_windows_and_pixel_bounds_follow_pbrt_v4() {
+    use crate::scene_load::FileCrop;
+    use sahara_render::PixelWindow;
+    let film = |extra: &str| {
+        let text = format!(
+            "Film \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 50 {extra}\nWorldBegin"
+        );
+        parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent"))
+    };
+    let window = |extra: &str| {
+        let s = film(extra).unwrap();
+        let c = s.loaded.settings.crop.expect("a crop");
+        (c, c.window(100, 50), s.loaded.warnings)
+    };
+    // Pairs in either order; pixels from ceil(f * size).
+    let (c, win, w) = window("\"float cropwindow\" [0.5 0.25 0.1 0.3]");
+    assert_eq!(c, FileCrop::Fractions([0.25, 0.5, 0.1, 0.3]));
+    assert_eq!(
+        win,
+        PixelWindow {
+            x0: 25,
+            x1: 50,
+            y0: 5,
+            y1: 15
+        }
+    );
+    assert!(w.is_empty(), "{w:?}");
+    // Pixel bounds are clipped to the image, with a warning.
+    let (_, win, w) = window("\"integer pixelbounds\" [10 120 -3 20]");
+    assert_eq!(
+        win,
+        PixelWindow {
+            x0: 10,
+            x1: 100,
+            y0: 0,
+            y1: 20
+        }
+    );
+    assert!(
+        w[0].contains("film 'pixelbounds' reach outside the image; clipped"),
+        "{w:?}"
+    );
+    // Both: the crop window wins, as in pbrt-v4.
+    let (c, _, w) = window("\"float cropwindow\" [0 1 0 0.5] \"integer pixelbounds\" [0 10 0 10]");
+    assert_eq!(c, FileCrop::Fractions([0.0, 1.0, 0.0, 0.5]));
+    assert!(
+        w[0].contains("both 'cropwindow' and 'pixelbounds' given"),
+        "{w:?}"
+    );
+    // Empty: an error at the parameter.
+    let e = film("\"float cropwindow\" [0.2 0.2 0 1]")
+        .unwrap_err()
+        .to_string();
+    assert_eq!(e, "t.pbrt: line 1: column 63: parameter \"float cropwindow\": holds no pixel of the 100x50 image");
+}
+
+#[test]
 fn camera_fov_is_the_shorter_axis_and_settings_map() {
     let text = "Film \"rgb\" \"integer xresolution\" 100 \"integer yresolution\" 200 \"string filename\" \"out.exr\"\n\
                 Sampler \"halton\" \"integer pixelsamples\" 8\nIntegrator \"volpath\" \"integer maxdepth\" 7\n\
@@ -338,12 +395,12 @@ fn pbrt_and_toml_scenes_render_the_same_spheres_disc_light_and_camera() {
     let pbrt = "Scale -1 1 1\nLookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n\
                 LightSource \"point\" \"rgb I\" [5 5 5] \"point3 from\" [1 2 0]\n\
                 AttributeBegin Material \"diffuse\" \"rgb reflectance\" [0.5 0.2 0.2] Translate 0 0 5 Shape \"sphere\" AttributeEnd\n\
-                AttributeBegin Material \"conductor\" \"rgb reflectance\" [0.9 0.8 0.3] \"float roughness\" 0.0625 Translate 1.25 -0.5 4 Shape \"sphere\" \"float radius\" 0.5 AttributeEnd\n\
+                AttributeBegin Material \"conductor\" \"rgb eta\" [0.2 0.9 1.1] \"rgb k\" [3.9 2.4 2.1] \"float roughness\" 0.0625 Translate 1.25 -0.5 4 Shape \"sphere\" \"float radius\" 0.5 AttributeEnd\n\
                 AttributeBegin Material \"diffuse\" \"rgb reflectance\" [0 0 0]\nAreaLightSource \"diffuse\" \"rgb L\" [4 4 4]\n\
                 Transform [1 0 0 0  0 0 1 0  0 -1 0 0  0 3 5 1] Shape \"disk\" \"float radius\" 1 AttributeEnd\n";
     let toml = "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, 1]\nvfov = 40\n\
                 [[material]]\nname = \"red\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.2, 0.2]\n\
-                [[material]]\nname = \"gold\"\ntype = \"conductor\"\ncolor = [0.9, 0.8, 0.3]\nroughness = 0.5\n\
+                [[material]]\nname = \"gold\"\ntype = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.1]\nroughness = 0.5\n\
                 [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 5]\nradius = 1\nmaterial = \"red\"\n\
                 [[object]]\ntype = \"sphere\"\ncenter = [1.25, -0.5, 4]\nradius = 0.5\nmaterial = \"gold\"\n\
                 [[light]]\ntype = \"area\"\nshape = \"disc\"\ncenter = [0, 3, 5]\nnormal = [0, -1, 0]\nradius = 1\nradiance = [4, 4, 4]\n\
@@ -402,10 +459,23 @@ fn the_fuzz_seed_with_every_directive_loads() {
         .materials
         .iter()
         .any(|m| m.is_emissive() && m.two_sided_emission));
-    assert_eq!(s.crop_window, Some([0.0, 1.0, 0.0, 1.0]));
-    assert!(w.iter().any(|l| l.contains("cropwindow")), "{w:#?}");
-    // The mix picks gold (amount 0.3 < 0.5): a conductor of gold's colour.
-    assert!(scene.materials.iter().any(|m| matches!(m.bsdf, sahara_render::Bsdf::Conductor { color, .. } if color.x > 0.9 && color.z < 0.45)));
+    assert_eq!(
+        s.loaded.settings.crop,
+        Some(crate::scene_load::FileCrop::Fractions([0.0, 1.0, 0.0, 1.0]))
+    );
+    // The mix picks gold (amount 0.3 < 0.5): the conductor of gold's
+    // named spectra, and says so.
+    let (eta, k) = (
+        Vec3::new(0.3267, 0.4015, 1.5758),
+        Vec3::new(36.1267, 2.3372, 1.7213),
+    );
+    assert!(scene.materials.iter().any(|m| matches!(m.bsdf,
+        sahara_render::Bsdf::ComplexConductor { eta: e, k: kk, roughness } if e == eta && kk == k && roughness == 0.1f32.sqrt().sqrt())));
+    assert!(
+        w.iter()
+            .any(|l| l.contains("material 'mix': the blend is replaced")),
+        "{w:#?}"
+    );
 }
 
 #[test]
@@ -434,4 +504,159 @@ fn an_octahedral_environment_map_becomes_a_lat_long_map_through_the_light_transf
     assert_eq!(at(Vec3::new(1.0, 0.3, 0.0)), Vec3::new(2.0, 0.0, 0.0));
     assert_eq!(at(Vec3::new(-1.0, 0.3, 0.0)), Vec3::ZERO);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A little-endian PFM of `w x h` RGB texels given from the top row.
+fn write_pfm(path: &Path, w: u32, h: u32, rgb_top_down: &[[f32; 3]]) {
+    let mut b = format!("PF\n{w} {h}\n-1\n").into_bytes();
+    for y in (0..h as usize).rev() {
+        for px in &rgb_top_down[y * w as usize..(y + 1) * w as usize] {
+            px.iter().for_each(|v| b.extend(v.to_le_bytes()));
+        }
+    }
+    std::fs::write(path, b).unwrap();
+}
+
+/// The texture of the material of the one shape of `text`.
+fn shape_material(dir: &Path, text: &str) -> (sahara_render::Material, Vec<String>) {
+    std::fs::write(dir.join("s.pbrt"), text).unwrap();
+    let s = load_pbrt(&dir.join("s.pbrt")).unwrap();
+    let id = s.loaded.scene.instances[0].material.unwrap();
+    (
+        s.loaded.scene.materials[id as usize].clone(),
+        s.loaded.warnings,
+    )
+}
+
+#[test]
+fn tga_and_pfm_imagemaps_load_and_textures_combine_texel_by_texel() {
+    let dir = folder("imagemaps");
+    // A 2x1 TGA, 24-bit, top-down: red, then grey 128.
+    let mut tga = vec![0u8, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 1, 0, 24, 0x20];
+    tga.extend([0, 0, 255, 128, 128, 128]);
+    std::fs::write(dir.join("a.tga"), &tga).unwrap();
+    write_pfm(
+        &dir.join("b.pfm"),
+        2,
+        1,
+        &[[0.0, 0.0, 1.0], [4.0, 4.0, 4.0]],
+    );
+    let quad = "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"point2 uv\" [0 0 1 0 0 1 1 1]";
+    let srgb = crate::srgb::srgb8_to_linear;
+    let (m, w) = shape_material(
+        &dir,
+        &format!("Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"a.tga\"\n\
+                  Texture \"b\" \"spectrum\" \"imagemap\" \"string filename\" \"b.pfm\"\n\
+                  Texture \"m\" \"spectrum\" \"mix\" \"texture tex1\" \"a\" \"texture tex2\" \"b\" \"float amount\" 0.25\n\
+                  Material \"diffuse\" \"texture reflectance\" \"m\"\n{quad}"),
+    );
+    assert!(w.is_empty(), "{w:?}");
+    let t = m.texture.expect("the mixed image");
+    assert_eq!((t.width, t.height), (2, 1));
+    assert_eq!(t.texels[0], Vec3::new(0.75, 0.0, 0.25));
+    assert_eq!(t.texels[1], Vec3::splat(0.75 * srgb(128) + 1.0));
+    // "linear": the 8-bit values as they are stored.
+    let (m, _) = shape_material(
+        &dir,
+        &format!("Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"a.tga\" \"string encoding\" \"linear\"\n\
+                  Material \"diffuse\" \"texture reflectance\" \"a\"\n{quad}"),
+    );
+    assert_eq!(m.texture.unwrap().texels[1], Vec3::splat(128.0 / 255.0));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn alpha_textures_cut_shapes_out() {
+    let dir = folder("alpha");
+    let quad = "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"point2 uv\" [0 0 1 0 0 1 1 1]";
+    // A float checkerboard of 2 x 1 checks: opaque in u < 1/2 (tex1 = 1).
+    let (m, w) = shape_material(
+        &dir,
+        &format!(
+            "Texture \"c\" \"float\" \"checkerboard\" \"float uscale\" 2 \"float vscale\" 1\n\
+                  Material \"diffuse\" \"rgb reflectance\" [0.2 0.4 0.6]\n\
+                  AttributeBegin {quad} \"texture alpha\" \"c\" AttributeEnd\n"
+        ),
+    );
+    assert!(w.is_empty(), "{w:?}");
+    assert_eq!(m.alpha_mode, sahara_render::AlphaMode::Blend);
+    for u in [0.0, 0.5, 0.999] {
+        let at = glam::Vec2::new(0.1, 0.5);
+        assert!(!m.passes(at, u), "opaque check");
+        let hole = glam::Vec2::new(0.9, 0.5);
+        assert!(m.passes(hole, u), "the hole");
+    }
+    assert_eq!(m.tint(glam::Vec2::new(0.9, 0.5)), Vec3::ONE);
+    // An RGBA TGA as a float texture is its alpha; the colour texture keeps its texels.
+    let mut tga = vec![0u8, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 1, 0, 32, 0x28];
+    tga.extend([0, 0, 255, 255, 0, 255, 0, 0]);
+    std::fs::write(dir.join("leaf.tga"), &tga).unwrap();
+    let (m, _) = shape_material(
+        &dir,
+        &format!(
+            "Texture \"leaf\" \"spectrum\" \"imagemap\" \"string filename\" \"leaf.tga\"\n\
+                  Texture \"cut\" \"float\" \"imagemap\" \"string filename\" \"leaf.tga\"\n\
+                  Material \"diffuse\" \"texture reflectance\" \"leaf\"\n\
+                  AttributeBegin {quad} \"texture alpha\" \"cut\" AttributeEnd\n"
+        ),
+    );
+    let t = m.texture.as_ref().unwrap();
+    assert_eq!(t.alpha.as_deref(), Some(&[1.0, 0.0][..]));
+    assert_eq!(t.texels[0], Vec3::new(1.0, 0.0, 0.0));
+    // A constant alpha of 0 removes the shape; 0.5 is half transparent.
+    std::fs::write(dir.join("s.pbrt"), format!("AttributeBegin {quad} \"float alpha\" 0 AttributeEnd\nAttributeBegin {quad} \"float alpha\" 0.5 AttributeEnd\n")).unwrap();
+    let s = load_pbrt(&dir.join("s.pbrt")).unwrap();
+    assert_eq!(s.loaded.scene.instances.len(), 1);
+    let m = &s.loaded.scene.materials[s.loaded.scene.instances[0].material.unwrap() as usize];
+    assert_eq!(
+        (m.alpha_mode, m.alpha),
+        (sahara_render::AlphaMode::Blend, 0.5)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_fuzz_seed_with_every_material_warns_only_of_what_it_approximates() {
+    use sahara_render::Bsdf;
+    let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds/pbrt/materials.pbrt");
+    let text = std::fs::read(&seed).unwrap();
+    let s = parse_pbrt(&text, "seed.pbrt", Path::new("/nonexistent")).unwrap();
+    let w = &s.loaded.warnings;
+    // The approximations, one line each: nothing else is lost.
+    let kinds: Vec<&str> = w
+        .iter()
+        .map(|l| l.split(": ").nth(1).unwrap_or(""))
+        .collect();
+    assert_eq!(
+        kinds,
+        [
+            "material 'coatedconductor'",
+            "material 'plastic'",
+            "material 'substrate'",
+            "material 'uber'",
+            "material 'translucent'",
+            "material 'dielectric'"
+        ],
+        "{w:#?}"
+    );
+    let m = &s.loaded.scene.materials;
+    let has = |f: &dyn Fn(&sahara_render::Material) -> bool| m.iter().any(f);
+    assert!(has(
+        &|m| matches!(m.bsdf, Bsdf::CoatedDiffuse { ior, .. } if ior == 1.4)
+            && m.alpha_mode == sahara_render::AlphaMode::Blend
+    ));
+    assert!(has(&|m| matches!(m.bsdf, Bsdf::ThinDielectric { .. })));
+    assert!(has(
+        &|m| matches!(m.bsdf, Bsdf::Dielectric { ior } if ior == 1.6727)
+    ));
+    assert!(has(
+        &|m| matches!(m.bsdf, Bsdf::Diffuse { albedo } if albedo == Vec3::new(0.75, 0.0, 0.25))
+    ));
+    // The sampled conductor spectra were fitted: eta between the samples' extremes.
+    assert!(has(
+        &|m| matches!(m.bsdf, Bsdf::ComplexConductor { eta, roughness, .. }
+        if eta.min_element() >= 0.2 && eta.max_element() <= 0.5 && roughness > 0.4)
+    ));
+    // 13 shapes: the sphere of alpha 0 is not there.
+    assert_eq!(s.loaded.scene.instances.len(), 12);
 }

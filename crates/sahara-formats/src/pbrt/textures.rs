@@ -25,7 +25,8 @@ use super::params::{FloatParam, SpectrumParam};
 use super::spectrum::{self, Use};
 use super::warnings::Warnings;
 use crate::error::FormatError;
-use crate::image_in::load_rgb_f32;
+use crate::image_in::load_image;
+use crate::srgb::linear_to_srgb8;
 
 /// A colour, optionally times an image.
 #[derive(Clone, Debug, PartialEq)]
@@ -42,6 +43,23 @@ impl Tint {
         Self {
             color: c,
             image: None,
+        }
+    }
+
+    /// The texture a Sahara material holds for this tint: the image with
+    /// the colour multiplied in, a 1 x 1 image of a colour other than
+    /// white, or none for white.
+    pub(crate) fn baked(&self) -> Option<Arc<Texture>> {
+        match &self.image {
+            Some(t) if self.color == Vec3::ONE => Some(t.clone()),
+            Some(t) => {
+                let texels = t.texels.iter().map(|&v| v * self.color).collect();
+                let mut out = Texture::new(t.width, t.height, texels);
+                out.alpha = t.alpha.clone();
+                Some(Arc::new(out))
+            }
+            None if self.color == Vec3::ONE => None,
+            None => Some(Arc::new(Texture::new(1, 1, vec![self.color]))),
         }
     }
 
@@ -108,6 +126,22 @@ pub(crate) fn rgb_of(
         SpectrumParam::Texture(_) => unreachable!("textures are looked up by the caller"),
     };
     Ok(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
+}
+
+/// The samples of a spectrum given as wavelength-value pairs or as a
+/// file, `None` for the other kinds (and for an unreadable file, which
+/// [`rgb_of`] reports).
+pub(crate) fn spectral_samples(
+    p: &SpectrumParam,
+    folders: &[std::path::PathBuf],
+) -> Option<Vec<(f64, f64)>> {
+    match p {
+        SpectrumParam::Sampled(pairs) => Some(pairs.clone()),
+        SpectrumParam::Named(name, _) if spectrum::named(name).is_none() => {
+            read_spectrum_file(&super::parser::resolve(folders, name))
+        }
+        _ => None,
+    }
 }
 
 /// A spectrum file: wavelength-value pairs, `#` comments.
@@ -178,6 +212,25 @@ impl<'a> Textures<'a> {
                     );
                 }
                 Ok(f64::from(tint.mean().x))
+            }
+        }
+    }
+
+    /// The value of float parameter `name` of `e` as a tint whose red
+    /// channel holds it (a texture keeps its image), or `default`.
+    pub(crate) fn float_tint(
+        &mut self,
+        e: &Entity,
+        name: &str,
+        default: f64,
+        warnings: &mut Warnings,
+    ) -> Result<Tint, FormatError> {
+        match e.params.float_or_texture(name)? {
+            None => Ok(Tint::constant(Vec3::splat(default as f32))),
+            Some(FloatParam::Value(v)) => Ok(Tint::constant(Vec3::splat(v as f32))),
+            Some(FloatParam::Texture(t)) => {
+                let loc = e.params.get(name).expect("present").loc.clone();
+                self.texture(&t, true, &loc, warnings, 0)
             }
         }
     }
@@ -276,17 +329,13 @@ impl<'a> Textures<'a> {
                 // pbrt-v3 names them tex1 and tex2.
                 let t1 = self.operand(e, "tex1", 1.0, float, warnings, depth)?;
                 let t2 = self.operand(e, "tex2", 1.0, float, warnings, depth)?;
-                product(product(tex, scale, e, warnings), product(t1, t2, e, warnings), e, warnings)
+                combine(&[&tex, &scale, &t1, &t2], |v| v[0] * v[1] * v[2] * v[3])
             }
             "mix" => {
                 let a = self.operand(e, "tex1", 0.0, float, warnings, depth)?;
                 let b = self.operand(e, "tex2", 1.0, float, warnings, depth)?;
                 let amount = self.operand(e, "amount", 0.5, true, warnings, depth)?;
-                if a.image.is_some() || b.image.is_some() || amount.image.is_some() {
-                    warnings.add("texture 'mix' of images: replaced by the mix of their means", &e.loc);
-                }
-                let t = amount.mean().x;
-                Tint::constant(a.mean() * (1.0 - t) + b.mean() * t)
+                combine(&[&a, &b, &amount], |v| v[0].lerp(v[1], v[2].x))
             }
             "imagemap" => {
                 let Some(file) = e.params.string("filename")? else {
@@ -297,48 +346,63 @@ impl<'a> Textures<'a> {
                 let invert = e.params.bool("invert", false)?;
                 let _ = (e.params.string("filter")?, e.params.string("wrap")?);
                 let _ = (e.params.float("maxanisotropy", 8.0)?, e.params.bool("trilinear", false)?);
-                if let Some(enc) = e.params.string("encoding")? {
-                    if enc != "sRGB" {
-                        warnings.add(
-                            format!("imagemap encoding \"{enc}\": 8-bit images are always read as sRGB"),
-                            &e.loc,
-                        );
+                let encoding = e.params.string("encoding")?.map(str::to_owned);
+                let v3_gamma = match e.params.has("gamma") {
+                    true => Some(e.params.bool("gamma", true)?),
+                    false => None,
+                };
+                let Some(img) = self.image(&path, &e.loc, warnings) else {
+                    return Ok(Tint::constant(Vec3::splat(0.5 * scale)));
+                };
+                let img = match recode(&img, &path, encoding.as_deref(), v3_gamma) {
+                    Ok(Some(t)) => Arc::new(t),
+                    Ok(None) => img,
+                    Err(what) => {
+                        warnings.add(format!("imagemap encoding {what}; read as sRGB"), &e.loc);
+                        img
                     }
-                }
-                if e.params.bool("gamma", false)? {
-                    warnings.add("imagemap \"gamma\": 8-bit images are always read as sRGB", &e.loc);
-                }
-                match self.image(&path, &e.loc, warnings) {
-                    Some(img) if !invert => Tint {
+                };
+                // A float texture of a colour image is the mean of its
+                // channels, or its alpha when it has one (as pbrt-v4 filters them).
+                let img = if float { Arc::new(float_channel(&img)) } else { img };
+                if invert {
+                    let mut t = (*img).clone();
+                    t.texels
+                        .iter_mut()
+                        .for_each(|v| *v = (Vec3::ONE - *v * scale).max(Vec3::ZERO));
+                    Tint {
+                        color: Vec3::ONE,
+                        image: Some(Arc::new(t)),
+                    }
+                } else {
+                    Tint {
                         color: Vec3::splat(scale),
                         image: Some(img),
-                    },
-                    Some(img) => {
-                        let texels = img
-                            .texels
-                            .iter()
-                            .map(|&t| (Vec3::ONE - t * scale).max(Vec3::ZERO))
-                            .collect();
-                        Tint {
-                            color: Vec3::ONE,
-                            image: Some(Arc::new(Texture::new(img.width, img.height, texels))),
-                        }
                     }
-                    None => Tint::constant(Vec3::splat(0.5 * scale)),
                 }
             }
             "checkerboard" => {
                 let dim = e.params.int("dimension", 2)?;
-                let a = self.operand(e, "tex1", 1.0, float, warnings, depth)?.mean();
-                let b = self.operand(e, "tex2", 0.0, float, warnings, depth)?.mean();
-                if dim != 2 || mapping != "uv" || ud != 0.0 || vd != 0.0 {
+                let a = self.operand(e, "tex1", 1.0, float, warnings, depth)?;
+                let b = self.operand(e, "tex2", 0.0, float, warnings, depth)?;
+                if dim != 2 || mapping != "uv" {
                     warnings.add(
                         "texture 'checkerboard' other than 2D in uv: replaced by the mean of its two values",
                         &e.loc,
                     );
-                    return Ok(Tint::constant((a + b) * 0.5));
+                    return Ok(Tint::constant((a.mean() + b.mean()) * 0.5));
                 }
-                return Ok(checkerboard(a, b, us, vs));
+                let mask = checkerboard(us, vs, ud, vd);
+                return Ok(if a.image.is_none() && b.image.is_none() {
+                    let t = mask.image.expect("an image");
+                    let texels = t.texels.iter().map(|m| if m.x > 0.5 { a.color } else { b.color }).collect();
+                    Tint {
+                        color: Vec3::ONE,
+                        image: Some(Arc::new(Texture::new(t.width, t.height, texels))),
+                    }
+                } else {
+                    combine(&[&a, &b, &mask], |v| if v[2].x > 0.5 { v[0] } else { v[1] })
+                });
             }
             "bilerp" => {
                 let mut v = [Vec3::ZERO; 4];
@@ -384,10 +448,12 @@ impl<'a> Textures<'a> {
         if let Some(t) = self.images.get(path) {
             return t.clone();
         }
-        let t = match load_rgb_f32(path) {
-            Ok((w, h, rgb)) if w > 0 && h > 0 => {
-                let texels = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
-                Some(Arc::new(Texture::new(w, h, texels)))
+        let t = match load_image(path) {
+            Ok(i) if i.width > 0 && i.height > 0 => {
+                let texels = i.rgb.chunks_exact(3).map(Vec3::from_slice).collect();
+                let mut t = Texture::new(i.width, i.height, texels);
+                t.alpha = i.alpha;
+                Some(Arc::new(t))
             }
             Ok(_) => {
                 warnings.add(
@@ -406,37 +472,117 @@ impl<'a> Textures<'a> {
     }
 }
 
-/// `a` times `b`: colours multiply; of two images only the first is kept (a warning).
-fn product(a: Tint, b: Tint, e: &Entity, warnings: &mut Warnings) -> Tint {
-    let image = match (a.image, b.image) {
-        (Some(x), Some(_)) => {
-            warnings.add(
-                "texture 'scale' of two images: the second is replaced by its mean",
-                &e.loc,
-            );
-            Some(x)
-        }
-        (x, y) => x.or(y),
+/// An 8-bit image (PNG, JPEG, TGA, which are read as sRGB) as another
+/// `encoding` says: pbrt-v4's `"linear"` or `"gamma G"`, pbrt-v3's `gamma`
+/// false (linear). `Ok(None)`: as read (sRGB, or a float image, whose
+/// values are linear whatever the encoding says).
+fn recode(
+    img: &Texture,
+    path: &Path,
+    encoding: Option<&str>,
+    v3_gamma: Option<bool>,
+) -> Result<Option<Texture>, String> {
+    let eight_bit = path
+        .extension()
+        .map(|x| x.to_string_lossy().to_ascii_lowercase())
+        .is_some_and(|x| matches!(x.as_str(), "png" | "jpg" | "jpeg" | "tga"));
+    let gamma = match (encoding, v3_gamma) {
+        (Some("sRGB") | None, None | Some(true)) => return Ok(None),
+        (None, Some(false)) | (Some("linear"), _) => 1.0,
+        (Some(enc), _) => match enc.strip_prefix("gamma ").map(|g| g.trim().parse::<f32>()) {
+            Some(Ok(g)) if g > 0.0 && g.is_finite() => g,
+            _ => return Err(format!("\"{enc}\" is not sRGB, linear or gamma G")),
+        },
     };
+    if !eight_bit {
+        return Ok(None);
+    }
+    let mut t = img.clone();
+    // The stored byte, recovered exactly from its sRGB decoding.
+    let byte = |v: f32| f32::from(linear_to_srgb8(v)) / 255.0;
+    t.texels
+        .iter_mut()
+        .for_each(|v| *v = Vec3::from_array(v.to_array().map(|c| byte(c).powf(gamma))));
+    Ok(Some(t))
+}
+
+/// A colour image as a float texture (the value in every channel): its
+/// alpha where it has some below 1, else the mean of its channels.
+fn float_channel(img: &Texture) -> Texture {
+    let alpha = img.alpha.as_ref().filter(|a| a.iter().any(|&v| v < 1.0));
+    let texels = match alpha {
+        Some(a) => a.iter().map(|&v| Vec3::splat(v)).collect(),
+        None => img
+            .texels
+            .iter()
+            .map(|v| Vec3::splat((v.x + v.y + v.z) / 3.0))
+            .collect(),
+    };
+    Texture::new(img.width, img.height, texels)
+}
+
+/// `f` of several tints texel by texel: of constants, a constant; else an
+/// image on the grid of the largest operand image (keeping its alpha), each
+/// operand looked up bilinearly at that grid's texel centres (exact when
+/// the images have the same size).
+fn combine(ops: &[&Tint], f: impl Fn(&[Vec3]) -> Vec3) -> Tint {
+    let Some(grid) = ops
+        .iter()
+        .filter_map(|t| t.image.as_ref())
+        .max_by_key(|t| t.texels.len())
+    else {
+        let v: Vec<Vec3> = ops.iter().map(|t| t.color).collect();
+        return Tint::constant(f(&v));
+    };
+    let (w, h) = (grid.width, grid.height);
+    let mut texels = Vec::with_capacity(grid.texels.len());
+    let mut v = vec![Vec3::ZERO; ops.len()];
+    for y in 0..h {
+        for x in 0..w {
+            let uv = glam::Vec2::new(
+                (x as f32 + 0.5) / w as f32,
+                1.0 - (y as f32 + 0.5) / h as f32,
+            );
+            for (slot, t) in v.iter_mut().zip(ops) {
+                *slot = match &t.image {
+                    Some(i) if Arc::ptr_eq(i, grid) => t.color * i.texels[(y * w + x) as usize],
+                    Some(i) => t.color * i.bilinear(uv),
+                    None => t.color,
+                };
+            }
+            texels.push(f(&v));
+        }
+    }
+    let mut out = Texture::new(w, h, texels);
+    out.alpha = grid.alpha.clone();
     Tint {
-        color: a.color * b.color,
-        image,
+        color: Vec3::ONE,
+        image: Some(Arc::new(out)),
     }
 }
 
-/// A 2D checkerboard of `us` x `vs` checks over the unit square, `a` where
-/// `floor(u us) + floor(v vs)` is even, baked at 8 texels per check.
-fn checkerboard(a: Vec3, b: Vec3, us: f64, vs: f64) -> Tint {
-    let checks = |s: f64| s.abs().round().clamp(1.0, f64::from(MAX_BAKED_SIDE / 8)) as u32;
-    let (cu, cv) = (checks(us), checks(vs));
-    let (w, h) = (cu * 8, cv * 8);
+/// Texels per check of a baked checkerboard (while the image stays within
+/// [`MAX_BAKED_SIDE`]): a bilinear lookup blurs a check's edge over one
+/// texel, 1/32 of the check.
+const TEXELS_PER_CHECK: f64 = 32.0;
+
+/// pbrt's 2D checkerboard over the unit square of uv: 1 where
+/// `floor(u us + ud) + floor(v vs + vd)` is even (pbrt's `tex1`), else 0,
+/// evaluated at the texel centres of an image of [`TEXELS_PER_CHECK`]
+/// texels per check. Texture coordinates outside the unit square repeat
+/// it (pbrt's pattern continues; the two agree for even integer scales).
+fn checkerboard(us: f64, vs: f64, ud: f64, vd: f64) -> Tint {
+    let side =
+        |s: f64| (s.abs().ceil().max(1.0) * TEXELS_PER_CHECK).min(f64::from(MAX_BAKED_SIDE)) as u32;
+    let (w, h) = (side(us), side(vs));
     let mut texels = Vec::with_capacity((w * h) as usize);
     for y in 0..h {
         // Row 0 is the top (v = 1).
-        let v_check = (h - 1 - y) / 8;
+        let v = 1.0 - (f64::from(y) + 0.5) / f64::from(h);
         for x in 0..w {
-            let even = (x / 8 + v_check) % 2 == 0;
-            texels.push(if even { a } else { b });
+            let u = (f64::from(x) + 0.5) / f64::from(w);
+            let parity = ((u * us + ud).floor() + (v * vs + vd).floor()).rem_euclid(2.0);
+            texels.push(Vec3::splat(if parity == 0.0 { 1.0 } else { 0.0 }));
         }
     }
     Tint {
@@ -466,4 +612,45 @@ fn bilerp(v00: Vec3, v01: Vec3, v10: Vec3, v11: Vec3) -> Tint {
         color: Vec3::ONE,
         image: Some(Arc::new(Texture::new(n, n, texels))),
     }
+}
+
+/// `base` (a material's colour texture, or white) with the opacity of
+/// `alpha`'s image (its red channel) as its alpha channel, on the grid of
+/// the larger of the two; the other is looked up bilinearly at its texel
+/// centres.
+pub(crate) fn with_opacity(base: Option<&Arc<Texture>>, alpha: &Texture) -> Arc<Texture> {
+    let white;
+    let base = match base {
+        Some(b) => b.as_ref(),
+        None => {
+            white = Texture::new(1, 1, vec![Vec3::ONE]);
+            &white
+        }
+    };
+    let grid = if base.texels.len() >= alpha.texels.len() {
+        base
+    } else {
+        alpha
+    };
+    let (w, h) = (grid.width, grid.height);
+    let mut texels = Vec::with_capacity(grid.texels.len());
+    let mut opacity = Vec::with_capacity(grid.texels.len());
+    for y in 0..h {
+        for x in 0..w {
+            let uv = glam::Vec2::new(
+                (x as f32 + 0.5) / w as f32,
+                1.0 - (y as f32 + 0.5) / h as f32,
+            );
+            let at = |t: &Texture| {
+                if t.width == w && t.height == h {
+                    t.texels[(y * w + x) as usize]
+                } else {
+                    t.bilinear(uv)
+                }
+            };
+            texels.push(at(base));
+            opacity.push(at(alpha).x.clamp(0.0, 1.0));
+        }
+    }
+    Arc::new(Texture::new(w, h, texels).with_alpha(opacity))
 }

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use sahara_render::{Filter, Integrator, SamplerKind, ToneMap};
+use sahara_render::{Filter, Integrator, PixelWindow, SamplerKind, ToneMap};
 
 use crate::scene_file::{
     FilmSpec, FilterSpec, IntegratorSpec, SamplerKind as SamplerSpecKind, SamplerSpec, ToneMapSpec,
@@ -31,6 +31,38 @@ pub struct FileSettings {
     pub tonemap: ToneMap,
     /// Output image, resolved relative to the scene file, if the file names one.
     pub output: Option<PathBuf>,
+    /// The part of the image to render, if the file asks for one.
+    pub crop: Option<FileCrop>,
+}
+
+/// The pixels a scene file asks to render (pbrt's film `cropwindow` and
+/// `pixelbounds`), resolved against the image size when that is known.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FileCrop {
+    /// `x0, x1, y0, y1` as fractions of the image, y from the top: pixels
+    /// `ceil(x0 W)..ceil(x1 W)`, `ceil(y0 H)..ceil(y1 H)` (pbrt-v4's rule).
+    Fractions([f64; 4]),
+    /// Pixels `x0..x1`, `y0..y1`, clipped to the image.
+    Pixels([i64; 4]),
+}
+
+impl FileCrop {
+    /// The pixels of a `width x height` image this crop keeps (may be empty).
+    pub fn window(&self, width: u32, height: u32) -> PixelWindow {
+        match *self {
+            FileCrop::Fractions(f) => sahara_render::split::crop(width, height, f),
+            FileCrop::Pixels([x0, x1, y0, y1]) => {
+                let clip = |v: i64, size: u32| v.clamp(0, i64::from(size)) as u32;
+                let (x0, y0) = (clip(x0, width), clip(y0, height));
+                PixelWindow {
+                    x0,
+                    x1: clip(x1, width).max(x0),
+                    y0,
+                    y1: clip(y1, height).max(y0),
+                }
+            }
+        }
+    }
 }
 
 impl FileSettings {
@@ -59,6 +91,7 @@ impl FileSettings {
                 ToneMapSpec::Filmic => ToneMap::Filmic,
             },
             output: film.output.clone(),
+            crop: None,
         }
     }
 }
