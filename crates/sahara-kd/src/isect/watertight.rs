@@ -13,11 +13,9 @@ use crate::math::{Ray, Triangle};
 #[inline(always)]
 pub(crate) fn permutation(kz: usize, neg: bool) -> [usize; 3] {
     let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
-    if neg {
-        [ky, kx, kz]
-    } else {
-        [kx, ky, kz]
-    }
+    // A swap without a branch when `neg`.
+    let swap = (kx ^ ky) & (neg as usize).wrapping_neg();
+    [kx ^ swap, ky ^ swap, kz]
 }
 
 /// Per-ray constants of the watertight test (Woop, Benthin, Wald 2013,
@@ -38,16 +36,15 @@ pub struct RayShear {
 impl RayShear {
     /// Precompute the shear for a ray direction.
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        // Without branches (the same choices as `x >= y && x >= z`, else
+        // `y >= z`): rays in a batch have unrelated directions, which the
+        // branch predictor cannot guess.
         let a = dir.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
-        let [kx, ky, kz] = permutation(kz, dir[kz] < 0.0);
-        let s = Vec3::new(dir[kx] / dir[kz], dir[ky] / dir[kz], 1.0 / dir[kz]);
+        let x_wins = (a.x >= a.y) & (a.x >= a.z);
+        let kz = (!x_wins as usize) * (2 - (a.y >= a.z) as usize);
+        let d = dir.to_array();
+        let [kx, ky, kz] = permutation(kz, d[kz] < 0.0);
+        let s = Vec3::new(d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
         Self {
             origin,
             k: [kx, ky, kz],

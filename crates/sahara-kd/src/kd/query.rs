@@ -69,11 +69,10 @@ impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for ClosestLeaf<'_, L,
     }
 
     #[inline(always)]
-    fn prefetch(&self, offset: usize) {
-        self.layout.prefetch(offset);
+    fn leaf_address(&self, offset: usize) -> (*const u8, *const u8) {
         // The hit's triangle index is read from the index array.
         let run = self.tree.indices.as_ptr().wrapping_add(offset);
-        crate::leaf::layout::prefetch_lines(run.cast(), 1);
+        (self.layout.address(offset), run.cast())
     }
 }
 
@@ -121,8 +120,9 @@ impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for AnyLeaf<L, SIMD> {
     }
 
     #[inline(always)]
-    fn prefetch(&self, offset: usize) {
-        self.layout.prefetch(offset);
+    fn leaf_address(&self, offset: usize) -> (*const u8, *const u8) {
+        let a = self.layout.address(offset);
+        (a, a)
     }
 }
 

@@ -40,11 +40,13 @@ pub(crate) trait LeafVisit<C> {
         closest: &mut f32,
     ) -> LeafResult;
 
-    /// Asks the cache for the leaf whose index run starts at `offset` (a
-    /// hint for walks that visit it later).
+    /// Where the data of the leaf whose index run starts at `offset` lies,
+    /// for a prefetch: its first block, and the other line its test reads
+    /// (null where there is nothing to fetch).
     #[inline(always)]
-    fn prefetch(&self, offset: usize) {
+    fn leaf_address(&self, offset: usize) -> (*const u8, *const u8) {
         let _ = offset;
+        (std::ptr::null(), std::ptr::null())
     }
 }
 

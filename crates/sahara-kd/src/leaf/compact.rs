@@ -73,6 +73,12 @@ impl IndexedBlocks {
         (Self { words }, starts)
     }
 
+    /// The first word, for addresses of blocks (prefetches).
+    #[inline(always)]
+    pub(crate) fn words_ptr(&self) -> *const u32 {
+        self.words.as_ptr()
+    }
+
     /// The block starting at word `at`.
     ///
     /// # Safety

@@ -212,12 +212,9 @@ pub(crate) trait Layout: Copy {
     /// these blocks belong to.
     unsafe fn blocks(&self, offset: usize, count: usize) -> impl Iterator<Item = Self::Block<'_>>;
 
-    /// Asks the cache for the first block of the leaf with offset field
-    /// `offset` (a hint: any offset is safe).
-    #[inline(always)]
-    fn prefetch(&self, offset: usize) {
-        let _ = offset;
-    }
+    /// The address of the first block of the leaf with offset field
+    /// `offset`, for a prefetch (any offset is safe: nothing is read).
+    fn address(&self, offset: usize) -> *const u8;
 }
 
 /// Asks the cache for the `lines` 64-byte lines from `p` (a hint: any
@@ -262,12 +259,8 @@ impl Layout for Whole<'_> {
     }
 
     #[inline(always)]
-    fn prefetch(&self, offset: usize) {
-        let block = self.0.as_ptr().wrapping_add(offset / BLOCK_WIDTH);
-        prefetch_lines(
-            block.cast(),
-            std::mem::size_of::<TriangleBlock>().div_ceil(64),
-        );
+    fn address(&self, offset: usize) -> *const u8 {
+        self.0.as_ptr().wrapping_add(offset / BLOCK_WIDTH).cast()
     }
 }
 
@@ -289,6 +282,11 @@ impl Layout for Indexed<'_> {
             next: unsafe { self.0.block(offset) },
             left: count.div_ceil(BLOCK_WIDTH),
         }
+    }
+
+    #[inline(always)]
+    fn address(&self, offset: usize) -> *const u8 {
+        self.0.words_ptr().wrapping_add(offset).cast()
     }
 }
 

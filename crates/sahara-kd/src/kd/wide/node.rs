@@ -79,6 +79,13 @@ pub(crate) fn leaf_of(word: u32, shift: u32, binary: &[Node]) -> (u32, u32) {
     }
 }
 
+/// [`leaf_of`] for a leaf stored inline (a meaningless pair for one that
+/// is not): no load, for prefetches.
+#[inline(always)]
+pub(crate) fn leaf_of_inline(word: u32, shift: u32) -> (u32, u32) {
+    ((word & PAYLOAD_MASK) << shift, (word >> COUNT_SHIFT) & COUNT_MASK)
+}
+
 /// The leaf word of binary leaf `index` (non-empty): its offset and count
 /// inline when they fit, else the node's index; `None` if neither fits.
 fn leaf_word(index: u32, n: &Node, shift: u32) -> Option<u32> {

@@ -24,7 +24,7 @@ use std::mem::MaybeUninit;
 
 use glam::Vec3;
 
-use super::node::{leaf_of, WideNode, FAR_FIRST, LEAF_BIT, PLANES, WIDTH};
+use super::node::{leaf_of, leaf_of_inline, WideNode, FAR_FIRST, LEAF_BIT, PLANES, WIDTH};
 use crate::build::MAX_DEPTH;
 use crate::kd::interval::{may_hold_closer, widened_t0, widened_t1};
 use crate::kd::walk::{LeafResult, LeafVisit};
@@ -172,15 +172,18 @@ impl Walker {
                 vector::step::<SIMD>(n, &self.ray, t0, t1, self.closest, &mut self.stack, sp)
             };
             self.sp += k;
-            if k == 0 {
-                return self.prefetch_top::<P, C, PREFETCH>(tree, leaf);
-            }
-            // The new top from the registers: loaded back from the stack,
-            // it would wait for the vector stores just made.
             if PREFETCH {
-                prefetch_word(tree, leaf, top);
+                // The new top from the registers (loaded back from the
+                // stack, it would wait for the vector stores just made), or
+                // the one below when nothing was pushed; chosen without a
+                // branch, which the predictor could not guess. Entry 0 is
+                // written at the start, so the load is always of a pushed
+                // word.
+                // SAFETY: as above.
+                let below = unsafe { self.stack.node[self.sp.max(1) - 1].assume_init() };
+                prefetch_word(tree, leaf, if k != 0 { top } else { below });
             }
-            return true;
+            return self.sp != 0;
         }
         self.sp += step(n, &self.ray, t0, t1, self.closest, &mut self.stack, sp);
         self.prefetch_top::<P, C, PREFETCH>(tree, leaf)
@@ -217,15 +220,21 @@ impl Walker {
 }
 
 /// Asks the cache for the wide node or the leaf that child word `word`
-/// names.
+/// names, without a branch on which it is (the predictor could not guess
+/// it): the address is selected, and five lines are fetched from it (a
+/// block of eight triangles, or a node and the nodes after it, its first
+/// subtree), and one more line the leaf test reads. A leaf that does not
+/// fit its word inline gets a useless hint.
 #[inline(always)]
 fn prefetch_word<P: LeafStorage, C>(tree: &KdTree<P>, leaf: &impl LeafVisit<C>, word: u32) {
-    if word & LEAF_BIT != 0 {
-        let (offset, _) = leaf_of(word, tree.wide_shift, &tree.nodes);
-        leaf.prefetch(offset as usize);
-    } else {
-        prefetch_lines(tree.wide.as_ptr().wrapping_add(word as usize).cast(), 1);
-    }
+    let (offset, _) = leaf_of_inline(word, tree.wide_shift);
+    let (block, other) = leaf.leaf_address(offset as usize);
+    let node = tree.wide.as_ptr().wrapping_add(word as usize).cast::<u8>();
+    let is_leaf = word & LEAF_BIT != 0;
+    let first = if is_leaf { block } else { node };
+    let second = if is_leaf { other } else { node };
+    prefetch_lines(first, 5);
+    prefetch_lines(second, 1);
 }
 
 /// The planes of slot `c` at the three levels.
