@@ -83,7 +83,10 @@ pub(crate) fn leaf_of(word: u32, shift: u32, binary: &[Node]) -> (u32, u32) {
 /// is not): no load, for prefetches.
 #[inline(always)]
 pub(crate) fn leaf_of_inline(word: u32, shift: u32) -> (u32, u32) {
-    ((word & PAYLOAD_MASK) << shift, (word >> COUNT_SHIFT) & COUNT_MASK)
+    (
+        (word & PAYLOAD_MASK) << shift,
+        (word >> COUNT_SHIFT) & COUNT_MASK,
+    )
 }
 
 /// The leaf word of binary leaf `index` (non-empty): its offset and count

@@ -144,19 +144,22 @@ impl Walker {
                 self.stack.t1[sp].assume_init(),
             )
         };
-        // Entries are front to back except where a ray lies in a plane
-        // (both sides get its whole interval), so every entry is checked,
-        // as in the binary walk.
-        if !may_hold_closer(t0, self.closest) {
-            return self.prefetch_top::<P, C, PREFETCH>(tree, leaf);
-        }
+        // Every stacked cell may hold a closer hit: the steps push only
+        // such cells, and a closer hit drops the others at once (see
+        // `drop_beyond_closest`), so no entry is popped only to be passed
+        // over.
+        debug_assert!(may_hold_closer(t0, self.closest));
         if node & LEAF_BIT != 0 {
             counters.leaf();
             let (offset, count) = leaf_of(node, tree.wide_shift, &tree.nodes);
+            let before = self.closest;
             let r = leaf.visit(offset as usize, count as usize, counters, &mut self.closest);
             if let LeafResult::Stop = r {
                 self.sp = 0;
                 return false;
+            }
+            if self.closest < before {
+                self.drop_beyond_closest();
             }
             return self.prefetch_top::<P, C, PREFETCH>(tree, leaf);
         }
@@ -187,6 +190,30 @@ impl Walker {
         }
         self.sp += step(n, &self.ray, t0, t1, self.closest, &mut self.stack, sp);
         self.prefetch_top::<P, C, PREFETCH>(tree, leaf)
+    }
+
+    /// Removes the stacked cells entered beyond the closest hit (keeping
+    /// the others in order): the walk then ends as soon as the last cell
+    /// that may hold a closer hit is done, instead of popping the others
+    /// one step at a time.
+    #[inline(always)]
+    fn drop_beyond_closest(&mut self) {
+        let mut kept = 0;
+        for i in 0..self.sp {
+            // SAFETY: entries below `sp` were written by a push.
+            let (node, t0, t1) = unsafe {
+                (
+                    self.stack.node[i].assume_init(),
+                    self.stack.t0[i].assume_init(),
+                    self.stack.t1[i].assume_init(),
+                )
+            };
+            self.stack.node[kept] = MaybeUninit::new(node);
+            self.stack.t0[kept] = MaybeUninit::new(t0);
+            self.stack.t1[kept] = MaybeUninit::new(t1);
+            kept += may_hold_closer(t0, self.closest) as usize;
+        }
+        self.sp = kept;
     }
 
     /// With `PREFETCH`, asks the cache for the top entry's node or leaf;
