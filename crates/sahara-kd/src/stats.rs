@@ -29,9 +29,12 @@ pub struct TreeStats {
     pub references: usize,
     /// References per referenced triangle (1 = no duplication).
     pub duplication: f64,
-    /// Bytes of nodes + index array + leaf data (a triangle tree's leaf
-    /// blocks hold its triangles; it keeps no other copy).
+    /// Bytes of nodes + wide nodes + index array + leaf data (a triangle
+    /// tree's leaf blocks hold its triangles; it keeps no other copy).
     pub memory_bytes: usize,
+    /// Bytes of the wide nodes derived for the batch walks (included in
+    /// `memory_bytes`; 0 without them).
+    pub wide_node_bytes: usize,
     /// The tree's SAH cost with its build's K_T, K_I and leaf width W:
     /// `sum_inner SA/SA_root K_T + sum_leaves SA/SA_root K_I ceil(n / W)`.
     pub sah_cost: f64,
@@ -100,7 +103,9 @@ impl<P: LeafStorage> KdTree<P> {
         s.mean_leaf_triangles = s.references as f64 / non_empty.max(1) as f64;
         let distinct = referenced.iter().filter(|&&r| r).count();
         s.duplication = s.references as f64 / distinct.max(1) as f64;
+        s.wide_node_bytes = std::mem::size_of_val(self.wide.as_slice());
         s.memory_bytes = std::mem::size_of_val(self.nodes.as_slice())
+            + s.wide_node_bytes
             + std::mem::size_of_val(self.indices.as_slice())
             + P::leaf_data_bytes(&self.leaf_data);
         s

@@ -199,7 +199,15 @@ pub fn stats_report(r: &StatsReport) -> String {
                 t.duplication
             ),
         ),
-        ("memory", bytes(t.memory_bytes)),
+        (
+            "memory",
+            format!(
+                "{} (wide nodes {}: {:.3}x the tree without them)",
+                bytes(t.memory_bytes),
+                bytes(t.wide_node_bytes),
+                t.memory_bytes as f64 / (t.memory_bytes - t.wide_node_bytes).max(1) as f64
+            ),
+        ),
         ("SAH cost", format!("{:.3}", t.sah_cost)),
         (
             "expected",

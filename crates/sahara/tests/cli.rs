@@ -212,6 +212,7 @@ fn stats_json_has_the_tree_statistics() {
         "leaves",
         "max_depth",
         "memory_bytes",
+        "wide_node_bytes",
         "sah_cost",
         "expected_triangles",
     ] {
