@@ -1,8 +1,9 @@
 //! Criterion benchmarks of the accelerator's hot paths on the Stanford bunny
 //! (read in place from the shared scenes, `$SAHARA_SCENES` to override):
 //! building each kind of tree, tracing the protocol's ray sets on one
-//! thread (closest hit for primary / diffuse / random, any hit for shadow),
-//! primary rays in 4x2 tiles as single rays and as packets, in 4x4 tiles
+//! thread (closest hit for primary / diffuse / random, any hit for shadow)
+//! ray by ray and as batches (interleaved over the wide nodes, and over
+//! the binary nodes one by one), primary rays in 4x2 tiles as single rays and as packets, in 4x4 tiles
 //! as 16-ray packets, and the
 //! leaf tests alone (eight triangles against one ray, one triangle against
 //! eight rays, eight triangles against a packet's frustum; portable builds,
@@ -14,7 +15,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize};
 use sahara_bench::runner::PacketSize;
 use sahara_bench::{HitRecord, ProtocolCamera, SceneFrame};
-use sahara_kd::internals::{Frustum, IndexedBlocks, PacketShear, RayShear, BLOCK_WIDTH};
+use sahara_kd::internals::{BatchWalk, Frustum, IndexedBlocks, PacketShear, RayShear, BLOCK_WIDTH};
 use sahara_kd::{BuildParams, Builder, KdTree, Ray, TriangleBlock};
 use sahara_render::mesh::Mesh;
 
@@ -99,6 +100,27 @@ fn trace(c: &mut Criterion) {
                 }
             })
         });
+    }
+    // Batches on this thread: the interleaved wide walk and the binary walk
+    // ray by ray, on every set (whatever the batch's coherence).
+    for (name, rays, any) in &sets {
+        g.throughput(Throughput::Elements(rays.len() as u64));
+        for walk in [BatchWalk::Wide, BatchWalk::Binary] {
+            let label = format!("{name}_batch_{}", format!("{walk:?}").to_lowercase());
+            let mut hits = vec![None; rays.len()];
+            let mut occluded = vec![false; rays.len()];
+            g.bench_function(label, |bench| {
+                bench.iter(|| {
+                    if *any {
+                        tree.any_hits_walked(rays, &mut occluded, walk);
+                        occluded.iter().filter(|&&o| o).count()
+                    } else {
+                        tree.closest_hits_walked(rays, &mut hits, walk);
+                        hits.iter().filter(|h| h.is_some()).count()
+                    }
+                })
+            });
+        }
     }
     // The packet path on primary rays: whole 4x2 tiles spread over the image.
     let tiled = spread_tiles(&primary, PacketSize::Eight);
