@@ -20,7 +20,7 @@
 //! and `alpha = r` without; pbrt-v3 remaps with its polynomial in `ln r`.
 
 use glam::Vec3;
-use sahara_render::Material;
+use sahara_render::{Material, TextureMap};
 
 use super::description::Entity;
 use super::spectrum::{self, Use};
@@ -85,7 +85,7 @@ fn roughness(
 /// A diffuse material of reflectance `tint`.
 fn diffuse(tint: Tint) -> Material {
     let mut m = Material::diffuse(tint.color.clamp(Vec3::ZERO, Vec3::ONE));
-    m.texture = tint.image;
+    m.textures.base_color = tint.image.map(TextureMap::new);
     m
 }
 
@@ -219,7 +219,7 @@ pub(crate) fn map_material(
             } else {
                 Material::conductor(color.color, r)
             };
-            m.texture = color.image;
+            m.textures.base_color = color.image.map(TextureMap::new);
             m
         }
         "dielectric" | "glass" | "thindielectric" => {
@@ -257,7 +257,7 @@ pub(crate) fn map_material(
         "mirror" => {
             let kr = tex.spectrum(e, "Kr", grey(0.9), Use::Reflectance, w)?;
             let mut m = Material::mirror(kr.color);
-            m.texture = kr.image;
+            m.textures.base_color = kr.image.map(TextureMap::new);
             m
         }
         "coateddiffuse" | "plastic" | "substrate" | "uber" => {

@@ -48,10 +48,7 @@ impl Tint {
     /// The mean value (the image's mean texel times the colour).
     pub(crate) fn mean(&self) -> Vec3 {
         match &self.image {
-            Some(t) => {
-                let sum: Vec3 = t.texels.iter().copied().sum();
-                self.color * sum / t.texels.len() as f32
-            }
+            Some(t) => self.color * t.mean(),
             None => self.color,
         }
     }
@@ -315,9 +312,8 @@ impl<'a> Textures<'a> {
                     },
                     Some(img) => {
                         let texels = img
-                            .texels
-                            .iter()
-                            .map(|&t| (Vec3::ONE - t * scale).max(Vec3::ZERO))
+                            .texels()
+                            .map(|t| (Vec3::ONE - t * scale).max(Vec3::ZERO))
                             .collect();
                         Tint {
                             color: Vec3::ONE,

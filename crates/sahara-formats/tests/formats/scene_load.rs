@@ -145,7 +145,7 @@ fn a_glass_mtl_becomes_a_dielectric_in_the_scene() {
     assert_eq!(s.scene.materials[0].bsdf, Bsdf::Dielectric { ior: 1.5 });
     assert_eq!(s.scene.meshes[0].material_ids, Some(vec![0, 0]));
     assert!(
-        s.default_light,
+        s.default_light(),
         "no emitter: the default sky and sun light it"
     );
     assert!(s.scene.environment.is_some() && s.scene.lights.len() == 1);
@@ -166,7 +166,7 @@ fn an_emissive_mtl_is_an_emitter_and_needs_no_default_light() {
             albedo: Vec3::splat(0.78)
         }
     );
-    assert!(!s.default_light);
+    assert!(!s.default_light());
     assert!(s.scene.environment.is_none() && s.scene.lights.is_empty());
 }
 
@@ -186,7 +186,7 @@ fn the_shared_cornell_box_light_emits_17_12_4() {
         .collect();
     assert_eq!(emitters.len(), 1);
     assert_eq!(emitters[0].emission, Vec3::new(17.0, 12.0, 4.0));
-    assert!(!s.default_light);
+    assert!(!s.default_light());
     assert!(s.camera_source.ends_with("cornell_box.camera.json"));
     assert_eq!(s.scene.camera.eye, Vec3::new(278.0, 273.0, -800.0));
 }
@@ -209,11 +209,17 @@ fn textures_load_once_and_a_missing_one_is_a_warning() {
         "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\nusemtl c\nf 2 1 3\n",
     );
     let s = load_mesh_scene(&obj).unwrap();
-    let [a, b, c] = [0, 1, 2].map(|i| s.scene.materials[i].texture.clone());
+    let [a, b, c] = [0, 1, 2].map(|i| {
+        s.scene.materials[i]
+            .textures
+            .base_color
+            .as_ref()
+            .map(|m| m.texture.clone())
+    });
     let (a, b) = (a.unwrap(), b.unwrap());
     assert!(std::sync::Arc::ptr_eq(&a, &b), "one file, one texture");
     assert_eq!((a.width, a.height), (2, 1));
-    assert_eq!(a.texels[0], Vec3::new(1.0, 0.0, 0.0));
+    assert_eq!(a.texel(0, 0), Vec3::new(1.0, 0.0, 0.0));
     assert!(c.is_none());
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
     assert!(s.warnings[0].contains("gone.png"), "{}", s.warnings[0]);
