@@ -462,3 +462,43 @@ fn an_area_light_carries_the_material_it_names() {
         "{e}"
     );
 }
+
+#[test]
+fn the_scene_files_sky_key_adds_what_it_names() {
+    let dir = TempDir::new("load-sky");
+    dir.write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n");
+    let scene = |sky: &str| {
+        let toml = format!(
+            "{sky}\n[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n\n[film]\nwidth = 4\nheight = 4\n\n\
+             [[object]]\ntype = \"mesh\"\nfile = \"quad.obj\"\n\n\
+             [[light]]\ntype = \"point\"\nposition = [0, 0, 2]\nintensity = [1e-3, 1e-3, 1e-3]\n"
+        );
+        load_scene(&dir.write("s.toml", toml))
+    };
+    // Without the key: the file's lights alone, however weak.
+    let s = scene("").unwrap().scene;
+    assert_eq!((s.lights.len(), s.environment.is_some()), (1, false));
+    // auto: the point light is weak, so the default sky and sun come in.
+    let s = scene("sky = \"auto\"").unwrap().scene;
+    assert_eq!(s.lights.len(), 2);
+    assert_eq!(
+        s.environment,
+        Some(sahara_render::Environment::Constant(
+            sahara_formats::sky::DEFAULT_SKY
+        ))
+    );
+    let s = scene("sky = \"default\"").unwrap().scene;
+    assert_eq!(s.lights.len(), 2);
+    // A map relative to the scene file; one that is missing names the file.
+    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n".to_vec();
+    hdr.extend_from_slice(&[128, 64, 32, 129, 128, 64, 32, 129]);
+    dir.write("env.hdr", hdr);
+    let s = scene("sky = \"env.hdr\"").unwrap().scene;
+    assert!(matches!(
+        s.environment,
+        Some(sahara_render::Environment::Map { .. })
+    ));
+    assert_eq!(s.lights.len(), 1);
+    let e = scene("sky = \"gone.exr\"").unwrap_err().to_string();
+    assert!(e.contains("s.toml") && e.contains("gone.exr"), "{e}");
+}
