@@ -164,6 +164,8 @@ pub struct GltfClearcoat {
     pub texture: Option<GltfTexture>,
     /// `clearcoatRoughnessTexture` (green channel), multiplying `roughness`.
     pub roughness_texture: Option<GltfTexture>,
+    /// `clearcoatNormalTexture`, with its `scale`.
+    pub normal_texture: Option<(GltfTexture, f32)>,
 }
 
 /// A texture reference: the image, how it is sampled and which uv set it
@@ -804,6 +806,7 @@ impl Loader<'_> {
                 texture: texture(clearcoat, "clearcoatTexture", "")?.map(|t| t.0),
                 roughness_texture: texture(clearcoat, "clearcoatRoughnessTexture", "")?
                     .map(|t| t.0),
+                normal_texture: texture(clearcoat, "clearcoatNormalTexture", "scale")?,
             })
         } else {
             None

@@ -32,16 +32,17 @@
 //! double-sided is black from behind. `alphaMode` `MASK` (with
 //! `alphaCutoff`) and `BLEND` cut the surface by the base colour's alpha
 //! factor times the base colour texture's alpha channel.
-//! `KHR_materials_clearcoat` is a coat over the material (its normal
-//! texture is not read: the coat follows the base's normal).
+//! `KHR_materials_clearcoat` is a coat over the material, with its own
+//! normal map (without one the coat follows the surface's normal, not the
+//! base's normal map).
 //!
 //! Every glTF texture is read with its sampler's wrap modes, its uv set
 //! (`TEXCOORD_0` or `_1`) and its `KHR_texture_transform`: the base colour
 //! (sRGB; alpha linear), metallic (blue) and roughness (green) of the
 //! metallic-roughness texture, the normal map with its `scale`, occlusion
 //! (red) with its `strength`, the emissive texture (sRGB), and the clear
-//! coat's strength (red) and roughness (green); every data texture is
-//! linear.
+//! coat's strength (red), roughness (green) and normal map; every data
+//! texture is linear.
 //!
 //! A texture that cannot be read is a warning and the material goes
 //! without it. Each image is decoded once per encoding ([`TextureCache`]).
@@ -267,8 +268,8 @@ pub fn gltf_material(
         .with_alpha(m.alpha_mode, m.base_color[3].clamp(0.0, 1.0));
     out.two_sided_emission = m.double_sided;
     let label = m.name.as_deref().unwrap_or("(unnamed)");
-    let mut map = |t: &Option<GltfTexture>, role: &str, encoding: Encoding| {
-        let t = t.as_ref()?;
+    let mut map = |t: Option<&GltfTexture>, role: &str, encoding: Encoding| {
+        let t = t?;
         if t.tex_coord > 1 {
             warnings.push(format!(
                 "{name}: material '{label}': {role} uses TEXCOORD_{}, which is not loaded; the material goes without it",
@@ -285,40 +286,41 @@ pub fn gltf_material(
         )
     };
     let tex = &mut out.textures;
-    tex.base_color = map(&m.base_color_texture, "base colour texture", Encoding::Srgb);
+    tex.base_color = map(
+        m.base_color_texture.as_ref(),
+        "base colour texture",
+        Encoding::Srgb,
+    );
     if let Some(mr) = map(
-        &m.metallic_roughness_texture,
+        m.metallic_roughness_texture.as_ref(),
         "metallic-roughness texture",
         Encoding::Linear,
     ) {
         tex.metallic = Some(ScalarMap::new(mr.clone(), Channel::B));
         tex.roughness = Some(ScalarMap::new(mr, Channel::G));
     }
-    let normal = m
-        .normal_texture
-        .as_ref()
-        .map(|(t, s)| (Some(t.clone()), *s));
-    if let Some((t, scale)) = normal {
-        tex.normal = map(&t, "normal texture", Encoding::Linear).map(|map| NormalMap {
+    if let Some((t, scale)) = &m.normal_texture {
+        tex.normal = map(Some(t), "normal texture", Encoding::Linear).map(|map| NormalMap {
             map,
-            scale: if scale.is_finite() { scale } else { 1.0 },
+            scale: if scale.is_finite() { *scale } else { 1.0 },
         });
     }
-    let occlusion = m
-        .occlusion_texture
-        .as_ref()
-        .map(|(t, s)| (Some(t.clone()), *s));
-    if let Some((t, strength)) = occlusion {
-        tex.occlusion = map(&t, "occlusion texture", Encoding::Linear).map(|map| OcclusionMap {
-            map: ScalarMap::new(map, Channel::R),
-            strength: if strength.is_finite() {
-                strength.clamp(0.0, 1.0)
-            } else {
-                1.0
-            },
-        });
+    if let Some((t, strength)) = &m.occlusion_texture {
+        tex.occlusion =
+            map(Some(t), "occlusion texture", Encoding::Linear).map(|map| OcclusionMap {
+                map: ScalarMap::new(map, Channel::R),
+                strength: if strength.is_finite() {
+                    strength.clamp(0.0, 1.0)
+                } else {
+                    1.0
+                },
+            });
     }
-    tex.emission = map(&m.emissive_texture, "emissive texture", Encoding::Srgb);
+    tex.emission = map(
+        m.emissive_texture.as_ref(),
+        "emissive texture",
+        Encoding::Srgb,
+    );
     if let Some(c) = &m.clearcoat {
         let unit = |x: f32| {
             if x.is_finite() {
@@ -331,14 +333,20 @@ pub fn gltf_material(
             factor: unit(c.factor),
             roughness: unit(c.roughness),
             ior: 1.5,
-            factor_map: map(&c.texture, "clearcoat texture", Encoding::Linear)
+            factor_map: map(c.texture.as_ref(), "clearcoat texture", Encoding::Linear)
                 .map(|m| ScalarMap::new(m, Channel::R)),
             roughness_map: map(
-                &c.roughness_texture,
+                c.roughness_texture.as_ref(),
                 "clearcoat roughness texture",
                 Encoding::Linear,
             )
             .map(|m| ScalarMap::new(m, Channel::G)),
+            normal_map: c.normal_texture.as_ref().and_then(|(t, scale)| {
+                map(Some(t), "clearcoat normal texture", Encoding::Linear).map(|map| NormalMap {
+                    map,
+                    scale: if scale.is_finite() { *scale } else { 1.0 },
+                })
+            }),
         }))
         .filter(|c| c.factor > 0.0);
     }

@@ -12,6 +12,7 @@ use sahara_kd::{Ray, TraversalCounters};
 
 use crate::light::LightSample;
 use crate::material::textures::perturbed_normal;
+use crate::material::NormalMap;
 use crate::material::{BsdfSample, PointBsdf};
 use crate::sampler::dims;
 use crate::sampler::PixelSampler;
@@ -245,15 +246,20 @@ impl Shading {
         } else {
             UvFootprint::POINT
         };
-        let point = material.at(&uvs, &fp);
-        let ns = match (point.normal, &material.textures.normal) {
+        let mut point = material.at(&uvs, &fp);
+        let mapped = |m: Option<Vec3>, map: Option<&NormalMap>| match (m, map) {
             (Some(m), Some(map)) => {
                 let (t, sign) = world.tangent(hit, map.map.uv_set);
                 perturbed_normal(hit.ns, t, sign, m)
             }
             _ => hit.ns,
         };
+        let ns = mapped(point.normal, material.textures.normal.as_ref());
         let frame = Frame::from_normal(ns);
+        if let (Some(coat), Some(c)) = (&mut point.bsdf.coat, &material.clearcoat) {
+            let n = mapped(point.coat_normal, c.normal_map.as_ref());
+            *coat = coat.with_normal(frame.to_local(n));
+        }
         let wo_world = -dir;
         let emitted = if material.is_emissive() {
             material.emitted(hit.ng.dot(wo_world), &uvs, &fp)

@@ -13,13 +13,21 @@
 //! Sampling picks the coat with probability `c E(wo) / (c E(wo) +
 //! (1 - c E(wo)) / 2)` (the base taken to reflect half of what reaches it)
 //! and the base's own sampling otherwise; densities are the mixture.
+//!
+//! The coat has a normal of its own (glTF's `clearcoatNormalTexture`, else
+//! the surface's normal without the base's normal map): its lobe and its
+//! albedo are taken in that frame, and the lobe is scaled by the ratio of
+//! the cosines to the coat's and to the shading normal, so that the
+//! light it reflects is what a surface facing that way would reflect.
 
 use glam::{Vec2, Vec3};
 
 use super::albedo;
 use super::fresnel::{reflect, schlick_f90};
+use super::layered::{to_side, upper};
 use super::microfacet::Ggx;
 use super::{Bsdf, BsdfEval, BsdfSample};
+use crate::sampling::Frame;
 
 /// The coat lobe at one shading point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,6 +38,8 @@ pub struct Coat {
     pub roughness: f32,
     /// Reflectance at normal incidence (from the coat's index).
     pub f0: f32,
+    /// The coat's normal in the shading frame (+z: the shading normal).
+    pub normal: Vec3,
 }
 
 impl Coat {
@@ -45,7 +55,31 @@ impl Coat {
             factor: unit(factor),
             roughness: unit(roughness),
             f0: ((eta - 1.0) / (eta + 1.0)).powi(2),
+            normal: Vec3::Z,
         }
+    }
+
+    /// This coat with its normal `n` (unit, in the shading frame; one
+    /// below the surface is ignored).
+    pub fn with_normal(mut self, n: Vec3) -> Self {
+        self.normal = if n.z > 1e-4 && n.is_finite() {
+            n
+        } else {
+            Vec3::Z
+        };
+        self
+    }
+
+    /// The coat's frame, if its normal is not the shading normal.
+    #[inline]
+    fn frame(&self) -> Option<Frame> {
+        (self.normal != Vec3::Z).then(|| Frame::from_normal(self.normal))
+    }
+
+    /// `w` (upper hemisphere of the shading frame) in the coat's frame.
+    #[inline]
+    fn local(&self, frame: &Option<Frame>, w: Vec3) -> Vec3 {
+        frame.as_ref().map_or(w, |f| f.to_local(w))
     }
 
     /// The coat's reflected fraction from `mu`, times its strength.
@@ -76,10 +110,11 @@ impl Coat {
         Ggx::from_roughness(self.roughness).is_smooth()
     }
 
-    /// The coat lobe alone, `wo` and `wi` above the surface.
-    fn lobe(&self, wo: Vec3, wi: Vec3) -> BsdfEval {
+    /// The coat lobe alone for `wo` and `wi` in the coat's frame, its
+    /// value scaled to the shading frame, where `wi` has cosine `cos_i`.
+    fn lobe(&self, wo: Vec3, wi: Vec3, cos_i: f32) -> BsdfEval {
         let ggx = Ggx::from_roughness(self.roughness);
-        if ggx.is_smooth() {
+        if ggx.is_smooth() || wo.z <= 0.0 || wi.z <= 0.0 || cos_i <= 0.0 {
             return BsdfEval::ZERO;
         }
         let h = (wo + wi).normalize();
@@ -88,7 +123,7 @@ impl Coat {
             return BsdfEval::ZERO;
         }
         BsdfEval {
-            f: Vec3::splat(self.fresnel(oh) * ggx.d(h) * ggx.g(wo, wi) / (4.0 * wo.z * wi.z)),
+            f: Vec3::splat(self.fresnel(oh) * ggx.d(h) * ggx.g(wo, wi) / (4.0 * wo.z * cos_i)),
             pdf: ggx.pdf_visible(wo, h) / (4.0 * oh),
         }
     }
@@ -100,9 +135,11 @@ impl Coat {
             return b;
         }
         let (uo, ui) = (upper(wo), upper(wi));
-        let p = self.probability(uo);
-        let c = self.lobe(uo, ui);
-        let dim = (1.0 - self.albedo(uo.z)) * (1.0 - self.albedo(ui.z));
+        let frame = self.frame();
+        let (co, ci) = (self.local(&frame, uo), self.local(&frame, ui));
+        let p = self.probability(co);
+        let c = self.lobe(co, ci, ui.z);
+        let dim = (1.0 - self.albedo(co.z)) * (1.0 - self.albedo(ci.z));
         BsdfEval {
             f: c.f + b.f * dim,
             pdf: p * c.pdf + (1.0 - p) * b.pdf,
@@ -123,22 +160,32 @@ impl Coat {
         }
         let flip = wo.z < 0.0;
         let uo = upper(wo);
-        let p = self.probability(uo);
+        let frame = self.frame();
+        let co = self.local(&frame, uo);
+        let p = self.probability(co);
         if u_lobe < p {
+            if co.z <= 0.0 {
+                return None;
+            }
+            let to_shading = |w: Vec3| frame.as_ref().map_or(w, |f| f.to_world(w));
             let ggx = Ggx::from_roughness(self.roughness);
             if ggx.is_smooth() {
+                let wi = to_shading(Vec3::new(-co.x, -co.y, co.z));
+                if wi.z <= 0.0 {
+                    return None;
+                }
                 return Some(BsdfSample {
-                    wi: to_side(Vec3::new(-uo.x, -uo.y, uo.z), flip),
-                    weight: Vec3::splat(self.fresnel(uo.z) / p),
+                    wi: to_side(wi, flip),
+                    weight: Vec3::splat(self.fresnel(co.z) / p),
                     pdf: p,
                     delta: true,
                 });
             }
-            let m = ggx.sample_visible(uo, u);
-            if uo.dot(m) <= 0.0 {
+            let m = ggx.sample_visible(co, u);
+            if co.dot(m) <= 0.0 {
                 return None;
             }
-            let wi = reflect(uo, m);
+            let wi = to_shading(reflect(co, m));
             if wi.z <= 0.0 {
                 return None;
             }
@@ -160,7 +207,8 @@ impl Coat {
             // Transmission through the base: the coat only reflects.
             return Some(s);
         }
-        let dim = (1.0 - self.albedo(wo.z)) * (1.0 - self.albedo(wi.z));
+        let (co, ci) = (self.local(&frame, upper(wo)), self.local(&frame, upper(wi)));
+        let dim = (1.0 - self.albedo(co.z)) * (1.0 - self.albedo(ci.z));
         if s.delta {
             return Some(BsdfSample {
                 weight: s.weight * dim / (1.0 - p),
@@ -181,30 +229,13 @@ impl Coat {
     }
 }
 
-#[inline]
-fn upper(w: Vec3) -> Vec3 {
-    Vec3::new(w.x, w.y, w.z.abs())
-}
-
-#[inline]
-fn to_side(w: Vec3, below: bool) -> Vec3 {
-    if below {
-        Vec3::new(w.x, w.y, -w.z)
-    } else {
-        w
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::hash::{hash3, unit_f32};
+    use crate::material::tests::u2;
     use crate::sampling::uniform_sphere;
     use std::f32::consts::PI;
-
-    fn u2(a: u64, i: u64) -> Vec2 {
-        Vec2::new(unit_f32(hash3(a, i, 0)), unit_f32(hash3(a, i, 1)))
-    }
 
     fn bases() -> Vec<Bsdf> {
         vec![
@@ -263,8 +294,9 @@ mod tests {
     fn sampling_agrees_with_evaluation() {
         let g = 400u64;
         let n = g * g;
-        for roughness in [0.1f32, 0.5] {
-            let coat = Coat::new(0.8, roughness, 1.5);
+        let tilted = Vec3::new(0.3, -0.2, 0.9).normalize();
+        for (roughness, normal) in [(0.1f32, Vec3::Z), (0.5, Vec3::Z), (0.3, tilted)] {
+            let coat = Coat::new(0.8, roughness, 1.5).with_normal(normal);
             for base in bases() {
                 let wo = Vec3::new(0.5, 0.2, 0.7).normalize();
                 let (mut sampled, mut kept, mut quad, mut pdf_sum) = (0.0f64, 0u64, 0.0f64, 0.0f64);
@@ -284,7 +316,10 @@ mod tests {
                     pdf_sum += (e.pdf * 4.0 * PI) as f64;
                 }
                 let (a, b) = (sampled / n as f64, quad / n as f64);
-                assert!((a - b).abs() < 0.005 + 0.01 * b, "{base:?}: {a} vs {b}");
+                assert!(
+                    (a - b).abs() < 0.005 + 0.01 * b,
+                    "{base:?} coat normal {normal}: {a} vs {b}"
+                );
                 let (p, k) = (pdf_sum / n as f64, kept as f64 / n as f64);
                 assert!((p - k).abs() < 0.01, "{base:?}: pdf {p}, kept {k}");
             }

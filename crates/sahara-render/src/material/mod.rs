@@ -436,6 +436,7 @@ impl Material {
             t.emission.as_ref(),
             c.and_then(|c| c.factor_map.as_ref()).map(|m| &m.map),
             c.and_then(|c| c.roughness_map.as_ref()).map(|m| &m.map),
+            c.and_then(|c| c.normal_map.as_ref()).map(|m| &m.map),
         ]
         .into_iter()
         .flatten()
@@ -446,10 +447,9 @@ impl Material {
     /// (which then need a footprint).
     pub fn has_textures(&self) -> bool {
         !self.textures.is_empty()
-            || self
-                .clearcoat
-                .as_ref()
-                .is_some_and(|c| c.factor_map.is_some() || c.roughness_map.is_some())
+            || self.clearcoat.as_ref().is_some_and(|c| {
+                c.factor_map.is_some() || c.roughness_map.is_some() || c.normal_map.is_some()
+            })
     }
 
     /// True if the material emits light.
@@ -477,10 +477,12 @@ impl Material {
         });
         SurfacePoint {
             bsdf: PointBsdf { bsdf, tint, coat },
-            normal: t
-                .normal
+            normal: t.normal.as_ref().and_then(|n| n.lookup(uvs, fp)),
+            coat_normal: self
+                .clearcoat
                 .as_ref()
-                .and_then(|n| textures::decode_normal(n.map.lookup(uvs, fp).truncate(), n.scale)),
+                .and_then(|c| c.normal_map.as_ref())
+                .and_then(|n| n.lookup(uvs, fp)),
             occlusion: t.occlusion.as_ref().map_or(1.0, |o| {
                 let v = o.map.lookup(uvs, fp).clamp(0.0, 1.0);
                 1.0 + o.strength.clamp(0.0, 1.0) * (v - 1.0)
@@ -511,6 +513,8 @@ pub struct SurfacePoint {
     pub bsdf: PointBsdf,
     /// The normal map's normal in tangent space, if the material has one.
     pub normal: Option<Vec3>,
+    /// The coat's normal map's normal in tangent space, if it has one.
+    pub coat_normal: Option<Vec3>,
     /// The factor on light arriving by indirect paths (1: none).
     pub occlusion: f32,
 }
@@ -582,7 +586,8 @@ mod tests {
     use crate::sampling::uniform_sphere;
     use std::f32::consts::PI;
 
-    fn u2(a: u64, i: u64) -> Vec2 {
+    /// Two uniform numbers from a hash of `(a, i)`.
+    pub(super) fn u2(a: u64, i: u64) -> Vec2 {
         Vec2::new(unit_f32(hash3(a, i, 0)), unit_f32(hash3(a, i, 1)))
     }
 

@@ -28,6 +28,15 @@ pub struct NormalMap {
     pub scale: f32,
 }
 
+impl NormalMap {
+    /// The tangent-space normal at a hit (`None` where the texel is no
+    /// direction).
+    #[inline]
+    pub fn lookup(&self, uvs: &[Vec2; 2], fp: &UvFootprint) -> Option<Vec3> {
+        decode_normal(self.map.lookup(uvs, fp).truncate(), self.scale)
+    }
+}
+
 /// Ambient occlusion painted into a texture.
 ///
 /// A path tracer finds the occlusion of the geometry it is given by
@@ -89,6 +98,9 @@ pub struct Clearcoat {
     pub factor_map: Option<ScalarMap>,
     /// Multiplies `roughness`.
     pub roughness_map: Option<ScalarMap>,
+    /// The coat's own normal map; without one the coat follows the
+    /// surface's normal, not the base's normal map (glTF's rule).
+    pub normal_map: Option<NormalMap>,
 }
 
 impl Bsdf {
