@@ -591,6 +591,39 @@ mod tests {
         Vec2::new(unit_f32(hash3(a, i, 0)), unit_f32(hash3(a, i, 1)))
     }
 
+    /// The albedo of `b` from `wo` two ways — the mean sample weight (red
+    /// channel) and a quadrature of `eval` over the sphere (a jittered
+    /// equal-area grid of `g` x `g` cells, accurate even for peaked lobes)
+    /// — with the integral of the sampling pdf and the fraction of
+    /// samples kept; every sample's pdf is checked against `eval`'s.
+    pub(super) fn albedo_two_ways(
+        b: &PointBsdf,
+        wo: Vec3,
+        g: u64,
+        seed: u64,
+    ) -> (f64, f64, f64, f64) {
+        let n = g * g;
+        let (mut sampled, mut accepted, mut quad, mut pdf_integral) =
+            (0.0f64, 0u64, 0.0f64, 0.0f64);
+        for i in 0..n {
+            if let Some(s) = b.sample(wo, unit_f32(hash3(9, i, 7)), u2(seed, i)) {
+                sampled += s.weight.x as f64;
+                accepted += 1;
+                let e = b.eval(wo, s.wi);
+                let rel = (e.pdf - s.pdf).abs() / s.pdf.max(1e-3);
+                assert!(rel < 1e-2, "{b:?}: pdf {} vs {}", s.pdf, e.pdf);
+            }
+            let j = u2(100 + seed, i);
+            let cell = Vec2::new((i % g) as f32 + j.x, (i / g) as f32 + j.y) / g as f32;
+            let wi = uniform_sphere(cell);
+            let e = b.eval(wo, wi);
+            quad += (e.f.x * wi.z.abs() * 4.0 * PI) as f64;
+            pdf_integral += (e.pdf * 4.0 * PI) as f64;
+        }
+        let n = n as f64;
+        (sampled / n, quad / n, pdf_integral / n, accepted as f64 / n)
+    }
+
     fn non_delta() -> Vec<Bsdf> {
         vec![
             Bsdf::Diffuse { albedo: Vec3::ONE },
@@ -890,32 +923,9 @@ mod tests {
             Vec3::new(0.8, -0.2, 0.3).normalize(),
             Vec3::new(0.2, 0.3, -0.7).normalize(),
         ];
-        let g = 600u64;
-        let n = g * g;
         for bsdf in non_delta() {
             for (k, wo) in wos.iter().enumerate() {
-                let mut sampled = 0.0f64;
-                let mut accepted = 0u64;
-                let mut quad = 0.0f64;
-                let mut pdf_integral = 0.0f64;
-                for i in 0..n {
-                    if let Some(s) =
-                        bsdf.sample(Vec3::ONE, *wo, unit_f32(hash3(9, i, 7)), u2(k as u64, i))
-                    {
-                        sampled += s.weight.x as f64;
-                        accepted += 1;
-                        let e = bsdf.eval(Vec3::ONE, *wo, s.wi);
-                        let rel = (e.pdf - s.pdf).abs() / s.pdf.max(1e-3);
-                        assert!(rel < 1e-2, "{bsdf:?}: pdf {} vs {}", s.pdf, e.pdf);
-                    }
-                    let j = u2(100 + k as u64, i);
-                    let cell = Vec2::new((i % g) as f32 + j.x, (i / g) as f32 + j.y) / g as f32;
-                    let wi = uniform_sphere(cell);
-                    let e = bsdf.eval(Vec3::ONE, *wo, wi);
-                    quad += (e.f.x * wi.z.abs() * 4.0 * PI) as f64;
-                    pdf_integral += (e.pdf * 4.0 * PI) as f64;
-                }
-                let (a, b) = (sampled / n as f64, quad / n as f64);
+                let (a, b, p, kept) = albedo_two_ways(&PointBsdf::new(bsdf), *wo, 600, k as u64);
                 assert!(
                     (a - b).abs() < 0.005 + 0.01 * b,
                     "{bsdf:?} wo {wo}: sampled {a} quadrature {b}"
@@ -927,8 +937,6 @@ mod tests {
                 if bsdf.is_reflective_only() {
                     assert!(a <= 1.0 + 5e-3, "{bsdf:?}: albedo {a} > 1");
                 }
-                let p = pdf_integral / n as f64;
-                let kept = accepted as f64 / n as f64;
                 assert!(
                     (p - kept).abs() < 0.01,
                     "{bsdf:?}: pdf integrates to {p}, kept {kept}"
