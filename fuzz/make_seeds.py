@@ -203,6 +203,99 @@ def gltf_seeds():
     ext["meshes"] = [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0},
                                      {"attributes": {"POSITION": 0}, "indices": 1, "material": 1}]}]
     put("gltf", "materials.gltf", json.dumps(ext, indent=1))
+    put("gltf", "extensions.gltf", json.dumps(extensions_doc(), indent=1))
+    # What the loader refuses by name: glTF 1.0, and required compression.
+    put("gltf", "gltf1.gltf", json.dumps({"asset": {"version": "1.0"}, "meshes": {"m": {}}}))
+    draco = dict(text)
+    draco["extensionsUsed"] = ["KHR_draco_mesh_compression", "KHR_materials_sheen"]
+    draco["extensionsRequired"] = ["KHR_draco_mesh_compression"]
+    put("gltf", "draco.gltf", json.dumps(draco, indent=1))
+
+
+def extensions_doc():
+    """A quad with every texture role, sampler wrap modes, texture
+    transforms, two uv sets, tangents, quantized positions
+    (KHR_mesh_quantization), a clear coat, punctual lights, cameras and an
+    unsupported optional extension."""
+    # Positions as unnormalized shorts, uvs as normalized unsigned shorts,
+    # normals as normalized bytes, tangents as floats.
+    positions = struct.pack("<16h", 0, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 0, 1, 0, 0)
+    uv0 = struct.pack("<8H", 0, 0, 65535, 0, 65535, 65535, 0, 65535)
+    uv1 = struct.pack("<8f", 0, 0, 2, 0, 2, 2, 0, 2)
+    normals = struct.pack("<16b", *([0, 0, 127, 0] * 4))
+    tangents = struct.pack("<16f", *([1, 0, 0, 1] * 4))
+    indices = struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    blob = positions + uv0 + uv1 + normals + tangents + indices
+    views, offset = [], 0
+    for part, stride in [(positions, 8), (uv0, 4), (uv1, 8), (normals, 4), (tangents, 16), (indices, None)]:
+        view = {"buffer": 0, "byteOffset": offset, "byteLength": len(part)}
+        if stride:
+            view["byteStride"] = stride
+        views.append(view)
+        offset += len(part)
+    image = png(2, 2, 6, 8, [bytes([255, 128, 0, 255, 0, 255, 128, 128]), bytes([128, 128, 255, 255, 9, 9, 9, 0])])
+
+    def tex(index, **kw):
+        info = {"index": index}
+        info.update(kw)
+        return info
+
+    transform = {"KHR_texture_transform": {"offset": [0.5, 0.25], "rotation": 0.3, "scale": [2, 3], "texCoord": 1}}
+    return {
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_texture_transform", "KHR_materials_clearcoat", "KHR_lights_punctual",
+                           "KHR_mesh_quantization", "KHR_materials_emissive_strength", "KHR_materials_sheen"],
+        "extensionsRequired": ["KHR_mesh_quantization", "KHR_texture_transform"],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "point", "color": [1, 0.9, 0.8], "intensity": 100, "range": 10},
+            {"type": "spot", "intensity": 500, "spot": {"innerConeAngle": 0.2, "outerConeAngle": 0.6}},
+            {"type": "directional", "intensity": 3000}]}},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1, 2, 3, 4, 5]}],
+        "nodes": [
+            {"mesh": 0, "scale": [0.001, 0.001, 0.001]},
+            {"extensions": {"KHR_lights_punctual": {"light": 0}}, "translation": [0, 2, 0]},
+            {"extensions": {"KHR_lights_punctual": {"light": 1}}, "rotation": [-0.7071, 0, 0, 0.7071]},
+            {"extensions": {"KHR_lights_punctual": {"light": 2}}},
+            {"camera": 0, "translation": [0, 0, 3], "name": "front"},
+            {"camera": 1, "translation": [0, 3, 0]},
+        ],
+        "cameras": [
+            {"type": "perspective", "name": "front", "perspective": {"yfov": 0.8, "znear": 0.1, "aspectRatio": 1.5}},
+            {"type": "orthographic", "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}},
+        ],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1, "TEXCOORD_1": 2,
+                                                   "NORMAL": 3, "TANGENT": 4},
+                                    "indices": 5, "material": 0}]}],
+        "materials": [{
+            "pbrMetallicRoughness": {"baseColorTexture": tex(0), "metallicRoughnessTexture": tex(1, texCoord=1),
+                                     "metallicFactor": 0.5, "roughnessFactor": 0.7},
+            "normalTexture": tex(2, scale=0.8, extensions=transform),
+            "occlusionTexture": tex(0, strength=0.5),
+            "emissiveTexture": tex(1),
+            "emissiveFactor": [1, 1, 1],
+            "extensions": {
+                "KHR_materials_emissive_strength": {"emissiveStrength": 3},
+                "KHR_materials_clearcoat": {"clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.1,
+                                            "clearcoatTexture": tex(0), "clearcoatRoughnessTexture": tex(1),
+                                            "clearcoatNormalTexture": tex(2)},
+                "KHR_materials_sheen": {"sheenColorFactor": [1, 0, 0]}},
+        }],
+        "textures": [{"source": 0, "sampler": 0}, {"source": 0, "sampler": 1}, {"source": 0}],
+        "samplers": [{"wrapS": 33071, "wrapT": 33648}, {"wrapS": 10497, "wrapT": 33071}],
+        "images": [{"uri": "data:image/png;base64," + base64.b64encode(image).decode()}],
+        "buffers": [{"byteLength": len(blob),
+                     "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+        "bufferViews": views,
+        "accessors": [
+            {"bufferView": 0, "componentType": 5122, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5123, "normalized": True, "count": 4, "type": "VEC2"},
+            {"bufferView": 2, "componentType": 5126, "count": 4, "type": "VEC2"},
+            {"bufferView": 3, "componentType": 5120, "normalized": True, "count": 4, "type": "VEC3"},
+            {"bufferView": 4, "componentType": 5126, "count": 4, "type": "VEC4"},
+            {"bufferView": 5, "componentType": 5123, "count": 6, "type": "SCALAR"},
+        ],
+    }
 
 
 def png(width, height, colour_type, depth, rows):

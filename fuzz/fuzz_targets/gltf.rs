@@ -1,5 +1,6 @@
 //! `load_gltf` on arbitrary bytes (.gltf JSON or .glb): no panic; meshes with
-//! indices in range, or a one-line error naming the file.
+//! indices in range, lights and cameras that convert, or a one-line error
+//! naming the file.
 //!
 //! `sahara_formats::gltf` has no in-memory entry point, so each input is
 //! written to a file in a fresh private folder (in /dev/shm when there is one)
@@ -45,6 +46,13 @@ fuzz_target!(|data: &[u8]| {
             }
             for instance in &scene.instances {
                 assert!(instance.mesh < scene.meshes.len());
+            }
+            // Lights and cameras convert whatever the file's numbers.
+            for light in &scene.lights {
+                let _ = light.to_light(glam::Mat4::IDENTITY);
+            }
+            for camera in &scene.cameras {
+                let _ = camera.to_camera();
             }
         }
         Err(e) => check_error(&e, &name),

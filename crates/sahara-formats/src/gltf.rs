@@ -1,11 +1,15 @@
 //! glTF 2.0 scenes (`.gltf` with external or embedded buffers, and `.glb`).
 //!
 //! What is read: the default scene (else the first; else every root node),
-//! each node's world transform (parent * local, `matrix` or TRS), and every
+//! each node's world transform (parent * local, `matrix` or TRS), every
 //! triangle primitive (`TRIANGLES`, `TRIANGLE_STRIP`, `TRIANGLE_FAN`) of
-//! the meshes those nodes use: `POSITION`, `NORMAL`, `TEXCOORD_0`,
-//! indices, and the metallic-roughness material with its base colour
-//! texture and emission. Points and lines are skipped with a warning.
+//! the meshes those nodes use (`POSITION`, `NORMAL`, `TANGENT`,
+//! `TEXCOORD_0`, `TEXCOORD_1`, indices, in float or in the integer forms
+//! of `KHR_mesh_quantization`), the metallic-roughness materials with all
+//! their textures and the extensions in [`extensions::SUPPORTED`], the
+//! perspective cameras and the `KHR_lights_punctual` lights the scene's
+//! nodes carry. Points and lines are skipped with a warning, and so are
+//! orthographic cameras.
 //!
 //! A glTF mesh (all its primitives merged, with per-triangle material ids)
 //! becomes one [`GltfMesh`], stored once however many nodes use it; each use
@@ -13,6 +17,8 @@
 //! or `data:` URIs, never from the network. Every error names the file.
 
 mod accessor;
+pub mod extensions;
+mod texture_info;
 mod uri;
 
 use std::collections::HashMap;
@@ -20,8 +26,10 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use ::gltf::mesh::Mode;
-use glam::{Mat4, Quat, Vec2, Vec3};
+use glam::{Affine2, Mat4, Quat, Vec2, Vec3, Vec4};
 use sahara_render::mesh::Mesh;
+use sahara_render::texture::Wrap;
+use serde_json::Value;
 
 use crate::error::FormatError;
 use uri::UriTarget;
@@ -35,6 +43,10 @@ pub struct GltfScene {
     pub instances: Vec<GltfInstance>,
     /// The materials the meshes' `material_ids` refer to (a default is appended if needed).
     pub materials: Vec<GltfMaterial>,
+    /// The perspective cameras of the scene's nodes, in scene order.
+    pub cameras: Vec<GltfCamera>,
+    /// The `KHR_lights_punctual` lights of the scene's nodes.
+    pub lights: Vec<GltfLight>,
     /// Problems that did not stop loading, one line each.
     pub warnings: Vec<String>,
 }
@@ -50,6 +62,10 @@ pub struct GltfMesh {
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex `TEXCOORD_0`, parallel to `mesh.positions`, if any primitive has them (others get 0, 0).
     pub uvs: Option<Vec<Vec2>>,
+    /// Per-vertex `TEXCOORD_1`, likewise.
+    pub uvs1: Option<Vec<Vec2>>,
+    /// Per-vertex `TANGENT` (xyz and the handedness w), if every primitive has them.
+    pub tangents: Option<Vec<Vec4>>,
     /// Per-triangle index into [`GltfScene::materials`], parallel to `mesh.indices`.
     pub material_ids: Vec<u32>,
 }
@@ -72,6 +88,17 @@ pub struct GltfMaterial {
     pub base_color: [f32; 4],
     /// Base colour texture (sRGB), multiplied by `base_color`.
     pub base_color_texture: Option<GltfTexture>,
+    /// Metallic (blue channel) and roughness (green channel), linear,
+    /// multiplied by `metallic` and `roughness`.
+    pub metallic_roughness_texture: Option<GltfTexture>,
+    /// Tangent-space normal map (linear), with its `scale`.
+    pub normal_texture: Option<(GltfTexture, f32)>,
+    /// Ambient occlusion (red channel, linear), with its `strength`.
+    pub occlusion_texture: Option<(GltfTexture, f32)>,
+    /// Emissive texture (sRGB), multiplied by `emissive`.
+    pub emissive_texture: Option<GltfTexture>,
+    /// `KHR_materials_clearcoat`, if the material has it.
+    pub clearcoat: Option<GltfClearcoat>,
     /// Metalness factor in `[0, 1]`.
     pub metallic: f32,
     /// Perceptual roughness factor in `[0, 1]`.
@@ -107,6 +134,11 @@ impl GltfMaterial {
             name: None,
             base_color: [1.0; 4],
             base_color_texture: None,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            occlusion_texture: None,
+            emissive_texture: None,
+            clearcoat: None,
             metallic: 1.0,
             roughness: 1.0,
             emissive: [0.0; 3],
@@ -121,13 +153,129 @@ impl GltfMaterial {
     }
 }
 
-/// A texture reference: the image and which uv set it uses.
+/// `KHR_materials_clearcoat`: a clear coat over the material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GltfClearcoat {
+    /// `clearcoatFactor`.
+    pub factor: f32,
+    /// `clearcoatRoughnessFactor`.
+    pub roughness: f32,
+    /// `clearcoatTexture` (red channel), multiplying `factor`.
+    pub texture: Option<GltfTexture>,
+    /// `clearcoatRoughnessTexture` (green channel), multiplying `roughness`.
+    pub roughness_texture: Option<GltfTexture>,
+    /// `clearcoatNormalTexture`, with its `scale`.
+    pub normal_texture: Option<(GltfTexture, f32)>,
+}
+
+/// A texture reference: the image, how it is sampled and which uv set it
+/// uses.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GltfTexture {
     /// Where the image is.
     pub image: GltfImage,
-    /// Which `TEXCOORD_n` set (only 0 is loaded into [`GltfMesh::uvs`]).
+    /// The image's index in the file (textures sharing an image share it).
+    pub image_index: usize,
+    /// Which `TEXCOORD_n` set (0 and 1 are loaded).
     pub tex_coord: u32,
+    /// The sampler's wrap modes along u (`wrapS`) and v (`wrapT`).
+    pub wrap: [Wrap; 2],
+    /// `KHR_texture_transform`, in glTF's uv space (v running down the
+    /// image); the identity without it.
+    pub transform: Affine2,
+}
+
+/// A perspective camera of a node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GltfCamera {
+    /// The camera's name in the file, if any.
+    pub name: Option<String>,
+    /// The node's world transform (the camera looks down its -Z, +Y up).
+    pub transform: Mat4,
+    /// Vertical field of view, radians.
+    pub yfov: f32,
+    /// Width over height, if the file gives it.
+    pub aspect_ratio: Option<f32>,
+}
+
+/// What a `KHR_lights_punctual` light is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GltfLightKind {
+    /// Emits in all directions (intensity in candela).
+    Point,
+    /// A cone (intensity in candela), angles in radians from the axis.
+    Spot {
+        /// Where the falloff starts.
+        inner_cone_angle: f32,
+        /// Where the light ends.
+        outer_cone_angle: f32,
+    },
+    /// From infinitely far (intensity in lux).
+    Directional,
+}
+
+/// A `KHR_lights_punctual` light of a node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GltfLight {
+    /// The light's name in the file, if any.
+    pub name: Option<String>,
+    /// Point, spot or directional.
+    pub kind: GltfLightKind,
+    /// Linear RGB colour.
+    pub color: [f32; 3],
+    /// Candela (point, spot) or lux (directional).
+    pub intensity: f32,
+    /// Distance beyond which the light is cut off, if given.
+    pub range: Option<f32>,
+    /// The node's world transform (spot and directional lights shine down
+    /// its -Z).
+    pub transform: Mat4,
+}
+
+/// Luminous efficacy taken for `KHR_lights_punctual` lights: 683 lm/W,
+/// the efficacy at 555 nm that defines the candela.
+pub const LUMENS_PER_WATT: f32 = 683.0;
+
+impl GltfCamera {
+    /// The camera as the renderer's (aspect 1: the caller sets it from the
+    /// image size, keeping the vertical field of view).
+    pub fn to_camera(&self) -> sahara_render::Camera {
+        let eye = self.transform.transform_point3(Vec3::ZERO);
+        let forward = self.transform.transform_vector3(Vec3::NEG_Z);
+        let up = self.transform.transform_vector3(Vec3::Y);
+        sahara_render::Camera::look_at(eye, eye + forward, up, self.yfov.to_degrees(), 1.0)
+    }
+}
+
+impl GltfLight {
+    /// The light as the renderer's, placed by `placement` times the node's
+    /// transform. glTF's photometric intensity becomes radiometric at
+    /// [`LUMENS_PER_WATT`] (candela to W/sr, lux to W/m²), as Blender reads
+    /// and writes it, while emission (`emissiveFactor` times its strength)
+    /// is radiance as it stands (docs/lighting.md says why). `range` is
+    /// not used: light falls off with the square of the distance, as the
+    /// glTF specification asks of renderers that ignore it.
+    pub fn to_light(&self, placement: Mat4) -> sahara_render::Light {
+        let xf = placement * self.transform;
+        let power = Vec3::from_array(self.color).max(Vec3::ZERO) * self.intensity.max(0.0)
+            / LUMENS_PER_WATT;
+        let position = xf.transform_point3(Vec3::ZERO);
+        let axis = xf.transform_vector3(Vec3::NEG_Z).normalize_or(Vec3::NEG_Z);
+        match self.kind {
+            GltfLightKind::Point => sahara_render::Light::point(position, power),
+            GltfLightKind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => sahara_render::Light::spot(
+                position,
+                position + axis,
+                power,
+                inner_cone_angle.to_degrees(),
+                outer_cone_angle.to_degrees(),
+            ),
+            GltfLightKind::Directional => sahara_render::Light::directional(axis, power),
+        }
+    }
 }
 
 /// Where a texture's image is: a file, or bytes inside the glTF.
@@ -153,17 +301,28 @@ fn load(path: &Path) -> Result<GltfScene, FormatError> {
     let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
     let name = path.display().to_string();
     let folder = path.parent().unwrap_or(Path::new(""));
+    let pre = extensions::prescan(&bytes, &name)?;
     let ::gltf::Gltf { document, blob } = parse(&bytes, &name)?;
     let buffers = load_buffers(&document, blob, folder, &name)?;
+    let (json, warnings) = match pre {
+        Some(p) => (p.json, p.warnings),
+        None => (Value::Null, Vec::new()),
+    };
     let mut loader = Loader {
         name: &name,
         folder,
         buffers: &buffers,
-        scene: GltfScene::default(),
+        document: &document,
+        json: &json,
+        scene: GltfScene {
+            warnings,
+            ..GltfScene::default()
+        },
         mesh_slot: HashMap::new(),
         material_slot: HashMap::new(),
         default_material: None,
     };
+    let mut orthographic = 0;
     for (node, transform) in scene_nodes(&document, &name)? {
         if let Some(mesh) = node.mesh() {
             let slot = loader.mesh(&mesh)?;
@@ -172,6 +331,46 @@ fn load(path: &Path) -> Result<GltfScene, FormatError> {
                 transform,
             });
         }
+        if let Some(camera) = node.camera() {
+            match camera.projection() {
+                ::gltf::camera::Projection::Perspective(p) => {
+                    loader.scene.cameras.push(GltfCamera {
+                        name: camera.name().map(str::to_owned),
+                        transform,
+                        yfov: p.yfov(),
+                        aspect_ratio: p.aspect_ratio(),
+                    })
+                }
+                ::gltf::camera::Projection::Orthographic(_) => orthographic += 1,
+            }
+        }
+        if let Some(light) = node.light() {
+            use ::gltf::khr_lights_punctual::Kind;
+            let kind = match light.kind() {
+                Kind::Point => GltfLightKind::Point,
+                Kind::Directional => GltfLightKind::Directional,
+                Kind::Spot {
+                    inner_cone_angle,
+                    outer_cone_angle,
+                } => GltfLightKind::Spot {
+                    inner_cone_angle,
+                    outer_cone_angle,
+                },
+            };
+            loader.scene.lights.push(GltfLight {
+                name: light.name().map(str::to_owned),
+                kind,
+                color: light.color(),
+                intensity: light.intensity(),
+                range: light.range(),
+                transform,
+            });
+        }
+    }
+    if orthographic > 0 {
+        loader.scene.warnings.push(format!(
+            "{name}: {orthographic} orthographic camera(s) skipped (only perspective cameras are supported)"
+        ));
     }
     Ok(loader.scene)
 }
@@ -203,15 +402,23 @@ fn parse(bytes: &[u8], name: &str) -> Result<::gltf::Gltf, FormatError> {
     }
     match ::gltf::Gltf::from_slice(bytes) {
         Err(::gltf::Error::Validation(problems))
-            if problems.iter().all(|(path, e)| {
-                let path = path.as_str();
-                matches!(e, ::gltf::json::validation::Error::Missing)
-                    && (path.ends_with(".min") || path.ends_with(".max"))
-            }) =>
+            if problems.iter().all(|(path, e)| tolerated(path.as_str(), e)) =>
         {
             ::gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| describe_error(name, e))
         }
         other => other.map_err(|e| describe_error(name, e)),
+    }
+}
+
+/// True for the validation problems Sahara reads past: missing `POSITION`
+/// bounds, and required extensions that Sahara supports but the `gltf`
+/// crate does not know (the prescan refused every other one).
+fn tolerated(path: &str, e: &::gltf::json::validation::Error) -> bool {
+    use ::gltf::json::validation::Error;
+    match e {
+        Error::Missing => path.ends_with(".min") || path.ends_with(".max"),
+        Error::Unsupported => path.starts_with("extensionsRequired"),
+        _ => false,
     }
 }
 
@@ -386,10 +593,42 @@ struct Loader<'a> {
     name: &'a str,
     folder: &'a Path,
     buffers: &'a [Vec<u8>],
+    document: &'a ::gltf::Document,
+    /// The file's plain JSON (null if the prescan could not read it).
+    json: &'a Value,
     scene: GltfScene,
     mesh_slot: HashMap<usize, usize>,
     material_slot: HashMap<usize, u32>,
     default_material: Option<u32>,
+}
+
+/// A per-vertex attribute gathered over a mesh's primitives: present if
+/// some primitive has it (the others padded with `fill`).
+struct Gathered<T> {
+    values: Option<Vec<T>>,
+    fill: T,
+}
+
+impl<T: Copy> Gathered<T> {
+    fn new(fill: T) -> Self {
+        Self { values: None, fill }
+    }
+
+    /// Adds a primitive's values (`None`: it has none) after `base`
+    /// vertices of earlier primitives, `count` of its own.
+    fn add(&mut self, base: usize, count: usize, values: Option<Vec<T>>) {
+        match values {
+            Some(v) => {
+                let all = self.values.get_or_insert_with(|| vec![self.fill; base]);
+                all.extend(v);
+            }
+            None => {
+                if let Some(all) = &mut self.values {
+                    all.resize(base + count, self.fill);
+                }
+            }
+        }
+    }
 }
 
 impl Loader<'_> {
@@ -403,8 +642,11 @@ impl Loader<'_> {
             ..GltfMesh::default()
         };
         let mut all_normals = true;
+        let mut all_tangents = true;
         let mut normals = Vec::new();
-        let mut uvs: Option<Vec<Vec2>> = None;
+        let mut tangents = Vec::new();
+        let mut uvs = Gathered::new(Vec2::ZERO);
+        let mut uvs1 = Gathered::new(Vec2::ZERO);
         for primitive in mesh.primitives() {
             let fail = |e: String| {
                 FormatError::in_file(
@@ -428,8 +670,7 @@ impl Loader<'_> {
             let positions = primitive
                 .get(&::gltf::Semantic::Positions)
                 .ok_or_else(|| fail("no POSITION attribute".to_owned()))?;
-            let positions =
-                accessor::read_floats(&positions, self.buffers, 3, false).map_err(fail)?;
+            let positions = accessor::read_floats(&positions, self.buffers, 3).map_err(fail)?;
             let count = positions.len() / 3;
             let base = out.mesh.positions.len();
             if base + count > u32::MAX as usize {
@@ -438,29 +679,35 @@ impl Loader<'_> {
             out.mesh
                 .positions
                 .extend(positions.chunks_exact(3).map(Vec3::from_slice));
-            match primitive.get(&::gltf::Semantic::Normals) {
-                Some(a) if all_normals => {
-                    let n = accessor::read_floats(&a, self.buffers, 3, false).map_err(fail)?;
-                    if n.len() != positions.len() {
-                        return Err(fail(format!(
-                            "{} normals for {count} positions",
-                            n.len() / 3
-                        )));
-                    }
-                    normals.extend(n.chunks_exact(3).map(Vec3::from_slice));
-                }
+            let per_vertex = |semantic: ::gltf::Semantic, n: usize, what: &str| {
+                primitive
+                    .get(&semantic)
+                    .map(|a| {
+                        let v = accessor::read_floats(&a, self.buffers, n).map_err(fail)?;
+                        if v.len() / n != count {
+                            return Err(fail(format!(
+                                "{} {what} for {count} positions",
+                                v.len() / n
+                            )));
+                        }
+                        Ok(v)
+                    })
+                    .transpose()
+            };
+            match per_vertex(::gltf::Semantic::Normals, 3, "normals")? {
+                Some(n) if all_normals => normals.extend(n.chunks_exact(3).map(Vec3::from_slice)),
                 _ => all_normals = false,
             }
-            if let Some(a) = primitive.get(&::gltf::Semantic::TexCoords(0)) {
-                let t = accessor::read_floats(&a, self.buffers, 2, true).map_err(fail)?;
-                if t.len() / 2 != count {
-                    return Err(fail(format!("{} uvs for {count} positions", t.len() / 2)));
-                }
-                let uvs = uvs.get_or_insert_with(|| vec![Vec2::ZERO; base]);
-                uvs.extend(t.chunks_exact(2).map(Vec2::from_slice));
-            } else if let Some(uvs) = &mut uvs {
-                uvs.resize(base + count, Vec2::ZERO);
+            match per_vertex(::gltf::Semantic::Tangents, 4, "tangents")? {
+                Some(t) if all_tangents => tangents.extend(t.chunks_exact(4).map(Vec4::from_slice)),
+                _ => all_tangents = false,
             }
+            let tex = |set| -> Result<Option<Vec<Vec2>>, FormatError> {
+                Ok(per_vertex(::gltf::Semantic::TexCoords(set), 2, "uvs")?
+                    .map(|t| t.chunks_exact(2).map(Vec2::from_slice).collect()))
+            };
+            uvs.add(base, count, tex(0)?);
+            uvs1.add(base, count, tex(1)?);
             let indices = match primitive.indices() {
                 Some(a) => accessor::read_indices(&a, self.buffers).map_err(fail)?,
                 None => (0..count as u32).collect(),
@@ -501,11 +748,16 @@ impl Loader<'_> {
             out.material_ids
                 .extend(std::iter::repeat_n(material, added));
         }
-        if let Some(uvs) = &mut uvs {
-            uvs.resize(out.mesh.positions.len(), Vec2::ZERO);
+        let nv = out.mesh.positions.len();
+        for g in [&mut uvs, &mut uvs1] {
+            if let Some(v) = &mut g.values {
+                v.resize(nv, Vec2::ZERO);
+            }
         }
-        out.normals = (all_normals && !out.mesh.positions.is_empty()).then_some(normals);
-        out.uvs = uvs;
+        out.normals = (all_normals && nv > 0).then_some(normals);
+        out.tangents = (all_tangents && nv > 0).then_some(tangents);
+        out.uvs = uvs.values;
+        out.uvs1 = uvs1.values;
         let slot = self.scene.meshes.len();
         self.scene.meshes.push(out);
         self.mesh_slot.insert(mesh.index(), slot);
@@ -527,19 +779,47 @@ impl Loader<'_> {
         }
         let pbr = material.pbr_metallic_roughness();
         let strength = material.emissive_strength().unwrap_or(1.0);
-        let texture = match pbr.base_color_texture() {
-            Some(info) => self
-                .image(&info.texture().source(), index)?
-                .map(|image| GltfTexture {
-                    image,
-                    tex_coord: info.tex_coord(),
-                }),
-            None => None,
+        let raw = &self.json["materials"][index];
+        let raw_pbr = &raw["pbrMetallicRoughness"];
+        let clearcoat = &raw["extensions"]["KHR_materials_clearcoat"];
+        let mut texture = |parent: &Value, key: &str, amount: &str| -> Result<_, FormatError> {
+            match texture_info::read(parent, key, amount) {
+                Some(info) => Ok(self.texture(&info, index, key)?.map(|t| (t, info.amount))),
+                None => Ok(None),
+            }
+        };
+        let factor = |v: &Value, key: &str, default: f32| {
+            v.get(key)
+                .and_then(Value::as_f64)
+                .map_or(default, |x| x as f32)
+        };
+        let base_color_texture = texture(raw_pbr, "baseColorTexture", "")?.map(|t| t.0);
+        let metallic_roughness_texture =
+            texture(raw_pbr, "metallicRoughnessTexture", "")?.map(|t| t.0);
+        let normal_texture = texture(raw, "normalTexture", "scale")?;
+        let occlusion_texture = texture(raw, "occlusionTexture", "strength")?;
+        let emissive_texture = texture(raw, "emissiveTexture", "")?.map(|t| t.0);
+        let clearcoat = if clearcoat.is_object() {
+            Some(GltfClearcoat {
+                factor: factor(clearcoat, "clearcoatFactor", 0.0),
+                roughness: factor(clearcoat, "clearcoatRoughnessFactor", 0.0),
+                texture: texture(clearcoat, "clearcoatTexture", "")?.map(|t| t.0),
+                roughness_texture: texture(clearcoat, "clearcoatRoughnessTexture", "")?
+                    .map(|t| t.0),
+                normal_texture: texture(clearcoat, "clearcoatNormalTexture", "scale")?,
+            })
+        } else {
+            None
         };
         let converted = GltfMaterial {
             name: material.name().map(str::to_owned),
             base_color: pbr.base_color_factor(),
-            base_color_texture: texture,
+            base_color_texture,
+            metallic_roughness_texture,
+            normal_texture,
+            occlusion_texture,
+            emissive_texture,
+            clearcoat,
             metallic: pbr.metallic_factor(),
             roughness: pbr.roughness_factor(),
             emissive: material.emissive_factor().map(|e| e * strength),
@@ -567,11 +847,50 @@ impl Loader<'_> {
         Ok(id)
     }
 
+    /// The texture a `textureInfo` names (`role`, in material `material`,
+    /// for messages); `None` (with a warning) when its image file is
+    /// missing or the texture has no image Sahara can read.
+    fn texture(
+        &mut self,
+        info: &texture_info::TextureInfo,
+        material: usize,
+        role: &str,
+    ) -> Result<Option<GltfTexture>, FormatError> {
+        let texture = self.document.textures().nth(info.index).ok_or_else(|| {
+            FormatError::in_file(
+                self.name,
+                format!(
+                    "materials[{material}].{role}: texture {} does not exist ({} textures)",
+                    info.index,
+                    self.document.textures().len()
+                ),
+            )
+        })?;
+        let wrap = |w: ::gltf::texture::WrappingMode| match w {
+            ::gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+            ::gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+            ::gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        };
+        let sampler = texture.sampler();
+        let image = texture.source();
+        let image_index = image.index();
+        Ok(self
+            .image(&image, material, role)?
+            .map(|image| GltfTexture {
+                image,
+                image_index,
+                tex_coord: info.tex_coord,
+                wrap: [wrap(sampler.wrap_s()), wrap(sampler.wrap_t())],
+                transform: info.transform,
+            }))
+    }
+
     /// Where an image is; a missing file is a warning (the material is then untextured).
     fn image(
         &mut self,
         image: &::gltf::Image,
         material: usize,
+        role: &str,
     ) -> Result<Option<GltfImage>, FormatError> {
         let fail =
             |e: String| FormatError::in_file(self.name, format!("image {}: {e}", image.index()));
@@ -601,7 +920,7 @@ impl Loader<'_> {
                     UriTarget::File(file) if file.is_file() => Ok(Some(GltfImage::File(file))),
                     UriTarget::File(file) => {
                         self.scene.warnings.push(format!(
-                            "{}: material {material}: base colour texture {} not found; the material is untextured",
+                            "{}: material {material}: {role} {} not found; the material goes without it",
                             self.name,
                             file.display()
                         ));

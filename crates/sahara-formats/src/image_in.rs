@@ -1,12 +1,19 @@
-//! Image readers for textures and environment maps: linear float RGB out.
+//! Image readers for textures and environment maps: PNG, JPEG, Radiance
+//! HDR, OpenEXR, TGA and PFM.
 //!
-//! PNG, JPEG and 8-bit TGA are taken as sRGB-encoded and converted to
-//! linear; Radiance HDR, OpenEXR and PFM are linear already. The format is
-//! recognised by the file's first bytes (TGA, which has no signature, by
-//! its footer or a `.tga` name). Grey images are expanded to RGB; alpha is
-//! kept by [`decode_image`] for PNG and TGA. The size in the header is
-//! checked against [`MAX_IMAGE_SIDE`] and [`MAX_IMAGE_PIXELS`] before any
-//! pixel memory is allocated.
+//! - [`decode_texture`]: a material's texture. 8-bit PNG and JPEG stay
+//!   8-bit, their colour channels read as sRGB or as plain values as the
+//!   texture's role says ([`Encoding`]: colours are sRGB, data such as
+//!   normals and roughness is not); 16-bit PNG and 8-bit TGA become float
+//!   the same way; Radiance HDR, OpenEXR and PFM are linear floats. Alpha
+//!   is kept.
+//! - [`decode_image`]: linear float RGB and alpha (8-bit images taken as
+//!   sRGB); [`decode_rgb_f32`] without the alpha (environment maps).
+//!
+//! The format is recognised by the file's first bytes (TGA, which has no
+//! signature, by its footer or a `.tga` name). Grey images are expanded to
+//! RGB. The size in the header is checked against [`MAX_IMAGE_SIDE`] and
+//! [`MAX_IMAGE_PIXELS`] before any pixel memory is allocated.
 
 mod pfm;
 mod tga;
@@ -15,8 +22,12 @@ use std::fs;
 use std::io::Cursor;
 use std::path::Path;
 
+use glam::Vec3;
+use sahara_render::texture::Encoding;
+use sahara_render::Texture;
+
 use crate::error::FormatError;
-use crate::srgb::{srgb8_to_linear, srgb_to_linear};
+use crate::srgb::{linear_to_srgb8, srgb8_to_linear, srgb_to_linear};
 
 /// Largest width or height accepted, in pixels.
 pub const MAX_IMAGE_SIDE: u32 = 1 << 16;
@@ -80,9 +91,41 @@ pub fn decode_image(bytes: &[u8], name: &str) -> Result<Image, FormatError> {
     Ok(image)
 }
 
-fn decode(bytes: &[u8], name: &str) -> Result<RgbF32Image, FormatError> {
+/// The alpha channel of a PNG image held in memory (values in `[0, 1]`,
+/// row-major from the top left), or `None` if it has none or is not a PNG.
+/// Call it on bytes that [`decode_rgb_f32`] accepted (which checked the
+/// size).
+pub fn decode_png_alpha(bytes: &[u8]) -> Option<Vec<f32>> {
+    let image = image::load_from_memory_with_format(bytes, image::ImageFormat::Png).ok()?;
+    if !image.color().has_alpha() {
+        return None;
+    }
+    Some(image.into_rgba32f().pixels().map(|p| p.0[3]).collect())
+}
+
+/// An image as the `image` crate decodes it, after the size checks.
+enum Decoded {
+    /// A PNG, JPEG or HDR image.
+    Image(image::DynamicImage, image::ImageFormat),
+    /// An OpenEXR image (linear RGB).
+    Exr(RgbF32Image),
+}
+
+fn decode_any(bytes: &[u8], name: &str) -> Result<Decoded, FormatError> {
     if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-        return decode_exr(bytes, name);
+        return decode_exr(bytes, name).map(Decoded::Exr);
+    }
+    if bytes.starts_with(&[0xAB, b'K', b'T', b'X', b' ', b'2', b'0', 0xBB]) {
+        return Err(FormatError::in_file(
+            name,
+            "KTX2/Basis Universal textures are not supported; convert the texture to PNG or JPEG",
+        ));
+    }
+    if bytes.len() >= 12 && &bytes[..4] == b"RIFF" && &bytes[8..12] == b"WEBP" {
+        return Err(FormatError::in_file(
+            name,
+            "WebP textures are not supported; convert the texture to PNG or JPEG",
+        ));
     }
     let reader = image::ImageReader::new(Cursor::new(bytes))
         .with_guessed_format()
@@ -93,6 +136,15 @@ fn decode(bytes: &[u8], name: &str) -> Result<RgbF32Image, FormatError> {
             "not a PNG, JPEG, Radiance HDR, OpenEXR, TGA or PFM image (unrecognised first bytes)",
         )
     })?;
+    if !matches!(
+        format,
+        image::ImageFormat::Hdr | image::ImageFormat::Png | image::ImageFormat::Jpeg
+    ) {
+        return Err(FormatError::in_file(
+            name,
+            format!("{format:?} images are not supported; use PNG, JPEG, HDR, EXR, TGA or PFM"),
+        ));
+    }
     let (width, height) = image::ImageReader::with_format(Cursor::new(bytes), format)
         .into_dimensions()
         .map_err(|e| FormatError::in_file(name, format!("bad {format:?} header: {e}")))?;
@@ -106,48 +158,113 @@ fn decode(bytes: &[u8], name: &str) -> Result<RgbF32Image, FormatError> {
     let decoded = reader
         .decode()
         .map_err(|e| FormatError::in_file(name, format!("cannot decode {format:?} image: {e}")))?;
+    Ok(Decoded::Image(decoded, format))
+}
+
+/// True for the 8-bit colour types.
+fn is_8bit(c: image::ColorType) -> bool {
+    matches!(
+        c,
+        image::ColorType::L8
+            | image::ColorType::La8
+            | image::ColorType::Rgb8
+            | image::ColorType::Rgba8
+    )
+}
+
+fn decode(bytes: &[u8], name: &str) -> Result<RgbF32Image, FormatError> {
+    let (decoded, format) = match decode_any(bytes, name)? {
+        Decoded::Exr(rgb) => return Ok(rgb),
+        Decoded::Image(d, f) => (d, f),
+    };
+    let (width, height) = (decoded.width(), decoded.height());
     let rgb = match format {
         image::ImageFormat::Hdr => decoded.into_rgb32f().into_raw(),
-        image::ImageFormat::Png | image::ImageFormat::Jpeg => {
-            if matches!(
-                decoded.color(),
-                image::ColorType::L8
-                    | image::ColorType::La8
-                    | image::ColorType::Rgb8
-                    | image::ColorType::Rgba8
-            ) {
-                decoded
-                    .into_rgb8()
-                    .into_raw()
-                    .into_iter()
-                    .map(srgb8_to_linear)
-                    .collect()
-            } else {
-                let mut rgb = decoded.into_rgb32f().into_raw();
-                rgb.iter_mut().for_each(|v| *v = srgb_to_linear(*v));
-                rgb
-            }
-        }
-        other => {
-            return Err(FormatError::in_file(
-                name,
-                format!("{other:?} images are not supported; use PNG, JPEG, HDR or EXR"),
-            ))
+        _ if is_8bit(decoded.color()) => decoded
+            .into_rgb8()
+            .into_raw()
+            .into_iter()
+            .map(srgb8_to_linear)
+            .collect(),
+        _ => {
+            let mut rgb = decoded.into_rgb32f().into_raw();
+            rgb.iter_mut().for_each(|v| *v = srgb_to_linear(*v));
+            rgb
         }
     };
     Ok((width, height, rgb))
 }
 
-/// The alpha channel of a PNG image held in memory (values in `[0, 1]`,
-/// row-major from the top left), or `None` if it has none or is not a PNG.
-/// Call it on bytes that [`decode_rgb_f32`] accepted (which checked the
-/// size).
-pub fn decode_png_alpha(bytes: &[u8]) -> Option<Vec<f32>> {
-    let image = image::load_from_memory_with_format(bytes, image::ImageFormat::Png).ok()?;
-    if !image.color().has_alpha() {
-        return None;
+/// Decodes an image held in memory as a material texture whose colour
+/// channels are encoded as `encoding` says (float images are linear
+/// whatever the role); `name` is used in error messages.
+pub fn decode_texture(
+    bytes: &[u8],
+    name: &str,
+    encoding: Encoding,
+) -> Result<Texture, FormatError> {
+    if pfm::is_pfm(bytes) || tga::is_tga(bytes, name) {
+        // Float textures: PFM is linear; an 8-bit TGA's codes, decoded as
+        // sRGB by `decode_image`, are recovered exactly for data roles.
+        let tga = !pfm::is_pfm(bytes);
+        let i = decode_image(bytes, name)?;
+        let value = |v: f32| match encoding {
+            Encoding::Linear if tga => f32::from(linear_to_srgb8(v)) / 255.0,
+            _ => v,
+        };
+        let rgb = i
+            .rgb
+            .chunks_exact(3)
+            .map(|t| Vec3::new(value(t[0]), value(t[1]), value(t[2])))
+            .collect();
+        let t = Texture::new(i.width, i.height, rgb);
+        return Ok(match i.alpha {
+            Some(a) => t.with_alpha(a),
+            None => t,
+        });
     }
-    Some(image.into_rgba32f().pixels().map(|p| p.0[3]).collect())
+    let (decoded, format) = match decode_any(bytes, name).map_err(crate::scene_file::one_line)? {
+        Decoded::Exr((w, h, rgb)) => {
+            return Ok(Texture::new(
+                w,
+                h,
+                rgb.chunks_exact(3).map(Vec3::from_slice).collect(),
+            ))
+        }
+        Decoded::Image(d, f) => (d, f),
+    };
+    let (w, h) = (decoded.width(), decoded.height());
+    let has_alpha = decoded.color().has_alpha();
+    if format != image::ImageFormat::Hdr && is_8bit(decoded.color()) {
+        let texels = decoded
+            .into_rgba8()
+            .into_raw()
+            .chunks_exact(4)
+            .map(|t| [t[0], t[1], t[2], t[3]])
+            .collect();
+        return Ok(Texture::from_rgba8(w, h, texels, encoding, has_alpha));
+    }
+    let rgba = decoded.into_rgba32f().into_raw();
+    let decode = |v: f32| match (format, encoding) {
+        (image::ImageFormat::Hdr, _) | (_, Encoding::Linear) => v,
+        (_, Encoding::Srgb) => srgb_to_linear(v),
+    };
+    let rgb = rgba
+        .chunks_exact(4)
+        .map(|t| Vec3::new(decode(t[0]), decode(t[1]), decode(t[2])))
+        .collect();
+    let t = Texture::new(w, h, rgb);
+    Ok(if has_alpha {
+        t.with_alpha(rgba.chunks_exact(4).map(|t| t[3]).collect())
+    } else {
+        t
+    })
+}
+
+/// Reads an image file as a material texture (see [`decode_texture`]).
+pub fn load_texture(path: &Path, encoding: Encoding) -> Result<Texture, FormatError> {
+    let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
+    decode_texture(&bytes, &path.display().to_string(), encoding)
 }
 
 /// Rejects empty images and images beyond the size limits.

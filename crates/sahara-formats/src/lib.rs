@@ -32,6 +32,7 @@ pub mod pbrt;
 pub mod ply;
 pub mod scene_file;
 pub mod scene_load;
+pub mod sky;
 pub mod srgb;
 
 use std::path::{Path, PathBuf};

@@ -23,38 +23,60 @@
 //! **glTF**: the metallic-roughness BSDF (`Bsdf::MetallicRoughness`) with
 //! the material's base colour, metallic and roughness factors, its
 //! `KHR_materials_ior` index and `KHR_materials_specular` strength and
-//! colour; the base colour texture multiplies the base colour. A material
-//! with `KHR_materials_transmission` of at least 0.5 is glass instead: a
-//! thin pane (`ThinDielectric`) when it has no `KHR_materials_volume`
-//! thickness (glTF's thin-walled default), else a solid of the material's
-//! index, rough when its roughness is. `emissive` is emitted (from both
-//! faces when the material is double-sided), and a material that is not
+//! colour. A material with `KHR_materials_transmission` of at least 0.5 is
+//! glass instead: a thin pane (`ThinDielectric`) when it has no
+//! `KHR_materials_volume` thickness (glTF's thin-walled default), else a
+//! solid of the material's index, rough when its roughness is. `emissive`
+//! times `KHR_materials_emissive_strength` is emitted (from both faces
+//! when the material is double-sided), and a material that is not
 //! double-sided is black from behind. `alphaMode` `MASK` (with
 //! `alphaCutoff`) and `BLEND` cut the surface by the base colour's alpha
-//! factor times the base colour texture's alpha channel (PNG). Metallic /
-//! roughness textures, normal maps and occlusion are ignored.
+//! factor times the base colour texture's alpha channel.
+//! `KHR_materials_clearcoat` is a coat over the material, with its own
+//! normal map (without one the coat follows the surface's normal, not the
+//! base's normal map).
 //!
-//! A texture that cannot be read is a warning and the material is
-//! untextured. Each texture file is decoded once ([`TextureCache`]).
+//! Every glTF texture is read with its sampler's wrap modes, its uv set
+//! (`TEXCOORD_0` or `_1`) and its `KHR_texture_transform`: the base colour
+//! (sRGB; alpha linear), metallic (blue) and roughness (green) of the
+//! metallic-roughness texture, the normal map with its `scale`, occlusion
+//! (red) with its `strength`, the emissive texture (sRGB), and the clear
+//! coat's strength (red), roughness (green) and normal map; every data
+//! texture is linear.
+//!
+//! A texture that cannot be read is a warning and the material goes
+//! without it. Each image is decoded once per encoding ([`TextureCache`]).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{Affine2, Vec2, Vec3};
+use sahara_render::material::{Clearcoat, NormalMap, OcclusionMap};
+use sahara_render::texture::{Channel, Encoding, ScalarMap, TextureMap};
 use sahara_render::{Bsdf, Material, Texture};
 
-use crate::gltf::{GltfImage, GltfMaterial};
-use crate::image_in::{decode_png_alpha, decode_rgb_f32, load_rgb_f32, RgbF32Image};
+use crate::gltf::{GltfImage, GltfMaterial, GltfTexture};
+use crate::image_in::{decode_texture, load_texture};
 use crate::mtl::MtlMaterial;
 
 /// IOR used for MTL glass that gives none (`Ni` <= 1).
 pub const DEFAULT_GLASS_IOR: f32 = 1.5;
 
-/// Decoded textures by file, so that a file used by many materials is read once.
+/// Where a texture's image came from, as the cache knows it.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum Source {
+    /// A file.
+    File(PathBuf),
+    /// Image `index` embedded in the glTF file `file`.
+    Embedded(String, usize),
+}
+
+/// Decoded textures by image and encoding, so that an image used by many
+/// materials is read once.
 #[derive(Debug, Default)]
 pub struct TextureCache {
-    files: HashMap<PathBuf, Option<Arc<Texture>>>,
+    images: HashMap<(Source, Encoding), Option<Arc<Texture>>>,
 }
 
 impl TextureCache {
@@ -63,47 +85,71 @@ impl TextureCache {
         Self::default()
     }
 
-    /// The texture in `path`, decoded on first use; `None` (and a warning) if it cannot be read.
-    pub fn file(&mut self, path: &Path, warnings: &mut Vec<String>) -> Option<Arc<Texture>> {
-        if let Some(t) = self.files.get(path) {
-            return t.clone();
-        }
-        let t = to_texture(load_rgb_f32(path), warnings);
-        self.files.insert(path.to_path_buf(), t.clone());
-        t
+    /// The texture in `path` read as `encoding`, decoded on first use;
+    /// `None` (and a warning) if it cannot be read.
+    pub fn file(
+        &mut self,
+        path: &Path,
+        encoding: Encoding,
+        warnings: &mut Vec<String>,
+    ) -> Option<Arc<Texture>> {
+        self.get(Source::File(path.to_path_buf()), encoding, warnings, || {
+            load_texture(path, encoding)
+        })
     }
 
-    /// Number of distinct texture files decoded (or tried).
+    fn get(
+        &mut self,
+        source: Source,
+        encoding: Encoding,
+        warnings: &mut Vec<String>,
+        decode: impl FnOnce() -> Result<Texture, crate::FormatError>,
+    ) -> Option<Arc<Texture>> {
+        self.images
+            .entry((source, encoding))
+            .or_insert_with(|| match decode() {
+                Ok(t) => Some(Arc::new(t)),
+                Err(e) => {
+                    warnings.push(format!("{e}; the material goes without this texture"));
+                    None
+                }
+            })
+            .clone()
+    }
+
+    /// The image of a glTF texture of the file `name`, read as `encoding`.
+    fn gltf(
+        &mut self,
+        t: &GltfTexture,
+        name: &str,
+        encoding: Encoding,
+        warnings: &mut Vec<String>,
+    ) -> Option<Arc<Texture>> {
+        match &t.image {
+            GltfImage::File(path) => self.file(path, encoding, warnings),
+            GltfImage::Embedded { bytes, .. } => self.get(
+                Source::Embedded(name.to_owned(), t.image_index),
+                encoding,
+                warnings,
+                || {
+                    decode_texture(
+                        bytes,
+                        &format!("{name} (embedded image {})", t.image_index),
+                        encoding,
+                    )
+                },
+            ),
+        }
+    }
+
+    /// Number of distinct images decoded (or tried), per encoding.
     pub fn len(&self) -> usize {
-        self.files.len()
+        self.images.len()
     }
 
     /// True if no texture was asked for.
     pub fn is_empty(&self) -> bool {
-        self.files.is_empty()
-    }
-}
-
-/// A decoded image as a texture, or a warning.
-fn to_texture(
-    image: Result<RgbF32Image, crate::FormatError>,
-    warnings: &mut Vec<String>,
-) -> Option<Arc<Texture>> {
-    match image {
-        Ok((w, h, rgb)) if w > 0 && h > 0 && rgb.len() == w as usize * h as usize * 3 => {
-            let texels = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
-            Some(Arc::new(Texture::new(w, h, texels)))
-        }
-        Ok((w, h, _)) => {
-            warnings.push(format!(
-                "a {w}x{h} texture has no usable texels; the material is untextured"
-            ));
-            None
-        }
-        Err(e) => {
-            warnings.push(format!("{e}; the material is untextured"));
-            None
-        }
+        self.images.is_empty()
     }
 }
 
@@ -155,7 +201,9 @@ pub fn mtl_material(
     let mut out = Material::new(bsdf).with_emission(emission(m.ke));
     if let Some(path) = &m.map_kd {
         if matches!(bsdf, Bsdf::Diffuse { .. } | Bsdf::Conductor { .. }) {
-            out.texture = textures.file(path, warnings);
+            out.textures.base_color = textures
+                .file(path, Encoding::Srgb, warnings)
+                .map(TextureMap::new);
         }
     }
     out
@@ -203,7 +251,11 @@ pub fn gltf_bsdf(m: &GltfMaterial) -> Bsdf {
     }
 }
 
-/// A glTF material as a renderer material; `name` (the glTF file) is used in warnings about embedded images.
+/// glTF's uv space (v down the image) to Sahara's (v up) and back: the
+/// flip `(u, v) -> (u, 1 - v)`.
+const FLIP_V: Affine2 = Affine2::from_cols(Vec2::X, Vec2::NEG_Y, Vec2::Y);
+
+/// A glTF material as a renderer material; `name` (the glTF file) is used in warnings.
 pub fn gltf_material(
     m: &GltfMaterial,
     name: &str,
@@ -215,35 +267,88 @@ pub fn gltf_material(
         .with_two_sided(m.double_sided)
         .with_alpha(m.alpha_mode, m.base_color[3].clamp(0.0, 1.0));
     out.two_sided_emission = m.double_sided;
-    if let Some(t) = &m.base_color_texture {
-        if t.tex_coord != 0 {
+    let label = m.name.as_deref().unwrap_or("(unnamed)");
+    let mut map = |t: Option<&GltfTexture>, role: &str, encoding: Encoding| {
+        let t = t?;
+        if t.tex_coord > 1 {
             warnings.push(format!(
-                "{name}: material '{}': base colour texture uses TEXCOORD_{}, which is not loaded; the material is untextured",
-                m.name.as_deref().unwrap_or("(unnamed)"),
+                "{name}: material '{label}': {role} uses TEXCOORD_{}, which is not loaded; the material goes without it",
                 t.tex_coord
             ));
-        } else {
-            out.texture = match &t.image {
-                GltfImage::File(path) => textures.file(path, warnings),
-                GltfImage::Embedded { bytes, .. } => to_texture(
-                    decode_rgb_f32(bytes, &format!("{name} (embedded image)")),
-                    warnings,
-                ),
-            };
-            // Cut-outs and transparency read the texture's alpha channel.
-            if out.has_holes() {
-                let bytes = match &t.image {
-                    GltfImage::File(path) => std::fs::read(path).ok(),
-                    GltfImage::Embedded { bytes, .. } => Some(bytes.clone()),
-                };
-                let alpha = bytes.as_deref().and_then(decode_png_alpha);
-                if let (Some(tex), Some(alpha)) = (&out.texture, alpha) {
-                    if alpha.len() == tex.texels.len() {
-                        out.texture = Some(Arc::new((**tex).clone().with_alpha(alpha)));
-                    }
-                }
-            }
+            return None;
         }
+        let texture = textures.gltf(t, name, encoding, warnings)?;
+        Some(
+            TextureMap::new(texture)
+                .with_wrap(t.wrap[0], t.wrap[1])
+                .with_uv_set(t.tex_coord as u8)
+                .with_transform(FLIP_V * t.transform * FLIP_V),
+        )
+    };
+    let tex = &mut out.textures;
+    tex.base_color = map(
+        m.base_color_texture.as_ref(),
+        "base colour texture",
+        Encoding::Srgb,
+    );
+    if let Some(mr) = map(
+        m.metallic_roughness_texture.as_ref(),
+        "metallic-roughness texture",
+        Encoding::Linear,
+    ) {
+        tex.metallic = Some(ScalarMap::new(mr.clone(), Channel::B));
+        tex.roughness = Some(ScalarMap::new(mr, Channel::G));
+    }
+    if let Some((t, scale)) = &m.normal_texture {
+        tex.normal = map(Some(t), "normal texture", Encoding::Linear).map(|map| NormalMap {
+            map,
+            scale: if scale.is_finite() { *scale } else { 1.0 },
+        });
+    }
+    if let Some((t, strength)) = &m.occlusion_texture {
+        tex.occlusion =
+            map(Some(t), "occlusion texture", Encoding::Linear).map(|map| OcclusionMap {
+                map: ScalarMap::new(map, Channel::R),
+                strength: if strength.is_finite() {
+                    strength.clamp(0.0, 1.0)
+                } else {
+                    1.0
+                },
+            });
+    }
+    tex.emission = map(
+        m.emissive_texture.as_ref(),
+        "emissive texture",
+        Encoding::Srgb,
+    );
+    if let Some(c) = &m.clearcoat {
+        let unit = |x: f32| {
+            if x.is_finite() {
+                x.clamp(0.0, 1.0)
+            } else {
+                0.0
+            }
+        };
+        out.clearcoat = Some(Box::new(Clearcoat {
+            factor: unit(c.factor),
+            roughness: unit(c.roughness),
+            ior: 1.5,
+            factor_map: map(c.texture.as_ref(), "clearcoat texture", Encoding::Linear)
+                .map(|m| ScalarMap::new(m, Channel::R)),
+            roughness_map: map(
+                c.roughness_texture.as_ref(),
+                "clearcoat roughness texture",
+                Encoding::Linear,
+            )
+            .map(|m| ScalarMap::new(m, Channel::G)),
+            normal_map: c.normal_texture.as_ref().and_then(|(t, scale)| {
+                map(Some(t), "clearcoat normal texture", Encoding::Linear).map(|map| NormalMap {
+                    map,
+                    scale: if scale.is_finite() { *scale } else { 1.0 },
+                })
+            }),
+        }))
+        .filter(|c| c.factor > 0.0);
     }
     out
 }

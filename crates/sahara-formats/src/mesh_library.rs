@@ -14,6 +14,7 @@ use glam::{Mat4, Vec2};
 use sahara_render::{Scene, SceneMesh};
 
 use crate::error::FormatError;
+use crate::gltf::{GltfCamera, GltfLight};
 use crate::material_map::{gltf_material, mtl_material, TextureCache};
 
 /// One scene mesh made from a file, and where the file puts it.
@@ -36,6 +37,11 @@ pub struct LoadedFile {
     pub material: Option<u32>,
     /// True if a material of the file emits light.
     pub emissive: bool,
+    /// The file's cameras (glTF), placed in the file's space.
+    pub cameras: Vec<GltfCamera>,
+    /// The file's lights (glTF `KHR_lights_punctual`), placed in the
+    /// file's space.
+    pub lights: Vec<GltfLight>,
 }
 
 /// Every mesh file loaded so far, by canonical path.
@@ -101,6 +107,8 @@ impl MeshLibrary {
                     }],
                     material: Some(self.default_material(scene)),
                     emissive: false,
+                    cameras: Vec::new(),
+                    lights: Vec::new(),
                 }
             }
             "gltf" | "glb" => self.load_gltf(scene, path, own_materials)?,
@@ -130,7 +138,7 @@ impl MeshLibrary {
             mesh: obj.mesh,
             normals: obj.normals,
             uvs: obj.uvs,
-            material_ids: None,
+            ..SceneMesh::default()
         };
         let mut emissive = false;
         let material = if own_materials {
@@ -153,6 +161,8 @@ impl MeshLibrary {
             }],
             material,
             emissive,
+            cameras: Vec::new(),
+            lights: Vec::new(),
         })
     }
 
@@ -178,6 +188,12 @@ impl MeshLibrary {
         } else {
             Some(self.default_material(scene))
         };
+        // glTF puts uv (0, 0) at the image's top left; textures here have v
+        // running bottom to top. (Tangents need no change: glTF's bitangent
+        // already points up the image.)
+        let flip = |uvs: Option<Vec<Vec2>>| {
+            uvs.map(|uvs| uvs.iter().map(|uv| Vec2::new(uv.x, 1.0 - uv.y)).collect())
+        };
         let ids: Vec<u32> = g
             .meshes
             .into_iter()
@@ -185,11 +201,9 @@ impl MeshLibrary {
                 scene.add_mesh(SceneMesh {
                     mesh: m.mesh,
                     normals: m.normals,
-                    // glTF puts uv (0, 0) at the image's top left; textures here
-                    // have v running bottom to top.
-                    uvs: m
-                        .uvs
-                        .map(|uvs| uvs.iter().map(|uv| Vec2::new(uv.x, 1.0 - uv.y)).collect()),
+                    uvs: flip(m.uvs),
+                    uvs1: flip(m.uvs1),
+                    tangents: m.tangents,
                     material_ids: own_materials
                         .then(|| m.material_ids.iter().map(|&i| first + i).collect()),
                 })
@@ -212,6 +226,8 @@ impl MeshLibrary {
             parts,
             material,
             emissive,
+            cameras: g.cameras,
+            lights: g.lights,
         })
     }
 }

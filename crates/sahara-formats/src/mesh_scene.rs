@@ -1,53 +1,89 @@
 //! A bare mesh file (`.obj`, `.ply`, `.gltf`, `.glb`) as a scene to render.
 //!
-//! Materials come from the file (MTL, glTF; grey for PLY), the camera from
-//! the `<stem>.camera.json` sidecar when there is one, else it frames the
-//! mesh's bounds from above and to the side; a default sky and sun light
-//! the scene only when none of its materials emits.
+//! Materials come from the file (MTL, glTF; grey for PLY), and so do a
+//! glTF file's lights. The camera is, in order: the one asked for (a
+//! sidecar file, or a glTF camera by name), the `<stem>.camera.json`
+//! sidecar, the glTF file's first camera, else one that frames the mesh's
+//! bounds from above and to the side. The sky follows [`crate::sky`]
+//! (`auto` unless told otherwise: the default sky and sun when the file's
+//! own lights are weak).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use sahara_render::{Camera, Environment, Instance, Light, Placement, Scene};
+use sahara_render::{Camera, Instance, Placement, Scene};
 
 use crate::camera::{read_sidecar, sidecar_path};
 use crate::error::FormatError;
 use crate::mesh_library::MeshLibrary;
+use crate::sky::{self, Sky, SkyUsed};
 
-/// Radiance of the default sky.
-pub const DEFAULT_SKY: Vec3 = Vec3::new(0.55, 0.6, 0.7);
-/// Direction the default sun's light travels.
-pub const DEFAULT_SUN_DIRECTION: Vec3 = Vec3::new(-0.4, -1.0, -0.3);
-/// Irradiance of the default sun.
-pub const DEFAULT_SUN: Vec3 = Vec3::splat(2.5);
+pub use crate::sky::{DEFAULT_SKY, DEFAULT_SUN, DEFAULT_SUN_DIRECTION};
+
 /// Vertical field of view of the automatic camera, degrees.
 pub const AUTO_VFOV_DEG: f32 = 45.0;
+
+/// Which camera a mesh file is seen by.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub enum CameraChoice {
+    /// The `<stem>.camera.json` sidecar, else the file's first camera,
+    /// else the automatic one.
+    #[default]
+    Auto,
+    /// A camera sidecar file.
+    Sidecar(PathBuf),
+    /// The glTF file's camera of this name.
+    Named(String),
+}
+
+impl CameraChoice {
+    /// What `--camera VALUE` means: a sidecar if `VALUE` names an
+    /// existing file or ends in `.json`, else a camera name.
+    pub fn from_arg(value: &str) -> CameraChoice {
+        let path = Path::new(value);
+        if path.is_file() || value.to_ascii_lowercase().ends_with(".json") {
+            CameraChoice::Sidecar(path.to_path_buf())
+        } else {
+            CameraChoice::Named(value.to_owned())
+        }
+    }
+}
 
 /// A mesh file made into a scene.
 #[derive(Clone, Debug)]
 pub struct MeshScene {
     /// The scene (camera aspect 1: the caller sets it from the image size).
     pub scene: Scene,
-    /// Where the camera came from: the sidecar's path, or `auto`.
+    /// Where the camera came from: the sidecar's path, the glTF camera, or
+    /// `auto`.
     pub camera_source: String,
-    /// True if the default sky and sun were added.
-    pub default_light: bool,
+    /// What lights the scene besides its own lights.
+    pub sky: SkyUsed,
     /// Problems that did not stop loading, one line each, naming the file.
     pub warnings: Vec<String>,
 }
 
-/// Loads a mesh file with its materials, camera and (if needed) the default light.
-pub fn load_mesh_scene(path: &Path) -> Result<MeshScene, FormatError> {
-    load_mesh_scene_with_camera(path, None)
+impl MeshScene {
+    /// True if the default sky and sun were added.
+    pub fn default_light(&self) -> bool {
+        self.sky == SkyUsed::Default
+    }
 }
 
-/// Loads a mesh file as [`load_mesh_scene`] does, with the camera of the
-/// sidecar `camera` if given (instead of `<stem>.camera.json` or the
-/// automatic one).
-pub fn load_mesh_scene_with_camera(
+/// Loads a mesh file with its materials, lights, camera and (if its own
+/// lights are weak) the default sky and sun.
+pub fn load_mesh_scene(path: &Path) -> Result<MeshScene, FormatError> {
+    load_mesh_scene_with(path, &CameraChoice::Auto, &Sky::Auto)
+}
+
+/// Loads a mesh file as [`load_mesh_scene`] does, seen by `camera` and
+/// lit as `sky` says.
+pub fn load_mesh_scene_with(
     path: &Path,
-    camera: Option<&Path>,
+    camera: &CameraChoice,
+    sky: &Sky,
 ) -> Result<MeshScene, FormatError> {
+    let name = path.display().to_string();
     // Placeholder camera until the bounds are known.
     let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
     let mut library = MeshLibrary::new();
@@ -59,31 +95,94 @@ pub fn load_mesh_scene_with_camera(
             material: file.material,
         });
     }
-    let sidecar = camera.map_or_else(|| sidecar_path(path), Path::to_path_buf);
-    let (camera, camera_source) = if camera.is_some() || sidecar.exists() {
-        let c = read_sidecar(&sidecar)?;
-        (
+    for l in &file.lights {
+        scene.add_light(l.to_light(glam::Mat4::IDENTITY));
+    }
+    scene.generate_tangents();
+    let sidecar = sidecar_path(path);
+    let from_sidecar = |p: &Path| -> Result<(Camera, String), FormatError> {
+        let c = read_sidecar(p)?;
+        Ok((
             Camera::look_at(c.eye, c.target, c.up, c.vfov_deg, 1.0),
-            sidecar.display().to_string(),
-        )
-    } else {
+            p.display().to_string(),
+        ))
+    };
+    let named = |c: &crate::gltf::GltfCamera| {
         (
-            auto_camera(&scene, &path.display().to_string())?,
-            "auto".into(),
+            c.to_camera(),
+            format!(
+                "{name}: camera '{}'",
+                c.name.as_deref().unwrap_or("(unnamed)")
+            ),
         )
     };
+    let (camera, camera_source) = match camera {
+        CameraChoice::Sidecar(p) => from_sidecar(p)?,
+        CameraChoice::Named(want) => {
+            let found = file
+                .cameras
+                .iter()
+                .find(|c| c.name.as_deref() == Some(want.as_str()));
+            match found {
+                Some(c) => named(c),
+                None => {
+                    let names: Vec<String> = file
+                        .cameras
+                        .iter()
+                        .map(|c| format!("'{}'", c.name.as_deref().unwrap_or("(unnamed)")))
+                        .collect();
+                    return Err(FormatError::in_file(
+                        &name,
+                        if names.is_empty() {
+                            format!("no camera named '{want}': the file has no cameras (and no file {want} exists)")
+                        } else {
+                            format!(
+                                "no camera named '{want}' (the file's cameras: {})",
+                                names.join(", ")
+                            )
+                        },
+                    ));
+                }
+            }
+        }
+        CameraChoice::Auto if sidecar.exists() => from_sidecar(&sidecar)?,
+        CameraChoice::Auto => match file.cameras.first() {
+            Some(c) => named(c),
+            None if !has_finite_triangles(&scene) => {
+                library.warnings.push(format!(
+                    "{name}: every triangle has a NaN or infinite corner: nothing to frame; \
+                     the camera looks at the origin from +Z"
+                ));
+                (
+                    Camera::look_at(
+                        Vec3::new(0.0, 0.0, 5.0),
+                        Vec3::ZERO,
+                        Vec3::Y,
+                        AUTO_VFOV_DEG,
+                        1.0,
+                    ),
+                    "auto (nothing to frame)".into(),
+                )
+            }
+            None => (auto_camera(&scene, &name)?, "auto".into()),
+        },
+    };
     scene.camera = camera;
-    let default_light = !file.emissive;
-    if default_light {
-        scene.environment = Some(Environment::Constant(DEFAULT_SKY));
-        scene.add_light(Light::directional(DEFAULT_SUN_DIRECTION, DEFAULT_SUN));
-    }
+    let sky = sky::apply(&mut scene, sky)?;
     Ok(MeshScene {
         scene,
         camera_source,
-        default_light,
+        sky,
         warnings: library.warnings,
     })
+}
+
+/// True if some instance has a triangle whose corners are all finite.
+fn has_finite_triangles(scene: &Scene) -> bool {
+    scene
+        .instances
+        .iter()
+        .any(|i| !scene.meshes[i.mesh as usize].mesh.bounds().is_empty())
 }
 
 /// A camera that sees the whole scene: looking at the centre of its bounds

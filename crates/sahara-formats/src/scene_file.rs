@@ -68,6 +68,9 @@ use crate::error::FormatError;
 /// A parsed and checked scene file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SceneFile {
+    /// What lights the scene besides its lights (`sky = "auto"`,
+    /// `"default"`, `"none"` or an image file; `none` when absent).
+    pub sky: crate::sky::Sky,
     /// The camera.
     pub camera: CameraSpec,
     /// Named materials, in file order.

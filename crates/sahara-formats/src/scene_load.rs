@@ -25,15 +25,20 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
-use sahara_render::{Bsdf, Camera, Environment, Instance, Light, Material, Scene, Texture};
+use sahara_render::texture::Encoding;
+use sahara_render::{
+    Bsdf, Camera, Environment, Instance, Light, Material, Scene, Texture, TextureMap,
+};
 
 use crate::error::FormatError;
 use crate::image_in::load_rgb_f32;
+use crate::material_map::TextureCache;
 use crate::mesh_library::{file_key, MeshLibrary};
 use crate::scene_file::{
     load_scene_file, CameraSpec, EnvironmentSpec, LightSpec, MaterialKind, MaterialSpec,
     Placement as PlacementSpec, SceneFile, ShapeSpec,
 };
+use crate::sky::Sky;
 
 pub use placement::{placement, srt};
 pub use settings::{FileCrop, FileSettings};
@@ -51,7 +56,16 @@ pub struct LoadedScene {
 
 /// Reads a scene file and builds its scene (meshes, textures and maps read relative to it).
 pub fn load_scene(path: &Path) -> Result<LoadedScene, FormatError> {
-    let file = load_scene_file(path)?;
+    load_scene_with_sky(path, None)
+}
+
+/// Reads a scene file as [`load_scene`] does, lit by `sky` instead of the
+/// file's `sky` key if given.
+pub fn load_scene_with_sky(path: &Path, sky: Option<&Sky>) -> Result<LoadedScene, FormatError> {
+    let mut file = load_scene_file(path)?;
+    if let Some(sky) = sky {
+        file.sky = sky.clone();
+    }
     build_scene(&file, &path.display().to_string())
 }
 
@@ -64,8 +78,9 @@ pub fn build_scene(file: &SceneFile, name: &str) -> Result<LoadedScene, FormatEr
     let mut library = MeshLibrary::new();
 
     let mut named = HashMap::new();
+    let mut textures = TextureCache::new();
     for m in &file.materials {
-        let id = scene.add_material(material_of(m, &mut library.warnings, name));
+        let id = scene.add_material(material_of(m, &mut textures, &mut library.warnings, name));
         named.insert(m.name.as_str(), id);
     }
     // Files some object shows with their own materials.
@@ -93,6 +108,12 @@ pub fn build_scene(file: &SceneFile, name: &str) -> Result<LoadedScene, FormatEr
                         placement: placement(&o.placement, part.transform),
                         material: material.or(f.material),
                     });
+                }
+                // A glTF file's lights, where the object puts the file
+                // (where it starts, if it moves).
+                let at = placement(&o.placement, Mat4::IDENTITY).at(0.0);
+                for l in &f.lights {
+                    scene.add_light(l.to_light(Mat4::from(at)));
                 }
                 if matches!(o.placement, PlacementSpec::Motion { .. })
                     && material.map_or(f.emissive, |m| is_emissive(&scene, m))
@@ -128,6 +149,9 @@ pub fn build_scene(file: &SceneFile, name: &str) -> Result<LoadedScene, FormatEr
     for l in &file.lights {
         add_light(&mut scene, l, &named, name)?;
     }
+    scene.generate_tangents();
+    crate::sky::apply(&mut scene, &file.sky)
+        .map_err(|e| FormatError::in_file(name, format!("sky: {e}")))?;
     // A scene without light is reported by `Scene::diagnostics`, with the
     // other problems of the finished scene.
     let warnings = std::mem::take(&mut library.warnings);
@@ -150,60 +174,39 @@ pub fn camera_of(c: &CameraSpec, aspect: f32) -> Camera {
         .with_shutter(c.shutter_open, c.shutter_close)
 }
 
-/// The renderer material of a `[[material]]` (a texture that cannot be read is a warning).
-fn material_of(m: &MaterialSpec, warnings: &mut Vec<String>, name: &str) -> Material {
-    let mut out = material_kind_of(m, warnings, name)
+/// The renderer material of a `[[material]]` (a texture that cannot be
+/// read is a warning); its texture's alpha channel, if any, cuts out
+/// holes when the material's alpha mode says so.
+fn material_of(
+    m: &MaterialSpec,
+    textures: &mut TextureCache,
+    warnings: &mut Vec<String>,
+    name: &str,
+) -> Material {
+    let mut out = material_kind_of(m)
         .with_two_sided(m.two_sided)
         .with_alpha(m.alpha_mode, m.alpha);
-    // Cut-outs and transparency read a PNG texture's alpha channel.
     let file = match &m.kind {
         MaterialKind::Diffuse { texture, .. }
         | MaterialKind::MetallicRoughness { texture, .. }
         | MaterialKind::CoatedDiffuse { texture, .. } => texture.as_deref(),
         _ => None,
     };
-    if let (true, Some(path), Some(tex)) = (out.has_holes(), file, &out.texture) {
-        let alpha = std::fs::read(path)
-            .ok()
-            .and_then(|b| crate::image_in::decode_png_alpha(&b));
-        if let Some(alpha) = alpha.filter(|a| a.len() == tex.texels.len()) {
-            out.texture = Some(Arc::new((**tex).clone().with_alpha(alpha)));
-        }
+    if let Some(path) = file {
+        let mut problems = Vec::new();
+        out.textures.base_color = textures
+            .file(path, Encoding::Srgb, &mut problems)
+            .map(TextureMap::new);
+        warnings.extend(
+            problems
+                .into_iter()
+                .map(|p| format!("{name}: material '{}': {p}", m.name)),
+        );
     }
     out
 }
 
-/// The texture of a `[[material]]` (a warning and none if it cannot be read).
-fn texture_of(
-    m: &MaterialSpec,
-    path: &Path,
-    warnings: &mut Vec<String>,
-    name: &str,
-) -> Option<Arc<Texture>> {
-    match load_rgb_f32(path) {
-        Ok((w, h, rgb)) if w > 0 && h > 0 => {
-            let texels = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
-            Some(Arc::new(Texture::new(w, h, texels)))
-        }
-        Ok(_) => {
-            warnings.push(format!(
-                "{name}: material '{}': texture {} is empty; the material is untextured",
-                m.name,
-                path.display()
-            ));
-            None
-        }
-        Err(e) => {
-            warnings.push(format!(
-                "{name}: material '{}': {e}; the material is untextured",
-                m.name
-            ));
-            None
-        }
-    }
-}
-
-fn material_kind_of(m: &MaterialSpec, warnings: &mut Vec<String>, name: &str) -> Material {
+fn material_kind_of(m: &MaterialSpec) -> Material {
     match &m.kind {
         MaterialKind::ComplexConductor { eta, k, roughness } => {
             Material::new(Bsdf::ComplexConductor {
@@ -214,50 +217,32 @@ fn material_kind_of(m: &MaterialSpec, warnings: &mut Vec<String>, name: &str) ->
         }
         MaterialKind::MetallicRoughness {
             base_color,
-            texture,
             metallic,
             roughness,
             ior,
             specular,
             specular_color,
-        } => {
-            let mut out = Material::new(Bsdf::MetallicRoughness {
-                base_color: *base_color,
-                metallic: *metallic,
-                roughness: *roughness,
-                ior: *ior,
-                specular: *specular,
-                specular_color: *specular_color,
-            });
-            out.texture = texture
-                .as_deref()
-                .and_then(|p| texture_of(m, p, warnings, name));
-            out
-        }
+            ..
+        } => Material::new(Bsdf::MetallicRoughness {
+            base_color: *base_color,
+            metallic: *metallic,
+            roughness: *roughness,
+            ior: *ior,
+            specular: *specular,
+            specular_color: *specular_color,
+        }),
         MaterialKind::CoatedDiffuse {
             albedo,
-            texture,
             ior,
             roughness,
-        } => {
-            let mut out = Material::new(Bsdf::CoatedDiffuse {
-                albedo: *albedo,
-                ior: *ior,
-                roughness: *roughness,
-            });
-            out.texture = texture
-                .as_deref()
-                .and_then(|p| texture_of(m, p, warnings, name));
-            out
-        }
+            ..
+        } => Material::new(Bsdf::CoatedDiffuse {
+            albedo: *albedo,
+            ior: *ior,
+            roughness: *roughness,
+        }),
         MaterialKind::ThinDielectric { ior } => Material::new(Bsdf::ThinDielectric { ior: *ior }),
-        MaterialKind::Diffuse { albedo, texture } => {
-            let mut out = Material::diffuse(*albedo);
-            out.texture = texture
-                .as_deref()
-                .and_then(|p| texture_of(m, p, warnings, name));
-            out
-        }
+        MaterialKind::Diffuse { albedo, .. } => Material::diffuse(*albedo),
         MaterialKind::Conductor { color, roughness } => Material::conductor(*color, *roughness),
         MaterialKind::Mirror { color } => Material::mirror(*color),
         MaterialKind::Dielectric { ior } => Material::glass(*ior),

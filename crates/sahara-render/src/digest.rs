@@ -2,11 +2,9 @@
 //! that changes its pixels, so that pieces of one frame rendered apart can
 //! be recognised as such before they are added up.
 
-use std::fmt::Write;
-use std::sync::Arc;
-
 use glam::Vec3;
 use sha2::{Digest, Sha256};
+use std::fmt::Write;
 
 use crate::light::Environment;
 use crate::render::RenderSettings;
@@ -52,7 +50,7 @@ fn vec3s(v: &[Vec3]) -> impl Iterator<Item = [u8; 4]> + '_ {
 /// do not change a pixel of the frame.
 ///
 /// The scene's large arrays (mesh vertices, triangles, normals, texture
-/// coordinates, material ids, texels) enter as their bytes; the rest of it
+/// coordinates, tangents, material ids, texels) enter as their bytes; the rest of it
 /// through its `Debug` form, which prints every float so that it reads
 /// back to the same bits.
 pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
@@ -64,9 +62,15 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
         if let Some(n) = &m.normals {
             bytes(&mut h, "normals", &mut vec3s(n));
         }
-        if let Some(uv) = &m.uvs {
-            let mut it = uv.iter().flat_map(|p| p.to_array()).map(f32::to_le_bytes);
-            bytes(&mut h, "uvs", &mut it);
+        for (tag, uv) in [("uvs", &m.uvs), ("uvs1", &m.uvs1)] {
+            if let Some(uv) = uv {
+                let mut it = uv.iter().flat_map(|p| p.to_array()).map(f32::to_le_bytes);
+                bytes(&mut h, tag, &mut it);
+            }
+        }
+        if let Some(t) = &m.tangents {
+            let mut it = t.iter().flat_map(|p| p.to_array()).map(f32::to_le_bytes);
+            bytes(&mut h, "tangents", &mut it);
         }
         if let Some(ids) = &m.material_ids {
             bytes(
@@ -76,24 +80,26 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
             );
         }
     }
-    // The rest of the scene, with each texture replaced by a placeholder
-    // once its texels are hashed (in order of first use).
-    let placeholder = Arc::new(Texture::new(1, 1, vec![Vec3::ZERO]));
-    let texture = |h: &mut HashWriter, t: &mut Arc<Texture>| {
-        let _ = write!(h, "texture {}x{}", t.width, t.height);
-        bytes(h, "texels", &mut vec3s(&t.texels));
-        *t = placeholder.clone();
+    // Texels of every texture, in order of use; the rest of the scene's
+    // `Debug` form names textures by size and format only.
+    let texture = |h: &mut HashWriter, t: &Texture| {
+        let _ = write!(h, "texture {t:?}");
+        let mut it = t
+            .texels_rgba()
+            .flat_map(|p| p.to_array())
+            .map(f32::to_le_bytes);
+        bytes(h, "texels", &mut it);
     };
-    let mut rest = Scene {
+    let rest = Scene {
         meshes: Vec::new(),
         ..scene.clone()
     };
-    for m in &mut rest.materials {
-        if let Some(t) = &mut m.texture {
-            texture(&mut h, t);
+    for m in &rest.materials {
+        for map in m.texture_maps() {
+            texture(&mut h, &map.texture);
         }
     }
-    if let Some(Environment::Map { texture: t, .. }) = &mut rest.environment {
+    if let Some(Environment::Map { texture: t, .. }) = &rest.environment {
         texture(&mut h, t);
     }
     let scene = &rest;
@@ -169,10 +175,25 @@ mod tests {
         nudged.meshes[0].mesh.positions[0].x += 1e-3;
         assert_ne!(frame_digest(&nudged, &base), d);
         let mut textured = scene.clone();
-        let texels = |v: f32| Arc::new(Texture::new(1, 2, vec![Vec3::ONE, Vec3::splat(v)]));
-        textured.materials[0].texture = Some(texels(0.5));
+        let texels = |v: f32| {
+            crate::TextureMap::new(std::sync::Arc::new(Texture::new(
+                1,
+                2,
+                vec![Vec3::ONE, Vec3::splat(v)],
+            )))
+        };
+        textured.materials[0].textures.base_color = Some(texels(0.5));
         let t = frame_digest(&textured, &base);
-        textured.materials[0].texture = Some(texels(0.25));
+        textured.materials[0].textures.base_color = Some(texels(0.25));
         assert_ne!(frame_digest(&textured, &base), t);
+        // The same texels in another role, or wrapped otherwise: another
+        // frame.
+        let mut moved = textured.clone();
+        moved.materials[0].textures.emission = moved.materials[0].textures.base_color.take();
+        assert_ne!(frame_digest(&moved, &base), t);
+        let mut clamped = textured.clone();
+        let map = clamped.materials[0].textures.base_color.as_mut().unwrap();
+        map.wrap = [crate::texture::Wrap::Clamp; 2];
+        assert_ne!(frame_digest(&clamped, &base), t);
     }
 }

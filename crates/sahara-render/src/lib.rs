@@ -35,6 +35,7 @@ pub mod scene;
 pub mod shape;
 pub mod split;
 pub mod sums;
+mod tangents;
 pub mod texture;
 pub mod world;
 
@@ -44,7 +45,7 @@ pub use filter::Filter;
 pub use instance::{Instance, Placement, Srt};
 pub use integrator::Integrator;
 pub use light::{Environment, Light};
-pub use material::{AlphaMode, Bsdf, Material};
+pub use material::{AlphaMode, Bsdf, Material, MaterialTextures};
 pub use mesh::{Mesh, SceneMesh};
 pub use render::{
     cost_maps, render, render_watched, CostMaps, Preview, Progress, RenderResult, RenderSettings,
@@ -55,4 +56,4 @@ pub use scene::Scene;
 pub use shape::Shape;
 pub use split::PixelWindow;
 pub use sums::{PixelSum, SumBuffer};
-pub use texture::Texture;
+pub use texture::{Texture, TextureMap};

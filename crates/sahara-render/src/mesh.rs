@@ -23,6 +23,21 @@ impl Mesh {
         Triangle::from_indexed(&self.positions, &self.indices)
     }
 
+    /// The triangles no ray can hit, which the kd-tree skips: those with a
+    /// corner missing or not finite, and those of zero area.
+    pub fn skipped_counts(&self) -> (usize, usize) {
+        let (mut non_finite, mut flat) = (0, 0);
+        for t in &self.indices {
+            let v = t.map(|k| self.positions.get(k as usize).copied().unwrap_or(Vec3::NAN));
+            if !v.iter().all(|p| p.is_finite()) {
+                non_finite += 1;
+            } else if !Triangle::new(v[0], v[1], v[2]).is_hittable() {
+                flat += 1;
+            }
+        }
+        (non_finite, flat)
+    }
+
     /// Number of triangles no ray can hit (a corner missing, not finite, or
     /// zero area): the kd-tree skips them.
     pub fn unhittable_count(&self) -> usize {
@@ -35,12 +50,18 @@ impl Mesh {
             .count()
     }
 
-    /// Bounds of the vertices that triangles use.
+    /// Bounds of the vertices of the triangles whose three corners are
+    /// finite (a triangle with a NaN or infinite corner is skipped by the
+    /// kd-tree, and must not stretch the scene's bounds to infinity).
     pub fn bounds(&self) -> Aabb {
         self.indices
             .iter()
+            .filter_map(|t| {
+                let v = t.map(|k| self.positions.get(k as usize).copied().unwrap_or(Vec3::NAN));
+                v.iter().all(|p| p.is_finite()).then_some(v)
+            })
             .flatten()
-            .fold(Aabb::EMPTY, |b, &i| b.grow(self.positions[i as usize]))
+            .fold(Aabb::EMPTY, |b, p| b.grow(p))
     }
 }
 
@@ -56,6 +77,15 @@ pub struct SceneMesh {
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex texture coordinates (parallel to `mesh.positions`).
     pub uvs: Option<Vec<glam::Vec2>>,
+    /// A second set of per-vertex texture coordinates, which textures
+    /// may read instead (glTF's `TEXCOORD_1`).
+    pub uvs1: Option<Vec<glam::Vec2>>,
+    /// Per-vertex tangents for normal maps (parallel to
+    /// `mesh.positions`): `xyz` the direction of increasing `u` of the uv
+    /// set the normal map reads, `w` (+1 or -1) the handedness, the
+    /// bitangent being `w * normal x tangent` (glTF's `TANGENT`;
+    /// [`SceneMesh::generate_tangents`] makes them).
+    pub tangents: Option<Vec<glam::Vec4>>,
     /// Per-triangle material ids (parallel to `mesh.indices`); an
     /// instance's own material, when set, takes precedence.
     pub material_ids: Option<Vec<u32>>,
@@ -89,6 +119,12 @@ impl SceneMesh {
         }
         if self.uvs.as_ref().is_some_and(|n| n.len() != nv) {
             return Err("uvs: one per vertex expected".into());
+        }
+        if self.uvs1.as_ref().is_some_and(|n| n.len() != nv) {
+            return Err("uvs1: one per vertex expected".into());
+        }
+        if self.tangents.as_ref().is_some_and(|n| n.len() != nv) {
+            return Err("tangents: one per vertex expected".into());
         }
         if self
             .material_ids

@@ -234,9 +234,13 @@ pub fn render_watched(
     mut preview: Option<Preview<'_>>,
 ) -> RenderResult {
     let start = Instant::now();
-    let world = World::new(scene, &settings.build);
-    let build_time = start.elapsed();
+    let mut world = World::new(scene, &settings.build);
     let (w, h) = (settings.width.max(1), settings.height.max(1));
+    world.set_film(
+        h,
+        u64::from(settings.spp) * u64::from(settings.passes.max(1)),
+    );
+    let build_time = start.elapsed();
     let window = settings
         .window
         .unwrap_or(PixelWindow::full(w, h))

@@ -111,6 +111,50 @@ impl Scene {
         })
     }
 
+    /// Gives every mesh that a normal-mapped material is used on, and that
+    /// has no tangents, MikkTSpace tangents for the uv set of the normal
+    /// map ([`SceneMesh::generate_tangents`]); loaders call it once the
+    /// scene is complete. Returns the number of meshes given tangents.
+    /// (Without tangents a normal map is read in a frame made per
+    /// triangle from its uv gradient: right for flat, unmirrored meshes,
+    /// but with visible seams on smooth ones.)
+    pub fn generate_tangents(&mut self) -> usize {
+        let mut wanted: Vec<Option<u8>> = vec![None; self.meshes.len()];
+        let normal_set = |id: u32| {
+            self.materials
+                .get(id as usize)
+                .and_then(|m| m.textures.normal.as_ref())
+                .map(|n| n.map.uv_set)
+        };
+        for inst in &self.instances {
+            let Some(w) = wanted.get_mut(inst.mesh as usize) else {
+                continue;
+            };
+            if w.is_some() {
+                continue;
+            }
+            *w = match (inst.material, &self.meshes[inst.mesh as usize].material_ids) {
+                (Some(m), _) => normal_set(m),
+                (None, Some(ids)) => {
+                    let mut seen = std::collections::HashSet::new();
+                    ids.iter()
+                        .filter(|&&id| seen.insert(id))
+                        .find_map(|&id| normal_set(id))
+                }
+                (None, None) => normal_set(0),
+            };
+        }
+        let mut n = 0;
+        for (mesh, set) in self.meshes.iter_mut().zip(wanted) {
+            if let Some(set) = set {
+                if mesh.tangents.is_none() && mesh.generate_tangents(set) {
+                    n += 1;
+                }
+            }
+        }
+        n
+    }
+
     /// Checks every index and array length; returns the first problem.
     pub fn validate(&self) -> Result<(), String> {
         for (i, m) in self.meshes.iter().enumerate() {
@@ -154,19 +198,32 @@ impl Scene {
     }
 
     /// Problems that do not stop a render, one line each: triangles no ray
-    /// can hit (non-finite coordinates or zero area; the kd-trees leave them
-    /// out) and a scene without any light (it renders black but for what
-    /// emits).
+    /// can hit, over all meshes (non-finite coordinates or zero area; the
+    /// kd-trees leave them out, and bounds and framing ignore them) and a
+    /// scene without any light (it renders black but for what emits).
     pub fn diagnostics(&self) -> Vec<String> {
         let mut out = Vec::new();
-        for (i, m) in self.meshes.iter().enumerate() {
-            let n = m.mesh.unhittable_count();
-            if n > 0 {
-                out.push(format!(
-                    "mesh {i}: {n} of {} triangles skipped (non-finite coordinates or zero area)",
-                    m.mesh.indices.len()
-                ));
-            }
+        let (mut non_finite, mut flat, mut total) = (0, 0, 0);
+        for m in &self.meshes {
+            let (a, b) = m.mesh.skipped_counts();
+            non_finite += a;
+            flat += b;
+            total += m.mesh.indices.len();
+        }
+        if non_finite + flat > 0 {
+            let why: Vec<String> = [
+                (non_finite, "with a NaN or infinite corner"),
+                (flat, "of zero area"),
+            ]
+            .into_iter()
+            .filter(|(n, _)| *n > 0)
+            .map(|(n, what)| format!("{n} {what}"))
+            .collect();
+            out.push(format!(
+                "{} of {total} triangles skipped ({})",
+                non_finite + flat,
+                why.join(", ")
+            ));
         }
         if !self.has_light() {
             out.push(

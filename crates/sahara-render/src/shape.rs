@@ -182,6 +182,8 @@ impl Builder {
             },
             normals: Some(self.normals),
             uvs: Some(self.uvs),
+            uvs1: None,
+            tangents: None,
             material_ids: None,
         }
     }

@@ -7,12 +7,13 @@ use sahara_kd::{BuildParams, Counters, NoCounters, Ray};
 
 use crate::accel::{Accel, BatchBuffers, RawHit};
 use crate::distribution::Distribution1D;
-use crate::light::area::Emitter;
+use crate::light::area::{EmissionTextures, Emitter};
 use crate::light::{AreaLight, EnvLight, LightSample, LightSource};
 use crate::material::Material;
 use crate::sampling::Frame;
 use crate::scene::Scene;
 use crate::shape::Shape;
+use crate::texture::footprint::{CameraSpread, UvFootprint};
 
 /// A ray's intersection with a surface, in world space.
 #[derive(Clone, Copy, Debug)]
@@ -25,8 +26,16 @@ pub struct SurfaceHit {
     pub ng: Vec3,
     /// Unit shading normal, on the same side as `ng`.
     pub ns: Vec3,
-    /// Texture coordinates.
+    /// Texture coordinates (the mesh's first uv set; the barycentric
+    /// coordinates without one).
     pub uv: Vec2,
+    /// The mesh's second uv set (the first without one).
+    pub uv1: Vec2,
+    /// Barycentric coordinates of the hit (of the second and third
+    /// corner).
+    pub bary: Vec2,
+    /// Shutter fraction of the ray's time (where moving instances were).
+    pub shutter: f32,
     /// Material id.
     pub material: u32,
     /// Instance index.
@@ -55,6 +64,12 @@ impl SurfaceHit {
     #[inline]
     pub fn frame(&self) -> Frame {
         Frame::from_normal(self.ns)
+    }
+
+    /// Both uv sets.
+    #[inline]
+    pub fn uvs(&self) -> [Vec2; 2] {
+        [self.uv, self.uv1]
     }
 }
 
@@ -104,6 +119,9 @@ pub struct World<'a> {
     /// Whether any material has holes (alpha): shadow rays then look at
     /// what they meet.
     has_holes: bool,
+    /// The camera as texture lookups see it (none: lookups read the
+    /// finest MIP level).
+    pub spread: Option<CameraSpread>,
     /// Centre of the scene's bounds.
     pub center: Vec3,
     /// Radius of the scene's bounding sphere.
@@ -133,7 +151,11 @@ impl<'a> World<'a> {
             let Some(m) = material(scene.material_of(s.instance, 0)) else {
                 continue;
             };
-            if !m.is_emissive() || !s.shape.has_analytic_sampling() || inst.placement.is_moving() {
+            if !m.is_emissive()
+                || m.textures.emission.is_some()
+                || !s.shape.has_analytic_sampling()
+                || inst.placement.is_moving()
+            {
                 continue;
             }
             let emitter = match s.shape {
@@ -194,20 +216,50 @@ impl<'a> World<'a> {
             let mesh = &scene.meshes[inst.mesh as usize];
             let xf = inst.placement.at(0.0);
             let (mut tris, mut radiance, mut two) = (Vec::new(), Vec::new(), Vec::new());
+            let mut textures = EmissionTextures::default();
+            let mut map_of: Vec<(u32, u32)> = Vec::new();
             for (t, idx) in mesh.mesh.indices.iter().enumerate() {
-                let Some(m) = material(scene.material_of(i as u32, t as u32)) else {
+                let id = scene.material_of(i as u32, t as u32);
+                let Some(m) = material(id) else {
                     continue;
                 };
                 if !m.is_emissive() {
                     continue;
                 }
-                tris.push(idx.map(|k| xf.transform_point3(mesh.mesh.positions[k as usize])));
+                let corners = idx.map(|k| xf.transform_point3(mesh.mesh.positions[k as usize]));
+                if !corners.iter().all(|p| p.is_finite()) {
+                    continue;
+                }
+                tris.push(corners);
                 radiance.push(m.emission);
                 two.push(m.two_sided_emission);
+                textures
+                    .triangles
+                    .push(m.textures.emission.as_ref().map(|map| {
+                        let slot = match map_of.iter().find(|(mid, _)| *mid == id) {
+                            Some(&(_, s)) => s,
+                            None => {
+                                textures.maps.push(map.clone());
+                                let s = textures.maps.len() as u32 - 1;
+                                map_of.push((id, s));
+                                s
+                            }
+                        };
+                        let set = |uvs: Option<&Vec<Vec2>>| {
+                            uvs.map_or([Vec2::ZERO, Vec2::X, Vec2::Y], |t| {
+                                idx.map(|k| t[k as usize])
+                            })
+                        };
+                        let uv0 = set(mesh.uvs.as_ref());
+                        let uv1 = mesh.uvs1.as_ref().map_or(uv0, |_| set(mesh.uvs1.as_ref()));
+                        (slot, [uv0, uv1])
+                    }));
             }
             if !tris.is_empty() {
                 instance_light[i] = Some(lights.len() as u32);
-                lights.push(LightSource::Area(AreaLight::mesh(tris, radiance, two)));
+                lights.push(LightSource::Area(AreaLight::mesh(
+                    tris, radiance, two, textures,
+                )));
             }
         }
         let env = scene.environment.as_ref().map(|e| {
@@ -224,9 +276,85 @@ impl<'a> World<'a> {
             env,
             default_material: Scene::default_material(),
             has_holes: scene.materials.iter().any(Material::has_holes),
+            spread: None,
             center,
             radius,
         }
+    }
+
+    /// Sets the footprint of texture lookups from the film: `height`
+    /// pixels and `spp` samples per pixel in all (see
+    /// [`crate::texture::footprint`]).
+    pub fn set_film(&mut self, height: u32, spp: u64) {
+        let c = &self.scene.camera;
+        self.spread = Some(CameraSpread::new(c.eye, c.vfov_deg, height, spp));
+    }
+
+    /// The corners of the hit triangle in world space, and its mesh.
+    fn corners(&self, hit: &SurfaceHit) -> ([Vec3; 3], &crate::mesh::SceneMesh, [u32; 3]) {
+        let inst = &self.scene.instances[hit.instance as usize];
+        let mesh = &self.scene.meshes[inst.mesh as usize];
+        let idx = mesh.mesh.indices[hit.tri as usize];
+        let xf = self.accel.transform(hit.instance, hit.shutter);
+        (
+            idx.map(|k| xf.transform_point3(mesh.mesh.positions[k as usize])),
+            mesh,
+            idx,
+        )
+    }
+
+    /// The footprint of texture lookups at `hit`.
+    pub fn uv_footprint(&self, hit: &SurfaceHit) -> UvFootprint {
+        let Some(offsets) = self.spread.and_then(|s| s.surface_offsets(hit.p, hit.ng)) else {
+            return UvFootprint::POINT;
+        };
+        let (p, mesh, idx) = self.corners(hit);
+        let set = |uvs: Option<&Vec<Vec2>>| match uvs {
+            Some(t) => idx.map(|k| t[k as usize]),
+            None => [Vec2::ZERO, Vec2::X, Vec2::Y],
+        };
+        let uv0 = set(mesh.uvs.as_ref());
+        let uv1 = mesh
+            .uvs1
+            .as_ref()
+            .map_or(uv0, |t| idx.map(|k| t[k as usize]));
+        UvFootprint::on_triangle(p, [uv0, uv1], offsets)
+    }
+
+    /// The world-space tangent at `hit` for a normal map read from uv set
+    /// `uv_set`, with its handedness: the mesh's tangents interpolated,
+    /// else the direction of increasing `u` on the triangle.
+    pub fn tangent(&self, hit: &SurfaceHit, uv_set: u8) -> (Vec3, f32) {
+        let inst = &self.scene.instances[hit.instance as usize];
+        let mesh = &self.scene.meshes[inst.mesh as usize];
+        let xf = self.accel.transform(hit.instance, hit.shutter);
+        let m = glam::Mat3::from(xf.matrix3);
+        let mirror = if m.determinant() < 0.0 { -1.0 } else { 1.0 };
+        let idx = mesh.mesh.indices[hit.tri as usize];
+        if let Some(t) = &mesh.tangents {
+            let (b1, b2) = (hit.bary.x, hit.bary.y);
+            let [t0, t1, t2] = idx.map(|k| t[k as usize]);
+            let v = t0.truncate() * (1.0 - b1 - b2) + t1.truncate() * b1 + t2.truncate() * b2;
+            return (m * v, t0.w.signum() * mirror);
+        }
+        let (p, mesh, idx) = self.corners(hit);
+        let uvs = match uv_set {
+            0 => mesh.uvs.as_ref(),
+            _ => mesh.uvs1.as_ref().or(mesh.uvs.as_ref()),
+        };
+        let uv = uvs.map_or([Vec2::ZERO, Vec2::X, Vec2::Y], |t| {
+            idx.map(|k| t[k as usize])
+        });
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+        let det = d1.x * d2.y - d1.y * d2.x;
+        if det == 0.0 || !det.is_finite() {
+            return (e1, 1.0);
+        }
+        let dpdu = (e1 * d2.y - e2 * d1.y) / det;
+        let dpdv = (e2 * d1.x - e1 * d2.x) / det;
+        let sign = hit.ng.cross(dpdu).dot(dpdv).signum();
+        (dpdu, sign)
     }
 
     /// The material with id `id` (a grey default when out of range).
@@ -364,19 +492,21 @@ impl<'a> World<'a> {
             }
             None => ng,
         };
-        let uv = match &mesh.uvs {
-            Some(t) => {
-                let [t0, t1, t2] = idx.map(|k| t[k as usize]);
-                t0 * b0 + t1 * b1 + t2 * b2
-            }
-            None => Vec2::new(b1, b2),
+        let lerp = |t: &Vec<Vec2>| {
+            let [t0, t1, t2] = idx.map(|k| t[k as usize]);
+            t0 * b0 + t1 * b1 + t2 * b2
         };
+        let uv = mesh.uvs.as_ref().map_or(Vec2::new(b1, b2), lerp);
+        let uv1 = mesh.uvs1.as_ref().map_or(uv, lerp);
         SurfaceHit {
             t: h.t,
             p,
             ng,
             ns,
             uv,
+            uv1,
+            bary: Vec2::new(b1, b2),
+            shutter: s,
             material: self.scene.material_of(h.instance, h.tri),
             instance: h.instance,
             tri: h.tri,
@@ -454,7 +584,7 @@ impl<'a> World<'a> {
             let hit = self.surface(&h, s);
             if Some(h.instance) != q.ignore {
                 let u = pass_through_draw(&ray, &hit, k);
-                if !self.material(hit.material).passes(hit.uv, u) {
+                if !self.material(hit.material).passes(&hit.uvs(), u) {
                     return false;
                 }
             }

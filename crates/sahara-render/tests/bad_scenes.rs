@@ -32,7 +32,16 @@ fn unhittable_triangles_are_skipped_and_counted() {
     let d = scene.diagnostics();
     assert_eq!(
         d,
-        vec!["mesh 0: 3 of 5 triangles skipped (non-finite coordinates or zero area)".to_string()]
+        vec![
+            "3 of 5 triangles skipped (2 with a NaN or infinite corner, 1 of zero area)"
+                .to_string()
+        ]
+    );
+    // Bounds ignore the triangles with a non-finite corner.
+    let b = scene.meshes[0].mesh.bounds();
+    assert_eq!(
+        (b.min, b.max),
+        (Vec3::new(-1.0, -1.0, 0.0), Vec3::new(1.0, 1.0, 0.0))
     );
     // The good part still renders, with no NaN: the quad covers the image
     // centre and, lit by a white sky, reflects albedo 0.5 there.

@@ -70,9 +70,10 @@ pub struct MergeArgs {
 #[derive(Debug, Args, Clone, PartialEq, Default)]
 pub struct RenderArgs {
     /// What to render: a scene file (.toml, .pbrt, .pbrt.gz), or a mesh (.obj, .ply, .gltf,
-    /// .glb) with its own materials, framed by its camera sidecar or
-    /// automatically and lit by a default sky and sun unless it emits
-    /// light; none for the built-in Cornell box.
+    /// .glb) with its own materials and lights, seen by its camera sidecar,
+    /// its own camera or an automatic one, and lit by a default sky and
+    /// sun when its own lights are weak (see --sky); none for the built-in
+    /// Cornell box.
     pub scene: Option<PathBuf>,
     /// Output image; the format follows the extension (.png, .exr)
     /// [default: the scene file's output, else <scene name>.png in the
@@ -115,10 +116,19 @@ pub struct RenderArgs {
     /// equal-time comparisons); --spp is then the samples of each pass.
     #[arg(long, value_name = "SECS")]
     pub time_limit: Option<f64>,
-    /// Camera sidecar JSON for a mesh (or the built-in scene), instead of
-    /// <dir>/<stem>.camera.json or the automatic camera.
-    #[arg(long, value_name = "FILE")]
-    pub camera: Option<PathBuf>,
+    /// The camera of a mesh (or the built-in scene): a sidecar JSON file,
+    /// or the name of one of a glTF file's cameras [default: the sidecar
+    /// <dir>/<stem>.camera.json, else a glTF file's first camera, else the
+    /// automatic camera].
+    #[arg(long, value_name = "FILE|NAME")]
+    pub camera: Option<String>,
+    /// What lights the scene besides its own lights: default (Sahara's sky
+    /// and sun), none, auto (the default sky and sun if the scene's own
+    /// lights are weak), or an equirectangular image FILE (.exr, .hdr)
+    /// [default: auto for a mesh, the scene file's `sky` key (else none)
+    /// for a scene file].
+    #[arg(long, value_name = "default|none|auto|FILE")]
+    pub sky: Option<String>,
     /// Kd-tree builder (as for `sahara bench`): a speed setting only, the
     /// image is the same with any [default: sah].
     #[arg(long, value_name = "NAME", value_parser = parse_builder)]

@@ -9,8 +9,9 @@ use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use sahara_formats::camera::read_sidecar;
 use sahara_formats::image_out::{write_image, Pixels};
-use sahara_formats::mesh_scene::load_mesh_scene_with_camera;
-use sahara_formats::scene_load::{load_scene, FileSettings};
+use sahara_formats::mesh_scene::{load_mesh_scene_with, CameraChoice};
+use sahara_formats::scene_load::{load_scene_with_sky, FileSettings};
+use sahara_formats::sky::Sky;
 use sahara_render::{
     builtin, render_watched, Camera, Integrator, Preview, Progress, RenderResult, RenderSettings,
     Scene, ToneMap,
@@ -38,7 +39,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         name,
         description,
         warnings,
-    } = load_input(args.scene.as_deref(), args.camera.as_deref())?;
+    } = load_input(
+        args.scene.as_deref(),
+        args.camera.as_deref(),
+        args.sky.as_deref(),
+    )?;
     let mut warnings = warnings;
     // The finished scene's problems, named after the file they come from.
     let from_file = args.scene.as_ref().map(|p| p.display().to_string());
@@ -432,15 +437,20 @@ fn progress_bar(settings: &RenderSettings) -> ProgressBar {
     bar
 }
 
-/// The scene to render: the built-in Cornell box, a scene file or a mesh file.
-fn load_input(path: Option<&Path>, camera: Option<&Path>) -> Result<Input> {
+/// The scene to render: the built-in Cornell box, a scene file or a mesh
+/// file, seen by `camera` (`--camera`) and lit as `sky` (`--sky`) says.
+fn load_input(path: Option<&Path>, camera: Option<&str>, sky: Option<&str>) -> Result<Input> {
     let flat = |e: sahara_formats::FormatError| anyhow!("{e}");
+    let sky = sky.map(|s| Sky::parse(s, Path::new("")));
     let Some(path) = path else {
         let mut scene = builtin::cornell_box();
         if let Some(file) = camera {
-            let c = read_sidecar(file).map_err(flat)?;
+            let c = read_sidecar(Path::new(file)).map_err(flat)?;
             scene.camera = Camera::look_at(c.eye, c.target, c.up, c.vfov_deg, 1.0);
-            eprintln!("camera: {}", file.display());
+            eprintln!("camera: {file}");
+        }
+        if let Some(sky) = &sky {
+            sahara_formats::sky::apply(&mut scene, sky).map_err(flat)?;
         }
         return Ok(Input {
             scene,
@@ -467,7 +477,10 @@ fn load_input(path: Option<&Path>, camera: Option<&Path>) -> Result<Input> {
             path.display()
         ),
         _ if pbrt => {
-            let p = sahara_formats::pbrt::load_pbrt(path).map_err(flat)?;
+            let mut p = sahara_formats::pbrt::load_pbrt(path).map_err(flat)?;
+            if let Some(sky) = &sky {
+                sahara_formats::sky::apply(&mut p.loaded.scene, sky).map_err(flat)?;
+            }
             (p.loaded.scene, Some(p.loaded.settings), p.loaded.warnings)
         }
         "toml" if camera.is_some() => bail!(
@@ -475,20 +488,14 @@ fn load_input(path: Option<&Path>, camera: Option<&Path>) -> Result<Input> {
             path.display()
         ),
         "toml" => {
-            let l = load_scene(path).map_err(flat)?;
+            let l = load_scene_with_sky(path, sky.as_ref()).map_err(flat)?;
             (l.scene, Some(l.settings), l.warnings)
         }
         "obj" | "ply" | "gltf" | "glb" => {
-            let m = load_mesh_scene_with_camera(path, camera).map_err(flat)?;
-            eprintln!(
-                "camera: {}; light: {}",
-                m.camera_source,
-                if m.default_light {
-                    "default sky and sun"
-                } else {
-                    "the mesh's emitters"
-                }
-            );
+            let camera = camera.map_or(CameraChoice::Auto, CameraChoice::from_arg);
+            let m = load_mesh_scene_with(path, &camera, sky.as_ref().unwrap_or(&Sky::Auto))
+                .map_err(flat)?;
+            eprintln!("camera: {}; light: {}", m.camera_source, m.sky);
             (m.scene, None, m.warnings)
         }
         "" => bail!(

@@ -120,12 +120,10 @@ fn a_mesh_renders_with_its_mtl_and_warnings_are_counted() {
     let _ = fs::remove_dir_all(&dir);
 }
 
-#[test]
-fn an_emissive_mesh_gets_no_default_light() {
-    let dir = temp_dir("emitter");
-    let obj = write_quad(&dir, "Kd 0 0 0\nKe 0.5 0.25 0.125");
+/// Renders `obj` at 16x16, 1 spp, with `extra` options; the EXR's pixels.
+fn render_exr(dir: &Path, obj: &Path, extra: &[&str]) -> (u32, Vec<f32>) {
     let exr = dir.join("quad.exr");
-    let out = sahara(&[
+    let mut args = vec![
         "render",
         obj.to_str().unwrap(),
         "--width",
@@ -136,13 +134,56 @@ fn an_emissive_mesh_gets_no_default_light() {
         "1",
         "-o",
         exr.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let out = sahara(&args);
     assert!(out.status.success(), "{}", stderr(&out));
     let (w, _, rgb) = load_rgb_f32(&exr).unwrap();
-    // The quad shows exactly its emission; the background is black (no sky).
+    (w, rgb)
+}
+
+#[test]
+fn weak_emitters_get_the_default_sky_unless_told_otherwise() {
+    let dir = temp_dir("emitter");
+    let sky = [0.55f32, 0.6, 0.7];
+    // A dim emitter: the default sky and sun keep the mesh lit.
+    let obj = write_quad(&dir, "Kd 0 0 0\nKe 0.2 0.1 0.05");
+    let (w, rgb) = render_exr(&dir, &obj, &[]);
     let c = ((8 * w + 8) * 3) as usize;
-    assert!((rgb[c] - 0.5).abs() < 1e-3 && (rgb[c + 2] - 0.125).abs() < 1e-3);
+    assert!((rgb[c] - 0.2).abs() < 1e-3 && (rgb[c + 2] - 0.05).abs() < 1e-3);
+    assert_eq!(&rgb[..3], &sky);
+    // --sky none: its own light only, a black background.
+    let (_, rgb) = render_exr(&dir, &obj, &["--sky", "none"]);
+    assert!((rgb[c] - 0.2).abs() < 1e-3 && (rgb[c + 2] - 0.05).abs() < 1e-3);
     assert_eq!(&rgb[..3], &[0.0, 0.0, 0.0]);
+    // A strong emitter lights the scene by itself: no sky.
+    let obj = write_quad(&dir, "Kd 0 0 0\nKe 500 250 125");
+    let (_, rgb) = render_exr(&dir, &obj, &[]);
+    assert!((rgb[c] - 500.0).abs() < 1e-1);
+    assert_eq!(&rgb[..3], &[0.0, 0.0, 0.0]);
+    // ... unless told otherwise.
+    let (_, rgb) = render_exr(&dir, &obj, &["--sky", "default"]);
+    assert_eq!(&rgb[..3], &sky);
+    // An environment map from a file, and a clear error for a missing one.
+    let map = dir.join("sky.hdr");
+    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n".to_vec();
+    hdr.extend_from_slice(&[128, 64, 32, 129, 128, 64, 32, 129]);
+    fs::write(&map, hdr).unwrap();
+    let (_, rgb) = render_exr(&dir, &obj, &["--sky", map.to_str().unwrap()]);
+    for (got, want) in rgb[..3].iter().zip([1.0, 0.5, 0.25]) {
+        assert!((got - want).abs() < 0.01, "{:?}", &rgb[..3]);
+    }
+    let png = dir.join("x.png");
+    let out = sahara(&[
+        "render",
+        obj.to_str().unwrap(),
+        "--sky",
+        "nowhere.exr",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("nowhere.exr"), "{}", stderr(&out));
     let _ = fs::remove_dir_all(&dir);
 }
 

@@ -8,41 +8,33 @@
 use ::gltf::accessor::{DataType, Dimensions};
 use ::gltf::Accessor;
 
-/// Reads a float accessor of `components` per element as a flat array.
-///
-/// `F32` is read as is; with `normalized_ok`, normalized `U8`/`U16`/`I8`/`I16`
-/// are mapped to `[0, 1]` (or `[-1, 1]`) as the glTF specification says.
+/// Reads a float accessor of `components` per element as a flat array:
+/// `F32` as is; the integer forms `KHR_mesh_quantization` allows as the
+/// glTF specification says: normalized `U8`/`U16`/`I8`/`I16` map to
+/// `[0, 1]` (or `[-1, 1]`), unnormalized ones are their integer values.
 pub(crate) fn read_floats(
     accessor: &Accessor,
     buffers: &[Vec<u8>],
     components: usize,
-    normalized_ok: bool,
 ) -> Result<Vec<f32>, String> {
     check_dimensions(accessor, components)?;
     let data_type = accessor.data_type();
-    let integer_ok = normalized_ok && accessor.normalized();
-    let convert: fn(&[u8]) -> f32 = match data_type {
-        DataType::F32 => |b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
-        DataType::U8 if integer_ok => |b| b[0] as f32 / 255.0,
-        DataType::U16 if integer_ok => |b| u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
-        DataType::I8 if integer_ok => |b| (b[0] as i8 as f32 / 127.0).max(-1.0),
-        DataType::I16 if integer_ok => {
-            |b| (i16::from_le_bytes([b[0], b[1]]) as f32 / 32767.0).max(-1.0)
-        }
-        other => {
+    let convert: fn(&[u8]) -> f32 = match (data_type, accessor.normalized()) {
+        (DataType::F32, _) => |b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+        (DataType::U8, true) => |b| b[0] as f32 / 255.0,
+        (DataType::U16, true) => |b| u16::from_le_bytes([b[0], b[1]]) as f32 / 65535.0,
+        (DataType::I8, true) => |b| (b[0] as i8 as f32 / 127.0).max(-1.0),
+        (DataType::I16, true) => |b| (i16::from_le_bytes([b[0], b[1]]) as f32 / 32767.0).max(-1.0),
+        (DataType::U8, false) => |b| b[0] as f32,
+        (DataType::U16, false) => |b| u16::from_le_bytes([b[0], b[1]]) as f32,
+        (DataType::I8, false) => |b| b[0] as i8 as f32,
+        (DataType::I16, false) => |b| i16::from_le_bytes([b[0], b[1]]) as f32,
+        (other, normalized) => {
             return Err(format!(
-                "accessor {} has component type {other:?}{}; expected FLOAT{}",
+                "accessor {} has component type {other:?}{}; expected FLOAT, or BYTE/SHORT \
+                 (normalized or not, KHR_mesh_quantization)",
                 accessor.index(),
-                if accessor.normalized() {
-                    " (normalized)"
-                } else {
-                    ""
-                },
-                if normalized_ok {
-                    " or normalized UNSIGNED_BYTE/UNSIGNED_SHORT"
-                } else {
-                    ""
-                }
+                if normalized { " (normalized)" } else { "" },
             ))
         }
     };

@@ -20,7 +20,7 @@ use glam::{Affine3A, DMat3, DMat4, DVec3, Mat4, Vec3};
 use sahara_render::mesh::SceneMesh;
 use sahara_render::{
     AlphaMode, Camera, Filter, Instance, Integrator, Material, Placement, SamplerKind, Scene,
-    Shape, Srt, ToneMap,
+    Shape, Srt, TextureMap, ToneMap,
 };
 
 use super::description::{Description, Entity, MaterialRef, ShapeDecl, Xform};
@@ -90,7 +90,8 @@ impl Materials<'_> {
         }
         let mut m = scene.materials[material as usize].clone();
         if let Some(img) = &alpha.image {
-            m.texture = Some(with_opacity(m.texture.as_ref(), img));
+            let base = m.textures.base_color.as_ref().map(|t| &t.texture);
+            m.textures.base_color = Some(TextureMap::new(with_opacity(base, img)));
         }
         let id = scene.add_material(m.with_alpha(AlphaMode::Blend, factor));
         self.cut.insert(key, id);

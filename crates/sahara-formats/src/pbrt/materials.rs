@@ -24,7 +24,7 @@
 //! pbrt-v3's `opacity` (uber) becomes stochastic transparency.
 
 use glam::Vec3;
-use sahara_render::{AlphaMode, Bsdf, Material};
+use sahara_render::{AlphaMode, Bsdf, Material, TextureMap};
 
 use super::description::Entity;
 use super::params::SpectrumParam;
@@ -90,14 +90,14 @@ fn roughness(
 /// A diffuse material of reflectance `tint`.
 fn diffuse(tint: Tint) -> Material {
     let mut m = Material::diffuse(tint.color.clamp(Vec3::ZERO, Vec3::ONE));
-    m.texture = tint.image;
+    m.textures.base_color = tint.image.map(TextureMap::new);
     m
 }
 
 /// A material of `bsdf` whose base colour is multiplied by `tint`.
 fn tinted(bsdf: Bsdf, tint: &Tint) -> Material {
     let mut m = Material::new(bsdf);
-    m.texture = tint.baked();
+    m.textures.base_color = tint.baked().map(TextureMap::new);
     m
 }
 
@@ -540,8 +540,8 @@ pub(crate) fn blend(a: &Material, b: &Material, t: f32) -> Option<Material> {
     }
     match (a.bsdf, b.bsdf) {
         (Bsdf::Diffuse { albedo: x }, Bsdf::Diffuse { albedo: y })
-            if a.texture.is_none()
-                && b.texture.is_none()
+            if a.textures.base_color.is_none()
+                && b.textures.base_color.is_none()
                 && Material {
                     bsdf: a.bsdf,
                     ..b.clone()
@@ -590,7 +590,14 @@ mod tests {
     /// a smooth (delta) BSDF.
     fn delta_reflectance(m: &Material, cos: f32) -> Vec3 {
         let wo = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
-        let tint = m.tint(glam::Vec2::splat(0.5));
+        let uv = glam::Vec2::splat(0.5);
+        let tint = m
+            .at(
+                &[uv, uv],
+                &sahara_render::texture::footprint::UvFootprint::POINT,
+            )
+            .bsdf
+            .tint;
         let s = m
             .bsdf
             .sample(tint, wo, 0.0, glam::Vec2::splat(0.5))

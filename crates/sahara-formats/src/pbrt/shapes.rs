@@ -127,7 +127,7 @@ fn scene_mesh(
         mesh: Mesh { positions, indices },
         normals,
         uvs,
-        material_ids: None,
+        ..SceneMesh::default()
     }
 }
 

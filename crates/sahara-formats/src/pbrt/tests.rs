@@ -551,17 +551,20 @@ fn tga_and_pfm_imagemaps_load_and_textures_combine_texel_by_texel() {
                   Material \"diffuse\" \"texture reflectance\" \"m\"\n{quad}"),
     );
     assert!(w.is_empty(), "{w:?}");
-    let t = m.texture.expect("the mixed image");
+    let t = m.textures.base_color.expect("the mixed image").texture;
     assert_eq!((t.width, t.height), (2, 1));
-    assert_eq!(t.texels[0], Vec3::new(0.75, 0.0, 0.25));
-    assert_eq!(t.texels[1], Vec3::splat(0.75 * srgb(128) + 1.0));
+    assert_eq!(t.texel(0, 0), Vec3::new(0.75, 0.0, 0.25));
+    assert_eq!(t.texel(1, 0), Vec3::splat(0.75 * srgb(128) + 1.0));
     // "linear": the 8-bit values as they are stored.
     let (m, _) = shape_material(
         &dir,
         &format!("Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"a.tga\" \"string encoding\" \"linear\"\n\
                   Material \"diffuse\" \"texture reflectance\" \"a\"\n{quad}"),
     );
-    assert_eq!(m.texture.unwrap().texels[1], Vec3::splat(128.0 / 255.0));
+    assert_eq!(
+        m.textures.base_color.unwrap().texture.texel(1, 0),
+        Vec3::splat(128.0 / 255.0)
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -582,11 +585,13 @@ fn alpha_textures_cut_shapes_out() {
     assert_eq!(m.alpha_mode, sahara_render::AlphaMode::Blend);
     for u in [0.0, 0.5, 0.999] {
         let at = glam::Vec2::new(0.1, 0.5);
-        assert!(!m.passes(at, u), "opaque check");
+        assert!(!m.passes(&[at, at], u), "opaque check");
         let hole = glam::Vec2::new(0.9, 0.5);
-        assert!(m.passes(hole, u), "the hole");
+        assert!(m.passes(&[hole, hole], u), "the hole");
     }
-    assert_eq!(m.tint(glam::Vec2::new(0.9, 0.5)), Vec3::ONE);
+    let hole = glam::Vec2::new(0.9, 0.5);
+    let point = sahara_render::texture::footprint::UvFootprint::POINT;
+    assert_eq!(m.at(&[hole, hole], &point).bsdf.tint, Vec3::ONE);
     // An RGBA TGA as a float texture is its alpha; the colour texture keeps its texels.
     let mut tga = vec![0u8, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 1, 0, 32, 0x28];
     tga.extend([0, 0, 255, 255, 0, 255, 0, 0]);
@@ -600,9 +605,10 @@ fn alpha_textures_cut_shapes_out() {
                   AttributeBegin {quad} \"texture alpha\" \"cut\" AttributeEnd\n"
         ),
     );
-    let t = m.texture.as_ref().unwrap();
-    assert_eq!(t.alpha.as_deref(), Some(&[1.0, 0.0][..]));
-    assert_eq!(t.texels[0], Vec3::new(1.0, 0.0, 0.0));
+    let t = &m.textures.base_color.as_ref().unwrap().texture;
+    let rgba: Vec<_> = t.texels_rgba().collect();
+    assert_eq!((rgba[0].w, rgba[1].w), (1.0, 0.0));
+    assert_eq!(rgba[0].truncate(), Vec3::new(1.0, 0.0, 0.0));
     // A constant alpha of 0 removes the shape; 0.5 is half transparent.
     std::fs::write(dir.join("s.pbrt"), format!("AttributeBegin {quad} \"float alpha\" 0 AttributeEnd\nAttributeBegin {quad} \"float alpha\" 0.5 AttributeEnd\n")).unwrap();
     let s = load_pbrt(&dir.join("s.pbrt")).unwrap();

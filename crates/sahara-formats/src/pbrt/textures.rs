@@ -53,10 +53,11 @@ impl Tint {
         match &self.image {
             Some(t) if self.color == Vec3::ONE => Some(t.clone()),
             Some(t) => {
-                let texels = t.texels.iter().map(|&v| v * self.color).collect();
-                let mut out = Texture::new(t.width, t.height, texels);
-                out.alpha = t.alpha.clone();
-                Some(Arc::new(out))
+                let texels = t.texels().map(|v| v * self.color).collect();
+                Some(Arc::new(with_alpha_of(
+                    t,
+                    Texture::new(t.width, t.height, texels),
+                )))
             }
             None if self.color == Vec3::ONE => None,
             None => Some(Arc::new(Texture::new(1, 1, vec![self.color]))),
@@ -66,10 +67,7 @@ impl Tint {
     /// The mean value (the image's mean texel times the colour).
     pub(crate) fn mean(&self) -> Vec3 {
         match &self.image {
-            Some(t) => {
-                let sum: Vec3 = t.texels.iter().copied().sum();
-                self.color * sum / t.texels.len() as f32
-            }
+            Some(t) => self.color * t.mean(),
             None => self.color,
         }
     }
@@ -366,13 +364,16 @@ impl<'a> Textures<'a> {
                 // channels, or its alpha when it has one (as pbrt-v4 filters them).
                 let img = if float { Arc::new(float_channel(&img)) } else { img };
                 if invert {
-                    let mut t = (*img).clone();
-                    t.texels
-                        .iter_mut()
-                        .for_each(|v| *v = (Vec3::ONE - *v * scale).max(Vec3::ZERO));
+                    let texels = img
+                        .texels()
+                        .map(|v| (Vec3::ONE - v * scale).max(Vec3::ZERO))
+                        .collect();
                     Tint {
                         color: Vec3::ONE,
-                        image: Some(Arc::new(t)),
+                        image: Some(Arc::new(with_alpha_of(
+                            &img,
+                            Texture::new(img.width, img.height, texels),
+                        ))),
                     }
                 } else {
                     Tint {
@@ -395,7 +396,7 @@ impl<'a> Textures<'a> {
                 let mask = checkerboard(us, vs, ud, vd);
                 return Ok(if a.image.is_none() && b.image.is_none() {
                     let t = mask.image.expect("an image");
-                    let texels = t.texels.iter().map(|m| if m.x > 0.5 { a.color } else { b.color }).collect();
+                    let texels = t.texels().map(|m| if m.x > 0.5 { a.color } else { b.color }).collect();
                     Tint {
                         color: Vec3::ONE,
                         image: Some(Arc::new(Texture::new(t.width, t.height, texels))),
@@ -451,9 +452,11 @@ impl<'a> Textures<'a> {
         let t = match load_image(path) {
             Ok(i) if i.width > 0 && i.height > 0 => {
                 let texels = i.rgb.chunks_exact(3).map(Vec3::from_slice).collect();
-                let mut t = Texture::new(i.width, i.height, texels);
-                t.alpha = i.alpha;
-                Some(Arc::new(t))
+                let t = Texture::new(i.width, i.height, texels);
+                Some(Arc::new(match i.alpha {
+                    Some(a) => t.with_alpha(a),
+                    None => t,
+                }))
             }
             Ok(_) => {
                 warnings.add(
@@ -497,24 +500,26 @@ fn recode(
     if !eight_bit {
         return Ok(None);
     }
-    let mut t = img.clone();
     // The stored byte, recovered exactly from its sRGB decoding.
     let byte = |v: f32| f32::from(linear_to_srgb8(v)) / 255.0;
-    t.texels
-        .iter_mut()
-        .for_each(|v| *v = Vec3::from_array(v.to_array().map(|c| byte(c).powf(gamma))));
-    Ok(Some(t))
+    let texels = img
+        .texels()
+        .map(|v| Vec3::from_array(v.to_array().map(|c| byte(c).powf(gamma))))
+        .collect();
+    Ok(Some(with_alpha_of(
+        img,
+        Texture::new(img.width, img.height, texels),
+    )))
 }
 
 /// A colour image as a float texture (the value in every channel): its
 /// alpha where it has some below 1, else the mean of its channels.
 fn float_channel(img: &Texture) -> Texture {
-    let alpha = img.alpha.as_ref().filter(|a| a.iter().any(|&v| v < 1.0));
+    let alpha = alpha_of(img).filter(|a| a.iter().any(|&v| v < 1.0));
     let texels = match alpha {
         Some(a) => a.iter().map(|&v| Vec3::splat(v)).collect(),
         None => img
-            .texels
-            .iter()
+            .texels()
             .map(|v| Vec3::splat((v.x + v.y + v.z) / 3.0))
             .collect(),
     };
@@ -529,13 +534,13 @@ fn combine(ops: &[&Tint], f: impl Fn(&[Vec3]) -> Vec3) -> Tint {
     let Some(grid) = ops
         .iter()
         .filter_map(|t| t.image.as_ref())
-        .max_by_key(|t| t.texels.len())
+        .max_by_key(|t| texel_count(t))
     else {
         let v: Vec<Vec3> = ops.iter().map(|t| t.color).collect();
         return Tint::constant(f(&v));
     };
     let (w, h) = (grid.width, grid.height);
-    let mut texels = Vec::with_capacity(grid.texels.len());
+    let mut texels = Vec::with_capacity(texel_count(grid));
     let mut v = vec![Vec3::ZERO; ops.len()];
     for y in 0..h {
         for x in 0..w {
@@ -545,7 +550,7 @@ fn combine(ops: &[&Tint], f: impl Fn(&[Vec3]) -> Vec3) -> Tint {
             );
             for (slot, t) in v.iter_mut().zip(ops) {
                 *slot = match &t.image {
-                    Some(i) if Arc::ptr_eq(i, grid) => t.color * i.texels[(y * w + x) as usize],
+                    Some(i) if Arc::ptr_eq(i, grid) => t.color * i.texel(x.into(), y.into()),
                     Some(i) => t.color * i.bilinear(uv),
                     None => t.color,
                 };
@@ -553,11 +558,9 @@ fn combine(ops: &[&Tint], f: impl Fn(&[Vec3]) -> Vec3) -> Tint {
             texels.push(f(&v));
         }
     }
-    let mut out = Texture::new(w, h, texels);
-    out.alpha = grid.alpha.clone();
     Tint {
         color: Vec3::ONE,
-        image: Some(Arc::new(out)),
+        image: Some(Arc::new(with_alpha_of(grid, Texture::new(w, h, texels)))),
     }
 }
 
@@ -627,14 +630,14 @@ pub(crate) fn with_opacity(base: Option<&Arc<Texture>>, alpha: &Texture) -> Arc<
             &white
         }
     };
-    let grid = if base.texels.len() >= alpha.texels.len() {
+    let grid = if texel_count(base) >= texel_count(alpha) {
         base
     } else {
         alpha
     };
     let (w, h) = (grid.width, grid.height);
-    let mut texels = Vec::with_capacity(grid.texels.len());
-    let mut opacity = Vec::with_capacity(grid.texels.len());
+    let mut texels = Vec::with_capacity(texel_count(grid));
+    let mut opacity = Vec::with_capacity(texel_count(grid));
     for y in 0..h {
         for x in 0..w {
             let uv = glam::Vec2::new(
@@ -643,7 +646,7 @@ pub(crate) fn with_opacity(base: Option<&Arc<Texture>>, alpha: &Texture) -> Arc<
             );
             let at = |t: &Texture| {
                 if t.width == w && t.height == h {
-                    t.texels[(y * w + x) as usize]
+                    t.texel(x.into(), y.into())
                 } else {
                     t.bilinear(uv)
                 }
@@ -653,4 +656,24 @@ pub(crate) fn with_opacity(base: Option<&Arc<Texture>>, alpha: &Texture) -> Arc<
         }
     }
     Arc::new(Texture::new(w, h, texels).with_alpha(opacity))
+}
+
+/// Texels in level 0 of `t`.
+fn texel_count(t: &Texture) -> usize {
+    t.width as usize * t.height as usize
+}
+
+/// The alpha channel of `t`'s level 0, if it has one.
+fn alpha_of(t: &Texture) -> Option<Vec<f32>> {
+    t.has_alpha()
+        .then(|| t.texels_rgba().map(|v| v.w).collect())
+}
+
+/// `out` (a texture on `src`'s grid) with `src`'s alpha channel, if it has
+/// one.
+fn with_alpha_of(src: &Texture, out: Texture) -> Texture {
+    match alpha_of(src) {
+        Some(a) => out.with_alpha(a),
+        None => out,
+    }
 }

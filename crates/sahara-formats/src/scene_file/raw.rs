@@ -18,6 +18,7 @@ pub(super) type V3 = [f32; 3];
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawScene {
+    pub sky: Opt<String>,
     pub camera: Option<Spanned<RawCamera>>,
     #[serde(default)]
     pub material: Vec<Spanned<RawMaterial>>,

@@ -11,6 +11,7 @@ use toml::Spanned;
 use super::raw::*;
 use super::*;
 use crate::image_out::ImageFormat;
+use crate::sky::Sky;
 
 /// Largest film width or height.
 const MAX_FILM_SIDE: i64 = 65536;
@@ -65,6 +66,10 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
         return Err(ctx.at(second.span(), "a scene has at most one environment light"));
     }
     Ok(SceneFile {
+        sky: raw
+            .sky
+            .as_ref()
+            .map_or(Sky::None, |s| Sky::parse(s.get_ref(), folder)),
         camera: ctx.camera(camera)?,
         materials,
         objects,

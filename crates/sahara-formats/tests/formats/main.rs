@@ -3,6 +3,7 @@
 mod camera;
 mod common;
 mod gltf;
+mod gltf_extensions;
 mod image_in;
 mod image_out;
 mod obj;

@@ -145,7 +145,7 @@ fn a_glass_mtl_becomes_a_dielectric_in_the_scene() {
     assert_eq!(s.scene.materials[0].bsdf, Bsdf::Dielectric { ior: 1.5 });
     assert_eq!(s.scene.meshes[0].material_ids, Some(vec![0, 0]));
     assert!(
-        s.default_light,
+        s.default_light(),
         "no emitter: the default sky and sun light it"
     );
     assert!(s.scene.environment.is_some() && s.scene.lights.len() == 1);
@@ -166,7 +166,7 @@ fn an_emissive_mtl_is_an_emitter_and_needs_no_default_light() {
             albedo: Vec3::splat(0.78)
         }
     );
-    assert!(!s.default_light);
+    assert!(!s.default_light());
     assert!(s.scene.environment.is_none() && s.scene.lights.is_empty());
 }
 
@@ -186,7 +186,7 @@ fn the_shared_cornell_box_light_emits_17_12_4() {
         .collect();
     assert_eq!(emitters.len(), 1);
     assert_eq!(emitters[0].emission, Vec3::new(17.0, 12.0, 4.0));
-    assert!(!s.default_light);
+    assert!(!s.default_light());
     assert!(s.camera_source.ends_with("cornell_box.camera.json"));
     assert_eq!(s.scene.camera.eye, Vec3::new(278.0, 273.0, -800.0));
 }
@@ -209,11 +209,17 @@ fn textures_load_once_and_a_missing_one_is_a_warning() {
         "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\nusemtl c\nf 2 1 3\n",
     );
     let s = load_mesh_scene(&obj).unwrap();
-    let [a, b, c] = [0, 1, 2].map(|i| s.scene.materials[i].texture.clone());
+    let [a, b, c] = [0, 1, 2].map(|i| {
+        s.scene.materials[i]
+            .textures
+            .base_color
+            .as_ref()
+            .map(|m| m.texture.clone())
+    });
     let (a, b) = (a.unwrap(), b.unwrap());
     assert!(std::sync::Arc::ptr_eq(&a, &b), "one file, one texture");
     assert_eq!((a.width, a.height), (2, 1));
-    assert_eq!(a.texels[0], Vec3::new(1.0, 0.0, 0.0));
+    assert_eq!(a.texel(0, 0), Vec3::new(1.0, 0.0, 0.0));
     assert!(c.is_none());
     assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
     assert!(s.warnings[0].contains("gone.png"), "{}", s.warnings[0]);
@@ -455,4 +461,44 @@ fn an_area_light_carries_the_material_it_names() {
             && e.contains("no [[material]] is named 'nope'"),
         "{e}"
     );
+}
+
+#[test]
+fn the_scene_files_sky_key_adds_what_it_names() {
+    let dir = TempDir::new("load-sky");
+    dir.write("quad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\n");
+    let scene = |sky: &str| {
+        let toml = format!(
+            "{sky}\n[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n\n[film]\nwidth = 4\nheight = 4\n\n\
+             [[object]]\ntype = \"mesh\"\nfile = \"quad.obj\"\n\n\
+             [[light]]\ntype = \"point\"\nposition = [0, 0, 2]\nintensity = [1e-3, 1e-3, 1e-3]\n"
+        );
+        load_scene(&dir.write("s.toml", toml))
+    };
+    // Without the key: the file's lights alone, however weak.
+    let s = scene("").unwrap().scene;
+    assert_eq!((s.lights.len(), s.environment.is_some()), (1, false));
+    // auto: the point light is weak, so the default sky and sun come in.
+    let s = scene("sky = \"auto\"").unwrap().scene;
+    assert_eq!(s.lights.len(), 2);
+    assert_eq!(
+        s.environment,
+        Some(sahara_render::Environment::Constant(
+            sahara_formats::sky::DEFAULT_SKY
+        ))
+    );
+    let s = scene("sky = \"default\"").unwrap().scene;
+    assert_eq!(s.lights.len(), 2);
+    // A map relative to the scene file; one that is missing names the file.
+    let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n".to_vec();
+    hdr.extend_from_slice(&[128, 64, 32, 129, 128, 64, 32, 129]);
+    dir.write("env.hdr", hdr);
+    let s = scene("sky = \"env.hdr\"").unwrap().scene;
+    assert!(matches!(
+        s.environment,
+        Some(sahara_render::Environment::Map { .. })
+    ));
+    assert_eq!(s.lights.len(), 1);
+    let e = scene("sky = \"gone.exr\"").unwrap_err().to_string();
+    assert!(e.contains("s.toml") && e.contains("gone.exr"), "{e}");
 }

@@ -37,12 +37,11 @@ pub(crate) fn step(
         return true;
     }
     let sh = Shading::new(world, &hit, ray.dir);
-    let mat = sh.material;
     if st.prev_delta {
-        st.l += st.beta * mat.emitted(hit.ng.dot(sh.wo_world));
+        st.l += st.beta * sh.emitted;
     }
     let depth = st.depth;
-    if !mat.bsdf.is_delta() {
+    if !sh.bsdf.is_delta() {
         for (j, light) in world.lights.iter().enumerate() {
             let n = if light.is_delta() { 1 } else { light_samples };
             for k in 0..n {
@@ -63,7 +62,7 @@ pub(crate) fn step(
             });
         }
     }
-    if depth >= max_depth || mat.bsdf.is_diffuse() {
+    if depth >= max_depth || sh.bsdf.is_diffuse() {
         return false;
     }
     let Some((s, next)) = sh.sample_bounce(ctx, &hit, depth) else {

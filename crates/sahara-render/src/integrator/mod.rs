@@ -11,10 +11,13 @@ use glam::Vec3;
 use sahara_kd::{Ray, TraversalCounters};
 
 use crate::light::LightSample;
-use crate::material::{BsdfSample, Material};
+use crate::material::textures::perturbed_normal;
+use crate::material::NormalMap;
+use crate::material::{BsdfSample, PointBsdf};
 use crate::sampler::dims;
 use crate::sampler::PixelSampler;
 use crate::sampling::Frame;
+use crate::texture::footprint::UvFootprint;
 use crate::world::{ShadowQuery, SurfaceHit, World};
 use state::Deferred;
 pub(crate) use state::PathState;
@@ -216,30 +219,60 @@ impl Integrator {
     }
 }
 
-/// The local shading setup at a hit: frame, outgoing direction, tint.
-pub(crate) struct Shading<'m> {
+/// The local shading setup at a hit: frame (normal-mapped), outgoing
+/// direction, the BSDF with its textures looked up, emission.
+pub(crate) struct Shading {
     pub frame: Frame,
     pub wo_world: Vec3,
     pub wo: Vec3,
-    pub material: &'m Material,
-    pub tint: Vec3,
+    /// The BSDF at the hit.
+    pub bsdf: PointBsdf,
+    /// The factor on light arriving by indirect paths (painted occlusion).
+    pub occlusion: f32,
+    /// Radiance the surface emits towards `wo`.
+    pub emitted: Vec3,
     /// The back of a one-sided material: it scatters nothing.
     pub blind: bool,
 }
 
-impl<'m> Shading<'m> {
+impl Shading {
     /// Shading at `hit` for a ray travelling along `dir`.
     #[inline]
-    pub fn new(world: &'m World, hit: &SurfaceHit, dir: Vec3) -> Self {
+    pub fn new(world: &World, hit: &SurfaceHit, dir: Vec3) -> Self {
         let material = world.material(hit.material);
-        let frame = hit.frame();
+        let uvs = hit.uvs();
+        let fp = if material.has_textures() {
+            world.uv_footprint(hit)
+        } else {
+            UvFootprint::POINT
+        };
+        let mut point = material.at(&uvs, &fp);
+        let mapped = |m: Option<Vec3>, map: Option<&NormalMap>| match (m, map) {
+            (Some(m), Some(map)) => {
+                let (t, sign) = world.tangent(hit, map.map.uv_set);
+                perturbed_normal(hit.ns, t, sign, m)
+            }
+            _ => hit.ns,
+        };
+        let ns = mapped(point.normal, material.textures.normal.as_ref());
+        let frame = Frame::from_normal(ns);
+        if let (Some(coat), Some(c)) = (&mut point.bsdf.coat, &material.clearcoat) {
+            let n = mapped(point.coat_normal, c.normal_map.as_ref());
+            *coat = coat.with_normal(frame.to_local(n));
+        }
         let wo_world = -dir;
+        let emitted = if material.is_emissive() {
+            material.emitted(hit.ng.dot(wo_world), &uvs, &fp)
+        } else {
+            Vec3::ZERO
+        };
         Self {
             frame,
             wo_world,
             wo: frame.to_local(wo_world),
-            material,
-            tint: material.tint(hit.uv),
+            bsdf: point.bsdf,
+            occlusion: point.occlusion,
+            emitted,
             blind: material.is_blind_side(wo_world.dot(hit.ng)),
         }
     }
@@ -249,11 +282,11 @@ impl<'m> Shading<'m> {
     /// can suggest it; that would leak light).
     #[inline]
     pub fn side_ok(&self, hit: &SurfaceHit, wi: Vec3) -> bool {
-        !self.material.bsdf.is_reflective_only() || wi.dot(hit.ng) * self.wo_world.dot(hit.ng) > 0.0
+        !self.bsdf.is_reflective_only() || wi.dot(hit.ng) * self.wo_world.dot(hit.ng) > 0.0
     }
 }
 
-impl Shading<'_> {
+impl Shading {
     /// The world direction of a sampled `wi`, or `None` if the path must
     /// end. A reflection that the shading normal sends below the geometric
     /// surface (at silhouettes of smooth-shaded meshes) is, for a delta
@@ -288,7 +321,7 @@ impl Shading<'_> {
         }
         let u_lobe = ctx.sampler.get_1d(dims::bounce(depth, dims::BSDF_LOBE));
         let u = ctx.sampler.get_2d(dims::bounce(depth, dims::BSDF_DIR));
-        let s = self.material.bsdf.sample(self.tint, self.wo, u_lobe, u)?;
+        let s = self.bsdf.sample(self.wo, u_lobe, u)?;
         let wi = self.scattered(hit, s.wi, s.delta)?;
         ctx.stats.bounce_rays += 1;
         Some((s, Ray::new(hit.spawn_origin(wi), wi)))
@@ -309,7 +342,7 @@ pub(crate) fn pass_through(ctx: &Context, st: &mut PathState, hit: &SurfaceHit) 
     let u = ctx
         .sampler
         .get_1d(dims::extra(st.depth, PASS_THROUGH_DIMS, st.pass_throughs));
-    if !m.passes(hit.uv, u) {
+    if !m.passes(&hit.uvs(), u) {
         return false;
     }
     st.pass_throughs += 1;
@@ -332,7 +365,7 @@ pub(crate) fn light_contribution(
         return None;
     }
     let wi = sh.frame.to_local(ls.wi);
-    let e = sh.material.bsdf.eval(sh.tint, sh.wo, wi);
+    let e = sh.bsdf.eval(sh.wo, wi);
     let c = e.f * wi.z.abs() * ls.li;
     if c.max_element() <= 0.0 {
         return None;
@@ -349,6 +382,7 @@ mod tests {
     use super::*;
     use crate::camera::Camera;
     use crate::light::Light;
+    use crate::material::Material;
     use crate::sampler::{SampleId, SamplerKind};
     use crate::scene::Scene;
     use crate::shape::Shape;
@@ -500,7 +534,7 @@ mod tests {
         // Blend at a uniform opacity of 0.3: about 70 % of shadow rays
         // pass.
         let mut half = cut_out_scene(AlphaMode::Blend);
-        half.materials[1].texture = None;
+        half.materials[1].textures.base_color = None;
         half.materials[1].alpha = 0.3;
         let world = World::new(&half, &BuildParams::default());
         let n = 4000;

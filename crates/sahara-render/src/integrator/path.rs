@@ -42,9 +42,8 @@ pub(crate) fn step(
         return true;
     }
     let sh = Shading::new(world, &hit, ray.dir);
-    let mat = sh.material;
-    if mat.is_emissive() {
-        let le = mat.emitted(hit.ng.dot(sh.wo_world));
+    {
+        let le = sh.emitted;
         if le != Vec3::ZERO {
             let w = if st.prev_delta {
                 1.0
@@ -61,12 +60,15 @@ pub(crate) fn step(
             st.l += st.beta * le * w;
         }
     }
+    // What reaches the last vertex by more than one scattering passes
+    // its painted occlusion.
+    st.beta *= std::mem::replace(&mut st.occlusion, 1.0);
     let depth = st.depth;
     if depth >= max_depth {
         return false;
     }
     // Next-event estimation: one light, chosen by power.
-    if !mat.bsdf.is_delta() {
+    if !sh.bsdf.is_delta() {
         let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
         let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
         if let Some((ls, pmf)) = world.sample_light(hit.p, u_pick, u) {
@@ -89,6 +91,7 @@ pub(crate) fn step(
         return false;
     };
     st.beta *= s.weight;
+    st.occlusion = sh.occlusion;
     st.prev_delta = s.delta;
     st.prev_pdf = s.pdf;
     st.prev_p = hit.p;

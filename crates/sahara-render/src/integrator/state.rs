@@ -43,6 +43,10 @@ pub(crate) struct PathState {
     pub light_sum: Vec3,
     /// Surfaces with holes the path has passed through.
     pub pass_throughs: u32,
+    /// The last vertex's painted occlusion, which light reaching it by
+    /// more than one scattering passes (applied to `beta` once the
+    /// emission at the next vertex is counted).
+    pub occlusion: f32,
 }
 
 impl PathState {
@@ -61,6 +65,7 @@ impl PathState {
             prev_p: ray.origin,
             light_sum: Vec3::ZERO,
             pass_throughs: 0,
+            occlusion: 1.0,
         }
     }
 

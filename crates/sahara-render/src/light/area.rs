@@ -7,6 +7,7 @@ use std::f32::consts::PI;
 use super::LightSample;
 use crate::distribution::Distribution1D;
 use crate::sampling::{concentric_disc, luminance, uniform_cone, uniform_triangle, Frame};
+use crate::texture::TextureMap;
 
 /// The emitting surface.
 #[derive(Clone, Debug)]
@@ -46,9 +47,41 @@ pub enum Emitter {
         radiance: Vec<Vec3>,
         /// Two-sided emission per triangle.
         two_sided: Vec<bool>,
+        /// Per triangle, the emission texture multiplying its radiance
+        /// (an index into `maps`) and its corners' uv sets.
+        textures: Vec<Option<(u32, [[Vec2; 3]; 2])>>,
+        /// The emission textures.
+        maps: Vec<TextureMap>,
+        /// Power of each triangle relative to its radiance (the
+        /// texture's mean over it, estimated), for light selection.
+        texture_power: Vec<f32>,
         /// Distribution over triangle areas.
         dist: Distribution1D,
     },
+}
+
+/// Triangles' textured emission, for [`AreaLight::mesh`].
+#[derive(Clone, Debug, Default)]
+pub struct EmissionTextures {
+    /// Per triangle, an index into `maps` and the corners' uv sets.
+    pub triangles: Vec<Option<(u32, [[Vec2; 3]; 2])>>,
+    /// The textures.
+    pub maps: Vec<TextureMap>,
+}
+
+impl EmissionTextures {
+    /// The texture factor at barycentric `(b1, b2)` of triangle `i`.
+    fn at(maps: &[TextureMap], t: &Option<(u32, [[Vec2; 3]; 2])>, b1: f32, b2: f32) -> Vec3 {
+        let Some((m, uv)) = t else {
+            return Vec3::ONE;
+        };
+        let lerp = |c: [Vec2; 3]| c[0] * (1.0 - b1 - b2) + c[1] * b1 + c[2] * b2;
+        let uvs = [lerp(uv[0]), lerp(uv[1])];
+        maps[*m as usize]
+            .lookup_sharp(&uvs)
+            .truncate()
+            .max(Vec3::ZERO)
+    }
 }
 
 /// An emitting surface with its radiance.
@@ -96,18 +129,51 @@ impl AreaLight {
         }
     }
 
-    /// A light over world-space triangles with per-triangle emission.
-    pub fn mesh(tris: Vec<[Vec3; 3]>, radiance: Vec<Vec3>, two_sided: Vec<bool>) -> Self {
+    /// A light over world-space triangles with per-triangle emission,
+    /// textured where `textures` says.
+    pub fn mesh(
+        tris: Vec<[Vec3; 3]>,
+        radiance: Vec<Vec3>,
+        two_sided: Vec<bool>,
+        textures: EmissionTextures,
+    ) -> Self {
         let areas: Vec<f32> = tris
             .iter()
             .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
             .collect();
         let area = areas.iter().map(|&a| a as f64).sum::<f64>() as f32;
+        let EmissionTextures {
+            mut triangles,
+            maps,
+        } = textures;
+        triangles.resize(tris.len(), None);
+        // A triangle's share of its texture, from a few points (and a
+        // floor from the texture's mean, so no part of it is left out
+        // entirely: this only steers which light is sampled).
+        let means: Vec<f32> = maps.iter().map(|m| luminance(m.texture.mean())).collect();
+        let texture_power = triangles
+            .iter()
+            .map(|t| match t {
+                None => 1.0,
+                Some((m, _)) => {
+                    let pts = [(1.0 / 3.0, 1.0 / 3.0), (0.1, 0.1), (0.8, 0.1), (0.1, 0.8)];
+                    let local: f32 = pts
+                        .iter()
+                        .map(|&(b1, b2)| luminance(EmissionTextures::at(&maps, t, b1, b2)))
+                        .sum::<f32>()
+                        / pts.len() as f32;
+                    0.9 * local + 0.1 * means[*m as usize]
+                }
+            })
+            .collect();
         Self {
             emitter: Emitter::Mesh {
                 tris,
                 radiance,
                 two_sided,
+                textures: triangles,
+                maps,
+                texture_power,
                 dist: Distribution1D::new(areas),
             },
             radiance: Vec3::ZERO,
@@ -124,14 +190,16 @@ impl AreaLight {
                 tris,
                 radiance,
                 two_sided,
+                texture_power,
                 ..
             } => tris
                 .iter()
                 .zip(radiance)
                 .zip(two_sided)
-                .map(|((t, l), &two)| {
+                .zip(texture_power)
+                .map(|(((t, l), &two), &k)| {
                     let a = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
-                    PI * a * luminance(*l) * if two { 2.0 } else { 1.0 }
+                    PI * a * luminance(*l) * k * if two { 2.0 } else { 1.0 }
                 })
                 .sum(),
             _ => PI * self.area * luminance(self.radiance) * if self.two_sided { 2.0 } else { 1.0 },
@@ -168,7 +236,10 @@ impl AreaLight {
                 tris,
                 radiance,
                 two_sided,
+                textures,
+                maps,
                 dist,
+                ..
             } => {
                 let (x, _, i) = dist.sample_continuous(u.x);
                 // Reuse the position within the chosen cell as a fresh
@@ -178,12 +249,13 @@ impl AreaLight {
                 let t = &tris[i];
                 let q = t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2;
                 let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-                (
-                    q,
-                    n,
-                    1.0 / self.area,
-                    Some(emitted(radiance[i], two_sided[i], n, p - q)),
-                )
+                let le = emitted(radiance[i], two_sided[i], n, p - q);
+                let le = if le == Vec3::ZERO {
+                    le
+                } else {
+                    le * EmissionTextures::at(maps, &textures[i], b1, b2)
+                };
+                (q, n, 1.0 / self.area, Some(le))
             }
         };
         let d = q - p;

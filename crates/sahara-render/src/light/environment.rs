@@ -82,7 +82,7 @@ impl EnvLight {
                 for y in 0..h {
                     let st = (PI * (y as f32 + 0.5) / h as f32).sin();
                     for x in 0..w {
-                        let l = luminance(texture.texels[y * w + x] * *scale).max(0.0);
+                        let l = luminance(texture.texel(x as i64, y as i64) * *scale).max(0.0);
                         f.push(l * st);
                         total += (l * st) as f64;
                         weight += st as f64;

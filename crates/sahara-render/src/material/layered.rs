@@ -333,13 +333,15 @@ impl Layered {
     }
 }
 
+/// `w` mirrored into the upper hemisphere.
 #[inline]
-fn upper(w: Vec3) -> Vec3 {
+pub(super) fn upper(w: Vec3) -> Vec3 {
     Vec3::new(w.x, w.y, w.z.abs())
 }
 
+/// `w` (upper hemisphere) mirrored below the surface if `below`.
 #[inline]
-fn to_side(w: Vec3, below: bool) -> Vec3 {
+pub(super) fn to_side(w: Vec3, below: bool) -> Vec3 {
     if below {
         Vec3::new(w.x, w.y, -w.z)
     } else {

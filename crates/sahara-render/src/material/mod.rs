@@ -1,10 +1,12 @@
-//! Materials: a BSDF, an optional albedo texture, and emission.
+//! Materials: a BSDF, textures by role, an optional clear coat, and
+//! emission.
 //!
 //! BSDFs work in a local shading frame whose +z is the shading normal (for
 //! glass: the outward normal). Values are radiance-transport BSDFs; a
 //! sample's `weight` is `f |cos| / pdf`.
 
 pub mod albedo;
+pub mod coat;
 pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
@@ -12,15 +14,19 @@ pub mod fresnel;
 mod layered;
 pub mod metals;
 pub mod microfacet;
+pub mod textures;
 
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
-use crate::texture::Texture;
+use crate::texture::footprint::UvFootprint;
+use crate::texture::{Texture, TextureMap};
+pub use coat::Coat;
 use fresnel::schlick;
 use layered::Layered;
 use microfacet::Ggx;
+pub use textures::{Clearcoat, MaterialTextures, NormalMap, OcclusionMap};
 
 /// The scattering model of a material.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -290,9 +296,14 @@ pub enum AlphaMode {
 pub struct Material {
     /// How the surface scatters light.
     pub bsdf: Bsdf,
-    /// Optional texture multiplying the albedo / colour (ignored by glass).
-    pub texture: Option<Arc<Texture>>,
-    /// Emitted radiance (zero for non-emitters).
+    /// Textures by role (see [`MaterialTextures`]); the base colour's is
+    /// ignored by glass. (Boxed, as is the coat: materials are passed by
+    /// value while scenes are built, and most have neither.)
+    pub textures: Box<MaterialTextures>,
+    /// A clear coat over the BSDF (reflectors only).
+    pub clearcoat: Option<Box<Clearcoat>>,
+    /// Emitted radiance (zero for non-emitters), times the emission
+    /// texture.
     pub emission: Vec3,
     /// Emit from both faces (default: only the front face, the side of the
     /// winding-order normal `(v1 - v0) x (v2 - v0)`).
@@ -312,7 +323,8 @@ impl Material {
     pub fn new(bsdf: Bsdf) -> Self {
         Self {
             bsdf,
-            texture: None,
+            textures: Box::default(),
+            clearcoat: None,
             emission: Vec3::ZERO,
             two_sided_emission: false,
             two_sided: true,
@@ -384,11 +396,19 @@ impl Material {
         self.alpha_mode != AlphaMode::Opaque
     }
 
-    /// True if a ray meeting the surface at `uv` passes through it, `u`
-    /// uniform in `[0, 1)` deciding for stochastic transparency.
+    /// True if a ray meeting the surface where its uv sets are `uvs`
+    /// passes through it, `u` uniform in `[0, 1)` deciding for stochastic
+    /// transparency.
     #[inline]
-    pub fn passes(&self, uv: Vec2, u: f32) -> bool {
-        let opacity = || self.alpha * self.texture.as_ref().map_or(1.0, |t| t.alpha(uv));
+    pub fn passes(&self, uvs: &[Vec2; 2], u: f32) -> bool {
+        let opacity = || {
+            self.alpha
+                * self
+                    .textures
+                    .base_color
+                    .as_ref()
+                    .map_or(1.0, |t| t.lookup_sharp(uvs).w)
+        };
         match self.alpha_mode {
             AlphaMode::Opaque => false,
             AlphaMode::Mask { cutoff } => opacity() < cutoff,
@@ -396,10 +416,40 @@ impl Material {
         }
     }
 
-    /// This material with an albedo texture.
+    /// This material with a base colour texture read with uv set 0,
+    /// repeating.
     pub fn with_texture(mut self, texture: Arc<Texture>) -> Self {
-        self.texture = Some(texture);
+        self.textures.base_color = Some(TextureMap::new(texture));
         self
+    }
+
+    /// Every texture map of the material: its roles, then the coat's.
+    pub fn texture_maps(&self) -> Vec<&TextureMap> {
+        let t = &self.textures;
+        let c = self.clearcoat.as_ref();
+        [
+            t.base_color.as_ref(),
+            t.metallic.as_ref().map(|m| &m.map),
+            t.roughness.as_ref().map(|m| &m.map),
+            t.normal.as_ref().map(|m| &m.map),
+            t.occlusion.as_ref().map(|m| &m.map.map),
+            t.emission.as_ref(),
+            c.and_then(|c| c.factor_map.as_ref()).map(|m| &m.map),
+            c.and_then(|c| c.roughness_map.as_ref()).map(|m| &m.map),
+            c.and_then(|c| c.normal_map.as_ref()).map(|m| &m.map),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
+    }
+
+    /// True if some texture of the material is read at shading points
+    /// (which then need a footprint).
+    pub fn has_textures(&self) -> bool {
+        !self.textures.is_empty()
+            || self.clearcoat.as_ref().is_some_and(|c| {
+                c.factor_map.is_some() || c.roughness_map.is_some() || c.normal_map.is_some()
+            })
     }
 
     /// True if the material emits light.
@@ -407,24 +457,125 @@ impl Material {
         self.emission.max_element() > 0.0
     }
 
-    /// The texture tint at `uv` (1 without a texture).
-    #[inline]
-    pub fn tint(&self, uv: Vec2) -> Vec3 {
-        match &self.texture {
-            Some(t) => t.bilinear(uv),
-            None => Vec3::ONE,
+    /// The material at a shading point whose uv sets are `uvs`, its
+    /// textures read with footprint `fp`.
+    pub fn at(&self, uvs: &[Vec2; 2], fp: &UvFootprint) -> SurfacePoint {
+        let t = &self.textures;
+        let tint = t
+            .base_color
+            .as_ref()
+            .map_or(Vec3::ONE, |m| m.lookup(uvs, fp).truncate());
+        let bsdf = self.bsdf.modulated(
+            textures::scalar(&t.metallic, uvs, fp),
+            textures::scalar(&t.roughness, uvs, fp),
+        );
+        let coat = self.clearcoat.as_ref().and_then(|c| {
+            let factor = c.factor * textures::scalar(&c.factor_map, uvs, fp).unwrap_or(1.0);
+            let roughness =
+                c.roughness * textures::scalar(&c.roughness_map, uvs, fp).unwrap_or(1.0);
+            (factor > 0.0 && bsdf.is_reflective_only()).then(|| Coat::new(factor, roughness, c.ior))
+        });
+        SurfacePoint {
+            bsdf: PointBsdf { bsdf, tint, coat },
+            normal: t.normal.as_ref().and_then(|n| n.lookup(uvs, fp)),
+            coat_normal: self
+                .clearcoat
+                .as_ref()
+                .and_then(|c| c.normal_map.as_ref())
+                .and_then(|n| n.lookup(uvs, fp)),
+            occlusion: t.occlusion.as_ref().map_or(1.0, |o| {
+                let v = o.map.lookup(uvs, fp).clamp(0.0, 1.0);
+                1.0 + o.strength.clamp(0.0, 1.0) * (v - 1.0)
+            }),
         }
     }
 
     /// Radiance emitted towards a direction with `cos_front` the cosine to
-    /// the front face's normal.
+    /// the front face's normal, where the uv sets are `uvs` (the emission
+    /// texture read with footprint `fp`).
     #[inline]
-    pub fn emitted(&self, cos_front: f32) -> Vec3 {
+    pub fn emitted(&self, cos_front: f32, uvs: &[Vec2; 2], fp: &UvFootprint) -> Vec3 {
         if cos_front > 0.0 || (self.two_sided_emission && cos_front < 0.0) {
-            self.emission
+            match &self.textures.emission {
+                Some(m) => self.emission * m.lookup(uvs, fp).truncate().max(Vec3::ZERO),
+                None => self.emission,
+            }
         } else {
             Vec3::ZERO
         }
+    }
+}
+
+/// A material at one shading point: its textures looked up.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    /// How the point scatters light.
+    pub bsdf: PointBsdf,
+    /// The normal map's normal in tangent space, if the material has one.
+    pub normal: Option<Vec3>,
+    /// The coat's normal map's normal in tangent space, if it has one.
+    pub coat_normal: Option<Vec3>,
+    /// The factor on light arriving by indirect paths (1: none).
+    pub occlusion: f32,
+}
+
+/// The BSDF at one shading point: the material's BSDF with its textured
+/// parameters, the base colour's tint, and the clear coat if any.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointBsdf {
+    /// The BSDF, metallic and roughness textures applied.
+    pub bsdf: Bsdf,
+    /// Multiplies the BSDF's colour.
+    pub tint: Vec3,
+    /// A coat over a reflector.
+    pub coat: Option<Coat>,
+}
+
+impl PointBsdf {
+    /// `bsdf` untinted and uncoated.
+    pub fn new(bsdf: Bsdf) -> Self {
+        Self {
+            bsdf,
+            tint: Vec3::ONE,
+            coat: None,
+        }
+    }
+
+    /// Value and density for `(wo, wi)` (see [`Bsdf::eval`]).
+    #[inline]
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> BsdfEval {
+        match &self.coat {
+            Some(c) => c.eval(&self.bsdf, self.tint, wo, wi),
+            None => self.bsdf.eval(self.tint, wo, wi),
+        }
+    }
+
+    /// An incident direction for `wo` (see [`Bsdf::sample`]).
+    #[inline]
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let s = match &self.coat {
+            Some(c) => c.sample(&self.bsdf, self.tint, wo, u_lobe, u)?,
+            None => return self.bsdf.sample(self.tint, wo, u_lobe, u),
+        };
+        (s.weight.is_finite() && s.pdf.is_finite() && s.pdf > 0.0).then_some(s)
+    }
+
+    /// True if every lobe is a delta.
+    #[inline]
+    pub fn is_delta(&self) -> bool {
+        self.bsdf.is_delta() && self.coat.is_none_or(|c| c.is_smooth())
+    }
+
+    /// True for an uncoated Lambertian BSDF.
+    #[inline]
+    pub fn is_diffuse(&self) -> bool {
+        self.bsdf.is_diffuse() && self.coat.is_none()
+    }
+
+    /// True if the BSDF only reflects.
+    #[inline]
+    pub fn is_reflective_only(&self) -> bool {
+        self.bsdf.is_reflective_only()
     }
 }
 
@@ -435,8 +586,42 @@ mod tests {
     use crate::sampling::uniform_sphere;
     use std::f32::consts::PI;
 
-    fn u2(a: u64, i: u64) -> Vec2 {
+    /// Two uniform numbers from a hash of `(a, i)`.
+    pub(super) fn u2(a: u64, i: u64) -> Vec2 {
         Vec2::new(unit_f32(hash3(a, i, 0)), unit_f32(hash3(a, i, 1)))
+    }
+
+    /// The albedo of `b` from `wo` two ways — the mean sample weight (red
+    /// channel) and a quadrature of `eval` over the sphere (a jittered
+    /// equal-area grid of `g` x `g` cells, accurate even for peaked lobes)
+    /// — with the integral of the sampling pdf and the fraction of
+    /// samples kept; every sample's pdf is checked against `eval`'s.
+    pub(super) fn albedo_two_ways(
+        b: &PointBsdf,
+        wo: Vec3,
+        g: u64,
+        seed: u64,
+    ) -> (f64, f64, f64, f64) {
+        let n = g * g;
+        let (mut sampled, mut accepted, mut quad, mut pdf_integral) =
+            (0.0f64, 0u64, 0.0f64, 0.0f64);
+        for i in 0..n {
+            if let Some(s) = b.sample(wo, unit_f32(hash3(9, i, 7)), u2(seed, i)) {
+                sampled += s.weight.x as f64;
+                accepted += 1;
+                let e = b.eval(wo, s.wi);
+                let rel = (e.pdf - s.pdf).abs() / s.pdf.max(1e-3);
+                assert!(rel < 1e-2, "{b:?}: pdf {} vs {}", s.pdf, e.pdf);
+            }
+            let j = u2(100 + seed, i);
+            let cell = Vec2::new((i % g) as f32 + j.x, (i / g) as f32 + j.y) / g as f32;
+            let wi = uniform_sphere(cell);
+            let e = b.eval(wo, wi);
+            quad += (e.f.x * wi.z.abs() * 4.0 * PI) as f64;
+            pdf_integral += (e.pdf * 4.0 * PI) as f64;
+        }
+        let n = n as f64;
+        (sampled / n, quad / n, pdf_integral / n, accepted as f64 / n)
     }
 
     fn non_delta() -> Vec<Bsdf> {
@@ -738,32 +923,9 @@ mod tests {
             Vec3::new(0.8, -0.2, 0.3).normalize(),
             Vec3::new(0.2, 0.3, -0.7).normalize(),
         ];
-        let g = 600u64;
-        let n = g * g;
         for bsdf in non_delta() {
             for (k, wo) in wos.iter().enumerate() {
-                let mut sampled = 0.0f64;
-                let mut accepted = 0u64;
-                let mut quad = 0.0f64;
-                let mut pdf_integral = 0.0f64;
-                for i in 0..n {
-                    if let Some(s) =
-                        bsdf.sample(Vec3::ONE, *wo, unit_f32(hash3(9, i, 7)), u2(k as u64, i))
-                    {
-                        sampled += s.weight.x as f64;
-                        accepted += 1;
-                        let e = bsdf.eval(Vec3::ONE, *wo, s.wi);
-                        let rel = (e.pdf - s.pdf).abs() / s.pdf.max(1e-3);
-                        assert!(rel < 1e-2, "{bsdf:?}: pdf {} vs {}", s.pdf, e.pdf);
-                    }
-                    let j = u2(100 + k as u64, i);
-                    let cell = Vec2::new((i % g) as f32 + j.x, (i / g) as f32 + j.y) / g as f32;
-                    let wi = uniform_sphere(cell);
-                    let e = bsdf.eval(Vec3::ONE, *wo, wi);
-                    quad += (e.f.x * wi.z.abs() * 4.0 * PI) as f64;
-                    pdf_integral += (e.pdf * 4.0 * PI) as f64;
-                }
-                let (a, b) = (sampled / n as f64, quad / n as f64);
+                let (a, b, p, kept) = albedo_two_ways(&PointBsdf::new(bsdf), *wo, 600, k as u64);
                 assert!(
                     (a - b).abs() < 0.005 + 0.01 * b,
                     "{bsdf:?} wo {wo}: sampled {a} quadrature {b}"
@@ -775,8 +937,6 @@ mod tests {
                 if bsdf.is_reflective_only() {
                     assert!(a <= 1.0 + 5e-3, "{bsdf:?}: albedo {a} > 1");
                 }
-                let p = pdf_integral / n as f64;
-                let kept = accepted as f64 / n as f64;
                 assert!(
                     (p - kept).abs() < 0.01,
                     "{bsdf:?}: pdf integrates to {p}, kept {kept}"
