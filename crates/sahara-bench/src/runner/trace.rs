@@ -55,30 +55,62 @@ pub fn trace_into(tree: &KdTree, rays: &[Ray], query: Query, out: &mut [HitRecor
         });
 }
 
-/// Trace `rays` into `out` with one call of the tree's batch query
-/// (`KdTree::closest_hits` or `KdTree::any_hits`), which splits the rays
-/// over the current rayon pool itself.
+/// The answers of one batch call, kept between timed runs so that a
+/// measurement times the query alone, not the allocation of its output.
+#[derive(Default)]
+pub struct BatchAnswers {
+    hits: Vec<Option<sahara_kd::Hit>>,
+    occluded: Vec<bool>,
+}
+
+impl BatchAnswers {
+    /// Answers `rays` with one call of the tree's batch query
+    /// (`KdTree::closest_hits` or `KdTree::any_hits`), which splits the
+    /// rays over the current rayon pool itself.
+    pub fn trace(&mut self, tree: &KdTree, rays: &[Ray], query: Query) {
+        match query {
+            Query::ClosestHit => {
+                self.hits.resize(rays.len(), None);
+                tree.closest_hits(rays, &mut self.hits);
+            }
+            Query::AnyHit => {
+                self.occluded.resize(rays.len(), false);
+                tree.any_hits(rays, &mut self.occluded);
+            }
+        }
+    }
+
+    /// The records of the last [`BatchAnswers::trace`] with `query`.
+    ///
+    /// # Panics
+    /// If `out` differs in length from the rays traced last.
+    pub fn records(&self, query: Query, out: &mut [HitRecord]) {
+        match query {
+            Query::ClosestHit => {
+                assert_eq!(self.hits.len(), out.len(), "one record per ray");
+                for (h, o) in self.hits.iter().zip(out) {
+                    *o = HitRecord::from_closest(*h);
+                }
+            }
+            Query::AnyHit => {
+                assert_eq!(self.occluded.len(), out.len(), "one record per ray");
+                for (h, o) in self.occluded.iter().zip(out) {
+                    *o = HitRecord::from_occluded(*h);
+                }
+            }
+        }
+    }
+}
+
+/// Trace `rays` into `out` with one call of the tree's batch query.
 ///
 /// # Panics
 /// If `out` and `rays` differ in length.
 pub fn trace_batch_into(tree: &KdTree, rays: &[Ray], query: Query, out: &mut [HitRecord]) {
     assert_eq!(rays.len(), out.len(), "one record per ray");
-    match query {
-        Query::ClosestHit => {
-            let mut hits = vec![None; rays.len()];
-            tree.closest_hits(rays, &mut hits);
-            for (h, o) in hits.into_iter().zip(out) {
-                *o = HitRecord::from_closest(h);
-            }
-        }
-        Query::AnyHit => {
-            let mut occluded = vec![false; rays.len()];
-            tree.any_hits(rays, &mut occluded);
-            for (h, o) in occluded.into_iter().zip(out) {
-                *o = HitRecord::from_occluded(h);
-            }
-        }
-    }
+    let mut answers = BatchAnswers::default();
+    answers.trace(tree, rays, query);
+    answers.records(query, out);
 }
 
 #[cfg(test)]
