@@ -85,7 +85,11 @@ impl KdTree<Triangle> {
     fn interleaves(&self, rays: &[Ray], walk: BatchWalk) -> bool {
         !self.wide.is_empty()
             && match walk {
-                BatchWalk::Auto => self.nodes.len() >= SMALL_TREE && !coherent(rays, self.bounds),
+                BatchWalk::Auto => {
+                    self.nodes.len() >= SMALL_TREE
+                        && self.expected_inner >= SHALLOW
+                        && !coherent(rays, self.bounds)
+                }
                 BatchWalk::Binary => false,
                 BatchWalk::Wide => true,
             }
@@ -111,6 +115,13 @@ const SAMPLE: usize = 32;
 /// Trees of fewer binary nodes take the binary walk: a walk of a few
 /// nodes costs less than the wide walk's set-up.
 const SMALL_TREE: usize = 64;
+
+/// Trees whose SAH expects fewer inner nodes per ray than this take the
+/// binary walk: most rays cross a few large cells (a small object in a
+/// large empty room), where the binary walk's steps are few and
+/// predictable and the wide walk's per-ray set-up is not repaid (figures
+/// in `docs/performance.md`).
+const SHALLOW: f32 = 8.0;
 
 /// True when most neighbouring rays of the batch start close together
 /// (within a hundredth of the tree's diagonal) and point within about 25

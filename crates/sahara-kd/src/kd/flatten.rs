@@ -18,7 +18,7 @@ impl<P: LeafStorage> KdTree<P> {
             true => super::wide::derive(&nodes, wide_shift).unwrap_or_default(),
             false => Vec::new(),
         };
-        KdTree {
+        let mut tree = KdTree {
             nodes,
             indices,
             prim_count: prims.len(),
@@ -27,7 +27,26 @@ impl<P: LeafStorage> KdTree<P> {
             params: *params,
             wide,
             wide_shift,
+            expected_inner: 0.0,
+        };
+        tree.expected_inner = tree.sah_expected_inner() as f32;
+        tree
+    }
+
+    /// Inner nodes a ray meeting the root is expected to visit by the
+    /// SAH's model (cell area over root area, summed over inner nodes).
+    pub(crate) fn sah_expected_inner(&self) -> f64 {
+        let root = self.bounds.surface_area();
+        if root <= 0.0 {
+            return 0.0;
         }
+        let mut sum = 0.0f64;
+        self.visit(|_, n, cell, _| {
+            if !n.is_leaf() {
+                sum += (cell.surface_area() / root) as f64;
+            }
+        });
+        sum
     }
 }
 

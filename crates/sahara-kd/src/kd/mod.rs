@@ -39,9 +39,13 @@ pub struct KdTree<P: LeafStorage = Triangle> {
     pub(crate) leaf_data: P::LeafData,
     pub(crate) bounds: Aabb,
     pub(crate) params: BuildParams,
-    /// The wide nodes derived from `nodes` for single-ray walks (empty
-    /// when not derived; see `wide`).
+    /// The wide nodes derived from `nodes` for batch walks (empty when
+    /// not derived; see `wide`).
     pub(crate) wide: Vec<wide::WideNode>,
+    /// The SAH expects a ray meeting the root to visit this many inner
+    /// nodes (see [`crate::TreeStats::expected_inner`]); batches on
+    /// shallower trees take the binary walk.
+    pub(crate) expected_inner: f32,
     /// Leaf offsets in `wide`'s leaf words are shifted down by this.
     pub(crate) wide_shift: u32,
 }
