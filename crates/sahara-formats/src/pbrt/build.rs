@@ -90,8 +90,14 @@ impl Materials<'_> {
         }
         let mut m = scene.materials[material as usize].clone();
         if let Some(img) = &alpha.image {
-            let base = m.textures.base_color.as_ref().map(|t| &t.texture);
-            m.textures.base_color = Some(TextureMap::new(with_opacity(base, img)));
+            // The opacity joins the base colour's image, read as that image
+            // is read (the alpha texture's own as a fallback).
+            let old = m.textures.base_color.take();
+            let texture = with_opacity(old.as_ref().map(|t| &t.texture), img);
+            m.textures.base_color = Some(match old {
+                Some(o) => TextureMap { texture, ..o },
+                None => alpha.sampling.map(texture),
+            });
         }
         let id = scene.add_material(m.with_alpha(AlphaMode::Blend, factor));
         self.cut.insert(key, id);

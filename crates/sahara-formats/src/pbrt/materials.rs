@@ -24,7 +24,7 @@
 //! pbrt-v3's `opacity` (uber) becomes stochastic transparency.
 
 use glam::Vec3;
-use sahara_render::{AlphaMode, Bsdf, Material, TextureMap};
+use sahara_render::{AlphaMode, Bsdf, Material};
 
 use super::description::Entity;
 use super::params::SpectrumParam;
@@ -90,14 +90,14 @@ fn roughness(
 /// A diffuse material of reflectance `tint`.
 fn diffuse(tint: Tint) -> Material {
     let mut m = Material::diffuse(tint.color.clamp(Vec3::ZERO, Vec3::ONE));
-    m.textures.base_color = tint.image.map(TextureMap::new);
+    m.textures.base_color = tint.image_map();
     m
 }
 
 /// A material of `bsdf` whose base colour is multiplied by `tint`.
 fn tinted(bsdf: Bsdf, tint: &Tint) -> Material {
     let mut m = Material::new(bsdf);
-    m.textures.base_color = tint.baked().map(TextureMap::new);
+    m.textures.base_color = tint.map();
     m
 }
 
@@ -280,7 +280,7 @@ fn layered(kd: &Tint, f0: Vec3, f90: f32, r: f32) -> Material {
         },
         &Tint {
             color: Vec3::ONE,
-            image: kd.image.clone(),
+            ..kd.clone()
         },
     )
 }
@@ -417,7 +417,7 @@ pub(crate) fn map_material(
                 },
                 &Tint {
                     color: Vec3::ONE,
-                    image: base.image,
+                    ..base
                 },
             )
         }
@@ -473,7 +473,7 @@ pub(crate) fn map_material(
             }
             diffuse(Tint {
                 color: base.color * scale,
-                image: base.image,
+                ..base
             })
         }
         "translucent" => {
@@ -487,7 +487,7 @@ pub(crate) fn map_material(
             }
             let kd = Tint {
                 color: kd.color * reflect,
-                image: kd.image,
+                ..kd
             };
             let ks = ks * reflect;
             layered(&kd, ks * 0.04, ks.max_element(), r)

@@ -569,6 +569,48 @@ fn tga_and_pfm_imagemaps_load_and_textures_combine_texel_by_texel() {
 }
 
 #[test]
+fn imagemaps_keep_their_wrap_mode_and_uv_scale_and_offset() {
+    let dir = folder("imagemap_sampling");
+    let mut tga = vec![0u8, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 1, 0, 24, 0x20];
+    tga.extend([0, 0, 255, 128, 128, 128]);
+    std::fs::write(dir.join("a.tga"), &tga).unwrap();
+    let quad = "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"point2 uv\" [0 0 1 0 0 1 1 1]";
+    let (m, w) = shape_material(
+        &dir,
+        &format!("Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"a.tga\" \"string wrap\" \"clamp\" \"float uscale\" 2 \"float vscale\" 3 \"float udelta\" 0.25 \"float vdelta\" 0.5\n\
+                  Material \"diffuse\" \"texture reflectance\" \"a\"\n{quad}"),
+    );
+    assert!(w.is_empty(), "{w:?}");
+    let map = m.textures.base_color.as_ref().expect("the image");
+    assert_eq!(map.wrap, [sahara_render::texture::Wrap::Clamp; 2]);
+    let uv = map.transform.transform_point2(glam::Vec2::new(1.0, 1.0));
+    assert_eq!(uv, glam::Vec2::new(2.25, 3.5));
+    // Past the right edge, clamping reads the last texel (grey), where
+    // repeating would read the first (red).
+    let grey = crate::srgb::srgb8_to_linear(128);
+    let point = sahara_render::texture::footprint::UvFootprint::POINT;
+    let far = glam::Vec2::new(0.9, 0.5);
+    let tint = m.at(&[far, far], &point).bsdf.tint;
+    assert!(
+        (tint - Vec3::splat(grey)).abs().max_element() < 1e-6,
+        "{tint}"
+    );
+    // pbrt's "black" border is not Sahara's: clamped, with a warning.
+    let (m, w) = shape_material(
+        &dir,
+        &format!("Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"a.tga\" \"string wrap\" \"black\"\n\
+                  Material \"diffuse\" \"texture reflectance\" \"a\"\n{quad}"),
+    );
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains("wrap 'black'"), "{w:?}");
+    assert_eq!(
+        m.textures.base_color.unwrap().wrap,
+        [sahara_render::texture::Wrap::Clamp; 2]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn alpha_textures_cut_shapes_out() {
     let dir = folder("alpha");
     let quad = "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"point2 uv\" [0 0 1 0 0 1 1 1]";

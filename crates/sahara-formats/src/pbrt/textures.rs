@@ -3,9 +3,11 @@
 //!
 //! - `constant`, `scale` and `mix` of constants fold into the colour;
 //!   `scale` of an image by a constant keeps the image and scales the colour.
-//! - `imagemap` (PNG, JPEG, HDR, EXR) becomes the image, with `scale` and
-//!   `invert` applied; its filtering is Sahara's bilinear lookup with
-//!   repeat wrapping whatever `filter` and `wrap` say.
+//! - `imagemap` (PNG, JPEG, HDR, EXR, TGA, PFM) becomes the image, with
+//!   `scale` and `invert` applied, read as Sahara reads every texture
+//!   (trilinear MIP-mapping by the ray's footprint, whatever `filter`
+//!   says), with its `wrap` mode and the `uv` mapping's `uscale`,
+//!   `vscale`, `udelta`, `vdelta` as the map's transform.
 //! - `checkerboard` (2D) and `bilerp` of constants are baked into images.
 //! - Everything else (3D checkerboards, `dots`, `fbm`, `wrinkled`, `windy`,
 //!   `marble`, `ptex`, `mix` of images, mapping other than `uv` with unit
@@ -17,8 +19,9 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use glam::Vec3;
-use sahara_render::Texture;
+use glam::{Affine2, Mat2, Vec2, Vec3};
+use sahara_render::texture::Wrap;
+use sahara_render::{Texture, TextureMap};
 
 use super::description::{Entity, TextureDecl};
 use super::params::{FloatParam, SpectrumParam};
@@ -35,6 +38,27 @@ pub(crate) struct Tint {
     pub(crate) color: Vec3,
     /// The image (linear RGB), if any.
     pub(crate) image: Option<Arc<Texture>>,
+    /// How the image is read.
+    pub(crate) sampling: Sampling,
+}
+
+/// How an image texture is read: pbrt's `wrap` and its `uv` mapping's
+/// scale and offset.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Sampling {
+    /// The wrap mode along both axes.
+    pub(crate) wrap: Wrap,
+    /// `(u, v)` to `(uscale u + udelta, vscale v + vdelta)`.
+    pub(crate) transform: Affine2,
+}
+
+impl Sampling {
+    /// The texture map reading `texture` this way.
+    pub(crate) fn map(self, texture: Arc<Texture>) -> TextureMap {
+        TextureMap::new(texture)
+            .with_wrap(self.wrap, self.wrap)
+            .with_transform(self.transform)
+    }
 }
 
 impl Tint {
@@ -43,7 +67,19 @@ impl Tint {
         Self {
             color: c,
             image: None,
+            sampling: Sampling::default(),
         }
+    }
+
+    /// The texture map a Sahara material holds for this tint (see
+    /// [`Tint::baked`]), read as the image says.
+    pub(crate) fn map(&self) -> Option<TextureMap> {
+        self.baked().map(|t| self.sampling.map(t))
+    }
+
+    /// The map of the image alone, without the colour, if there is one.
+    pub(crate) fn image_map(&self) -> Option<TextureMap> {
+        self.image.clone().map(|t| self.sampling.map(t))
     }
 
     /// The texture a Sahara material holds for this tint: the image with
@@ -342,7 +378,25 @@ impl<'a> Textures<'a> {
                 let path = super::parser::resolve(&e.folders, file);
                 let scale = e.params.float("scale", 1.0)? as f32;
                 let invert = e.params.bool("invert", false)?;
-                let _ = (e.params.string("filter")?, e.params.string("wrap")?);
+                let _ = e.params.string("filter")?;
+                let wrap = match e.params.string("wrap")?.unwrap_or("repeat") {
+                    "repeat" => Wrap::Repeat,
+                    "clamp" => Wrap::Clamp,
+                    other => {
+                        warnings.add(
+                            format!("imagemap wrap '{other}' is not supported; 'clamp' used"),
+                            &e.loc,
+                        );
+                        Wrap::Clamp
+                    }
+                };
+                let sampling = Sampling {
+                    wrap,
+                    transform: Affine2::from_mat2_translation(
+                        Mat2::from_diagonal(Vec2::new(us as f32, vs as f32)),
+                        Vec2::new(ud as f32, vd as f32),
+                    ),
+                };
                 let _ = (e.params.float("maxanisotropy", 8.0)?, e.params.bool("trilinear", false)?);
                 let encoding = e.params.string("encoding")?.map(str::to_owned);
                 let v3_gamma = match e.params.has("gamma") {
@@ -374,11 +428,13 @@ impl<'a> Textures<'a> {
                             &img,
                             Texture::new(img.width, img.height, texels),
                         ))),
+                        sampling,
                     }
                 } else {
                     Tint {
                         color: Vec3::splat(scale),
                         image: Some(img),
+                        sampling,
                     }
                 }
             }
@@ -400,6 +456,7 @@ impl<'a> Textures<'a> {
                     Tint {
                         color: Vec3::ONE,
                         image: Some(Arc::new(Texture::new(t.width, t.height, texels))),
+                        sampling: Sampling::default(),
                     }
                 } else {
                     combine(&[&a, &b, &mask], |v| if v[2].x > 0.5 { v[0] } else { v[1] })
@@ -429,7 +486,7 @@ impl<'a> Textures<'a> {
             }
         })
         .inspect(|t| {
-            if !plain_uv && t.image.is_some() {
+            if !plain_uv && t.image.is_some() && !(e.kind == "imagemap" && mapping == "uv") {
                 warnings.add(
                     "texture mapping other than 'uv' with unit scale and no offset is not supported; the plain uv mapping is used",
                     &e.loc,
@@ -531,10 +588,10 @@ fn float_channel(img: &Texture) -> Texture {
 /// operand looked up bilinearly at that grid's texel centres (exact when
 /// the images have the same size).
 fn combine(ops: &[&Tint], f: impl Fn(&[Vec3]) -> Vec3) -> Tint {
-    let Some(grid) = ops
+    let Some((grid, sampling)) = ops
         .iter()
-        .filter_map(|t| t.image.as_ref())
-        .max_by_key(|t| texel_count(t))
+        .filter_map(|t| t.image.as_ref().map(|i| (i, t.sampling)))
+        .max_by_key(|(i, _)| texel_count(i))
     else {
         let v: Vec<Vec3> = ops.iter().map(|t| t.color).collect();
         return Tint::constant(f(&v));
@@ -561,6 +618,7 @@ fn combine(ops: &[&Tint], f: impl Fn(&[Vec3]) -> Vec3) -> Tint {
     Tint {
         color: Vec3::ONE,
         image: Some(Arc::new(with_alpha_of(grid, Texture::new(w, h, texels)))),
+        sampling,
     }
 }
 
@@ -591,6 +649,7 @@ fn checkerboard(us: f64, vs: f64, ud: f64, vd: f64) -> Tint {
     Tint {
         color: Vec3::ONE,
         image: Some(Arc::new(Texture::new(w, h, texels))),
+        sampling: Sampling::default(),
     }
 }
 
@@ -614,6 +673,7 @@ fn bilerp(v00: Vec3, v01: Vec3, v10: Vec3, v11: Vec3) -> Tint {
     Tint {
         color: Vec3::ONE,
         image: Some(Arc::new(Texture::new(n, n, texels))),
+        sampling: Sampling::default(),
     }
 }
 
