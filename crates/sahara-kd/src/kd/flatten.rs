@@ -43,7 +43,7 @@ impl<P: LeafStorage> KdTree<P> {
         let mut sum = 0.0f64;
         self.visit(|_, n, cell, _| {
             if !n.is_leaf() {
-                sum += (cell.surface_area() / root) as f64;
+                sum += cell.surface_area() / root;
             }
         });
         sum
