@@ -300,6 +300,11 @@ pub fn load_gltf(path: &Path) -> Result<GltfScene, FormatError> {
 fn load(path: &Path) -> Result<GltfScene, FormatError> {
     let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
     let name = path.display().to_string();
+    if bytes.is_empty() {
+        // A failed download or an unfetched Git LFS object; the JSON
+        // parser's "EOF while parsing" would not say so.
+        return Err(FormatError::in_file(&name, "the file is empty"));
+    }
     let folder = path.parent().unwrap_or(Path::new(""));
     let pre = extensions::prescan(&bytes, &name)?;
     let ::gltf::Gltf { document, blob } = parse(&bytes, &name)?;

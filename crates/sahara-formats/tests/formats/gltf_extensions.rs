@@ -290,6 +290,11 @@ fn what_sahara_cannot_render_is_said_in_words() {
             at("old.gltf")
         )
     );
+    // An empty file (a failed download, an unfetched LFS object).
+    assert_eq!(
+        refused("empty.glb", b""),
+        format!("{}: the file is empty", at("empty.glb"))
+    );
     // glTF 1.0 without a version, and the binary container version 1.
     assert!(
         refused("nover.gltf", br#"{"meshes": {"box": {}}}"#).contains("glTF 1.0 is not supported")
