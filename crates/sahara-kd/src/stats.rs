@@ -87,7 +87,6 @@ impl<P: LeafStorage> KdTree<P> {
                 }
             } else {
                 s.inner += 1;
-                s.expected_inner += p;
             }
         });
         if root_area == 0.0 {
@@ -97,6 +96,8 @@ impl<P: LeafStorage> KdTree<P> {
             s.expected_triangles = s.references as f64;
             s.expected_leaf_tests = self.params.leaf_tests(s.references);
         }
+        // Summed at the build, in this visit's order.
+        s.expected_inner = self.expected_inner;
         s.sah_cost = s.expected_inner * k_t + s.expected_leaf_tests * k_i;
         s.mean_leaf_depth = depth_sum as f64 / s.leaves.max(1) as f64;
         let non_empty = s.leaves - s.empty_leaves;

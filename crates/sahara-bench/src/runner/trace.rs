@@ -102,17 +102,6 @@ impl BatchAnswers {
     }
 }
 
-/// Trace `rays` into `out` with one call of the tree's batch query.
-///
-/// # Panics
-/// If `out` and `rays` differ in length.
-pub fn trace_batch_into(tree: &KdTree, rays: &[Ray], query: Query, out: &mut [HitRecord]) {
-    assert_eq!(rays.len(), out.len(), "one record per ray");
-    let mut answers = BatchAnswers::default();
-    answers.trace(tree, rays, query);
-    answers.records(query, out);
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -37,21 +37,17 @@ impl KdTree<Triangle> {
     /// (for tests and measurements).
     #[doc(hidden)]
     pub fn closest_hits_walked(&self, rays: &[Ray], out: &mut [Option<Hit>], walk: BatchWalk) {
-        assert_eq!(rays.len(), out.len(), "one output slot per ray");
-        if self.interleaves(rays, walk) {
-            dispatch(
-                level::AVX512,
-                ClosestBatch {
-                    tree: self,
-                    rays,
-                    out,
-                },
-            );
-        } else {
-            for (r, o) in rays.iter().zip(out) {
-                *o = self.closest_hit(r);
-            }
-        }
+        self.batch(
+            rays,
+            out,
+            walk,
+            |out| ClosestBatch {
+                tree: self,
+                rays,
+                out,
+            },
+            |r| self.closest_hit(r),
+        );
     }
 
     /// Occlusion of many rays on the calling thread, as
@@ -64,19 +60,36 @@ impl KdTree<Triangle> {
     /// tests and measurements).
     #[doc(hidden)]
     pub fn any_hits_walked(&self, rays: &[Ray], out: &mut [bool], walk: BatchWalk) {
+        self.batch(
+            rays,
+            out,
+            walk,
+            |out| AnyBatch {
+                tree: self,
+                rays,
+                out,
+            },
+            |r| self.any_hit(r),
+        );
+    }
+
+    /// Answers `rays` into `out`: by the interleaved wide walk of
+    /// `kernel` if the batch takes it (see [`KdTree::interleaves`]), else
+    /// ray by ray with `one`.
+    fn batch<'a, T, K: Kernel<Output = ()>>(
+        &self,
+        rays: &[Ray],
+        out: &'a mut [T],
+        walk: BatchWalk,
+        kernel: impl FnOnce(&'a mut [T]) -> K,
+        one: impl Fn(&Ray) -> T,
+    ) {
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
         if self.interleaves(rays, walk) {
-            dispatch(
-                level::AVX512,
-                AnyBatch {
-                    tree: self,
-                    rays,
-                    out,
-                },
-            );
+            dispatch(level::AVX512, kernel(out));
         } else {
             for (r, o) in rays.iter().zip(out) {
-                *o = self.any_hit(r);
+                *o = one(r);
             }
         }
     }
@@ -121,7 +134,7 @@ const SMALL_TREE: usize = 64;
 /// large empty room), where the binary walk's steps are few and
 /// predictable and the wide walk's per-ray set-up is not repaid (figures
 /// in `docs/performance.md`).
-const SHALLOW: f32 = 8.0;
+const SHALLOW: f64 = 8.0;
 
 /// True when most neighbouring rays of the batch start close together
 /// (within a hundredth of the tree's diagonal) and point within about 25

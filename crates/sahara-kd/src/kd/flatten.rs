@@ -29,21 +29,21 @@ impl<P: LeafStorage> KdTree<P> {
             wide_shift,
             expected_inner: 0.0,
         };
-        tree.expected_inner = tree.sah_expected_inner() as f32;
+        tree.expected_inner = tree.sah_expected_inner();
         tree
     }
 
     /// Inner nodes a ray meeting the root is expected to visit by the
-    /// SAH's model (cell area over root area, summed over inner nodes).
-    pub(crate) fn sah_expected_inner(&self) -> f64 {
+    /// SAH's model (cell area over root area, summed over inner nodes;
+    /// 0 for a degenerate root), as [`crate::TreeStats::expected_inner`]
+    /// reports it.
+    fn sah_expected_inner(&self) -> f64 {
         let root = self.bounds.surface_area();
-        if root <= 0.0 {
-            return 0.0;
-        }
+        let inv_root = if root > 0.0 { 1.0 / root } else { 0.0 };
         let mut sum = 0.0f64;
         self.visit(|_, n, cell, _| {
             if !n.is_leaf() {
-                sum += cell.surface_area() / root;
+                sum += cell.surface_area() * inv_root;
             }
         });
         sum

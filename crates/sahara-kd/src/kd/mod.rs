@@ -45,7 +45,7 @@ pub struct KdTree<P: LeafStorage = Triangle> {
     /// The SAH expects a ray meeting the root to visit this many inner
     /// nodes (see [`crate::TreeStats::expected_inner`]); batches on
     /// shallower trees take the binary walk.
-    pub(crate) expected_inner: f32,
+    pub(crate) expected_inner: f64,
     /// Leaf offsets in `wide`'s leaf words are shifted down by this.
     pub(crate) wide_shift: u32,
 }
