@@ -28,7 +28,7 @@ fn cornell(c: &mut Criterion) {
             width: SIZE,
             height: SIZE,
             spp: SPP,
-            integrator: Integrator::from_name(name).expect("a known integrator"),
+            integrator: Integrator::named(name).expect("a known integrator"),
             ..Default::default()
         };
         g.bench_function(BenchmarkId::from_parameter(name), |b| {

@@ -18,7 +18,7 @@ use exr::prelude::{
     AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
     WritableImage,
 };
-use sahara_render::{PixelSum, PixelWindow, SumBuffer};
+use sahara_render::{IntegratorKind, PixelSum, PixelWindow, SumBuffer, ToneMap};
 
 use crate::atomic::write_atomically;
 use crate::error::FormatError;
@@ -53,14 +53,14 @@ pub struct PartInfo {
     pub complete: bool,
     /// How the part was chosen, e.g. `3/8 tiles` (empty if by hand).
     pub part: String,
-    /// The integrator's name (for the merged image's metadata).
-    pub integrator: String,
+    /// The integrator (for the merged image's metadata and its `cost` view).
+    pub integrator: IntegratorKind,
     /// The seed (for the merged image's metadata).
     pub seed: u64,
     /// Exposure in stops for a PNG of the merged frame.
     pub exposure: f32,
-    /// Tone map for a PNG of the merged frame (`clamp` or `filmic`).
-    pub tonemap: String,
+    /// Tone map for a PNG of the merged frame.
+    pub tonemap: ToneMap,
     /// Render statistics as (name, value) pairs, kept for people.
     pub stats: Vec<(String, String)>,
 }
@@ -83,10 +83,10 @@ impl PartInfo {
             ("sahara:complete", self.complete.to_string()),
             ("sahara:partial", (!self.complete).to_string()),
             ("sahara:part", self.part.clone()),
-            ("sahara:integrator", self.integrator.clone()),
+            ("sahara:integrator", self.integrator.to_string()),
             ("sahara:seed", self.seed.to_string()),
             ("sahara:exposure", self.exposure.to_string()),
-            ("sahara:tonemap", self.tonemap.clone()),
+            ("sahara:tonemap", self.tonemap.to_string()),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
@@ -160,6 +160,8 @@ impl PartInfo {
         if complete && samples_done != samples {
             return Err(bad("sahara:samples_done", &range(&samples_done)));
         }
+        let integrator = need("sahara:integrator")?;
+        let tonemap = need("sahara:tonemap")?;
         let seed = need("sahara:seed")?;
         let exposure = need("sahara:exposure")?;
         Ok(PartInfo {
@@ -172,14 +174,18 @@ impl PartInfo {
             samples_done,
             complete,
             part: get("sahara:part").unwrap_or_default(),
-            integrator: need("sahara:integrator")?,
+            integrator: integrator
+                .parse()
+                .map_err(|_| bad("sahara:integrator", &integrator))?,
             seed: seed.parse().map_err(|_| bad("sahara:seed", &seed))?,
             exposure: exposure
                 .parse()
                 .ok()
                 .filter(|e: &f32| e.is_finite())
                 .ok_or_else(|| bad("sahara:exposure", &exposure))?,
-            tonemap: need("sahara:tonemap")?,
+            tonemap: tonemap
+                .parse()
+                .map_err(|_| bad("sahara:tonemap", &tonemap))?,
             stats: Vec::new(),
         })
     }
@@ -390,10 +396,10 @@ mod tests {
             samples_done: 4..12,
             complete: true,
             part: "1/2 tiles".into(),
-            integrator: "path".into(),
+            integrator: IntegratorKind::Path,
             seed: 3,
             exposure: -0.5,
-            tonemap: "filmic".into(),
+            tonemap: ToneMap::Filmic,
             stats: vec![("rays".into(), "123".into())],
         }
     }
@@ -409,7 +415,7 @@ mod tests {
             y1: 4,
         };
         let mut sums = SumBuffer::new(2, 1, 4, 3);
-        let f = Filter::mitchell();
+        let f = Filter::from(sahara_render::FilterKind::Mitchell);
         for k in 0..40 {
             let (x, y) = (2 + k % 4, 1 + k % 3);
             let pos = Vec2::new(x as f32 + 0.1 * (k % 7) as f32, y as f32 + 0.3);

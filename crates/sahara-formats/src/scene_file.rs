@@ -62,6 +62,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
+use sahara_render::{Filter, Integrator, SamplerKind, Shape, ToneMap};
 
 use crate::error::FormatError;
 
@@ -79,12 +80,14 @@ pub struct SceneFile {
     pub objects: Vec<ObjectSpec>,
     /// Lights, in file order (at most one environment).
     pub lights: Vec<LightSpec>,
-    /// How radiance is estimated.
-    pub integrator: IntegratorSpec,
+    /// How radiance is estimated (`[integrator]`; parameters not given
+    /// take the renderer's defaults).
+    pub integrator: Integrator,
     /// How pixel samples are placed.
     pub sampler: SamplerSpec,
-    /// The pixel reconstruction filter.
-    pub filter: FilterSpec,
+    /// The pixel reconstruction filter (`[filter]`; parameters not given
+    /// take the renderer's defaults for the kind).
+    pub filter: Filter,
     /// Image size, exposure, tone mapping and output file.
     pub film: FilmSpec,
 }
@@ -238,38 +241,10 @@ pub enum ShapeSpec {
         /// The resolved path.
         path: PathBuf,
     },
-    /// The parallelogram `corner + s * edge_u + t * edge_v`, `s, t` in [0, 1]; front face along `edge_u x edge_v`.
-    Quad {
-        /// One corner.
-        corner: Vec3,
-        /// First edge from the corner.
-        edge_u: Vec3,
-        /// Second edge from the corner (not parallel to `edge_u`).
-        edge_v: Vec3,
-    },
-    /// A disc facing along `normal`.
-    Disc {
-        /// Centre.
-        center: Vec3,
-        /// Facing direction (non-zero; not necessarily unit).
-        normal: Vec3,
-        /// Radius (> 0).
-        radius: f32,
-    },
-    /// A sphere.
-    Sphere {
-        /// Centre.
-        center: Vec3,
-        /// Radius (> 0).
-        radius: f32,
-    },
-    /// An axis-aligned box.
-    Box {
-        /// Smallest corner.
-        min: Vec3,
-        /// Largest corner (> `min` on every axis).
-        max: Vec3,
-    },
+    /// A quad, disc, sphere or box in the object's own space (a disc's
+    /// normal made unit; a quad's edges not parallel; a box's `max` above
+    /// its `min` on every axis).
+    Builtin(Shape),
 }
 
 /// Where an object is: fixed, or moving linearly over the shutter interval.
@@ -378,49 +353,6 @@ pub enum EnvironmentSpec {
     },
 }
 
-/// `[integrator]`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum IntegratorSpec {
-    /// Cook's distribution ray tracing.
-    Distribution {
-        /// Largest number of specular/glossy bounces (>= 1, default 8).
-        max_depth: u32,
-        /// Samples per area light at every hit (>= 1, default 4).
-        light_samples: u32,
-    },
-    /// Path tracing with next-event estimation.
-    Path {
-        /// Largest number of bounces (>= 1, default 8).
-        max_depth: u32,
-        /// Bounces before Russian roulette (default 3).
-        rr_depth: u32,
-    },
-    /// Shading normals as colours.
-    Normals,
-    /// Distance to the first hit.
-    Depth,
-    /// Ambient occlusion.
-    Ao {
-        /// Rays per pixel sample (>= 1, default 4).
-        samples: u32,
-        /// Occlusion distance (>= 0; 0: a tenth of the scene's size).
-        distance: f32,
-    },
-    /// A heat map of kd-tree work.
-    Cost,
-}
-
-/// Sampler kinds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SamplerKind {
-    /// Independent uniform random numbers.
-    Independent,
-    /// Jittered strata.
-    Stratified,
-    /// Owen-scrambled Sobol points.
-    Sobol,
-}
-
 /// `[sampler]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SamplerSpec {
@@ -430,46 +362,6 @@ pub struct SamplerSpec {
     pub spp: u32,
     /// Seed (>= 0, default 0).
     pub seed: u64,
-}
-
-/// `[filter]`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum FilterSpec {
-    /// A box of half-width `radius` (default 0.5).
-    Box {
-        /// Half width in pixels (> 0).
-        radius: f32,
-    },
-    /// A tent of half-width `radius` (default 1).
-    Tent {
-        /// Half width in pixels (> 0).
-        radius: f32,
-    },
-    /// A truncated Gaussian (defaults: radius 1.5, sigma 0.5).
-    Gaussian {
-        /// Half width in pixels (> 0).
-        radius: f32,
-        /// Standard deviation in pixels (> 0).
-        sigma: f32,
-    },
-    /// Mitchell-Netravali (defaults: radius 2, b = c = 1/3).
-    Mitchell {
-        /// Half width in pixels (> 0).
-        radius: f32,
-        /// The B parameter.
-        b: f32,
-        /// The C parameter.
-        c: f32,
-    },
-}
-
-/// Tone mapping curves.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ToneMapSpec {
-    /// Clamp to [0, 1].
-    Clamp,
-    /// A filmic curve.
-    Filmic,
 }
 
 /// `[film]`.
@@ -482,7 +374,7 @@ pub struct FilmSpec {
     /// Exposure in stops (pixels scaled by `2^exposure`; default 0).
     pub exposure: f32,
     /// Tone mapping for 8-bit output (default clamp).
-    pub tonemap: ToneMapSpec,
+    pub tonemap: ToneMap,
     /// Output image (`.png` or `.exr`), resolved; `None` if not given.
     pub output: Option<PathBuf>,
 }

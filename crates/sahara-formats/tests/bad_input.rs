@@ -676,7 +676,7 @@ fn scene_file_errors_quoting_line_breaks_stay_one_line() {
     let m = assert_error(
         parse_scene_file(text, "bad.toml", Path::new("/nonexistent")),
         "bad.toml: line 8: column 8:",
-        &["unknown variant", "path\\nmax_depth = 3\\n"],
+        &["unknown integrator", "path\\nmax_depth = 3\\n"],
     );
     assert!(!m.contains('\r'), "{m:?}");
     // Names of things are quoted the same way.

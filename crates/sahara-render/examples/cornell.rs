@@ -10,7 +10,7 @@ fn main() {
     let spp: u32 = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(64);
     let integrator = args
         .get(4)
-        .and_then(|s| Integrator::from_name(s))
+        .and_then(|s| Integrator::named(s).ok())
         .unwrap_or_default();
     let scene = builtin::cornell_box();
     let settings = RenderSettings {

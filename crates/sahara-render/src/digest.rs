@@ -110,8 +110,8 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
          integrator {:?}\ncost scale {:?}\nscene {:?}",
         s.width,
         s.height,
-        u64::from(s.spp) * u64::from(s.passes),
         s.spp,
+        s.pass_size(),
         s.seed,
         s.sampler,
         s.filter,
@@ -157,12 +157,15 @@ mod tests {
                 ..base.clone()
             },
             RenderSettings {
-                spp: 8,
-                passes: 2,
+                spp: 16,
                 ..base.clone()
             },
             RenderSettings {
-                filter: crate::Filter::tent(),
+                pass_spp: 4,
+                ..base.clone()
+            },
+            RenderSettings {
+                filter: crate::Filter::from(crate::FilterKind::Tent),
                 ..base.clone()
             },
         ] {

@@ -2,6 +2,8 @@
 
 use glam::Vec3;
 
+use crate::names::name_table;
+
 /// A linear-RGB image, rows from the top.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
@@ -22,6 +24,11 @@ pub enum ToneMap {
     /// Narkowicz's fit of the ACES filmic curve: soft highlights.
     Filmic,
 }
+
+name_table!(ToneMap, "tone map", {
+    ToneMap::Clamp => "clamp",
+    ToneMap::Filmic => "filmic",
+});
 
 impl Film {
     /// A black image.

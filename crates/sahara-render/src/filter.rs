@@ -1,5 +1,7 @@
 //! Pixel reconstruction filters (separable, evaluated in pixel units).
 
+use crate::names::{name_table, Named};
+
 /// A reconstruction filter; pixel estimates are `sum w L / sum w` over the
 /// samples within its radius.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -34,32 +36,71 @@ pub enum Filter {
     },
 }
 
-impl Default for Filter {
-    fn default() -> Self {
-        Filter::Gaussian {
-            radius: 1.5,
-            sigma: 0.5,
+/// The filters by name, without their parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FilterKind {
+    /// [`Filter::Box`].
+    Box,
+    /// [`Filter::Tent`].
+    Tent,
+    /// [`Filter::Gaussian`].
+    Gaussian,
+    /// [`Filter::Mitchell`].
+    Mitchell,
+}
+
+name_table!(FilterKind, "filter", {
+    FilterKind::Box => "box",
+    FilterKind::Tent => "tent",
+    FilterKind::Gaussian => "gaussian",
+    FilterKind::Mitchell => "mitchell",
+});
+
+impl From<FilterKind> for Filter {
+    /// The filter of that kind with its default parameters: a one-pixel
+    /// box (radius 0.5), a tent of radius 1, a Gaussian of radius 1.5 and
+    /// sigma 0.5, Mitchell-Netravali with B = C = 1/3 and radius 2.
+    fn from(kind: FilterKind) -> Self {
+        match kind {
+            FilterKind::Box => Filter::Box { radius: 0.5 },
+            FilterKind::Tent => Filter::Tent { radius: 1.0 },
+            FilterKind::Gaussian => Filter::Gaussian {
+                radius: 1.5,
+                sigma: 0.5,
+            },
+            FilterKind::Mitchell => Filter::Mitchell {
+                radius: 2.0,
+                b: 1.0 / 3.0,
+                c: 1.0 / 3.0,
+            },
         }
     }
 }
 
+impl Default for Filter {
+    fn default() -> Self {
+        FilterKind::Gaussian.into()
+    }
+}
+
 impl Filter {
-    /// A one-pixel box.
-    pub fn box_filter() -> Self {
-        Filter::Box { radius: 0.5 }
+    /// The filter called `name`, with its default parameters.
+    pub fn named(name: &str) -> Result<Self, crate::UnknownName> {
+        FilterKind::from_name(name).map(Self::from)
     }
 
-    /// A tent of radius 1.
-    pub fn tent() -> Self {
-        Filter::Tent { radius: 1.0 }
+    /// The filter's name (its kind's, from the one name table).
+    pub fn name(&self) -> &'static str {
+        self.kind().name()
     }
 
-    /// Mitchell-Netravali with B = C = 1/3 and radius 2.
-    pub fn mitchell() -> Self {
-        Filter::Mitchell {
-            radius: 2.0,
-            b: 1.0 / 3.0,
-            c: 1.0 / 3.0,
+    /// Which filter this is, without its parameters.
+    pub fn kind(&self) -> FilterKind {
+        match self {
+            Filter::Box { .. } => FilterKind::Box,
+            Filter::Tent { .. } => FilterKind::Tent,
+            Filter::Gaussian { .. } => FilterKind::Gaussian,
+            Filter::Mitchell { .. } => FilterKind::Mitchell,
         }
     }
 
@@ -129,7 +170,7 @@ mod tests {
 
     #[test]
     fn mitchell_integrates_to_one_and_vanishes_at_the_edge() {
-        let f = Filter::mitchell();
+        let f = Filter::from(FilterKind::Mitchell);
         let n = 4000;
         let sum: f32 = (0..n)
             .map(|i| f.eval_1d(-2.0 + 4.0 * (i as f32 + 0.5) / n as f32) * 4.0 / n as f32)
@@ -142,7 +183,7 @@ mod tests {
     #[test]
     fn gaussian_and_tent_reach_zero_at_radius() {
         assert_eq!(Filter::default().eval(1.5, 0.0), 0.0);
-        assert_eq!(Filter::tent().eval(0.0, 1.0), 0.0);
-        assert_eq!(Filter::box_filter().eval(0.49, -0.49), 1.0);
+        assert_eq!(Filter::from(FilterKind::Tent).eval(0.0, 1.0), 0.0);
+        assert_eq!(Filter::from(FilterKind::Box).eval(0.49, -0.49), 1.0);
     }
 }

@@ -28,6 +28,7 @@ pub mod integrator;
 pub mod light;
 pub mod material;
 pub mod mesh;
+pub mod names;
 pub mod render;
 pub mod sampler;
 pub mod sampling;
@@ -41,19 +42,20 @@ pub mod world;
 
 pub use camera::Camera;
 pub use film::{Film, ToneMap};
-pub use filter::Filter;
+pub use filter::{Filter, FilterKind};
 pub use instance::{Instance, Placement, Srt};
-pub use integrator::Integrator;
+pub use integrator::{Integrator, IntegratorKind};
 pub use light::{Environment, Light};
 pub use material::{AlphaMode, Bsdf, Material, MaterialTextures};
 pub use mesh::{Mesh, SceneMesh};
+pub use names::{Named, UnknownName};
 pub use render::{
     cost_maps, render, render_watched, CostMaps, Preview, Progress, RenderResult, RenderSettings,
     RenderStats,
 };
 pub use sampler::SamplerKind;
 pub use scene::Scene;
-pub use shape::Shape;
+pub use shape::{Shape, ShapeKind};
 pub use split::PixelWindow;
 pub use sums::{PixelSum, SumBuffer};
 pub use texture::{Texture, TextureMap};

@@ -22,7 +22,7 @@ use crate::film::{heat_color, Film};
 use crate::filter::Filter;
 use crate::hash::hash2;
 use crate::integrator::wavefront::Wavefront;
-use crate::integrator::{Context, Integrator, PathState, TraceStats};
+use crate::integrator::{defaults, Context, Integrator, PathState, TraceStats};
 use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
 use crate::scene::Scene;
 use crate::split::PixelWindow;
@@ -36,12 +36,14 @@ pub struct RenderSettings {
     pub width: u32,
     /// Image height in pixels (the camera's aspect should be width/height).
     pub height: u32,
-    /// Samples per pixel in each pass.
+    /// Samples per pixel of the image.
     pub spp: u32,
-    /// Most passes to render (total samples per pixel: `spp * passes`).
-    pub passes: u32,
-    /// Stop starting passes after this long; a pass under way when it runs
-    /// out is abandoned (the first pass always completes).
+    /// Samples per pixel of each progressive pass (at most `spp`); the last
+    /// pass takes what is left of `spp`.
+    pub pass_spp: u32,
+    /// Stop starting passes after this long, even before `spp` samples; a
+    /// pass under way when it runs out is abandoned (the first pass always
+    /// completes). With a time limit, `spp` can be [`UNLIMITED_SPP`].
     pub time_limit: Option<Duration>,
     /// Set to true (e.g. on Ctrl-C) to stop; the passes completed are kept,
     /// and if the first pass is under way, the pixels it has finished.
@@ -66,9 +68,24 @@ pub struct RenderSettings {
     /// window's sums are those of the whole frame's render over it.
     pub window: Option<PixelWindow>,
     /// The sample indices of every pixel to render, counted over all
-    /// passes: sample `k` is index `k % spp` of pass `k / spp` (None:
-    /// `0..spp * passes`). The passes rendered are those the range meets.
+    /// passes: sample `k` is index `k % pass_spp` of pass `k / pass_spp`
+    /// (None: `0..spp`). The passes rendered are those the range meets.
     pub samples: Option<std::ops::Range<u32>>,
+}
+
+/// The `spp` of a render bounded by its time limit only.
+pub const UNLIMITED_SPP: u32 = u32::MAX;
+
+impl RenderSettings {
+    /// Samples per pixel of each pass: `pass_spp`, at least 1, at most `spp`.
+    pub fn pass_size(&self) -> u32 {
+        self.pass_spp.clamp(1, self.spp.max(1))
+    }
+
+    /// The most passes the render takes: `spp` in passes of [`Self::pass_size`].
+    pub fn passes(&self) -> u32 {
+        self.spp.max(1).div_ceil(self.pass_size())
+    }
 }
 
 impl Default for RenderSettings {
@@ -76,8 +93,8 @@ impl Default for RenderSettings {
         Self {
             width: 512,
             height: 512,
-            spp: 16,
-            passes: 1,
+            spp: defaults::SPP,
+            pass_spp: defaults::PASS_SPP,
             time_limit: None,
             cancel: None,
             seed: 0,
@@ -98,7 +115,8 @@ impl Default for RenderSettings {
 pub struct Progress {
     /// Current pass (0-based).
     pub pass: u32,
-    /// Most passes.
+    /// Most passes (when only a time limit bounds the render, those of
+    /// [`UNLIMITED_SPP`]).
     pub passes: u32,
     /// Tiles finished in this pass.
     pub tiles_done: u32,
@@ -236,10 +254,7 @@ pub fn render_watched(
     let start = Instant::now();
     let mut world = World::new(scene, &settings.build);
     let (w, h) = (settings.width.max(1), settings.height.max(1));
-    world.set_film(
-        h,
-        u64::from(settings.spp) * u64::from(settings.passes.max(1)),
-    );
+    world.set_film(h, u64::from(settings.spp.max(1)));
     let build_time = start.elapsed();
     let window = settings
         .window
@@ -273,11 +288,10 @@ pub fn render_watched(
             .is_some_and(|c| c.load(Ordering::Relaxed))
     };
     let out_of_time = || settings.time_limit.is_some_and(|t| start.elapsed() >= t);
-    let spp = settings.spp.max(1);
-    let all_passes = settings.passes.max(1);
+    let spp = settings.pass_size();
     // The passes the sample range meets, and the range within each.
     let (first_pass, passes, first, last) = match &settings.samples {
-        None => (0, all_passes, 0u64, u64::from(all_passes) * u64::from(spp)),
+        None => (0, settings.passes(), 0u64, u64::from(settings.spp.max(1))),
         Some(r) if r.start >= r.end => (0, 0, 0, 0),
         Some(r) => (
             r.start / spp,
@@ -566,7 +580,7 @@ impl Strip {
         let (w, h) = (s.width.max(1), s.height.max(1));
         let camera = &world.scene.camera;
         let inv = Vec2::new(1.0 / w as f32, 1.0 / h as f32);
-        let spp = s.spp;
+        let spp = s.pass_size();
         let per_pixel = indices.len() as u32;
         let n = ((x1 - x0) * (y1 - y0) * per_pixel) as usize;
         self.pos.clear();

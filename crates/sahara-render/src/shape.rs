@@ -6,6 +6,7 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
 use crate::mesh::{Mesh, SceneMesh};
+use crate::names::name_table;
 use crate::sampling::Frame;
 
 /// Segments of a tessellated disc's rim.
@@ -51,7 +52,37 @@ pub enum Shape {
     },
 }
 
+/// The built-in shapes by name, without their parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ShapeKind {
+    /// [`Shape::Quad`].
+    Quad,
+    /// [`Shape::Disc`].
+    Disc,
+    /// [`Shape::Sphere`].
+    Sphere,
+    /// [`Shape::Box`].
+    Box,
+}
+
+name_table!(ShapeKind, "shape", {
+    ShapeKind::Quad => "quad",
+    ShapeKind::Disc => "disc",
+    ShapeKind::Sphere => "sphere",
+    ShapeKind::Box => "box",
+});
+
 impl Shape {
+    /// Which shape this is, without its parameters.
+    pub fn kind(&self) -> ShapeKind {
+        match self {
+            Shape::Quad { .. } => ShapeKind::Quad,
+            Shape::Disc { .. } => ShapeKind::Disc,
+            Shape::Sphere { .. } => ShapeKind::Sphere,
+            Shape::Box { .. } => ShapeKind::Box,
+        }
+    }
+
     /// Surface area of the exact shape.
     pub fn area(&self) -> f32 {
         match *self {

@@ -11,8 +11,8 @@ use common::{run, settings};
 use glam::{Affine3A, Quat, Vec3};
 use sahara_render::world::World;
 use sahara_render::{
-    builtin, render, Camera, Environment, Filter, Instance, Integrator, Light, Material,
-    SamplerKind, Scene, Shape, Srt, Texture,
+    builtin, render, Camera, Environment, Filter, FilterKind, Instance, Integrator, Light,
+    Material, SamplerKind, Scene, Shape, Srt, Texture,
 };
 
 fn render_in_pool(threads: usize, scene: &Scene, s: &sahara_render::RenderSettings) -> Vec<u32> {
@@ -39,9 +39,9 @@ fn same_seed_same_bits_whatever_the_thread_count() {
         let mut s = settings(24, 24, 4, Integrator::default());
         s.sampler = sampler;
         // A filter wider than a pixel and small tiles: samples cross tiles.
-        s.filter = Filter::mitchell();
+        s.filter = Filter::from(FilterKind::Mitchell);
         s.tile_size = 5;
-        s.passes = 2;
+        s.spp *= 2;
         let one = render_in_pool(1, &scene, &s);
         let two = render_in_pool(2, &scene, &s);
         assert!(
@@ -201,9 +201,9 @@ fn no_nan_or_negative_anywhere() {
     });
     scene.validate().unwrap();
     for integrator in ["path", "distribution", "normals", "depth", "ao", "cost"] {
-        let integrator = Integrator::from_name(integrator).unwrap();
+        let integrator = Integrator::named(integrator).unwrap();
         let mut s = settings(30, 20, 8, integrator);
-        s.filter = Filter::mitchell();
+        s.filter = Filter::from(FilterKind::Mitchell);
         let r = run(&scene, &s);
         let mean = r.film.mean(0, 0, 30, 20);
         assert!(mean.max_element() > 0.0, "{integrator:?}: black image");
@@ -224,7 +224,7 @@ fn no_nan_or_negative_anywhere() {
 fn passes_stop_on_cancel_and_time_limit() {
     let scene = builtin::cornell_box();
     let mut s = settings(16, 16, 1, Integrator::default());
-    s.passes = 1_000_000;
+    s.spp *= 1_000_000;
     s.time_limit = Some(Duration::from_millis(150));
     let r = render(&scene, &s, &|_| {});
     assert!(r.stats.stopped_early && r.stats.passes >= 1 && r.stats.passes < 1_000_000);
@@ -241,7 +241,7 @@ fn passes_stop_on_cancel_and_time_limit() {
     // Progress reports every tile of every pass.
     let count = std::sync::atomic::AtomicU32::new(0);
     let mut s = settings(16, 16, 1, Integrator::default());
-    s.passes = 3;
+    s.spp *= 3;
     s.tile_size = 8;
     render(&scene, &s, &|p| {
         assert!(p.tiles_done <= p.tiles && p.pass < 3);
@@ -296,7 +296,7 @@ fn an_interrupted_first_pass_keeps_the_pixels_it_finished() {
     let mut s = settings(16, 16, 8, Integrator::default());
     // A box filter: each pixel only gets its own samples, so a finished
     // pixel is the same whether its neighbours were rendered or not.
-    s.filter = Filter::box_filter();
+    s.filter = Filter::from(FilterKind::Box);
     s.tile_size = 4;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -309,7 +309,7 @@ fn an_interrupted_first_pass_keeps_the_pixels_it_finished() {
     // so exactly the first two tiles (the top-left 8x4 pixels) are done.
     let cancel = Arc::new(AtomicBool::new(false));
     s.cancel = Some(cancel.clone());
-    s.passes = 3;
+    s.spp *= 3;
     let r = pool.install(|| {
         render(&scene, &s, &|p| {
             if p.tiles_done == 2 {
@@ -345,7 +345,7 @@ fn an_interrupted_first_pass_keeps_the_pixels_it_finished() {
 fn previews_come_between_passes_and_leave_the_image_unchanged() {
     let scene = builtin::cornell_box();
     let mut s = settings(12, 12, 1, Integrator::default());
-    s.passes = 4;
+    s.spp *= 4;
     let plain = render(&scene, &s, &|_| {});
     let mut seen = Vec::new();
     let watched = sahara_render::render_watched(

@@ -5,8 +5,8 @@ use glam::Vec3;
 use proptest::prelude::*;
 use sahara_render::split::{tile, PixelWindow};
 use sahara_render::{
-    builtin, render, Filter, Integrator, Material, RenderSettings, SamplerKind, Scene, Shape,
-    SumBuffer,
+    builtin, render, Filter, FilterKind, Integrator, Material, RenderSettings, SamplerKind, Scene,
+    Shape, SumBuffer,
 };
 
 /// The Cornell box with one more sphere of a chosen material.
@@ -32,19 +32,19 @@ fn scene(material: u8, centre: (f32, f32), radius: f32) -> Scene {
 fn integrator(i: u8) -> Integrator {
     match i % 5 {
         0 => Integrator::default(),
-        1 => Integrator::from_name("distribution").unwrap(),
-        2 => Integrator::from_name("ao").unwrap(),
-        3 => Integrator::from_name("normals").unwrap(),
-        _ => Integrator::from_name("cost").unwrap(),
+        1 => Integrator::named("distribution").unwrap(),
+        2 => Integrator::named("ao").unwrap(),
+        3 => Integrator::named("normals").unwrap(),
+        _ => Integrator::named("cost").unwrap(),
     }
 }
 
 fn filter(f: u8) -> Filter {
     match f % 4 {
-        0 => Filter::box_filter(),
-        1 => Filter::tent(),
+        0 => Filter::from(FilterKind::Box),
+        1 => Filter::from(FilterKind::Tent),
         2 => Filter::default(),
-        _ => Filter::mitchell(),
+        _ => Filter::from(FilterKind::Mitchell),
     }
 }
 
@@ -74,8 +74,8 @@ proptest! {
         let settings = RenderSettings {
             width: w,
             height: h,
-            spp: pass_spp,
-            passes: spp_total.div_ceil(pass_spp),
+            spp: spp_total,
+            pass_spp,
             seed,
             sampler: sampler(samp),
             filter: filter(filt),
@@ -83,7 +83,7 @@ proptest! {
             tile_size: 8,
             ..Default::default()
         };
-        let total = settings.spp * settings.passes;
+        let total = settings.spp;
         let whole = render(&scene, &settings, &|_| {});
         // Sample ranges at random cut points (some empty).
         let mut bounds: Vec<u32> = cuts.iter().map(|c| (c * total as f64) as u32).collect();

@@ -2,10 +2,14 @@
 
 use std::path::PathBuf;
 
+use std::marker::PhantomData;
+
+use clap::builder::{PossibleValue, StringValueParser, TypedValueParser};
 use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
 use sahara_bench::SetKind;
 use sahara_kd::{BuildParams, Builder};
 use sahara_render::mesh::Mesh;
+use sahara_render::{FilterKind, IntegratorKind, Named, SamplerKind, ToneMap};
 
 /// Default timed runs per set.
 pub const DEFAULT_RUNS: usize = 3;
@@ -80,8 +84,8 @@ pub struct RenderArgs {
     /// working folder].
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
-    /// Samples per pixel in all (or per pass with --time-limit) [default:
-    /// the scene file's, else 64].
+    /// Samples per pixel: exactly this many, the last pass shorter if need
+    /// be [default: the scene file's, else 64; with --time-limit, no cap].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
     pub spp: Option<u32>,
     /// Samples per pixel in each progressive pass [default: min(spp, 8)].
@@ -93,18 +97,18 @@ pub struct RenderArgs {
     /// Image height in pixels [default: the scene file's, else 512].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub height: Option<u32>,
-    /// Light transport: path, distribution, normals, depth, ao, cost
-    /// [default: the scene file's, else path].
-    #[arg(long, value_name = "NAME")]
-    pub integrator: Option<String>,
-    /// Sample generator: independent, stratified, sobol [default: the scene
-    /// file's, else sobol].
-    #[arg(long, value_name = "NAME")]
-    pub sampler: Option<String>,
-    /// Reconstruction filter: box, tent, gaussian, mitchell [default: the
-    /// scene file's, else gaussian].
-    #[arg(long, value_name = "NAME")]
-    pub filter: Option<String>,
+    /// Light transport, with its default parameters (or the scene file's,
+    /// if it names the same one) [default: the scene file's, else path].
+    #[arg(long, value_name = "NAME", value_parser = NameParser::<IntegratorKind>::new())]
+    pub integrator: Option<IntegratorKind>,
+    /// Sample generator [default: the scene file's, else sobol].
+    #[arg(long, value_name = "NAME", value_parser = NameParser::<SamplerKind>::new())]
+    pub sampler: Option<SamplerKind>,
+    /// Reconstruction filter, with its default parameters (or the scene
+    /// file's, if it names the same one) [default: the scene file's, else
+    /// gaussian].
+    #[arg(long, value_name = "NAME", value_parser = NameParser::<FilterKind>::new())]
+    pub filter: Option<FilterKind>,
     /// Rendering threads [default: all hardware threads].
     #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
     pub threads: Option<u16>,
@@ -113,7 +117,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub seed: Option<u64>,
     /// Render progressive passes until this many seconds have passed (for
-    /// equal-time comparisons); --spp is then the samples of each pass.
+    /// equal-time comparisons), or until --spp samples if it is given.
     #[arg(long, value_name = "SECS")]
     pub time_limit: Option<f64>,
     /// The camera of a mesh (or the built-in scene): a sidecar JSON file,
@@ -141,10 +145,9 @@ pub struct RenderArgs {
     /// Exposure in stops, for PNG output [default: the scene file's, else 0].
     #[arg(long, allow_negative_numbers = true)]
     pub exposure: Option<f32>,
-    /// Tone map for PNG output: clamp or filmic [default: the scene file's,
-    /// else clamp].
-    #[arg(long, value_name = "NAME")]
-    pub tonemap: Option<String>,
+    /// Tone map for PNG output [default: the scene file's, else clamp].
+    #[arg(long, value_name = "NAME", value_parser = NameParser::<ToneMap>::new())]
+    pub tonemap: Option<ToneMap>,
     /// Render part I (0-based) of N of the frame, divided as --split says,
     /// and write it as a part file (.exr) for `sahara merge`.
     #[arg(long, value_name = "I/N", value_parser = parse_part)]
@@ -167,6 +170,39 @@ pub struct RenderArgs {
     /// complete, do not render it again (for retried farm tasks).
     #[arg(long)]
     pub skip_existing: bool,
+}
+
+/// Parses a setting through the renderer's name table, so `--help` lists
+/// the names and a wrong one is refused with them.
+#[derive(Clone, Copy)]
+pub struct NameParser<T>(PhantomData<T>);
+
+impl<T> NameParser<T> {
+    /// The parser of `T`'s names.
+    pub fn new() -> Self {
+        NameParser(PhantomData)
+    }
+}
+
+impl<T: Named + Send + Sync> TypedValueParser for NameParser<T> {
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<T, clap::Error> {
+        StringValueParser::new()
+            .try_map(|name| T::from_name(&name))
+            .parse_ref(cmd, arg, value)
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        Some(Box::new(
+            T::ALL.iter().map(|v| PossibleValue::new(v.name())),
+        ))
+    }
 }
 
 /// `I/N` with I < N.

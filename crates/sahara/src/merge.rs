@@ -17,7 +17,7 @@ use sahara_formats::image_out::ImageFormat;
 use sahara_formats::part_file::{read_part, read_part_info, PartInfo};
 use sahara_render::split::{tile, PixelWindow};
 use sahara_render::{
-    cost_maps, Film, Integrator, RenderResult, RenderSettings, RenderStats, SumBuffer, ToneMap,
+    cost_maps, Film, Integrator, RenderResult, RenderSettings, RenderStats, SumBuffer,
 };
 
 use crate::cli::MergeArgs;
@@ -110,18 +110,9 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         }
     }
 
-    let integrator = Integrator::from_name(&first.integrator).ok_or_else(|| {
-        anyhow!(
-            "{}: unknown integrator {:?}",
-            first_path.display(),
-            first.integrator
-        )
-    })?;
+    let integrator = Integrator::from(first.integrator);
     let cost = matches!(integrator, Integrator::Cost).then(|| cost_maps(&mut film, None));
-    let tonemap = match first.tonemap.as_str() {
-        "filmic" => ToneMap::Filmic,
-        _ => ToneMap::Clamp,
-    };
+    let tonemap = first.tonemap;
     let settings = RenderSettings {
         width: w,
         height: h,

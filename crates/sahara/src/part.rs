@@ -43,7 +43,7 @@ pub fn plan(
         bail!("--preview-every does not apply to a part");
     }
     let (w, h) = (settings.width, settings.height);
-    let total = settings.spp * settings.passes;
+    let total = settings.spp;
     let mut window = match args.crop {
         Some(f) => crop(w, h, f),
         None => file_window.unwrap_or_else(|| PixelWindow::full(w, h)),
@@ -135,19 +135,16 @@ pub fn write(
         digest: record.digest.to_string(),
         width: settings.width,
         height: settings.height,
-        spp: settings.spp * settings.passes,
+        spp: settings.spp,
         window: piece.window,
         samples: piece.samples.clone(),
         samples_done: done.clone(),
         complete: !record.interrupted && done == piece.samples,
         part: piece.label.clone(),
-        integrator: settings.integrator.name().to_string(),
+        integrator: settings.integrator.kind(),
         seed: settings.seed,
         exposure: record.exposure,
-        tonemap: match record.tonemap {
-            ToneMap::Clamp => "clamp".into(),
-            ToneMap::Filmic => "filmic".into(),
-        },
+        tonemap: record.tonemap,
         stats: vec![
             ("passes".into(), s.passes.to_string()),
             ("rays".into(), s.rays().to_string()),

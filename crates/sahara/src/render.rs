@@ -12,6 +12,7 @@ use sahara_formats::image_out::{write_image, Pixels};
 use sahara_formats::mesh_scene::{load_mesh_scene_with, CameraChoice};
 use sahara_formats::scene_load::{load_scene_with_sky, FileSettings};
 use sahara_formats::sky::Sky;
+use sahara_render::render::UNLIMITED_SPP;
 use sahara_render::{
     builtin, render_watched, Camera, Integrator, Preview, Progress, RenderResult, RenderSettings,
     Scene, ToneMap,
@@ -54,7 +55,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     crate::warnings::print(&warnings);
     let RenderOptions {
         mut settings,
-        sampler_name,
         exposure,
         tonemap,
         output,
@@ -162,27 +162,29 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         );
     }
     eprintln!(
-        "rendering {description} at {}x{}, {} ({sampler_name}), {} spp in passes of {}, {} threads",
+        "rendering {description} at {}x{}, {} ({}), {} spp in passes of {}, {} threads",
         settings.width,
         settings.height,
         settings.integrator.name(),
-        if args.time_limit.is_some() {
+        settings.sampler,
+        if settings.spp == UNLIMITED_SPP {
             "unlimited".to_string()
         } else {
-            (settings.spp * settings.passes).to_string()
+            settings.spp.to_string()
         },
-        settings.spp,
+        settings.pass_size(),
         pool.current_num_threads()
     );
     // Started after the line above, so that it does not draw over it.
     let bar = progress_bar(&settings);
+    let unlimited = settings.spp == UNLIMITED_SPP;
     let on_progress = |p: Progress| {
-        if p.passes != u32::MAX {
+        if !unlimited {
             bar.set_length(u64::from(p.passes) * u64::from(p.tiles));
         }
         bar.set_position((p.pass as u64) * p.tiles as u64 + p.tiles_done as u64);
         let mrays = p.rays as f64 / p.elapsed.as_secs_f64().max(1e-9) / 1e6;
-        let of = if p.passes == u32::MAX {
+        let of = if unlimited {
             String::new()
         } else {
             format!("/{}", p.passes)
@@ -422,7 +424,7 @@ fn progress_bar(settings: &RenderSettings) -> ProgressBar {
         (None, "{spinner} {elapsed_precise} {msg} tiles {pos}")
     } else {
         (
-            Some(u64::from(settings.passes.max(1)) * tiles),
+            Some(u64::from(settings.passes()) * tiles),
             "{wide_bar} {percent:>3}% {msg} {elapsed_precise} eta {eta_precise}",
         )
     };

@@ -383,6 +383,39 @@ fn the_command_line_and_scene_files_share_their_defaults() {
 }
 
 #[test]
+fn spp_is_the_samples_per_pixel_rendered_whatever_the_pass_size() {
+    let dir = temp_dir("exact-spp");
+    for (spp, pass, passes) in [("10", "8", 2), ("10", "4", 3), ("5", "8", 1)] {
+        let out = dir.join(format!("s{spp}-{pass}.exr"));
+        let o = sahara(&[
+            "render",
+            "--width",
+            "8",
+            "--height",
+            "6",
+            "--spp",
+            spp,
+            "--pass-spp",
+            pass,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let log = stderr(&o);
+        assert!(o.status.success(), "{log}");
+        let pass_size = pass.parse::<u32>().unwrap().min(spp.parse().unwrap());
+        assert!(
+            log.contains(&format!(", {spp} spp in passes of {pass_size},")),
+            "{log}"
+        );
+        assert!(
+            log.contains(&format!(": {passes} passes, {spp} spp,")),
+            "{log}"
+        );
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_path_without_a_usable_extension_says_what_it_is() {
     let dir = temp_dir("no-ext");
     let bare = dir.join("scene");

@@ -28,7 +28,7 @@ fn exr_text(path: &std::path::Path, key: &str) -> Option<String> {
 /// Starts an open-ended render of the built-in scene into `out`, waits until
 /// it has rendered for `after`, sends `signal` and returns (exit code, stderr).
 fn interrupt(out: &std::path::Path, signal: &str, after: Duration) -> (Option<i32>, String) {
-    let args = ["--width", "24", "--height", "16", "--spp", "1"];
+    let args = ["--width", "24", "--height", "16", "--pass-spp", "1"];
     interrupt_render(
         &[&args[..], &["--time-limit", "600"]].concat(),
         out,

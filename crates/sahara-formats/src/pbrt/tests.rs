@@ -352,7 +352,7 @@ fn image(scene: &Scene, spp: u32) -> Vec<Vec3> {
         width: 24,
         height: 24,
         spp,
-        passes: 1,
+        pass_spp: spp,
         ..RenderSettings::default()
     };
     let mut scene = scene.clone();

@@ -5,7 +5,10 @@
 //! keys depend on a `type` (materials, objects, lights) list the union of
 //! all types' keys; which apply to which type is checked in `resolve`.
 
-use serde::Deserialize;
+use std::fmt;
+
+use sahara_render::{FilterKind, IntegratorKind, Named, SamplerKind, ShapeKind, ToneMap};
+use serde::{de, Deserialize, Deserializer};
 use toml::Spanned;
 
 /// An optional value with its position in the file.
@@ -97,15 +100,52 @@ pub(super) enum AlphaModeName {
     Blend,
 }
 
-/// Shape kinds (`type` of an `[[object]]`, `shape` of an area light).
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
+/// A setting's value read by its name in the renderer's name table, so an
+/// unknown name is an error at its place that lists the names there are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) struct Name<T>(pub T);
+
+impl<'de, T: Named> Deserialize<'de> for Name<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        T::from_name(&name).map(Name).map_err(de::Error::custom)
+    }
+}
+
+/// What an `[[object]]` is (`type`), and an area light's `shape`: a mesh
+/// file or one of the renderer's built-in shapes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum ShapeType {
     Mesh,
-    Quad,
-    Disc,
-    Sphere,
-    Box,
+    Builtin(ShapeKind),
+}
+
+impl<'de> Deserialize<'de> for ShapeType {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        if name == "mesh" {
+            return Ok(ShapeType::Mesh);
+        }
+        ShapeKind::from_name(&name)
+            .map(ShapeType::Builtin)
+            .map_err(|_| {
+                let mut names = vec!["mesh"];
+                names.extend(ShapeKind::names());
+                de::Error::custom(format!(
+                    "unknown shape '{name}'; expected {}",
+                    sahara_render::names::one_of(&names)
+                ))
+            })
+    }
+}
+
+impl fmt::Display for ShapeType {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ShapeType::Mesh => f.write_str("mesh"),
+            ShapeType::Builtin(kind) => kind.fmt(f),
+        }
+    }
 }
 
 /// `[[object]]`.
@@ -199,23 +239,11 @@ pub(super) struct RawLight {
     pub material: Opt<String>,
 }
 
-/// Integrator names.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub(super) enum IntegratorName {
-    Distribution,
-    Path,
-    Normals,
-    Depth,
-    Ao,
-    Cost,
-}
-
 /// `[integrator]`.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawIntegrator {
-    pub name: Spanned<IntegratorName>,
+    pub name: Spanned<Name<IntegratorKind>>,
     pub max_depth: Opt<i64>,
     pub rr_depth: Opt<i64>,
     pub light_samples: Opt<i64>,
@@ -223,51 +251,24 @@ pub(super) struct RawIntegrator {
     pub distance: Opt<f32>,
 }
 
-/// Sampler names.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub(super) enum SamplerName {
-    Independent,
-    Stratified,
-    Sobol,
-}
-
 /// `[sampler]`.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawSampler {
-    pub name: Opt<SamplerName>,
+    pub name: Opt<Name<SamplerKind>>,
     pub spp: Opt<i64>,
     pub seed: Opt<i64>,
-}
-
-/// Filter names.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub(super) enum FilterName {
-    Box,
-    Tent,
-    Gaussian,
-    Mitchell,
 }
 
 /// `[filter]`.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RawFilter {
-    pub name: Spanned<FilterName>,
+    pub name: Spanned<Name<FilterKind>>,
     pub radius: Opt<f32>,
     pub sigma: Opt<f32>,
     pub b: Opt<f32>,
     pub c: Opt<f32>,
-}
-
-/// Tone mapping curves.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub(super) enum ToneMapName {
-    Clamp,
-    Filmic,
 }
 
 /// `[film]`.
@@ -277,6 +278,6 @@ pub(super) struct RawFilm {
     pub width: Spanned<i64>,
     pub height: Spanned<i64>,
     pub exposure: Opt<f32>,
-    pub tonemap: Opt<ToneMapName>,
+    pub tonemap: Opt<Name<ToneMap>>,
     pub output: Opt<String>,
 }

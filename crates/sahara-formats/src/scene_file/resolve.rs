@@ -6,6 +6,9 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use sahara_render::integrator::defaults;
+use sahara_render::{
+    Filter, FilterKind, Integrator, IntegratorKind, SamplerKind, Shape, ShapeKind, ToneMap,
+};
 use toml::Spanned;
 
 use super::raw::*;
@@ -76,25 +79,19 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
         lights,
         integrator: match &raw.integrator {
             Some(i) => ctx.integrator(i.get_ref())?,
-            None => IntegratorSpec::Path {
-                max_depth: defaults::MAX_DEPTH,
-                rr_depth: defaults::RR_DEPTH,
-            },
+            None => Integrator::default(),
         },
         sampler: match &raw.sampler {
             Some(s) => ctx.sampler(s.get_ref())?,
             None => SamplerSpec {
-                kind: SamplerKind::Sobol,
+                kind: SamplerKind::default(),
                 spp: defaults::SPP,
                 seed: 0,
             },
         },
         filter: match &raw.filter {
             Some(f) => ctx.filter(f.get_ref())?,
-            None => FilterSpec::Gaussian {
-                radius: 1.5,
-                sigma: 0.5,
-            },
+            None => Filter::default(),
         },
         film: ctx.film(film.get_ref())?,
     })
@@ -582,7 +579,7 @@ impl Ctx<'_> {
             *o.kind.get_ref(),
             &raw.span(),
             &keys,
-            &format!("a {} object", type_name(&o.kind)),
+            &format!("a {} object", o.kind.get_ref()),
         )?;
         if let Some(m) = &o.material {
             if !materials.contains(m.get_ref().as_str()) {
@@ -623,10 +620,10 @@ impl Ctx<'_> {
     ) -> Result<ShapeSpec, FormatError> {
         let allowed: &[&str] = match kind {
             ShapeType::Mesh => &["file"],
-            ShapeType::Quad => &["corner", "edge_u", "edge_v"],
-            ShapeType::Disc => &["center", "normal", "radius"],
-            ShapeType::Sphere => &["center", "radius"],
-            ShapeType::Box => &["min", "max"],
+            ShapeType::Builtin(ShapeKind::Quad) => &["corner", "edge_u", "edge_v"],
+            ShapeType::Builtin(ShapeKind::Disc) => &["center", "normal", "radius"],
+            ShapeType::Builtin(ShapeKind::Sphere) => &["center", "radius"],
+            ShapeType::Builtin(ShapeKind::Box) => &["min", "max"],
         };
         let present = [
             ("file", span(k.file)),
@@ -669,7 +666,7 @@ impl Ctx<'_> {
                 }
                 ShapeSpec::Mesh { path }
             }
-            ShapeType::Quad => {
+            ShapeType::Builtin(ShapeKind::Quad) => {
                 let corner = self.vec(self.required(k.corner, "corner", entry, what)?, "corner")?;
                 let edge_u =
                     self.direction(self.required(k.edge_u, "edge_u", entry, what)?, "edge_u")?;
@@ -681,23 +678,24 @@ impl Ctx<'_> {
                         "`edge_v` is parallel to `edge_u`: the quad has no area",
                     ));
                 }
-                ShapeSpec::Quad {
+                ShapeSpec::Builtin(Shape::Quad {
                     corner,
                     edge_u,
                     edge_v,
-                }
+                })
             }
-            ShapeType::Disc => ShapeSpec::Disc {
+            ShapeType::Builtin(ShapeKind::Disc) => ShapeSpec::Builtin(Shape::Disc {
                 center: self.vec(self.required(k.center, "center", entry, what)?, "center")?,
                 normal: self
-                    .direction(self.required(k.normal, "normal", entry, what)?, "normal")?,
+                    .direction(self.required(k.normal, "normal", entry, what)?, "normal")?
+                    .normalize(),
                 radius: radius()?,
-            },
-            ShapeType::Sphere => ShapeSpec::Sphere {
+            }),
+            ShapeType::Builtin(ShapeKind::Sphere) => ShapeSpec::Builtin(Shape::Sphere {
                 center: self.vec(self.required(k.center, "center", entry, what)?, "center")?,
                 radius: radius()?,
-            },
-            ShapeType::Box => {
+            }),
+            ShapeType::Builtin(ShapeKind::Box) => {
                 let min = self.vec(self.required(k.min, "min", entry, what)?, "min")?;
                 let max_raw = self.required(k.max, "max", entry, what)?;
                 let max = self.vec(max_raw, "max")?;
@@ -707,7 +705,7 @@ impl Ctx<'_> {
                         format!("box max {max} must exceed min {min} on every axis"),
                     ));
                 }
-                ShapeSpec::Box { min, max }
+                ShapeSpec::Builtin(Shape::Box { min, max })
             }
         })
     }
@@ -849,7 +847,7 @@ impl Ctx<'_> {
             },
             LightType::Area => {
                 let kind = self.required(&l.shape, "shape", &entry, &what)?;
-                if matches!(kind.get_ref(), ShapeType::Mesh | ShapeType::Box) {
+                if matches!(kind.get_ref(), ShapeType::Mesh | ShapeType::Builtin(ShapeKind::Box)) {
                     return Err(self.at(kind.span(), "an area light's shape is quad, disc or sphere (for an emitting mesh, give the object an emission material)"));
                 }
                 let keys = ShapeKeys {
@@ -869,7 +867,7 @@ impl Ctx<'_> {
                     }
                 }
                 LightSpec::Area {
-                    shape: self.shape(*kind.get_ref(), &entry, &keys, &format!("{what} ({})", type_name(kind)))?,
+                    shape: self.shape(*kind.get_ref(), &entry, &keys, &format!("{what} ({})", kind.get_ref()))?,
                     radiance: need_power(&l.radiance, "radiance")?,
                     two_sided: l.two_sided.as_ref().is_some_and(|b| *b.get_ref()),
                     material: l.material.as_ref().map(|m| m.get_ref().clone()),
@@ -902,8 +900,9 @@ impl Ctx<'_> {
     }
 
     /// `[integrator]`.
-    fn integrator(&self, i: &RawIntegrator) -> Result<IntegratorSpec, FormatError> {
-        let what = format!("the {} integrator", type_name(&i.name));
+    fn integrator(&self, i: &RawIntegrator) -> Result<Integrator, FormatError> {
+        let kind = i.name.get_ref().0;
+        let what = format!("the {kind} integrator");
         let present = [
             ("max_depth", span(&i.max_depth)),
             ("rr_depth", span(&i.rr_depth)),
@@ -911,15 +910,15 @@ impl Ctx<'_> {
             ("samples", span(&i.samples)),
             ("distance", span(&i.distance)),
         ];
-        let allowed: &[&str] = match i.name.get_ref() {
-            IntegratorName::Distribution => &["max_depth", "light_samples"],
-            IntegratorName::Path => &["max_depth", "rr_depth"],
-            IntegratorName::Ao => &["samples", "distance"],
-            _ => &[],
+        let allowed: &[&str] = match kind {
+            IntegratorKind::Distribution => &["max_depth", "light_samples"],
+            IntegratorKind::Path => &["max_depth", "rr_depth"],
+            IntegratorKind::Ao => &["samples", "distance"],
+            IntegratorKind::Normals | IntegratorKind::Depth | IntegratorKind::Cost => &[],
         };
         self.only(&present, allowed, &what)?;
-        Ok(match i.name.get_ref() {
-            IntegratorName::Distribution => IntegratorSpec::Distribution {
+        Ok(match kind {
+            IntegratorKind::Distribution => Integrator::Distribution {
                 max_depth: self.count(&i.max_depth, "max_depth", defaults::MAX_DEPTH, 1)?,
                 light_samples: self.count(
                     &i.light_samples,
@@ -928,13 +927,13 @@ impl Ctx<'_> {
                     1,
                 )?,
             },
-            IntegratorName::Path => IntegratorSpec::Path {
+            IntegratorKind::Path => Integrator::Path {
                 max_depth: self.count(&i.max_depth, "max_depth", defaults::MAX_DEPTH, 1)?,
                 rr_depth: self.count(&i.rr_depth, "rr_depth", defaults::RR_DEPTH, 0)?,
             },
-            IntegratorName::Normals => IntegratorSpec::Normals,
-            IntegratorName::Depth => IntegratorSpec::Depth,
-            IntegratorName::Ao => IntegratorSpec::Ao {
+            IntegratorKind::Normals => Integrator::Normals,
+            IntegratorKind::Depth => Integrator::Depth,
+            IntegratorKind::Ao => Integrator::Ao {
                 samples: self.count(&i.samples, "samples", defaults::AO_SAMPLES, 1)?,
                 distance: self.number(
                     &i.distance,
@@ -944,7 +943,7 @@ impl Ctx<'_> {
                     "at least 0",
                 )?,
             },
-            IntegratorName::Cost => IntegratorSpec::Cost,
+            IntegratorKind::Cost => Integrator::Cost,
         })
     }
 
@@ -961,48 +960,45 @@ impl Ctx<'_> {
             }
         };
         Ok(SamplerSpec {
-            kind: match s.name.as_ref().map(|n| *n.get_ref()) {
-                None | Some(SamplerName::Sobol) => SamplerKind::Sobol,
-                Some(SamplerName::Independent) => SamplerKind::Independent,
-                Some(SamplerName::Stratified) => SamplerKind::Stratified,
-            },
+            kind: s
+                .name
+                .as_ref()
+                .map_or_else(SamplerKind::default, |n| n.get_ref().0),
             spp: self.count(&s.spp, "spp", defaults::SPP, 1)?,
             seed,
         })
     }
 
     /// `[filter]`.
-    fn filter(&self, f: &RawFilter) -> Result<FilterSpec, FormatError> {
-        let what = format!("the {} filter", type_name(&f.name));
+    fn filter(&self, f: &RawFilter) -> Result<Filter, FormatError> {
+        let kind = f.name.get_ref().0;
+        let what = format!("the {kind} filter");
         let present = [
             ("radius", span(&f.radius)),
             ("sigma", span(&f.sigma)),
             ("b", span(&f.b)),
             ("c", span(&f.c)),
         ];
-        let allowed: &[&str] = match f.name.get_ref() {
-            FilterName::Box | FilterName::Tent => &["radius"],
-            FilterName::Gaussian => &["radius", "sigma"],
-            FilterName::Mitchell => &["radius", "b", "c"],
+        let allowed: &[&str] = match kind {
+            FilterKind::Box | FilterKind::Tent => &["radius"],
+            FilterKind::Gaussian => &["radius", "sigma"],
+            FilterKind::Mitchell => &["radius", "b", "c"],
         };
         self.only(&present, allowed, &what)?;
+        // Every key defaults to the renderer's default for the kind.
         let radius =
             |default| self.number(&f.radius, "radius", default, |r| r > 0.0, "greater than 0");
-        Ok(match f.name.get_ref() {
-            FilterName::Box => FilterSpec::Box {
-                radius: radius(0.5)?,
+        Ok(match Filter::from(kind) {
+            Filter::Box { radius: r } => Filter::Box { radius: radius(r)? },
+            Filter::Tent { radius: r } => Filter::Tent { radius: radius(r)? },
+            Filter::Gaussian { radius: r, sigma } => Filter::Gaussian {
+                radius: radius(r)?,
+                sigma: self.number(&f.sigma, "sigma", sigma, |s| s > 0.0, "greater than 0")?,
             },
-            FilterName::Tent => FilterSpec::Tent {
-                radius: radius(1.0)?,
-            },
-            FilterName::Gaussian => FilterSpec::Gaussian {
-                radius: radius(1.5)?,
-                sigma: self.number(&f.sigma, "sigma", 0.5, |s| s > 0.0, "greater than 0")?,
-            },
-            FilterName::Mitchell => FilterSpec::Mitchell {
-                radius: radius(2.0)?,
-                b: self.number(&f.b, "b", 1.0 / 3.0, |_| true, "finite")?,
-                c: self.number(&f.c, "c", 1.0 / 3.0, |_| true, "finite")?,
+            Filter::Mitchell { radius: r, b, c } => Filter::Mitchell {
+                radius: radius(r)?,
+                b: self.number(&f.b, "b", b, |_| true, "finite")?,
+                c: self.number(&f.c, "c", c, |_| true, "finite")?,
             },
         })
     }
@@ -1037,10 +1033,10 @@ impl Ctx<'_> {
             width: side(&f.width, "width")?,
             height: side(&f.height, "height")?,
             exposure: self.number(&f.exposure, "exposure", 0.0, |_| true, "finite")?,
-            tonemap: match f.tonemap.as_ref().map(|t| *t.get_ref()) {
-                None | Some(ToneMapName::Clamp) => ToneMapSpec::Clamp,
-                Some(ToneMapName::Filmic) => ToneMapSpec::Filmic,
-            },
+            tonemap: f
+                .tonemap
+                .as_ref()
+                .map_or_else(ToneMap::default, |t| t.get_ref().0),
             output,
         })
     }

@@ -4,9 +4,7 @@ use std::path::PathBuf;
 
 use sahara_render::{Filter, Integrator, PixelWindow, SamplerKind, ToneMap};
 
-use crate::scene_file::{
-    FilmSpec, FilterSpec, IntegratorSpec, SamplerKind as SamplerSpecKind, SamplerSpec, ToneMapSpec,
-};
+use crate::scene_file::{FilmSpec, SamplerSpec};
 
 /// How a scene file asks to be rendered (`[integrator]`, `[sampler]`, `[filter]`, `[film]`).
 #[derive(Clone, Debug, PartialEq)]
@@ -68,64 +66,23 @@ impl FileCrop {
 impl FileSettings {
     /// The settings of a parsed scene file.
     pub fn from_specs(
-        integrator: &IntegratorSpec,
+        integrator: &Integrator,
         sampler: &SamplerSpec,
-        filter: &FilterSpec,
+        filter: &Filter,
         film: &FilmSpec,
     ) -> Self {
         Self {
-            integrator: integrator_of(integrator),
-            sampler: match sampler.kind {
-                SamplerSpecKind::Independent => SamplerKind::Independent,
-                SamplerSpecKind::Stratified => SamplerKind::Stratified,
-                SamplerSpecKind::Sobol => SamplerKind::Sobol,
-            },
+            integrator: *integrator,
+            sampler: sampler.kind,
             spp: sampler.spp,
             seed: sampler.seed,
-            filter: filter_of(filter),
+            filter: *filter,
             width: film.width,
             height: film.height,
             exposure: film.exposure,
-            tonemap: match film.tonemap {
-                ToneMapSpec::Clamp => ToneMap::Clamp,
-                ToneMapSpec::Filmic => ToneMap::Filmic,
-            },
+            tonemap: film.tonemap,
             output: film.output.clone(),
             crop: None,
         }
-    }
-}
-
-/// The renderer's integrator for an `[integrator]` table.
-pub fn integrator_of(spec: &IntegratorSpec) -> Integrator {
-    match *spec {
-        IntegratorSpec::Distribution {
-            max_depth,
-            light_samples,
-        } => Integrator::Distribution {
-            max_depth,
-            light_samples,
-        },
-        IntegratorSpec::Path {
-            max_depth,
-            rr_depth,
-        } => Integrator::Path {
-            max_depth,
-            rr_depth,
-        },
-        IntegratorSpec::Normals => Integrator::Normals,
-        IntegratorSpec::Depth => Integrator::Depth,
-        IntegratorSpec::Ao { samples, distance } => Integrator::Ao { samples, distance },
-        IntegratorSpec::Cost => Integrator::Cost,
-    }
-}
-
-/// The renderer's filter for a `[filter]` table.
-pub fn filter_of(spec: &FilterSpec) -> Filter {
-    match *spec {
-        FilterSpec::Box { radius } => Filter::Box { radius },
-        FilterSpec::Tent { radius } => Filter::Tent { radius },
-        FilterSpec::Gaussian { radius, sigma } => Filter::Gaussian { radius, sigma },
-        FilterSpec::Mitchell { radius, b, c } => Filter::Mitchell { radius, b, c },
     }
 }

@@ -14,29 +14,10 @@ use crate::scene_file::ShapeSpec;
 
 /// The renderer shape of a built-in shape spec (`None` for a mesh file).
 pub fn shape_of(spec: &ShapeSpec) -> Option<Shape> {
-    Some(match *spec {
-        ShapeSpec::Mesh { .. } => return None,
-        ShapeSpec::Quad {
-            corner,
-            edge_u,
-            edge_v,
-        } => Shape::Quad {
-            corner,
-            edge_u,
-            edge_v,
-        },
-        ShapeSpec::Disc {
-            center,
-            normal,
-            radius,
-        } => Shape::Disc {
-            center,
-            normal: normal.normalize(),
-            radius,
-        },
-        ShapeSpec::Sphere { center, radius } => Shape::Sphere { center, radius },
-        ShapeSpec::Box { min, max } => Shape::Box { min, max },
-    })
+    match *spec {
+        ShapeSpec::Mesh { .. } => None,
+        ShapeSpec::Builtin(shape) => Some(shape),
+    }
 }
 
 /// `shape` under the affine map `m`, if it is again a shape of its kind.

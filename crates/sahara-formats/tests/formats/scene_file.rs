@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
 use sahara_formats::scene_file::*;
+use sahara_render::{Filter, Integrator, SamplerKind, Shape, ToneMap};
 
 use crate::common::TempDir;
 
@@ -264,29 +265,29 @@ fn a_complete_scene_parses_into_the_expected_values() {
     assert_eq!(
         s.objects[2],
         ObjectSpec {
-            shape: ShapeSpec::Quad {
+            shape: ShapeSpec::Builtin(Shape::Quad {
                 corner: Vec3::new(-1., 0., -1.),
                 edge_u: Vec3::new(2., 0., 0.),
                 edge_v: Vec3::new(0., 0., 2.)
-            },
+            }),
             material: None,
             placement: Placement::Static(TransformSpec::IDENTITY)
         }
     );
     assert_eq!(
         s.objects[3].shape,
-        ShapeSpec::Disc {
+        ShapeSpec::Builtin(Shape::Disc {
             center: Vec3::new(0., 3., 0.),
             normal: Vec3::NEG_Y,
             radius: 0.3
-        }
+        })
     );
     assert_eq!(
         s.objects[4].shape,
-        ShapeSpec::Box {
+        ShapeSpec::Builtin(Shape::Box {
             min: Vec3::splat(-1.),
             max: Vec3::new(1., 0., 1.)
-        }
+        })
     );
 
     assert_eq!(s.lights.len(), 5);
@@ -302,7 +303,7 @@ fn a_complete_scene_parses_into_the_expected_values() {
     );
     assert!(matches!(
         &s.lights[3],
-        LightSpec::Area { shape: ShapeSpec::Quad { .. }, radiance, two_sided: false, material: None } if *radiance == Vec3::splat(8.)
+        LightSpec::Area { shape: ShapeSpec::Builtin(Shape::Quad { .. }), radiance, two_sided: false, material: None } if *radiance == Vec3::splat(8.)
     ));
     assert_eq!(
         s.lights[4],
@@ -313,7 +314,7 @@ fn a_complete_scene_parses_into_the_expected_values() {
     );
     assert_eq!(
         s.integrator,
-        IntegratorSpec::Distribution {
+        Integrator::Distribution {
             max_depth: 6,
             light_samples: 4
         }
@@ -328,7 +329,7 @@ fn a_complete_scene_parses_into_the_expected_values() {
     );
     assert_eq!(
         s.filter,
-        FilterSpec::Mitchell {
+        Filter::Mitchell {
             radius: 2.,
             b: 0.5,
             c: 0.25
@@ -340,7 +341,7 @@ fn a_complete_scene_parses_into_the_expected_values() {
             width: 320,
             height: 240,
             exposure: -1.,
-            tonemap: ToneMapSpec::Filmic,
+            tonemap: ToneMap::Filmic,
             output: Some(at("renders/out.EXR"))
         }
     );
@@ -357,7 +358,7 @@ fn a_minimal_scene_gets_the_documented_defaults() {
     assert_eq!((s.camera.shutter_open, s.camera.shutter_close), (0.0, 0.0));
     assert_eq!(
         s.integrator,
-        IntegratorSpec::Path {
+        Integrator::Path {
             max_depth: 8,
             rr_depth: 3
         }
@@ -372,12 +373,12 @@ fn a_minimal_scene_gets_the_documented_defaults() {
     );
     assert_eq!(
         s.filter,
-        FilterSpec::Gaussian {
+        Filter::Gaussian {
             radius: 1.5,
             sigma: 0.5
         }
     );
-    assert_eq!(s.film.tonemap, ToneMapSpec::Clamp);
+    assert_eq!(s.film.tonemap, ToneMap::Clamp);
     assert_eq!(s.film.exposure, 0.0);
     assert_eq!(s.film.output, None);
     assert!(s.objects.is_empty() && s.lights.is_empty() && s.materials.is_empty());
@@ -621,7 +622,7 @@ fn every_example_scene_loads() {
         .any(|m| matches!(m.kind, MaterialKind::Dielectric { .. })));
     assert!(matches!(
         cornell.integrator,
-        IntegratorSpec::Distribution { .. }
+        Integrator::Distribution { .. }
     ));
     let dof = load("bunny_dof.toml");
     assert!(dof.camera.aperture_radius > 0.0);

@@ -14,6 +14,7 @@ use crate::light::LightSample;
 use crate::material::textures::perturbed_normal;
 use crate::material::NormalMap;
 use crate::material::{BsdfSample, PointBsdf};
+use crate::names::{name_table, Named};
 use crate::sampler::dims;
 use crate::sampler::PixelSampler;
 use crate::sampling::Frame;
@@ -75,48 +76,87 @@ pub mod defaults {
     pub const AO_DISTANCE: f32 = 0.0;
     /// Samples per pixel of a render that does not say.
     pub const SPP: u32 = 64;
+    /// Samples per pixel of each progressive pass of a render that does
+    /// not say.
+    pub const PASS_SPP: u32 = 8;
 }
 
 impl Default for Integrator {
     fn default() -> Self {
-        Integrator::Path {
-            max_depth: defaults::MAX_DEPTH,
-            rr_depth: defaults::RR_DEPTH,
+        IntegratorKind::Path.into()
+    }
+}
+
+/// The integrators by name, without their parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum IntegratorKind {
+    /// [`Integrator::Path`].
+    Path,
+    /// [`Integrator::Distribution`].
+    Distribution,
+    /// [`Integrator::Normals`].
+    Normals,
+    /// [`Integrator::Depth`].
+    Depth,
+    /// [`Integrator::Ao`].
+    Ao,
+    /// [`Integrator::Cost`].
+    Cost,
+}
+
+name_table!(IntegratorKind, "integrator", {
+    IntegratorKind::Path => "path",
+    IntegratorKind::Distribution => "distribution",
+    IntegratorKind::Normals => "normals",
+    IntegratorKind::Depth => "depth",
+    IntegratorKind::Ao => "ao",
+    IntegratorKind::Cost => "cost",
+});
+
+impl From<IntegratorKind> for Integrator {
+    /// The integrator of that kind with the parameters of [`defaults`].
+    fn from(kind: IntegratorKind) -> Self {
+        match kind {
+            IntegratorKind::Path => Integrator::Path {
+                max_depth: defaults::MAX_DEPTH,
+                rr_depth: defaults::RR_DEPTH,
+            },
+            IntegratorKind::Distribution => Integrator::Distribution {
+                max_depth: defaults::MAX_DEPTH,
+                light_samples: defaults::LIGHT_SAMPLES,
+            },
+            IntegratorKind::Normals => Integrator::Normals,
+            IntegratorKind::Depth => Integrator::Depth,
+            IntegratorKind::Ao => Integrator::Ao {
+                samples: defaults::AO_SAMPLES,
+                distance: defaults::AO_DISTANCE,
+            },
+            IntegratorKind::Cost => Integrator::Cost,
         }
     }
 }
 
 impl Integrator {
-    /// A short name (`path`, `distribution`, `normals`, `depth`, `ao`,
-    /// `cost`).
-    pub fn name(&self) -> &'static str {
+    /// Which integrator this is, without its parameters.
+    pub fn kind(&self) -> IntegratorKind {
         match self {
-            Integrator::Path { .. } => "path",
-            Integrator::Distribution { .. } => "distribution",
-            Integrator::Normals => "normals",
-            Integrator::Depth => "depth",
-            Integrator::Ao { .. } => "ao",
-            Integrator::Cost => "cost",
+            Integrator::Path { .. } => IntegratorKind::Path,
+            Integrator::Distribution { .. } => IntegratorKind::Distribution,
+            Integrator::Normals => IntegratorKind::Normals,
+            Integrator::Depth => IntegratorKind::Depth,
+            Integrator::Ao { .. } => IntegratorKind::Ao,
+            Integrator::Cost => IntegratorKind::Cost,
         }
     }
 
-    /// The integrator called `name` with the default parameters of [`defaults`].
-    pub fn from_name(name: &str) -> Option<Self> {
-        Some(match name {
-            "path" => Integrator::default(),
-            "distribution" => Integrator::Distribution {
-                max_depth: defaults::MAX_DEPTH,
-                light_samples: defaults::LIGHT_SAMPLES,
-            },
-            "normals" => Integrator::Normals,
-            "depth" => Integrator::Depth,
-            "ao" => Integrator::Ao {
-                samples: defaults::AO_SAMPLES,
-                distance: defaults::AO_DISTANCE,
-            },
-            "cost" => Integrator::Cost,
-            _ => return None,
-        })
+    /// The integrator called `name`, with the parameters of [`defaults`].
+    pub fn named(name: &str) -> Result<Self, crate::UnknownName> {
+        IntegratorKind::from_name(name).map(Self::from)
+    }
+
+    /// The integrator's name (its kind's, from the one name table).
+    pub fn name(&self) -> &'static str {
+        self.kind().name()
     }
 }
 
@@ -490,9 +530,7 @@ mod tests {
             stats: &mut stats,
         };
         let ray = Ray::new(Vec3::new(x, 3.0, 0.0), -Vec3::Y);
-        Integrator::from_name("path")
-            .unwrap()
-            .li(&mut ctx, &ray, 0.0)
+        Integrator::named("path").unwrap().li(&mut ctx, &ray, 0.0)
     }
 
     #[test]

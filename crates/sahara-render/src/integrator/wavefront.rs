@@ -282,7 +282,7 @@ mod tests {
             let world = World::new(&scene, &BuildParams::default());
             assert_eq!(world.accel.instance_count() > 8, extra > 0);
             for integrator in ["path", "distribution"] {
-                let integrator = Integrator::from_name(integrator).unwrap();
+                let integrator = Integrator::named(integrator).unwrap();
                 let (w, h, spp) = (12u32, 10u32, 3u32);
                 let mut paths = Vec::new();
                 for y in 0..h {

@@ -13,8 +13,10 @@ pub mod stratified;
 
 use glam::Vec2;
 
+use crate::names::name_table;
+
 /// Which sample generator fills the dimensions.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum SamplerKind {
     /// Independent uniform random numbers.
     Independent,
@@ -26,6 +28,12 @@ pub enum SamplerKind {
     #[default]
     Sobol,
 }
+
+name_table!(SamplerKind, "sampler", {
+    SamplerKind::Independent => "independent",
+    SamplerKind::Stratified => "stratified",
+    SamplerKind::Sobol => "sobol",
+});
 
 /// Identity of one pixel sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

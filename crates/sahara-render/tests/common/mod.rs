@@ -2,16 +2,20 @@
 #![allow(dead_code)]
 
 use glam::Vec3;
-use sahara_render::{render, Filter, Integrator, RenderResult, RenderSettings, SamplerKind, Scene};
+use sahara_render::{
+    render, Filter, FilterKind, Integrator, RenderResult, RenderSettings, SamplerKind, Scene,
+};
 
-/// Settings for a small test render with a one-pixel box filter.
+/// Settings for a small test render with a one-pixel box filter, its
+/// samples in one pass.
 pub fn settings(width: u32, height: u32, spp: u32, integrator: Integrator) -> RenderSettings {
     RenderSettings {
         width,
         height,
         spp,
+        pass_spp: spp,
         integrator,
-        filter: Filter::box_filter(),
+        filter: Filter::from(FilterKind::Box),
         sampler: SamplerKind::Sobol,
         tile_size: 16,
         seed: 1,

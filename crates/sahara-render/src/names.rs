@@ -1,0 +1,144 @@
+//! The names of the settings a user picks by name: integrator, sampler,
+//! filter, tone map and shape kind. Each setting has one name table, here
+//! beside the type it names; the command line, the scene file and every
+//! scene reader parse and print names through it, so adding a setting is a
+//! change in this crate only.
+
+use std::fmt;
+
+/// A setting chosen by name from a fixed list.
+pub trait Named: Copy + Sized + 'static {
+    /// What the setting is called in messages (`"integrator"`).
+    const WHAT: &'static str;
+    /// Every value, in the order messages and documents list them.
+    const ALL: &'static [Self];
+
+    /// The value's name, as written in files and on the command line.
+    fn name(self) -> &'static str;
+
+    /// The value called `name` (exact, lower case).
+    fn from_name(name: &str) -> Result<Self, UnknownName> {
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|v| v.name() == name)
+            .ok_or_else(|| UnknownName {
+                what: Self::WHAT,
+                name: name.to_owned(),
+                expected: Self::ALL.iter().map(|v| v.name()).collect(),
+            })
+    }
+
+    /// Every value's name, in the order of [`Named::ALL`].
+    fn names() -> Vec<&'static str> {
+        Self::ALL.iter().map(|v| v.name()).collect()
+    }
+}
+
+/// A name that is not in a setting's table.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownName {
+    /// What the setting is called (`"filter"`).
+    pub what: &'static str,
+    /// The name given.
+    pub name: String,
+    /// The names the setting has.
+    pub expected: Vec<&'static str>,
+}
+
+impl fmt::Display for UnknownName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "unknown {} '{}'; expected {}",
+            self.what,
+            self.name,
+            one_of(&self.expected)
+        )
+    }
+}
+
+impl std::error::Error for UnknownName {}
+
+/// `"a, b or c"`.
+pub fn one_of(names: &[&str]) -> String {
+    match names {
+        [] => String::new(),
+        [one] => (*one).to_owned(),
+        [init @ .., last] => format!("{} or {last}", init.join(", ")),
+    }
+}
+
+/// Implements [`Named`], `FromStr` and `Display` for a type from its one
+/// table of `value => "name"` pairs.
+macro_rules! name_table {
+    ($ty:ty, $what:literal, { $($value:path => $name:literal),+ $(,)? }) => {
+        impl $crate::names::Named for $ty {
+            const WHAT: &'static str = $what;
+            const ALL: &'static [Self] = &[$($value),+];
+
+            fn name(self) -> &'static str {
+                match self {
+                    $($value => $name,)+
+                }
+            }
+        }
+
+        impl std::str::FromStr for $ty {
+            type Err = $crate::names::UnknownName;
+
+            fn from_str(s: &str) -> Result<Self, Self::Err> {
+                <Self as $crate::names::Named>::from_name(s)
+            }
+        }
+
+        impl std::fmt::Display for $ty {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str($crate::names::Named::name(*self))
+            }
+        }
+    };
+}
+pub(crate) use name_table;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{FilterKind, IntegratorKind, SamplerKind, ShapeKind, ToneMap};
+
+    fn round_trips<T: Named + PartialEq + fmt::Debug + std::str::FromStr>() {
+        let names = T::names();
+        for (i, v) in T::ALL.iter().enumerate() {
+            assert_eq!(T::from_name(v.name()), Ok(*v));
+            assert!(!names[..i].contains(&v.name()), "{} twice", v.name());
+        }
+        let e = T::from_name("no-such-name").unwrap_err().to_string();
+        assert!(e.starts_with(&format!("unknown {} 'no-such-name'; expected ", T::WHAT)));
+        assert!(
+            e.ends_with(&format!(" or {}", names.last().unwrap())),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn every_table_round_trips_and_names_its_values_in_errors() {
+        round_trips::<IntegratorKind>();
+        round_trips::<SamplerKind>();
+        round_trips::<FilterKind>();
+        round_trips::<ToneMap>();
+        round_trips::<ShapeKind>();
+        assert_eq!(
+            IntegratorKind::from_name("whitted")
+                .unwrap_err()
+                .to_string(),
+            "unknown integrator 'whitted'; expected path, distribution, normals, depth, ao or cost"
+        );
+    }
+
+    #[test]
+    fn one_of_joins_names() {
+        assert_eq!(one_of(&["a"]), "a");
+        assert_eq!(one_of(&["a", "b"]), "a or b");
+        assert_eq!(one_of(&["a", "b", "c"]), "a, b or c");
+    }
+}
