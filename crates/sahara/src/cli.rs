@@ -86,16 +86,16 @@ pub struct RenderArgs {
     pub output: Option<PathBuf>,
     /// Samples per pixel: exactly this many, the last pass shorter if need
     /// be [default: the scene file's, else 64; with --time-limit, no cap].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
     pub spp: Option<u32>,
     /// Samples per pixel in each progressive pass [default: min(spp, 8)].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
     pub pass_spp: Option<u32>,
     /// Image width in pixels [default: the scene file's, else 512].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub width: Option<u32>,
     /// Image height in pixels [default: the scene file's, else 512].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub height: Option<u32>,
     /// Light transport, with its default parameters (or the scene file's,
     /// if it names the same one) [default: the scene file's, else path].
@@ -110,11 +110,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME", value_parser = NameParser::<FilterKind>::new())]
     pub filter: Option<FilterKind>,
     /// Rendering threads [default: all hardware threads].
-    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u16).range(1..=1024))]
     pub threads: Option<u16>,
     /// Seed of every random decision (same seed, same image, bit for bit)
     /// [default: the scene file's, else 0].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub seed: Option<u64>,
     /// Render progressive passes until this many seconds have passed (for
     /// equal-time comparisons), or until --spp samples if it is given.
@@ -304,7 +304,7 @@ pub struct BenchOptions {
     pub tree: TreeOptions,
     /// Threads of the multi-threaded runs (and of the build) [default: all
     /// hardware threads].
-    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u16).range(1..=1024))]
     pub threads: Option<u16>,
     /// Timed runs per set and thread count; the best is reported.
     #[arg(long, default_value_t = DEFAULT_RUNS, value_parser = parse_runs)]
@@ -386,7 +386,7 @@ pub struct StatsArgs {
     #[arg(long, default_value_t = 1, value_parser = parse_runs)]
     pub runs: usize,
     /// Threads of the build [default: all hardware threads].
-    #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u16).range(1..=1024))]
     pub threads: Option<u16>,
     /// Print one JSON object on stdout.
     #[arg(long)]
@@ -411,7 +411,7 @@ pub struct TreeOptions {
     #[arg(long, value_parser = parse_bonus)]
     pub empty_bonus: Option<f32>,
     /// Depth cap [default: 8 + 1.3 log2 N].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=63))]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=63))]
     pub max_depth: Option<u32>,
     /// Leaf size at which the naive builders stop [default: 4].
     #[arg(long)]
@@ -419,7 +419,7 @@ pub struct TreeOptions {
     /// Triangles the SAH assumes a leaf tests at once: a leaf of n costs
     /// K_I ceil(n / W) [default: 8, the leaf block width; 1 is the classic
     /// SAH].
-    #[arg(long, value_name = "W", value_parser = clap::value_parser!(u32).range(1..=64))]
+    #[arg(long, value_name = "W", allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub leaf_width: Option<u32>,
     /// Extra SAH cost of each triangle in a leaf, in leaf tests: a leaf of n
     /// costs K_I (ceil(n / W) + C n) [default: the builder's].

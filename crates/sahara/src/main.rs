@@ -13,32 +13,68 @@ mod human;
 mod input;
 mod memory;
 mod merge;
+mod output;
 mod part;
 mod render;
 mod render_options;
+mod scene_input;
 mod stats;
 mod warnings;
 
 use std::process::ExitCode;
 
+use clap::error::ErrorKind;
 use clap::Parser;
 
 use cli::{Cli, Command, RenderArgs};
+use render::Finish;
+
+/// The exit code of a render stopped by a signal (128 + SIGINT, as shells
+/// report an interrupted command).
+const INTERRUPTED: u8 = 130;
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return argument_error(e),
+    };
     let result = match &cli.command {
-        Some(Command::Bench(args)) => bench::run_file(args),
-        Some(Command::Stats(args)) => stats::run(args),
+        Some(Command::Bench(args)) => bench::run_file(args).map(|()| Finish::Done),
+        Some(Command::Stats(args)) => stats::run(args).map(|()| Finish::Done),
         Some(Command::Render(args)) => render::run(args),
-        Some(Command::Merge(args)) => merge::run(args),
+        Some(Command::Merge(args)) => merge::run(args).map(|()| Finish::Done),
         None => render::run(&RenderArgs::default()),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(Finish::Done) => ExitCode::SUCCESS,
+        Ok(Finish::Interrupted) => ExitCode::from(INTERRUPTED),
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
         }
     }
+}
+
+/// Help and version as clap prints them; any other command-line error as
+/// one line (`docs/cli.md`), with exit code 1 like every other error.
+fn argument_error(e: clap::Error) -> ExitCode {
+    if matches!(
+        e.kind(),
+        ErrorKind::DisplayHelp
+            | ErrorKind::DisplayVersion
+            | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        e.exit();
+    }
+    let text = e.render().to_string();
+    let first = text.lines().next().unwrap_or("error: invalid arguments");
+    // `sahara scene.toml`, as pbrt and Mitsuba take a scene: say how.
+    let hint = match (e.kind(), std::env::args().nth(1)) {
+        (ErrorKind::InvalidSubcommand, Some(arg)) if std::path::Path::new(&arg).exists() => {
+            format!(" (did you mean: sahara render {arg})")
+        }
+        _ => String::new(),
+    };
+    eprintln!("{first}{hint}");
+    ExitCode::FAILURE
 }

@@ -11,9 +11,7 @@
 use std::ops::Range;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Context, Result};
-use sahara_formats::atomic::check_writable;
-use sahara_formats::image_out::ImageFormat;
+use anyhow::{anyhow, bail, Result};
 use sahara_formats::part_file::{read_part, read_part_info, PartInfo};
 use sahara_render::split::{tile, PixelWindow};
 use sahara_render::{
@@ -21,17 +19,14 @@ use sahara_render::{
 };
 
 use crate::cli::MergeArgs;
-use crate::render::Output;
+use crate::output::{check_output, Output};
 
 /// Entries of the list of what is missing shown in full.
 const MISSING_SHOWN: usize = 8;
 
 /// `sahara merge PARTS... -o OUT`.
 pub fn run(args: &MergeArgs) -> Result<()> {
-    ImageFormat::from_path(&args.output).map_err(|e| anyhow!("{e}"))?;
-    check_writable(&args.output)
-        .map_err(|e| anyhow!("{e}"))
-        .context("cannot write the merged image")?;
+    check_output(&args.output, false)?;
     let mut parts: Vec<(PathBuf, PartInfo)> = Vec::with_capacity(args.parts.len());
     for path in &args.parts {
         let info = read_part_info(path).map_err(|e| anyhow!("{e}"))?;
@@ -131,7 +126,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         cost,
     };
     let out = Output {
-        path: &args.output,
+        path: args.output.clone(),
         settings: &settings,
         exposure: first.exposure,
         tonemap,

@@ -22,25 +22,39 @@ pub struct Piece {
     pub label: String,
 }
 
-/// The piece the options ask for (None: a plain image). `file_window` is
-/// the crop the scene file asks for: the pixels `--part` divides unless
-/// `--crop` names others.
-pub fn plan(
-    args: &RenderArgs,
-    settings: &RenderSettings,
-    file_window: Option<PixelWindow>,
-) -> Result<Option<Piece>> {
-    if args.part.is_none() && args.crop.is_none() && args.samples.is_none() {
+/// True if the options ask for a part of the frame (`--part`, `--crop` or
+/// `--samples`).
+pub fn is_part(args: &RenderArgs) -> bool {
+    args.part.is_some() || args.crop.is_some() || args.samples.is_some()
+}
+
+/// Refuses options that do not go with the part asked for (or with no part).
+pub fn check_args(args: &RenderArgs) -> Result<()> {
+    if !is_part(args) {
         if args.skip_existing {
             bail!("--skip-existing applies to parts (--part, --crop or --samples)");
         }
-        return Ok(None);
+        return Ok(());
     }
     if args.time_limit.is_some() {
         bail!("--time-limit cannot make a part: a part's samples must be fixed in advance");
     }
     if args.preview_every.is_some() {
         bail!("--preview-every does not apply to a part");
+    }
+    Ok(())
+}
+
+/// The piece the options ask for (None: a plain image). `file_window` is
+/// the crop the scene file asks for: the pixels `--part` divides unless
+/// `--crop` names others. The options were checked by [`check_args`].
+pub fn plan(
+    args: &RenderArgs,
+    settings: &RenderSettings,
+    file_window: Option<PixelWindow>,
+) -> Result<Option<Piece>> {
+    if !is_part(args) {
+        return Ok(None);
     }
     let (w, h) = (settings.width, settings.height);
     let total = settings.spp;

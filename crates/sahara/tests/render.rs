@@ -278,6 +278,119 @@ fn an_unwritable_output_is_refused_before_rendering() {
 }
 
 #[test]
+fn every_output_is_checked_before_the_scene_is_loaded() {
+    let dir = temp_dir("outputs-first");
+    // The scene does not exist: an error about the output proves the
+    // output was checked first.
+    let missing = dir.join("missing.toml");
+    let readonly = dir.join("kept.png");
+    fs::write(&readonly, b"an earlier image").unwrap();
+    let mut perms = fs::metadata(&readonly).unwrap().permissions();
+    perms.set_readonly(true);
+    fs::set_permissions(&readonly, perms).unwrap();
+    let jpg = dir.join("out.jpg");
+    let bare = dir.join("out");
+    let tiff = dir.join("x.tiff");
+    let png_part = dir.join("part.png");
+    for (output, extra, what) in [
+        (&jpg, &[][..], "unsupported image file extension \"jpg\""),
+        (&bare, &[], "unsupported image file extension \"\""),
+        (&tiff, &[], "unsupported image file extension \"tiff\""),
+        (&readonly, &[], "read-only"),
+        (&png_part, &["--part", "0/2"], "name a .exr file"),
+    ] {
+        let out = sahara(
+            &[
+                &[
+                    "render",
+                    missing.to_str().unwrap(),
+                    "-o",
+                    output.to_str().unwrap(),
+                ],
+                extra,
+            ]
+            .concat(),
+        );
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(
+            err.contains(output.to_str().unwrap()) && err.contains(what),
+            "{err}"
+        );
+    }
+    assert_eq!(fs::read(&readonly).unwrap(), b"an earlier image");
+    let mut perms = fs::metadata(&readonly).unwrap().permissions();
+    #[allow(clippy::permissions_set_readonly_false)]
+    perms.set_readonly(false);
+    fs::set_permissions(&readonly, perms).unwrap();
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_log_that_is_not_a_terminal_gets_plain_progress_lines() {
+    let dir = temp_dir("plain-progress");
+    let out = dir.join("p.png");
+    let o = std::process::Command::new(common::SAHARA)
+        .args(["render", "--width", "40", "--height", "40", "--spp", "4"])
+        .args(["--pass-spp", "2", "-o", out.to_str().unwrap()])
+        .env("SAHARA_PROGRESS_EVERY", "0")
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("progress: pass 1/2"), "{err}");
+    assert!(err.contains("progress: pass 2/2"), "{err}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn argument_errors_are_one_line_with_exit_code_1() {
+    for (args, what) in [
+        (&["render", "--spp", "0"][..], "0 is not in 1..="),
+        (
+            &["render", "--width", "100000"],
+            "100000 is not in 1..=65536",
+        ),
+        (&["render", "--threads", "-1"], "-1 is not in 1..=1024"),
+        (
+            &["render", "--sampler", "halton"],
+            "unknown sampler 'halton'",
+        ),
+        (
+            &["render", "--filter", "lanczos"],
+            "expected box, tent, gaussian or mitchell",
+        ),
+        (
+            &["render", "--tonemap", "reinhard"],
+            "unknown tone map 'reinhard'",
+        ),
+        (&["render", "--no-such-option"], "--no-such-option"),
+    ] {
+        let out = sahara(args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains(what),
+            "{args:?}: {err}"
+        );
+    }
+    // A scene given without `render`, as pbrt and Mitsuba take one.
+    let dir = temp_dir("no-subcommand");
+    let scene = dir.join("scene.toml");
+    fs::write(&scene, "").unwrap();
+    let out = sahara(&[scene.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&format!("did you mean: sahara render {}", scene.display())),
+        "{err}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_render_that_cannot_fit_in_memory_is_refused_with_an_estimate() {
     let dir = temp_dir("huge");
     let out_png = dir.join("huge.png");
@@ -407,10 +520,12 @@ fn spp_is_the_samples_per_pixel_rendered_whatever_the_pass_size() {
             log.contains(&format!(", {spp} spp in passes of {pass_size},")),
             "{log}"
         );
-        assert!(
-            log.contains(&format!(": {passes} passes, {spp} spp,")),
-            "{log}"
-        );
+        let passes = if passes == 1 {
+            "1 pass".to_string()
+        } else {
+            format!("{passes} passes")
+        };
+        assert!(log.contains(&format!(": {passes}, {spp} spp,")), "{log}");
     }
     let _ = fs::remove_dir_all(&dir);
 }

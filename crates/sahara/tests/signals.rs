@@ -80,10 +80,12 @@ fn interrupt_render(
 fn sigterm_writes_the_completed_passes_marked_partial() {
     let dir = temp_dir("sigterm");
     let out = dir.join("image.exr");
-    // An existing file is replaced whole, never truncated in place.
-    fs::write(&out, b"the previous image").unwrap();
     let (code, log) = interrupt(&out, "-TERM", Duration::from_millis(1500));
     assert_eq!(code, Some(130), "{log}");
+    assert!(
+        log.contains("stopping: finishing the tiles under way"),
+        "{log}"
+    );
     assert!(log.contains("wrote PARTIAL image"), "{log}");
     assert_eq!(exr_text(&out, "sahara:partial").as_deref(), Some("true"));
     let spp: u32 = exr_text(&out, "sahara:spp").unwrap().parse().unwrap();
@@ -98,6 +100,36 @@ fn sigterm_writes_the_completed_passes_marked_partial() {
         .map(|e| e.unwrap().file_name())
         .collect();
     assert_eq!(names, ["image.exr"], "{names:?}");
+}
+
+#[test]
+fn an_interrupted_render_never_replaces_an_earlier_image() {
+    let dir = temp_dir("keep-earlier");
+    let out = dir.join("image.exr");
+    let complete = |spp: &str| {
+        let o = Command::new(SAHARA)
+            .args([
+                "render", "--width", "24", "--height", "16", "--spp", spp, "-o",
+            ])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    // A complete image of the same name, from an earlier run.
+    complete("2");
+    let before = fs::read(&out).unwrap();
+    let (code, log) = interrupt(&out, "-INT", Duration::from_millis(1500));
+    assert_eq!(code, Some(130), "{log}");
+    assert_eq!(fs::read(&out).unwrap(), before, "the earlier image changed");
+    let beside = dir.join("image.partial.exr");
+    assert!(log.contains("image.partial.exr"), "{log}");
+    assert!(log.contains("left as it was"), "{log}");
+    assert_eq!(exr_text(&beside, "sahara:partial").as_deref(), Some("true"));
+    // A complete render replaces the image and removes the partial one.
+    complete("3");
+    assert_eq!(exr_text(&out, "sahara:spp").as_deref(), Some("3"));
+    assert!(!beside.exists(), "a stale partial image was left");
 }
 
 #[test]

@@ -1,0 +1,227 @@
+//! Writing a rendered frame: the image (PNG or EXR, atomically, with its
+//! metadata) of `sahara render` and `sahara merge`, and the rules that keep
+//! a complete image from being replaced by a partial one.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, bail, Context, Result};
+use sahara_formats::atomic::check_writable;
+use sahara_formats::image_out::{write_image, ImageFormat, Pixels};
+use sahara_render::{Integrator, RenderResult, RenderSettings, ToneMap};
+
+/// Checks, before anything is loaded or rendered, that `path` names an
+/// image Sahara writes (`.png` or `.exr`, or `.exr` only for a part) in a
+/// folder where it can be written, and that an existing file there may be
+/// replaced (not read-only).
+pub(crate) fn check_output(path: &Path, part: bool) -> Result<()> {
+    let format = ImageFormat::from_path(path).map_err(|e| anyhow!("{e}"))?;
+    if part && format != ImageFormat::Exr {
+        bail!(
+            "{}: a part (--part, --crop, --samples) is written as OpenEXR: name a .exr file",
+            path.display()
+        );
+    }
+    if path.metadata().is_ok_and(|m| m.permissions().readonly()) {
+        bail!(
+            "{}: the file is read-only: not replaced (make it writable, or write elsewhere)",
+            path.display()
+        );
+    }
+    check_writable(path)
+        .map_err(|e| anyhow!("{e}"))
+        .context("cannot write the output image")
+}
+
+/// Where a partial image (a preview, an interrupted render) of `path`
+/// goes: `path` itself if nothing is there yet, else beside it as
+/// `<stem>.partial.<ext>`, so that a complete image from an earlier run is
+/// never replaced by an incomplete one.
+pub(crate) fn partial_path(path: &Path, existed: bool) -> PathBuf {
+    if !existed {
+        return path.to_path_buf();
+    }
+    let stem = path
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    let ext = path
+        .extension()
+        .map_or_else(String::new, |e| e.to_string_lossy().into_owned());
+    path.with_file_name(format!("{stem}.partial.{ext}"))
+}
+
+/// True if `path` ends in `.exr` (any case).
+pub(crate) fn is_exr(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+}
+
+/// Where and how the image is written.
+pub(crate) struct Output<'a> {
+    pub(crate) path: PathBuf,
+    pub(crate) settings: &'a RenderSettings,
+    pub(crate) exposure: f32,
+    pub(crate) tonemap: ToneMap,
+}
+
+impl Output<'_> {
+    /// Writes `result` (atomically), marked `partial` or not; `log` prints
+    /// what a debug view's colours mean.
+    pub(crate) fn write(&self, result: &RenderResult, partial: bool, log: bool) -> Result<()> {
+        let settings = self.settings;
+        let s = &result.stats;
+        let exr = is_exr(&self.path);
+        let rgb = result.film.to_rgb_f32();
+        let rgb8 = if exr {
+            Vec::new()
+        } else if matches!(settings.integrator, Integrator::Depth) {
+            // Raw distances would be a flat white or grey: map the nearest
+            // to the farthest hit onto white to dark grey (EXR keeps them raw).
+            let range = depth_range(&rgb, result.film.width, result.film.height);
+            if log {
+                match range {
+                    Some((near, far)) => eprintln!(
+                        "depth: nearest hit {near:.4} (white) to farthest {far:.4} (dark grey), \
+                         no hit black; EXR output keeps the raw distances"
+                    ),
+                    None => eprintln!("depth: no ray hit anything"),
+                }
+            }
+            depth_to_gray8(&rgb, range)
+        } else {
+            result.film.to_srgb8(self.exposure, self.tonemap)
+        };
+        let pixels = if exr {
+            Pixels::LinearRgbF32(&rgb)
+        } else {
+            Pixels::Rgb8(&rgb8)
+        };
+        // The film is the window's when the scene file crops the image.
+        let (width, height) = (result.film.width, result.film.height);
+        let finished = if s.passes == 0 {
+            s.first_pass_pixels
+        } else {
+            u64::from(width) * u64::from(height)
+        };
+        let metadata = vec![
+            (
+                "sahara:integrator".to_string(),
+                settings.integrator.name().to_string(),
+            ),
+            ("sahara:spp".to_string(), s.spp.to_string()),
+            ("sahara:seed".to_string(), settings.seed.to_string()),
+            ("sahara:partial".to_string(), partial.to_string()),
+            ("sahara:finished_pixels".to_string(), finished.to_string()),
+        ];
+        write_image(&self.path, width, height, pixels, &metadata)
+            .map_err(|e| anyhow!("{e}"))
+            .context("cannot write the output image")
+    }
+}
+
+/// The nearest and farthest distance in a depth image (0 is no hit).
+///
+/// The filter blends hit distances with the zeros of missed samples near
+/// silhouettes, which would make them look nearest: the nearest distance
+/// is taken from pixels at least [`SILHOUETTE_MARGIN`] pixels from any
+/// pixel without a hit (all pixels if none is that far).
+fn depth_range(rgb: &[f32], width: u32, height: u32) -> Option<(f32, f32)> {
+    let (w, h) = (width as usize, height as usize);
+    let d = |x: usize, y: usize| rgb[3 * (y * w + x)];
+    let hit = |v: f32| v > 0.0 && v.is_finite();
+    let far = (0..w * h)
+        .map(|k| rgb[3 * k])
+        .filter(|&v| hit(v))
+        .fold(0.0f32, f32::max);
+    if far <= 0.0 {
+        return None;
+    }
+    let m = SILHOUETTE_MARGIN;
+    let interior = |x: usize, y: usize| {
+        (y.saturating_sub(m)..(y + m + 1).min(h))
+            .all(|j| (x.saturating_sub(m)..(x + m + 1).min(w)).all(|i| hit(d(i, j))))
+    };
+    let nearest = |only_interior: bool| {
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .filter(|&(x, y)| hit(d(x, y)) && (!only_interior || interior(x, y)))
+            .map(|(x, y)| d(x, y))
+            .fold(f32::INFINITY, f32::min)
+    };
+    let near = match nearest(true) {
+        n if n.is_finite() => n,
+        _ => nearest(false),
+    };
+    Some((near.min(far), far))
+}
+
+/// Pixels around a silhouette that [`depth_range`] leaves out of the nearest distance.
+const SILHOUETTE_MARGIN: usize = 3;
+
+/// A depth image as 8-bit grey: `near` white, `far` dark grey (26), no hit black.
+fn depth_to_gray8(rgb: &[f32], range: Option<(f32, f32)>) -> Vec<u8> {
+    let Some((near, far)) = range else {
+        return vec![0; rgb.len()];
+    };
+    let span = (far - near).max(f32::MIN_POSITIVE);
+    rgb.iter()
+        .step_by(3)
+        .flat_map(|&d| {
+            let v = if d > 0.0 && d.is_finite() {
+                let t = ((d - near) / span).clamp(0.0, 1.0);
+                (255.0 * (1.0 - 0.9 * t)).round() as u8
+            } else {
+                0
+            };
+            [v; 3]
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A `w x h` depth image (three equal channels per pixel) from `f(x, y)`.
+    fn image(w: u32, h: u32, f: impl Fn(u32, u32) -> f32) -> Vec<f32> {
+        (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .flat_map(|(x, y)| [f(x, y); 3])
+            .collect()
+    }
+
+    #[test]
+    fn depth_range_ignores_silhouette_blends() {
+        // A 10x10 object at distance 2 to 3 on a background of misses; its
+        // border pixels are blends with the misses (0.5).
+        let rgb = image(20, 20, |x, y| {
+            let inside = (5..15).contains(&x) && (5..15).contains(&y);
+            let border = x == 5 || x == 14 || y == 5 || y == 14;
+            match (inside, border) {
+                (false, _) => 0.0,
+                (true, true) => 0.5,
+                (true, false) => 2.0 + x as f32 / 20.0,
+            }
+        });
+        let (near, far) = depth_range(&rgb, 20, 20).unwrap();
+        assert!(near >= 2.0, "near {near}");
+        assert!((far - (2.0 + 13.0 / 20.0)).abs() < 1e-6, "far {far}");
+        let grey = depth_to_gray8(&rgb, Some((near, far)));
+        assert_eq!(grey[0], 0, "a miss is black");
+        assert_eq!(grey[3 * (20 * 6 + 13)], 26, "the farthest hit is dark grey");
+        // No hit at all: no range, a black image.
+        let none = image(4, 4, |_, _| 0.0);
+        assert_eq!(depth_range(&none, 4, 4), None);
+        assert!(depth_to_gray8(&none, None).iter().all(|&v| v == 0));
+    }
+
+    #[test]
+    fn a_partial_image_goes_beside_an_existing_one() {
+        let p = Path::new("out/frame.exr");
+        assert_eq!(partial_path(p, false), p);
+        assert_eq!(partial_path(p, true), Path::new("out/frame.partial.exr"));
+        assert_eq!(
+            partial_path(Path::new("x.PNG"), true),
+            Path::new("x.partial.PNG")
+        );
+    }
+}

@@ -1,0 +1,119 @@
+//! What `sahara render` renders: the built-in Cornell box, a scene file
+//! (TOML or pbrt) or a mesh file, as a renderer scene with the settings its
+//! file asks for and the problems found while reading it.
+
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Result};
+use sahara_formats::camera::read_sidecar;
+use sahara_formats::mesh_scene::{load_mesh_scene_with, CameraChoice};
+use sahara_formats::scene_load::{load_scene_with_sky, FileSettings};
+use sahara_formats::sky::Sky;
+use sahara_render::{builtin, Camera, Scene};
+
+/// A scene to render, with what its file says about rendering it.
+pub(crate) struct Input {
+    /// The scene.
+    pub(crate) scene: Scene,
+    /// The render settings of a scene file (None: a mesh or the built-in scene).
+    pub(crate) file: Option<FileSettings>,
+    /// The scene's name, for the default output file.
+    pub(crate) name: String,
+    /// What the log calls it.
+    pub(crate) description: String,
+    /// Problems that did not stop loading, one line each.
+    pub(crate) warnings: Vec<String>,
+}
+
+/// The scene to render: the built-in Cornell box, a scene file or a mesh
+/// file, seen by `camera` (`--camera`) and lit as `sky` (`--sky`) says.
+pub(crate) fn load_input(
+    path: Option<&Path>,
+    camera: Option<&str>,
+    sky: Option<&str>,
+) -> Result<Input> {
+    let flat = |e: sahara_formats::FormatError| anyhow!("{e}");
+    let sky = sky.map(|s| Sky::parse(s, Path::new("")));
+    let Some(path) = path else {
+        let mut scene = builtin::cornell_box();
+        if let Some(file) = camera {
+            let c = read_sidecar(Path::new(file)).map_err(flat)?;
+            scene.camera = Camera::look_at(c.eye, c.target, c.up, c.vfov_deg, 1.0);
+            eprintln!("camera: {file}");
+        }
+        if let Some(sky) = &sky {
+            sahara_formats::sky::apply(&mut scene, sky).map_err(flat)?;
+        }
+        return Ok(Input {
+            scene,
+            file: None,
+            name: "cornell_box".into(),
+            description: "the built-in Cornell box".into(),
+            warnings: Vec::new(),
+        });
+    };
+    const EXPECTED: &str =
+        "expected a scene file (.toml, .pbrt, .pbrt.gz) or a mesh (.obj, .ply, .gltf, .glb)";
+    if path.is_dir() {
+        bail!("{}: is a folder; {EXPECTED}", path.display());
+    }
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    // A `FormatError`'s message already names the file and place.
+    let pbrt = sahara_formats::pbrt::is_pbrt_path(path);
+    let (scene, file, warnings) = match ext.as_str() {
+        _ if pbrt && camera.is_some() => bail!(
+            "{}: --camera applies to meshes and the built-in scene; a pbrt file has its own Camera",
+            path.display()
+        ),
+        _ if pbrt => {
+            let mut p = sahara_formats::pbrt::load_pbrt(path).map_err(flat)?;
+            if let Some(sky) = &sky {
+                sahara_formats::sky::apply(&mut p.loaded.scene, sky).map_err(flat)?;
+            }
+            (p.loaded.scene, Some(p.loaded.settings), p.loaded.warnings)
+        }
+        "toml" if camera.is_some() => bail!(
+            "{}: --camera applies to meshes and the built-in scene; a scene file has its own [camera]",
+            path.display()
+        ),
+        "toml" => {
+            let l = load_scene_with_sky(path, sky.as_ref()).map_err(flat)?;
+            (l.scene, Some(l.settings), l.warnings)
+        }
+        "obj" | "ply" | "gltf" | "glb" => {
+            let camera = camera.map_or(CameraChoice::Auto, CameraChoice::from_arg);
+            let m = load_mesh_scene_with(path, &camera, sky.as_ref().unwrap_or(&Sky::Auto))
+                .map_err(flat)?;
+            eprintln!("camera: {}; light: {}", m.camera_source, m.sky);
+            (m.scene, None, m.warnings)
+        }
+        "" => bail!(
+            "{}: the file name has no extension; {EXPECTED}",
+            path.display()
+        ),
+        _ => bail!("{}: cannot render .{ext} files; {EXPECTED}", path.display()),
+    };
+    Ok(Input {
+        scene,
+        file,
+        name: stem(path),
+        description: path.display().to_string(),
+        warnings,
+    })
+}
+
+/// The scene's name: the file name without its extension (`scene.pbrt.gz`
+/// is `scene`).
+fn stem(path: &Path) -> String {
+    let stem = path
+        .file_stem()
+        .map_or("render".into(), |s| s.to_string_lossy().into_owned());
+    // `scene.pbrt.gz` is the scene `scene`.
+    match stem.strip_suffix(".pbrt") {
+        Some(s) if !s.is_empty() => s.to_owned(),
+        _ => stem,
+    }
+}
