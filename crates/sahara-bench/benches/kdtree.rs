@@ -17,7 +17,7 @@ use sahara_bench::runner::PacketSize;
 use sahara_bench::{HitRecord, ProtocolCamera, SceneFrame};
 use sahara_kd::internals::{BatchWalk, Frustum, IndexedBlocks, PacketShear, RayShear, BLOCK_WIDTH};
 use sahara_kd::{BuildParams, Builder, KdTree, Ray, TriangleBlock};
-use sahara_render::mesh::Mesh;
+use sahara_render::Mesh;
 
 /// Rays per traced batch: enough to leave the caches' warm-up behind.
 const BATCH: usize = 1 << 16;

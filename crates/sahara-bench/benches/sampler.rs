@@ -9,8 +9,8 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec2;
-use sahara_render::hash::hash2;
-use sahara_render::sampler::{dims, PixelSampler, SampleId};
+use sahara_render::internals::hash2;
+use sahara_render::internals::{dims, PixelSampler, SampleId};
 use sahara_render::SamplerKind;
 
 const PIXELS: u64 = 256;

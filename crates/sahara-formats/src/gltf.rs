@@ -27,8 +27,8 @@ use std::path::{Path, PathBuf};
 
 use ::gltf::mesh::Mode;
 use glam::{Affine2, Mat4, Quat, Vec2, Vec3, Vec4};
-use sahara_render::mesh::Mesh;
-use sahara_render::texture::Wrap;
+use sahara_render::Mesh;
+use sahara_render::Wrap;
 use serde_json::Value;
 
 use crate::error::FormatError;

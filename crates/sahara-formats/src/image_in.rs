@@ -23,7 +23,7 @@ use std::io::Cursor;
 use std::path::Path;
 
 use glam::Vec3;
-use sahara_render::texture::Encoding;
+use sahara_render::Encoding;
 use sahara_render::Texture;
 
 use crate::error::FormatError;

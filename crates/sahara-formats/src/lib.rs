@@ -9,7 +9,7 @@
 //! - render parts: [`part_file`] (a piece of a frame and its exact sums, as EXR);
 //! - every error is a [`FormatError`]: one line naming the file and the place.
 //!
-//! Meshes come out as [`sahara_render::mesh::Mesh`]: one merged triangle list
+//! Meshes come out as [`sahara_render::Mesh`]: one merged triangle list
 //! in file order, polygons fan-triangulated as `(v0, vi, vi+1)`, so triangle
 //! number `k` is the `k`-th triangle of the file after triangulation.
 
@@ -37,7 +37,7 @@ pub mod srgb;
 
 use std::path::{Path, PathBuf};
 
-use sahara_render::mesh::Mesh;
+use sahara_render::Mesh;
 
 pub use error::FormatError;
 

@@ -52,9 +52,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Affine2, Vec2, Vec3};
-use sahara_render::material::{Clearcoat, NormalMap, OcclusionMap};
-use sahara_render::texture::{Channel, Encoding, ScalarMap, TextureMap};
 use sahara_render::{Bsdf, Material, Texture};
+use sahara_render::{Channel, Encoding, ScalarMap, TextureMap};
+use sahara_render::{Clearcoat, NormalMap, OcclusionMap};
 
 use crate::gltf::{GltfImage, GltfMaterial, GltfTexture};
 use crate::image_in::{decode_texture, load_texture};

@@ -20,7 +20,7 @@ use std::fs;
 use std::path::Path;
 
 use glam::Vec3;
-use sahara_render::mesh::Mesh;
+use sahara_render::Mesh;
 
 use crate::error::FormatError;
 use crate::fan::fan_triangulate;

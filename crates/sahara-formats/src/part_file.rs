@@ -33,7 +33,7 @@ const MAX_SIDE: u32 = 65536;
 #[derive(Clone, Debug, PartialEq)]
 pub struct PartInfo {
     /// Digest of the scene and of the settings that change pixels
-    /// ([`sahara_render::digest::frame_digest`]).
+    /// ([`sahara_render::frame_digest`]).
     pub digest: String,
     /// Frame width in pixels.
     pub width: u32,

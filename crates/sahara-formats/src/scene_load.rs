@@ -25,7 +25,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
-use sahara_render::texture::Encoding;
+use sahara_render::Encoding;
 use sahara_render::{
     Bsdf, Camera, Environment, Instance, Light, Material, Scene, Texture, TextureMap,
 };

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::Vec3;
-use sahara_render::sampling::luminance;
+use sahara_render::luminance;
 use sahara_render::{Environment, Light, Scene, Texture};
 
 use crate::error::FormatError;

@@ -1,6 +1,6 @@
 //! `sahara-render`: Sahara's renderer. It knows meshes as plain arrays,
 //! never as files: scenes come in as Rust values ([`Scene`]), images go out
-//! as float buffers ([`Film`]).
+//! as float buffers ([`Film`]) and exact per-pixel sums ([`SumBuffer`]).
 //!
 //! ```
 //! use sahara_render::{builtin, render, RenderSettings};
@@ -11,51 +11,78 @@
 //! assert_eq!(result.film.pixels.len(), 256);
 //! assert_eq!(result.stats.nan_samples, 0);
 //! ```
+//!
+//! The crate's parts, each importing only those before it in this list:
+//! `math` (hashing, piecewise distributions, warps) and `names` (the name
+//! tables of settings); `texture`; `material`, `light` and `sampler`;
+//! `scene` (camera, meshes, shapes, instances); `film` (the image,
+//! reconstruction filters, exact sums, pixel windows) and `accel` (the
+//! instances' kd-trees); `world` (the scene prepared for tracing);
+//! `integrator` (light transport); `render` (the settings, the loop of
+//! passes and tiles, the frame digest). See `docs/renderer.md` for the
+//! design.
 
 #![deny(missing_docs)]
 
-pub mod accel;
-pub mod builtin;
-pub mod camera;
+mod accel;
 mod cpu_time;
-pub mod digest;
-pub mod distribution;
-pub mod film;
-pub mod filter;
-pub mod hash;
-pub mod instance;
-pub mod integrator;
-pub mod light;
-pub mod material;
-pub mod mesh;
-pub mod names;
-pub mod render;
-pub mod sampler;
-pub mod sampling;
-pub mod scene;
-pub mod shape;
-pub mod split;
-pub mod sums;
-mod tangents;
-pub mod texture;
-pub mod world;
+mod film;
+mod integrator;
+mod light;
+mod material;
+mod math;
+mod names;
+mod render;
+mod sampler;
+mod scene;
+mod texture;
+mod world;
 
-pub use camera::Camera;
-pub use film::{Film, ToneMap};
-pub use filter::{Filter, FilterKind};
-pub use instance::{Instance, Placement, Srt};
-pub use integrator::{Integrator, IntegratorKind};
+// The scene model.
+pub use scene::builtin;
+pub use scene::camera::Camera;
+pub use scene::instance::{Instance, Placement, Srt};
+pub use scene::mesh::{Mesh, SceneMesh};
+pub use scene::shape::{Shape, ShapeKind};
+pub use scene::{Scene, ShapeInstance};
+
+// Materials, textures and lights.
+pub use light::environment::{coordinates as environment_uv, direction as environment_direction};
 pub use light::{Environment, Light};
-pub use material::{AlphaMode, Bsdf, Material, MaterialTextures};
-pub use mesh::{Mesh, SceneMesh};
-pub use names::{Named, UnknownName};
-pub use render::{
-    cost_maps, render, render_watched, CostMaps, Preview, Progress, RenderResult, RenderSettings,
-    RenderStats,
+pub use material::{
+    fresnel, metals, AlphaMode, Bsdf, Clearcoat, Material, MaterialTextures, NormalMap,
+    OcclusionMap,
 };
+pub use texture::footprint::UvFootprint;
+pub use texture::{
+    linear_to_srgb8, srgb8_to_linear, srgb_to_linear, Channel, Encoding, ScalarMap, Texture,
+    TextureMap, Wrap,
+};
+
+// How to render: the settings and their names.
+pub use film::filter::{Filter, FilterKind};
+pub use film::ToneMap;
+pub use integrator::{defaults, Integrator, IntegratorKind, TraceStats};
+pub use names::{one_of, Named, Parameter, UnknownName};
+pub use render::{RenderSettings, UNLIMITED_SPP};
 pub use sampler::SamplerKind;
-pub use scene::Scene;
-pub use shape::{Shape, ShapeKind};
-pub use split::PixelWindow;
-pub use sums::{PixelSum, SumBuffer};
-pub use texture::{Texture, TextureMap};
+
+// Rendering, and what comes out: the image, its exact sums, pieces of a frame.
+pub use film::sums::{PixelSum, SumBuffer};
+pub use film::window::{crop, sample_range, tile, PixelWindow};
+pub use film::Film;
+pub use math::warp::luminance;
+pub use render::digest::frame_digest;
+pub use render::{
+    cost_maps, render, render_watched, CostMaps, Preview, Progress, RenderResult, RenderStats,
+};
+
+/// Internals for the repository's tests and benchmarks: the scene prepared
+/// for tracing and the samplers on their own. Not part of the API; may
+/// change without notice.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::math::hash::hash2;
+    pub use crate::sampler::{dims, PixelSampler, SampleId};
+    pub use crate::world::World;
+}

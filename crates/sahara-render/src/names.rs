@@ -35,6 +35,38 @@ pub trait Named: Copy + Sized + 'static {
     }
 }
 
+/// A number a setting takes by name (a filter's `radius`): its default and
+/// the values it accepts. Readers of scene files take a setting's
+/// parameters from its list, so a new setting needs no change there.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Parameter {
+    /// Its name in files.
+    pub name: &'static str,
+    /// Its value when not given.
+    pub default: f32,
+    /// True if it must be greater than 0 (else any finite number).
+    pub positive: bool,
+}
+
+impl Parameter {
+    /// `value` if the parameter accepts it, else why not (one line).
+    pub fn check(&self, value: f32) -> Result<f32, String> {
+        if value.is_finite() && (!self.positive || value > 0.0) {
+            Ok(value)
+        } else {
+            Err(format!(
+                "`{}` is {value} but must be {}",
+                self.name,
+                if self.positive {
+                    "greater than 0"
+                } else {
+                    "finite"
+                }
+            ))
+        }
+    }
+}
+
 /// A name that is not in a setting's table.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct UnknownName {

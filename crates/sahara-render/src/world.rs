@@ -6,13 +6,13 @@ use sahara_kd::gamma;
 use sahara_kd::{BuildParams, Counters, NoCounters, Ray};
 
 use crate::accel::{Accel, BatchBuffers, RawHit};
-use crate::distribution::Distribution1D;
 use crate::light::area::{EmissionTextures, Emitter};
 use crate::light::{AreaLight, EnvLight, LightSample, LightSource};
 use crate::material::Material;
-use crate::sampling::Frame;
+use crate::math::piecewise::Distribution1D;
+use crate::math::warp::Frame;
+use crate::scene::shape::Shape;
 use crate::scene::Scene;
-use crate::shape::Shape;
 use crate::texture::footprint::{CameraSpread, UvFootprint};
 
 /// A ray's intersection with a surface, in world space.
@@ -163,7 +163,7 @@ impl<'a> World<'a> {
     }
 
     /// The corners of the hit triangle in world space, and its mesh.
-    fn corners(&self, hit: &SurfaceHit) -> ([Vec3; 3], &crate::mesh::SceneMesh, [u32; 3]) {
+    fn corners(&self, hit: &SurfaceHit) -> ([Vec3; 3], &crate::scene::mesh::SceneMesh, [u32; 3]) {
         let inst = &self.scene.instances[hit.instance as usize];
         let mesh = &self.scene.meshes[inst.mesh as usize];
         let idx = mesh.mesh.indices[hit.tri as usize];
@@ -721,5 +721,5 @@ fn pass_through_draw(ray: &Ray, hit: &SurfaceHit, k: u32) -> f32 {
     let b = (o[2] as u64) << 32 | d[0] as u64;
     let c = (d[1] as u64) << 32 | d[2] as u64;
     let e = (hit.instance as u64) << 32 | hit.tri as u64;
-    crate::hash::unit_f32(crate::hash::hash3(a ^ e, b, c.wrapping_add(k as u64)))
+    crate::math::hash::unit_f32(crate::math::hash::hash3(a ^ e, b, c.wrapping_add(k as u64)))
 }

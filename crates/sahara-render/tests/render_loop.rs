@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use common::{run, settings};
 use glam::{Affine3A, Quat, Vec3};
-use sahara_render::world::World;
+use sahara_render::internals::World;
 use sahara_render::{
     builtin, render, Camera, Environment, Filter, FilterKind, Instance, Integrator, Light,
     Material, SamplerKind, Scene, Shape, Srt, Texture,

@@ -3,11 +3,11 @@
 
 use glam::Vec3;
 use proptest::prelude::*;
-use sahara_render::split::{tile, PixelWindow};
 use sahara_render::{
     builtin, render, Filter, FilterKind, Integrator, Material, RenderSettings, SamplerKind, Scene,
     Shape, SumBuffer,
 };
+use sahara_render::{tile, PixelWindow};
 
 /// The Cornell box with one more sphere of a chosen material.
 fn scene(material: u8, centre: (f32, f32), radius: f32) -> Scene {

@@ -10,10 +10,10 @@ use std::sync::Arc;
 
 use common::{path, run, settings};
 use glam::{Affine3A, Vec2, Vec3};
-use sahara_render::material::{NormalMap, OcclusionMap};
-use sahara_render::mesh::{Mesh, SceneMesh};
-use sahara_render::texture::{Channel, ScalarMap};
 use sahara_render::{Camera, Light, Material, Scene, Texture, TextureMap};
+use sahara_render::{Channel, ScalarMap};
+use sahara_render::{Mesh, SceneMesh};
+use sahara_render::{NormalMap, OcclusionMap};
 use std::f32::consts::PI;
 
 /// A 2x2 quad in the plane z = 0 facing +z, uv running along `u_dir` and
@@ -206,7 +206,7 @@ fn an_emission_texture_lights_where_it_is_bright() {
     let t = Arc::new(Texture::new(2, 1, vec![Vec3::ONE, Vec3::ZERO]));
     let mut lamp = Material::emitter(Vec3::splat(3.0));
     lamp.textures.emission =
-        Some(TextureMap::new(t).with_wrap(sahara_render::texture::Wrap::Clamp, Default::default()));
+        Some(TextureMap::new(t).with_wrap(sahara_render::Wrap::Clamp, Default::default()));
     let lamp = scene.add_material(lamp);
     scene.add_object(quad(Vec3::X, Vec3::Y), Affine3A::IDENTITY, lamp);
     let r = run(&scene, &settings(8, 8, 4, path(2)));

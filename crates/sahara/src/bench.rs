@@ -10,7 +10,7 @@ use sahara_bench::report::{BenchReport, CameraReport, SetReport, SetReports};
 use sahara_bench::runner::{Bench, PacketSize, Pools};
 use sahara_bench::{HitRecord, ProtocolCamera, Query, SceneFrame, SetKind};
 use sahara_kd::Ray;
-use sahara_render::mesh::Mesh;
+use sahara_render::Mesh;
 
 use crate::cli::{BenchArgs, BenchOptions};
 use crate::demo_scene::demo_scene;

@@ -8,7 +8,7 @@ use clap::builder::{PossibleValue, StringValueParser, TypedValueParser};
 use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
 use sahara_bench::SetKind;
 use sahara_kd::{BuildParams, Builder};
-use sahara_render::mesh::Mesh;
+use sahara_render::Mesh;
 use sahara_render::{FilterKind, IntegratorKind, Named, SamplerKind, ToneMap};
 
 /// Default timed runs per set.

@@ -4,7 +4,7 @@
 use std::f32::consts::{PI, TAU};
 
 use glam::Vec3;
-use sahara_render::mesh::Mesh;
+use sahara_render::Mesh;
 
 /// Appends a quad `a b c d` (counter-clockwise) as two triangles.
 fn quad(mesh: &mut Mesh, a: u32, b: u32, c: u32, d: u32) {

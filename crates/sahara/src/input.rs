@@ -6,7 +6,7 @@ use anyhow::{anyhow, Context, Result};
 use sahara_bench::report::CameraReport;
 use sahara_bench::{ProtocolCamera, SceneFrame};
 use sahara_formats::camera::{read_sidecar, sidecar_path, CameraSidecar};
-use sahara_render::mesh::Mesh;
+use sahara_render::Mesh;
 
 /// Load a mesh (`.obj`, `.ply`, `.gltf`, `.glb`; a glTF scene's meshes
 /// merged in scene order), print its loading warnings, and check that the

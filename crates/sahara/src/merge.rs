@@ -13,10 +13,10 @@ use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
 use sahara_formats::part_file::{read_part, read_part_info, PartInfo};
-use sahara_render::split::{tile, PixelWindow};
 use sahara_render::{
     cost_maps, Film, Integrator, RenderResult, RenderSettings, RenderStats, SumBuffer,
 };
+use sahara_render::{tile, PixelWindow};
 
 use crate::cli::MergeArgs;
 use crate::output::{check_output, Output};

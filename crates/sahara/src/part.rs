@@ -6,7 +6,7 @@ use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
 use sahara_formats::part_file::{read_part_info, write_part, PartInfo};
-use sahara_render::split::{crop, sample_range, tile, PixelWindow};
+use sahara_render::{crop, sample_range, tile, PixelWindow};
 use sahara_render::{RenderResult, RenderSettings, SumBuffer, ToneMap};
 
 use crate::cli::{RenderArgs, Split};

@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use sahara_render::render::UNLIMITED_SPP;
+use sahara_render::UNLIMITED_SPP;
 use sahara_render::{render_watched, Preview, Progress, RenderResult, RenderSettings, ToneMap};
 
 use crate::cli::RenderArgs;
@@ -170,7 +170,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
     let piece = match piece {
         None => None,
         Some(p) => {
-            let digest = sahara_render::digest::frame_digest(&scene, &settings);
+            let digest = sahara_render::frame_digest(&scene, &settings);
             settings.window = Some(p.window);
             settings.samples = Some(p.samples.clone());
             if args.skip_existing {

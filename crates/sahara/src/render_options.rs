@@ -8,16 +8,16 @@ use std::time::Duration;
 use anyhow::{bail, Result};
 use sahara_formats::scene_load::FileSettings;
 use sahara_kd::BuildParams;
-use sahara_render::render::UNLIMITED_SPP;
+use sahara_render::UNLIMITED_SPP;
 use sahara_render::{Filter, Integrator, RenderSettings, ToneMap};
 
 use crate::cli::RenderArgs;
 
 /// Samples per pixel when neither the command line nor a scene file says
 /// (the renderer's default, which scene files use too).
-pub const DEFAULT_SPP: u32 = sahara_render::integrator::defaults::SPP;
+pub const DEFAULT_SPP: u32 = sahara_render::defaults::SPP;
 /// Samples per pixel of each pass when the command line does not say.
-const PASS_SPP: u32 = sahara_render::integrator::defaults::PASS_SPP;
+const PASS_SPP: u32 = sahara_render::defaults::PASS_SPP;
 /// Image side in pixels when neither the command line nor a scene file says.
 pub const DEFAULT_SIDE: u32 = 512;
 

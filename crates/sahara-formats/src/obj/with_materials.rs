@@ -17,7 +17,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
-use sahara_render::mesh::Mesh;
+use sahara_render::Mesh;
 
 use super::{locate, obj_load_options, tobj_source};
 use crate::error::FormatError;

@@ -17,7 +17,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use glam::{Affine3A, DMat3, DMat4, DVec3, Mat4, Vec3};
-use sahara_render::mesh::SceneMesh;
+use sahara_render::SceneMesh;
 use sahara_render::{
     AlphaMode, Camera, Filter, Instance, Integrator, Material, Placement, SamplerKind, Scene,
     Shape, Srt, TextureMap, ToneMap,

@@ -7,10 +7,10 @@
 //! written in the light's own space. A square image is read as the
 //! former, any other as the latter. The map is resampled once, texel by
 //! texel (nearest), onto a lat-long map in Sahara's world convention (Y up,
-//! see `sahara_render::light::environment`) through the light's transform.
+//! see `sahara_render::environment_direction`) through the light's transform.
 
 use glam::{DMat3, DVec3, Vec2, Vec3};
-use sahara_render::light::environment::direction;
+use sahara_render::environment_direction;
 use sahara_render::Texture;
 
 /// Clarberg's equal-area map: the square point in [0, 1]^2 of unit direction `d`.
@@ -68,7 +68,7 @@ pub(crate) fn to_lat_long(img: &Texture, light_to_world: DMat3) -> Texture {
                 (x as f32 + 0.5) / width as f32,
                 (y as f32 + 0.5) / height as f32,
             );
-            let (w, _) = direction(uv);
+            let (w, _) = environment_direction(uv);
             let d = (world_to_light * w.as_dvec3()).normalize_or_zero();
             texels.push(if octahedral {
                 let (s, t) = equal_area_square(d);

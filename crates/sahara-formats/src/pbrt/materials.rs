@@ -592,10 +592,7 @@ mod tests {
         let wo = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
         let uv = glam::Vec2::splat(0.5);
         let tint = m
-            .at(
-                &[uv, uv],
-                &sahara_render::texture::footprint::UvFootprint::POINT,
-            )
+            .at(&[uv, uv], &sahara_render::UvFootprint::POINT)
             .bsdf
             .tint;
         let s = m
@@ -614,7 +611,7 @@ mod tests {
             panic!("{:?}", m.bsdf)
         };
         assert_eq!((eta, roughness), (Vec3::ONE, 0.0));
-        let f0 = sahara_render::material::fresnel::conductor(1.0, eta, k);
+        let f0 = sahara_render::fresnel::conductor(1.0, eta, k);
         assert!(
             (f0 - Vec3::new(0.9, 0.5, 0.1)).abs().max_element() < 1e-5,
             "{f0}"

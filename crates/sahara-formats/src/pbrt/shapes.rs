@@ -15,8 +15,8 @@
 //! `ReverseOrientation` and for transforms that swap handedness.
 
 use glam::{Vec2, Vec3};
-use sahara_render::mesh::{Mesh, SceneMesh};
 use sahara_render::Shape;
+use sahara_render::{Mesh, SceneMesh};
 
 use super::description::Entity;
 use super::lexer::read_maybe_gz;

@@ -29,7 +29,7 @@
 //!   taken at the d line, 587.56 nm, where glass catalogues give `n_d`.
 
 use glam::Vec3;
-use sahara_render::material::fresnel;
+use sahara_render::fresnel;
 
 /// How a spectrum is used, which decides how it becomes RGB.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -45,9 +45,9 @@ pub(crate) enum Use {
 /// Wavelengths (nm) at which red, green and blue sample an unbounded
 /// spectrum: those of the renderer's metal presets.
 pub(crate) const RGB_WAVELENGTHS: [f64; 3] = [
-    sahara_render::material::metals::RGB_WAVELENGTHS[0] as f64,
-    sahara_render::material::metals::RGB_WAVELENGTHS[1] as f64,
-    sahara_render::material::metals::RGB_WAVELENGTHS[2] as f64,
+    sahara_render::metals::RGB_WAVELENGTHS[0] as f64,
+    sahara_render::metals::RGB_WAVELENGTHS[1] as f64,
+    sahara_render::metals::RGB_WAVELENGTHS[2] as f64,
 ];
 
 /// The d line of helium (nm): glass catalogues give the index `n_d` there.

@@ -498,7 +498,7 @@ fn an_octahedral_environment_map_becomes_a_lat_long_map_through_the_light_transf
     assert_eq!((texture.width, texture.height), (4, 2));
     // World (1, 1, 0) normalised is light (1, -1, 0): red, at twice the value.
     let at = |w: Vec3| {
-        let uv = sahara_render::light::environment::coordinates(w.normalize());
+        let uv = sahara_render::environment_uv(w.normalize());
         texture.texel((uv.x * 4.0) as i64, (uv.y * 2.0) as i64)
     };
     assert_eq!(at(Vec3::new(1.0, 0.3, 0.0)), Vec3::new(2.0, 0.0, 0.0));
@@ -582,13 +582,13 @@ fn imagemaps_keep_their_wrap_mode_and_uv_scale_and_offset() {
     );
     assert!(w.is_empty(), "{w:?}");
     let map = m.textures.base_color.as_ref().expect("the image");
-    assert_eq!(map.wrap, [sahara_render::texture::Wrap::Clamp; 2]);
+    assert_eq!(map.wrap, [sahara_render::Wrap::Clamp; 2]);
     let uv = map.transform.transform_point2(glam::Vec2::new(1.0, 1.0));
     assert_eq!(uv, glam::Vec2::new(2.25, 3.5));
     // Past the right edge, clamping reads the last texel (grey), where
     // repeating would read the first (red).
     let grey = crate::srgb::srgb8_to_linear(128);
-    let point = sahara_render::texture::footprint::UvFootprint::POINT;
+    let point = sahara_render::UvFootprint::POINT;
     let far = glam::Vec2::new(0.9, 0.5);
     let tint = m.at(&[far, far], &point).bsdf.tint;
     assert!(
@@ -605,7 +605,7 @@ fn imagemaps_keep_their_wrap_mode_and_uv_scale_and_offset() {
     assert!(w[0].contains("wrap 'black'"), "{w:?}");
     assert_eq!(
         m.textures.base_color.unwrap().wrap,
-        [sahara_render::texture::Wrap::Clamp; 2]
+        [sahara_render::Wrap::Clamp; 2]
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -632,7 +632,7 @@ fn alpha_textures_cut_shapes_out() {
         assert!(m.passes(&[hole, hole], u), "the hole");
     }
     let hole = glam::Vec2::new(0.9, 0.5);
-    let point = sahara_render::texture::footprint::UvFootprint::POINT;
+    let point = sahara_render::UvFootprint::POINT;
     assert_eq!(m.at(&[hole, hole], &point).bsdf.tint, Vec3::ONE);
     // An RGBA TGA as a float texture is its alpha; the colour texture keeps its texels.
     let mut tga = vec![0u8, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 1, 0, 32, 0x28];

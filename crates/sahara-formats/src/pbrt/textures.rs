@@ -20,7 +20,7 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Affine2, Mat2, Vec2, Vec3};
-use sahara_render::texture::Wrap;
+use sahara_render::Wrap;
 use sahara_render::{Texture, TextureMap};
 
 use super::description::{Entity, TextureDecl};

@@ -7,7 +7,7 @@
 
 use std::fmt;
 
-use sahara_render::{FilterKind, IntegratorKind, Named, SamplerKind, ShapeKind, ToneMap};
+use sahara_render::{IntegratorKind, Named, SamplerKind, ShapeKind, ToneMap};
 use serde::{de, Deserialize, Deserializer};
 use toml::Spanned;
 
@@ -31,7 +31,7 @@ pub(super) struct RawScene {
     pub light: Vec<Spanned<RawLight>>,
     pub integrator: Option<Spanned<RawIntegrator>>,
     pub sampler: Option<Spanned<RawSampler>>,
-    pub filter: Option<Spanned<RawFilter>>,
+    pub filter: Option<Spanned<RawNamedTable>>,
     pub film: Option<Spanned<RawFilm>>,
 }
 
@@ -133,7 +133,7 @@ impl<'de> Deserialize<'de> for ShapeType {
                 names.extend(ShapeKind::names());
                 de::Error::custom(format!(
                     "unknown shape '{name}'; expected {}",
-                    sahara_render::names::one_of(&names)
+                    sahara_render::one_of(&names)
                 ))
             })
     }
@@ -260,16 +260,10 @@ pub(super) struct RawSampler {
     pub seed: Opt<i64>,
 }
 
-/// `[filter]`.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawFilter {
-    pub name: Spanned<Name<FilterKind>>,
-    pub radius: Opt<f32>,
-    pub sigma: Opt<f32>,
-    pub b: Opt<f32>,
-    pub c: Opt<f32>,
-}
+/// A table whose keys depend on a setting named in it (`[filter]`: `name`
+/// and the named filter's parameters, which the renderer lists), with the
+/// position of every value.
+pub(super) type RawNamedTable = std::collections::BTreeMap<String, Spanned<toml::Value>>;
 
 /// `[film]`.
 #[derive(Deserialize)]

@@ -5,9 +5,9 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use sahara_render::integrator::defaults;
+use sahara_render::defaults;
 use sahara_render::{
-    Filter, FilterKind, Integrator, IntegratorKind, SamplerKind, Shape, ShapeKind, ToneMap,
+    Filter, FilterKind, Integrator, IntegratorKind, Named, SamplerKind, Shape, ShapeKind, ToneMap,
 };
 use toml::Spanned;
 
@@ -90,7 +90,7 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
             },
         },
         filter: match &raw.filter {
-            Some(f) => ctx.filter(f.get_ref())?,
+            Some(f) => ctx.filter(f)?,
             None => Filter::default(),
         },
         film: ctx.film(film.get_ref())?,
@@ -520,13 +520,13 @@ impl Ctx<'_> {
             ));
         }
         if let Some(name) = &m.metal {
-            let Some((eta, k)) = sahara_render::material::metals::preset(name.get_ref()) else {
+            let Some((eta, k)) = sahara_render::metals::preset(name.get_ref()) else {
                 return Err(self.at(
                     name.span(),
                     format!(
                         "no metal is named '{}' (known: {})",
                         name.get_ref(),
-                        sahara_render::material::metals::PRESETS.join(", ")
+                        sahara_render::metals::PRESETS.join(", ")
                     ),
                 ));
             };
@@ -969,38 +969,51 @@ impl Ctx<'_> {
         })
     }
 
-    /// `[filter]`.
-    fn filter(&self, f: &RawFilter) -> Result<Filter, FormatError> {
-        let kind = f.name.get_ref().0;
-        let what = format!("the {kind} filter");
-        let present = [
-            ("radius", span(&f.radius)),
-            ("sigma", span(&f.sigma)),
-            ("b", span(&f.b)),
-            ("c", span(&f.c)),
-        ];
-        let allowed: &[&str] = match kind {
-            FilterKind::Box | FilterKind::Tent => &["radius"],
-            FilterKind::Gaussian => &["radius", "sigma"],
-            FilterKind::Mitchell => &["radius", "b", "c"],
+    /// `[filter]`: `name` and the parameters the renderer lists for that
+    /// filter ([`FilterKind::parameters`]), so a new filter needs no change
+    /// here.
+    fn filter(&self, table: &Spanned<RawNamedTable>) -> Result<Filter, FormatError> {
+        let t = table.get_ref();
+        let name = t
+            .get("name")
+            .ok_or_else(|| self.at(table.span(), "the [filter] table needs the key `name`"))?;
+        let kind = match name.get_ref() {
+            toml::Value::String(s) => {
+                FilterKind::from_name(s).map_err(|e| self.at(name.span(), e.to_string()))?
+            }
+            _ => return Err(self.at(name.span(), "`name` must be a string")),
         };
-        self.only(&present, allowed, &what)?;
-        // Every key defaults to the renderer's default for the kind.
-        let radius =
-            |default| self.number(&f.radius, "radius", default, |r| r > 0.0, "greater than 0");
-        Ok(match Filter::from(kind) {
-            Filter::Box { radius: r } => Filter::Box { radius: radius(r)? },
-            Filter::Tent { radius: r } => Filter::Tent { radius: radius(r)? },
-            Filter::Gaussian { radius: r, sigma } => Filter::Gaussian {
-                radius: radius(r)?,
-                sigma: self.number(&f.sigma, "sigma", sigma, |s| s > 0.0, "greater than 0")?,
-            },
-            Filter::Mitchell { radius: r, b, c } => Filter::Mitchell {
-                radius: radius(r)?,
-                b: self.number(&f.b, "b", b, |_| true, "finite")?,
-                c: self.number(&f.c, "c", c, |_| true, "finite")?,
-            },
-        })
+        let parameters = kind.parameters();
+        let keys: Vec<&str> = parameters.iter().map(|p| p.name).collect();
+        if let Some((key, value)) = t
+            .iter()
+            .find(|(key, _)| *key != "name" && !keys.contains(&key.as_str()))
+        {
+            return Err(self.at(
+                value.span(),
+                format!(
+                    "the key `{key}` does not apply to the {kind} filter (its keys: {})",
+                    keys.join(", ")
+                ),
+            ));
+        }
+        let values = parameters
+            .iter()
+            .map(|p| match t.get(p.name) {
+                None => Ok(p.default),
+                Some(v) => {
+                    let x = match v.get_ref() {
+                        toml::Value::Integer(i) => *i as f32,
+                        toml::Value::Float(f) => *f as f32,
+                        _ => {
+                            return Err(self.at(v.span(), format!("`{}` must be a number", p.name)))
+                        }
+                    };
+                    p.check(x).map_err(|why| self.at(v.span(), why))
+                }
+            })
+            .collect::<Result<Vec<f32>, FormatError>>()?;
+        Ok(Filter::with_parameters(kind, &values))
     }
 
     /// `[film]`.

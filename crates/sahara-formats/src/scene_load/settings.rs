@@ -48,7 +48,7 @@ impl FileCrop {
     /// The pixels of a `width x height` image this crop keeps (may be empty).
     pub fn window(&self, width: u32, height: u32) -> PixelWindow {
         match *self {
-            FileCrop::Fractions(f) => sahara_render::split::crop(width, height, f),
+            FileCrop::Fractions(f) => sahara_render::crop(width, height, f),
             FileCrop::Pixels([x0, x1, y0, y1]) => {
                 let clip = |v: i64, size: u32| v.clamp(0, i64::from(size)) as u32;
                 let (x0, y0) = (clip(x0, width), clip(y0, height));

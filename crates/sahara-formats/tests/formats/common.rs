@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::Vec3;
-use sahara_render::mesh::Mesh;
+use sahara_render::Mesh;
 
 /// A fresh, empty folder under the system temp dir, removed on drop.
 pub struct TempDir(pub PathBuf);

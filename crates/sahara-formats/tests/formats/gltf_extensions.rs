@@ -9,8 +9,8 @@ use sahara_formats::gltf::{load_gltf, GltfLightKind, LUMENS_PER_WATT};
 use sahara_formats::material_map::{gltf_material, TextureCache};
 use sahara_formats::mesh_scene::{load_mesh_scene, load_mesh_scene_with, CameraChoice};
 use sahara_formats::sky::{Sky, SkyUsed};
-use sahara_render::texture::{Channel, Wrap};
 use sahara_render::{Bsdf, Light};
+use sahara_render::{Channel, Wrap};
 
 use crate::common::TempDir;
 use crate::gltf::{base64, f32s};
@@ -348,7 +348,7 @@ fn what_sahara_cannot_render_is_said_in_words() {
     );
     let mut cache = TextureCache::new();
     let mut warnings = Vec::new();
-    let t = cache.file(&ktx, sahara_render::texture::Encoding::Srgb, &mut warnings);
+    let t = cache.file(&ktx, sahara_render::Encoding::Srgb, &mut warnings);
     assert!(t.is_none());
     assert!(
         warnings[0].contains("KTX2/Basis Universal textures are not supported"),

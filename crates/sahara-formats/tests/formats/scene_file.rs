@@ -689,7 +689,7 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
         }
     );
     assert_eq!(m[3].kind, MaterialKind::ThinDielectric { ior: 1.52 });
-    let (eta, k) = sahara_render::material::metals::preset("gold").unwrap();
+    let (eta, k) = sahara_render::metals::preset("gold").unwrap();
     assert_eq!(
         m[4].kind,
         MaterialKind::ComplexConductor {

@@ -414,11 +414,7 @@ fn a_scene_file_integrator_without_parameters_gets_the_command_line_defaults() {
         );
         let l = load_scene(&path).unwrap();
         assert_eq!(Ok(l.settings.integrator), Integrator::named(name), "{name}");
-        assert_eq!(
-            l.settings.spp,
-            sahara_render::integrator::defaults::SPP,
-            "{name}"
-        );
+        assert_eq!(l.settings.spp, sahara_render::defaults::SPP, "{name}");
     }
 }
 

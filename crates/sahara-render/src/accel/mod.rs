@@ -9,8 +9,8 @@ pub mod top_level;
 use glam::Affine3A;
 use sahara_kd::{Aabb, BuildParams, Counters, Hit, KdTree, NoCounters, Ray, PACKET16};
 
-use crate::instance::{Instance, Placement};
-use crate::mesh::SceneMesh;
+use crate::scene::instance::{Instance, Placement};
+use crate::scene::mesh::SceneMesh;
 use top_level::InstanceList;
 
 /// Most instances whose trees [`Accel::closest_packet`] traces a packet

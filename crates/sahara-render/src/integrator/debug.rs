@@ -4,8 +4,8 @@ use glam::Vec3;
 use sahara_kd::{Ray, TraversalCounters};
 
 use super::Context;
+use crate::math::warp::{cosine_hemisphere, Frame};
 use crate::sampler::dims;
-use crate::sampling::{cosine_hemisphere, Frame};
 
 /// The shading normal at the first hit as `n / 2 + 1/2`.
 pub fn normals(ctx: &mut Context, ray: &Ray, time: f32) -> Vec3 {

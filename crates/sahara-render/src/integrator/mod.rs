@@ -11,13 +11,13 @@ use glam::Vec3;
 use sahara_kd::{Ray, TraversalCounters};
 
 use crate::light::LightSample;
-use crate::material::textures::perturbed_normal;
+use crate::material::maps::perturbed_normal;
 use crate::material::NormalMap;
 use crate::material::{BsdfSample, PointBsdf};
+use crate::math::warp::Frame;
 use crate::names::{name_table, Named};
 use crate::sampler::dims;
 use crate::sampler::PixelSampler;
-use crate::sampling::Frame;
 use crate::texture::footprint::UvFootprint;
 use crate::world::{ShadowQuery, SurfaceHit, World};
 use state::Deferred;
@@ -150,7 +150,7 @@ impl Integrator {
     }
 
     /// The integrator called `name`, with the parameters of [`defaults`].
-    pub fn named(name: &str) -> Result<Self, crate::UnknownName> {
+    pub fn named(name: &str) -> Result<Self, crate::names::UnknownName> {
         IntegratorKind::from_name(name).map(Self::from)
     }
 
@@ -195,7 +195,7 @@ pub struct Context<'w, 'a> {
 impl Integrator {
     /// Radiance along a camera ray at `time`, the ray queries answered one
     /// at a time (the render loop answers them in batches, with the same
-    /// result bit for bit: see [`wavefront`]).
+    /// result bit for bit: see `wavefront`).
     pub fn li(&self, ctx: &mut Context, ray: &Ray, time: f32) -> Vec3 {
         ctx.stats.camera_rays += 1;
         match *self {
@@ -420,12 +420,12 @@ pub(crate) fn light_contribution(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::Camera;
     use crate::light::Light;
     use crate::material::Material;
     use crate::sampler::{SampleId, SamplerKind};
+    use crate::scene::camera::Camera;
+    use crate::scene::shape::Shape;
     use crate::scene::Scene;
-    use crate::shape::Shape;
     use sahara_kd::BuildParams;
 
     /// Radiance seen at the centre of a quad whose back faces the camera

@@ -4,8 +4,8 @@
 
 use super::state::{Deferred, Op, PathState};
 use super::{light_contribution, Context, Shading};
+use crate::math::warp::power_heuristic;
 use crate::sampler::dims;
-use crate::sampling::power_heuristic;
 use crate::world::SurfaceHit;
 use glam::Vec3;
 

@@ -186,14 +186,14 @@ impl Wavefront {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::Camera;
-    use crate::instance::{Instance, Srt};
     use crate::light::environment::Environment;
     use crate::light::Light;
     use crate::material::Material;
     use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
+    use crate::scene::camera::Camera;
+    use crate::scene::instance::{Instance, Srt};
+    use crate::scene::shape::Shape;
     use crate::scene::Scene;
-    use crate::shape::Shape;
     use glam::{Quat, Vec2, Vec3};
     use sahara_kd::BuildParams;
 

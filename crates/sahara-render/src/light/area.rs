@@ -5,8 +5,8 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
 use super::LightSample;
-use crate::distribution::Distribution1D;
-use crate::sampling::{concentric_disc, luminance, uniform_cone, uniform_triangle, Frame};
+use crate::math::piecewise::Distribution1D;
+use crate::math::warp::{concentric_disc, luminance, uniform_cone, uniform_triangle, Frame};
 use crate::texture::TextureMap;
 
 /// The emitting surface.
@@ -290,7 +290,7 @@ impl AreaLight {
         let d2 = to_c.length_squared();
         if d2 <= r * r {
             // Inside: uniform on the surface.
-            let n = crate::sampling::uniform_sphere(u);
+            let n = crate::math::warp::uniform_sphere(u);
             let q = c + r * n;
             let d = q - p;
             let dist2 = d.length_squared();

@@ -4,7 +4,7 @@ use glam::Vec3;
 use std::f32::consts::PI;
 
 use super::LightSample;
-use crate::sampling::luminance;
+use crate::math::warp::luminance;
 
 /// Incident light from a distant source travelling along `direction`
 /// (unit), delivering `irradiance` on a surface facing it.

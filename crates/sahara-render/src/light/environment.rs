@@ -7,8 +7,8 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
 use super::LightSample;
-use crate::distribution::Distribution2D;
-use crate::sampling::{luminance, uniform_sphere};
+use crate::math::piecewise::Distribution2D;
+use crate::math::warp::{luminance, uniform_sphere};
 use crate::texture::Texture;
 
 /// The scene's surroundings.
@@ -161,7 +161,7 @@ impl EnvLight {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hash::{hash3, unit_f32};
+    use crate::math::hash::{hash3, unit_f32};
 
     #[test]
     fn coordinates_invert_direction() {

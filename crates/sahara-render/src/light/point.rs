@@ -4,7 +4,7 @@ use glam::Vec3;
 use std::f32::consts::PI;
 
 use super::LightSample;
-use crate::sampling::luminance;
+use crate::math::warp::luminance;
 
 /// Incident radiance at `p` from a point light of `intensity` (W/sr) at
 /// `position`: `I / d^2` along the connecting direction.

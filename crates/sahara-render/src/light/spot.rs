@@ -4,7 +4,7 @@ use glam::Vec3;
 use std::f32::consts::PI;
 
 use super::{point, LightSample};
-use crate::sampling::luminance;
+use crate::math::warp::luminance;
 
 /// Angular falloff: 1 inside the inner cone, 0 outside the outer one, a
 /// smoothstep in cosine between.

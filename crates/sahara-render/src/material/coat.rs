@@ -27,7 +27,7 @@ use super::fresnel::{reflect, schlick_f90};
 use super::layered::{to_side, upper};
 use super::microfacet::Ggx;
 use super::{Bsdf, BsdfEval, BsdfSample};
-use crate::sampling::Frame;
+use crate::math::warp::Frame;
 
 /// The coat lobe at one shading point.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -232,10 +232,10 @@ impl Coat {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hash::{hash3, unit_f32};
     use crate::material::tests::{albedo_two_ways, u2};
     use crate::material::PointBsdf;
-    use crate::sampling::uniform_sphere;
+    use crate::math::hash::{hash3, unit_f32};
+    use crate::math::warp::uniform_sphere;
 
     fn bases() -> Vec<Bsdf> {
         vec![

@@ -4,7 +4,7 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
 use super::{BsdfEval, BsdfSample};
-use crate::sampling::cosine_hemisphere;
+use crate::math::warp::cosine_hemisphere;
 
 /// Value and density of the Lambertian BRDF of reflectance `albedo`
 /// (two-sided: `wo` may be on either side, `wi` must be on the same one).

@@ -34,7 +34,7 @@ use super::albedo;
 use super::fresnel::{conductor, reflect, schlick_f90};
 use super::microfacet::Ggx;
 use super::{BsdfEval, BsdfSample};
-use crate::sampling::{cosine_hemisphere, luminance};
+use crate::math::warp::{cosine_hemisphere, luminance};
 
 /// The Fresnel term of the specular lobe.
 #[derive(Clone, Copy, Debug)]

@@ -104,7 +104,7 @@ impl Ggx {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hash::{hash2, unit_f32};
+    use crate::math::hash::{hash2, unit_f32};
 
     #[test]
     fn projected_ndf_integrates_to_one() {
@@ -117,7 +117,7 @@ mod tests {
             for i in 0..n {
                 let u = Vec2::new(unit_f32(hash2(1, i)), unit_f32(hash2(2, i)));
                 // Cosine-weighted: pdf z/pi, so D z / (z / pi) = pi D.
-                let m = crate::sampling::cosine_hemisphere(u);
+                let m = crate::math::warp::cosine_hemisphere(u);
                 sum += (PI * g.d(m)) as f64;
             }
             let est = sum / n as f64;

@@ -12,9 +12,9 @@ pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
 mod layered;
+pub mod maps;
 pub mod metals;
 pub mod microfacet;
-pub mod textures;
 
 use std::sync::Arc;
 
@@ -25,8 +25,8 @@ use crate::texture::{Texture, TextureMap};
 pub use coat::Coat;
 use fresnel::schlick;
 use layered::Layered;
+pub use maps::{Clearcoat, MaterialTextures, NormalMap, OcclusionMap};
 use microfacet::Ggx;
-pub use textures::{Clearcoat, MaterialTextures, NormalMap, OcclusionMap};
 
 /// The scattering model of a material.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -466,13 +466,12 @@ impl Material {
             .as_ref()
             .map_or(Vec3::ONE, |m| m.lookup(uvs, fp).truncate());
         let bsdf = self.bsdf.modulated(
-            textures::scalar(&t.metallic, uvs, fp),
-            textures::scalar(&t.roughness, uvs, fp),
+            maps::scalar(&t.metallic, uvs, fp),
+            maps::scalar(&t.roughness, uvs, fp),
         );
         let coat = self.clearcoat.as_ref().and_then(|c| {
-            let factor = c.factor * textures::scalar(&c.factor_map, uvs, fp).unwrap_or(1.0);
-            let roughness =
-                c.roughness * textures::scalar(&c.roughness_map, uvs, fp).unwrap_or(1.0);
+            let factor = c.factor * maps::scalar(&c.factor_map, uvs, fp).unwrap_or(1.0);
+            let roughness = c.roughness * maps::scalar(&c.roughness_map, uvs, fp).unwrap_or(1.0);
             (factor > 0.0 && bsdf.is_reflective_only()).then(|| Coat::new(factor, roughness, c.ior))
         });
         SurfacePoint {
@@ -582,8 +581,8 @@ impl PointBsdf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hash::{hash3, unit_f32};
-    use crate::sampling::uniform_sphere;
+    use crate::math::hash::{hash3, unit_f32};
+    use crate::math::warp::uniform_sphere;
     use std::f32::consts::PI;
 
     /// Two uniform numbers from a hash of `(a, i)`.

@@ -3,7 +3,7 @@
 use glam::Vec2;
 
 use super::SampleId;
-use crate::hash::{hash3, mix64, unit_f32};
+use crate::math::hash::{hash3, mix64, unit_f32};
 
 #[inline]
 fn key(id: &SampleId, dim: u32) -> u64 {

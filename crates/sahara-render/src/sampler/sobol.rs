@@ -19,12 +19,12 @@ use glam::Vec2;
 use sobol_burley::parts::{hash, owen_scramble_rev, u32_to_f32_norm};
 
 use super::SampleId;
-use crate::hash::mix64;
+use crate::math::hash::mix64;
 
 /// Samples per sequence that `sobol_burley` supports.
 const MAX_INDEX: u32 = 1 << 16;
 
-/// The key `crate::hash::hash2` xors into its first word, so that
+/// The key `crate::math::hash::hash2` xors into its first word, so that
 /// `hash2(a, b) == mix64(mix64(a ^ HASH2_KEY) + b)` (checked by a test).
 const HASH2_KEY: u64 = 0x9e37_79b9_7f4a_7c15;
 
@@ -123,22 +123,17 @@ fn scramble(sobol_rev: u32, seed: u32, key: u32) -> f32 {
     u32_to_f32_norm(owen_scramble_rev(sobol_rev, s).reverse_bits())
 }
 
-/// One scrambled Sobol number for dimension `dim`.
-#[inline]
-pub fn get_1d(id: &SampleId, dim: u32) -> f32 {
-    SobolSample::new(id).get_1d(dim)
-}
-
-/// One scrambled 2D Sobol point for dimension `dim`.
-#[inline]
-pub fn get_2d(id: &SampleId, dim: u32) -> Vec2 {
+/// One scrambled 2D Sobol point for dimension `dim` (the renderer draws
+/// through [`SobolSample`], which scrambles once per pixel sample).
+#[cfg(test)]
+fn get_2d(id: &SampleId, dim: u32) -> Vec2 {
     SobolSample::new(id).get_2d(dim)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hash::hash2;
+    use crate::math::hash::hash2;
 
     /// The straightforward form: the seed hashed per draw and every
     /// coordinate from `sobol_burley::sample`.

@@ -5,7 +5,7 @@
 use glam::Vec2;
 
 use super::SampleId;
-use crate::hash::{hash3, mix64, permute, unit_f32};
+use crate::math::hash::{hash3, mix64, permute, unit_f32};
 
 #[inline]
 fn dim_key(id: &SampleId, dim: u32) -> u64 {

@@ -99,7 +99,7 @@ impl UvFootprint {
 
     /// The footprint of the triangle with corners `p` (world space) and uv
     /// sets `uv[set]` for surface offsets `offsets` (from
-    /// [`CameraSpread::surface_offsets`]): uv is an affine function on the
+    /// `CameraSpread::surface_offsets`): uv is an affine function on the
     /// triangle's plane, whose gradient takes each offset to its change
     /// of uv.
     pub fn on_triangle(p: [Vec3; 3], uv: [[Vec2; 3]; 2], offsets: [Vec3; 2]) -> Self {
@@ -126,7 +126,7 @@ impl UvFootprint {
 
     /// The footprint's width in level-0 texels of `texture` read through
     /// `transform` from uv set `set`: the longer axis, but at most
-    /// [`MAX_ANISOTROPY`] times the shorter.
+    /// `MAX_ANISOTROPY` times the shorter.
     #[inline]
     pub fn texels(&self, set: usize, transform: &Affine2, texture: &Texture) -> f32 {
         let size = Vec2::new(texture.width as f32, texture.height as f32);

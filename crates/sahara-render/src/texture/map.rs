@@ -84,7 +84,7 @@ impl TextureMap {
     }
 
     /// Filtered linear RGBA at the hit whose uv sets are `uvs`, for a
-    /// lookup of footprint `footprint` (see [`super::footprint`]).
+    /// lookup of footprint `footprint` (see `super::footprint`).
     #[inline]
     pub fn lookup(&self, uvs: &[Vec2; 2], footprint: &UvFootprint) -> Vec4 {
         let set = self.uv_set as usize & 1;

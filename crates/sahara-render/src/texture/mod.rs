@@ -15,7 +15,7 @@ pub mod footprint;
 mod map;
 mod pyramid;
 
-use std::sync::{Arc, OnceLock};
+use std::sync::OnceLock;
 
 use glam::{Vec2, Vec3, Vec4};
 
@@ -230,9 +230,6 @@ impl Texture {
         self.bilinear_level(0, uv, [Wrap::Repeat; 2]).w
     }
 }
-
-/// A shared texture, as materials hold them.
-pub type SharedTexture = Arc<Texture>;
 
 /// The linear value of an 8-bit sRGB code (IEC 61966-2-1), from a table.
 #[inline]

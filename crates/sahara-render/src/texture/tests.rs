@@ -1,3 +1,5 @@
+use std::sync::Arc;
+
 use super::footprint::{CameraSpread, UvFootprint};
 use super::pyramid::box_weights;
 use super::*;

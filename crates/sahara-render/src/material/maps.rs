@@ -85,7 +85,7 @@ impl MaterialTextures {
 /// A clear dielectric coat over a material (glTF's
 /// `KHR_materials_clearcoat`, a car's paint, a varnish): GGX reflection
 /// off the coat, over the material beneath dimmed by what the coat
-/// reflects on the way in and on the way out (see [`super::coat`]).
+/// reflects on the way in and on the way out (see `super::coat`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Clearcoat {
     /// How much of the surface the coat covers, in `[0, 1]`.

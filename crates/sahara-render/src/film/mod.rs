@@ -1,5 +1,9 @@
 //! The rendered image: linear RGB floats, and conversions for display.
 
+pub mod filter;
+pub mod sums;
+pub mod window;
+
 use glam::Vec3;
 
 use crate::names::name_table;

@@ -1,13 +1,22 @@
-//! The scene description: plain values the caller fills in.
+//! The scene model: what is rendered, as plain values the caller fills
+//! in: the camera, meshes and built-in shapes placed as instances,
+//! materials, lights and the environment.
+
+pub mod builtin;
+pub mod camera;
+pub mod instance;
+pub mod mesh;
+pub mod shape;
+pub(crate) mod tangents;
 
 use glam::{Affine3A, Vec3};
 
-use crate::camera::Camera;
-use crate::instance::Instance;
 use crate::light::{Environment, Light};
 use crate::material::Material;
-use crate::mesh::SceneMesh;
-use crate::shape::Shape;
+use crate::scene::camera::Camera;
+use crate::scene::instance::Instance;
+use crate::scene::mesh::SceneMesh;
+use crate::scene::shape::Shape;
 
 /// A built-in shape placed in the scene, remembered so that an emissive one
 /// is sampled analytically rather than as triangles.

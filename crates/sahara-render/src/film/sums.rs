@@ -20,7 +20,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::filter::Filter;
+use crate::film::filter::Filter;
 
 /// Fractional bits of the fixed-point sums.
 pub const FRACTION_BITS: i32 = 52;
@@ -49,7 +49,7 @@ fn float(v: i128) -> f64 {
 }
 
 /// The sums of one pixel: filter-weighted radiance per channel and the
-/// filter weights, in fixed point ([`FRACTION_BITS`] fractional bits).
+/// filter weights, in fixed point (`FRACTION_BITS` fractional bits).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PixelSum {
     /// `sum w L` for R, G and B.
@@ -136,7 +136,7 @@ impl SumBuffer {
     /// Splats a sample of pixel `(x, y)` at film position `pos` (pixel
     /// units) with radiance `l` into every pixel of the buffer whose centre
     /// lies within the filter's radius; `margin` is the filter's reach in
-    /// whole pixels ([`filter_margin`]).
+    /// whole pixels (`filter_margin`).
     #[inline]
     pub fn splat(&mut self, filter: &Filter, margin: u32, x: u32, y: u32, pos: Vec2, l: Vec3) {
         if self.width == 0 || self.height == 0 {

@@ -1,6 +1,6 @@
 //! Pixel reconstruction filters (separable, evaluated in pixel units).
 
-use crate::names::{name_table, Named};
+use crate::names::{name_table, Named, Parameter};
 
 /// A reconstruction filter; pixel estimates are `sum w L / sum w` over the
 /// samples within its radius.
@@ -56,24 +56,56 @@ name_table!(FilterKind, "filter", {
     FilterKind::Mitchell => "mitchell",
 });
 
-impl From<FilterKind> for Filter {
-    /// The filter of that kind with its default parameters: a one-pixel
-    /// box (radius 0.5), a tent of radius 1, a Gaussian of radius 1.5 and
-    /// sigma 0.5, Mitchell-Netravali with B = C = 1/3 and radius 2.
-    fn from(kind: FilterKind) -> Self {
-        match kind {
-            FilterKind::Box => Filter::Box { radius: 0.5 },
-            FilterKind::Tent => Filter::Tent { radius: 1.0 },
-            FilterKind::Gaussian => Filter::Gaussian {
-                radius: 1.5,
-                sigma: 0.5,
+/// A filter's half width in pixels.
+const fn radius(default: f32) -> Parameter {
+    Parameter {
+        name: "radius",
+        default,
+        positive: true,
+    }
+}
+
+impl FilterKind {
+    /// The parameters of this kind, in the order [`Filter::with_parameters`]
+    /// takes them, with their defaults: a one-pixel box (radius 0.5), a
+    /// tent of radius 1, a Gaussian of radius 1.5 and sigma 0.5,
+    /// Mitchell-Netravali with B = C = 1/3 and radius 2.
+    pub fn parameters(self) -> &'static [Parameter] {
+        const THIRD: Parameter = Parameter {
+            name: "",
+            default: 1.0 / 3.0,
+            positive: false,
+        };
+        const BOX: &[Parameter] = &[radius(0.5)];
+        const TENT: &[Parameter] = &[radius(1.0)];
+        const GAUSSIAN: &[Parameter] = &[
+            radius(1.5),
+            Parameter {
+                name: "sigma",
+                default: 0.5,
+                positive: true,
             },
-            FilterKind::Mitchell => Filter::Mitchell {
-                radius: 2.0,
-                b: 1.0 / 3.0,
-                c: 1.0 / 3.0,
-            },
+        ];
+        const MITCHELL: &[Parameter] = &[
+            radius(2.0),
+            Parameter { name: "b", ..THIRD },
+            Parameter { name: "c", ..THIRD },
+        ];
+        match self {
+            FilterKind::Box => BOX,
+            FilterKind::Tent => TENT,
+            FilterKind::Gaussian => GAUSSIAN,
+            FilterKind::Mitchell => MITCHELL,
         }
+    }
+}
+
+impl From<FilterKind> for Filter {
+    /// The filter of that kind with the defaults of
+    /// [`FilterKind::parameters`].
+    fn from(kind: FilterKind) -> Self {
+        let defaults: Vec<f32> = kind.parameters().iter().map(|p| p.default).collect();
+        Filter::with_parameters(kind, &defaults)
     }
 }
 
@@ -84,8 +116,25 @@ impl Default for Filter {
 }
 
 impl Filter {
+    /// The filter of `kind` with `values`, one for each of
+    /// [`FilterKind::parameters`] in its order, each accepted by its
+    /// [`Parameter::check`].
+    pub fn with_parameters(kind: FilterKind, values: &[f32]) -> Self {
+        match (kind, values) {
+            (FilterKind::Box, &[radius]) => Filter::Box { radius },
+            (FilterKind::Tent, &[radius]) => Filter::Tent { radius },
+            (FilterKind::Gaussian, &[radius, sigma]) => Filter::Gaussian { radius, sigma },
+            (FilterKind::Mitchell, &[radius, b, c]) => Filter::Mitchell { radius, b, c },
+            _ => panic!(
+                "the {kind} filter takes {} values, not {}",
+                kind.parameters().len(),
+                values.len()
+            ),
+        }
+    }
+
     /// The filter called `name`, with its default parameters.
-    pub fn named(name: &str) -> Result<Self, crate::UnknownName> {
+    pub fn named(name: &str) -> Result<Self, crate::names::UnknownName> {
         FilterKind::from_name(name).map(Self::from)
     }
 
@@ -167,6 +216,36 @@ impl Filter {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_kind_is_built_from_its_parameter_list() {
+        for &kind in FilterKind::ALL {
+            let parameters = kind.parameters();
+            assert_eq!(parameters[0].name, "radius", "{kind}");
+            let defaults: Vec<f32> = parameters.iter().map(|p| p.default).collect();
+            let filter = Filter::with_parameters(kind, &defaults);
+            assert_eq!((filter.kind(), filter.radius()), (kind, defaults[0]));
+            assert_eq!(filter, Filter::from(kind));
+            for (i, p) in parameters.iter().enumerate() {
+                assert!(p.check(p.default).is_ok(), "{kind} {}", p.name);
+                assert!(!parameters[..i].iter().any(|q| q.name == p.name));
+            }
+        }
+        assert_eq!(
+            Filter::from(FilterKind::Mitchell),
+            Filter::Mitchell {
+                radius: 2.0,
+                b: 1.0 / 3.0,
+                c: 1.0 / 3.0
+            }
+        );
+        let radius = FilterKind::Box.parameters()[0];
+        assert_eq!(
+            radius.check(0.0),
+            Err("`radius` is 0 but must be greater than 0".into())
+        );
+        assert!(radius.check(f32::NAN).is_err());
+    }
 
     #[test]
     fn mitchell_integrates_to_one_and_vanishes_at_the_edge() {

@@ -5,9 +5,9 @@
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
-use crate::mesh::{Mesh, SceneMesh};
+use crate::math::warp::Frame;
 use crate::names::name_table;
-use crate::sampling::Frame;
+use crate::scene::mesh::{Mesh, SceneMesh};
 
 /// Segments of a tessellated disc's rim.
 pub const DISC_SEGMENTS: u32 = 128;

@@ -6,8 +6,8 @@ use glam::Vec3;
 use sha2::{Digest, Sha256};
 use std::fmt::Write;
 
+use super::RenderSettings;
 use crate::light::Environment;
-use crate::render::RenderSettings;
 use crate::scene::Scene;
 use crate::texture::Texture;
 
@@ -130,7 +130,7 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::builtin;
+    use crate::scene::builtin;
     use sahara_kd::{BuildParams, Builder};
 
     #[test]
@@ -142,7 +142,7 @@ mod tests {
         let same = RenderSettings {
             build: BuildParams::new(Builder::Binned { bins: 16 }),
             tile_size: 7,
-            window: Some(crate::split::PixelWindow::full(3, 3)),
+            window: Some(crate::film::window::PixelWindow::full(3, 3)),
             samples: Some(1..2),
             ..base.clone()
         };

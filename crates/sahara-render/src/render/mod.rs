@@ -3,11 +3,13 @@
 //! Determinism: every random number is a function of (seed, pixel, pass,
 //! sample, dimension), and samples are splatted with the filter into
 //! per-tile buffers (a tile plus a margin of the filter's radius) of exact
-//! fixed-point sums ([`crate::sums`]) that are added into the image after
+//! fixed-point sums ([`crate::film::sums`]) that are added into the image after
 //! each pass. The sums do not depend on how samples are grouped, so the
 //! same seed gives the same image bit for bit whatever the number of
 //! threads, the order tiles finish in, or the split of the frame into
 //! windows and sample ranges rendered separately and added up.
+
+pub mod digest;
 
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::Arc;
@@ -18,15 +20,15 @@ use rayon::prelude::*;
 use sahara_kd::BuildParams;
 
 use crate::cpu_time::process_cpu_time;
+use crate::film::filter::Filter;
+use crate::film::sums::{filter_margin, SumBuffer};
+use crate::film::window::PixelWindow;
 use crate::film::{heat_color, Film};
-use crate::filter::Filter;
-use crate::hash::hash2;
 use crate::integrator::wavefront::Wavefront;
 use crate::integrator::{defaults, Context, Integrator, PathState, TraceStats};
+use crate::math::hash::hash2;
 use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
 use crate::scene::Scene;
-use crate::split::PixelWindow;
-use crate::sums::{filter_margin, SumBuffer};
 use crate::world::World;
 
 /// How to render.

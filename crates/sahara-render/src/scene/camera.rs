@@ -3,7 +3,7 @@
 use glam::{Vec2, Vec3};
 use sahara_kd::Ray;
 
-use crate::sampling::concentric_disc;
+use crate::math::warp::concentric_disc;
 
 /// A perspective camera.
 ///

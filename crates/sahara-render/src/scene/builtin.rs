@@ -2,11 +2,11 @@
 
 use glam::Vec3;
 
-use crate::camera::Camera;
 use crate::material::Material;
-use crate::mesh::{Mesh, SceneMesh};
+use crate::scene::camera::Camera;
+use crate::scene::mesh::{Mesh, SceneMesh};
+use crate::scene::shape::Shape;
 use crate::scene::Scene;
-use crate::shape::Shape;
 
 /// The Cornell box: the Cornell Program of Computer Graphics' measured
 /// geometry (millimetres, Y up), the usual reflectances, the ceiling light
@@ -185,7 +185,7 @@ pub fn cornell_box() -> Scene {
         ids.extend([mat, mat]);
     }
     let m = scene.add_mesh(mesh);
-    scene.add_instance(crate::instance::Instance::new(
+    scene.add_instance(crate::scene::instance::Instance::new(
         m,
         glam::Affine3A::IDENTITY,
         None,

@@ -12,7 +12,7 @@ use std::collections::HashMap;
 use bevy_mikktspace::{generate_tangents, Geometry, TangentSpace};
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::mesh::SceneMesh;
+use crate::scene::mesh::SceneMesh;
 
 /// The mesh as the algorithm reads it, and its answers per corner.
 struct Corners<'a> {

@@ -1,0 +1,7 @@
+//! Numerics shared by the renderer's parts: counter-based hashing,
+//! piecewise-constant distributions, and warps of uniform samples onto
+//! discs, hemispheres, spheres, cones and triangles.
+
+pub mod hash;
+pub mod piecewise;
+pub mod warp;
