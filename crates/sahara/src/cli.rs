@@ -158,7 +158,8 @@ pub struct RenderArgs {
     pub split: Option<Split>,
     /// Render only the crop window X0,X1,Y0,Y1, fractions of the image (y
     /// from the top; pixel bounds rounded up, as pbrt-v4's); writes a part
-    /// file. With --part tiles, the tiles divide the crop window.
+    /// file. With --part (and --split tiles), the tiles divide the crop
+    /// window.
     #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = parse_crop)]
     pub crop: Option<[f64; 4]>,
     /// Render only sample indices START..END of every pixel (counted over
@@ -433,8 +434,8 @@ pub struct TreeOptions {
     /// the tree's memory, tracing some 3-13% slower.
     #[arg(long)]
     pub compact_leaves: bool,
-    /// Walk single rays over the binary 8-byte nodes only, without the
-    /// wide nodes derived from them (for comparisons).
+    /// Build no wide nodes: batches walk the binary 8-byte nodes ray by
+    /// ray, and the tree's memory holds no wide nodes (for comparisons).
     #[arg(long)]
     pub binary_nodes: bool,
     /// Use only the first FRACTION of the triangles, in file order (0 < F

@@ -40,6 +40,18 @@ fn vec3(v: [f32; 3]) -> String {
     format!("({} {} {})", v[0], v[1], v[2])
 }
 
+/// What the bench table's sets and columns are, printed under it.
+const BENCH_LEGEND: &str = "\
+sets: primary (camera rays, one per pixel), shadow (from the primary hits
+  to a point light), diffuse (cosine-weighted bounces from the primary
+  hits), random (rays between random points of the scene's box); closest
+  hit except shadow (any hit); docs/bench-protocol.md has the details
+t-sum: the sum of the hit distances in f64, to compare tracers ray for ray
+Mrays/s 1T: rays a second traced one by one on 1 thread, by wall time;
+  1T CPU: the same by the thread's CPU time; NT: on N threads
+batch: the whole set in one batch call on 1 thread; packets: 8- or 16-ray
+  packets of neighbouring camera rays; both checked hit for hit";
+
 /// The header and one table row per set.
 pub fn bench_report(r: &BenchReport) -> String {
     let mut s = String::new();
@@ -79,24 +91,48 @@ pub fn bench_report(r: &BenchReport) -> String {
         count(r.threads, "thread")
     );
     let _ = writeln!(s);
-    let all = format!("Mrays/s {}T", r.threads);
+    // With one thread the all-threads column would repeat the first.
+    let many = r.threads > 1;
+    let all = if many {
+        format!("{:>11}", format!("Mrays/s {}T", r.threads))
+    } else {
+        String::new()
+    };
     let _ = writeln!(
         s,
-        "{:<8} {:>11} {:>11} {:>22} {:>11} {:>11} {:>11}",
-        "set", "rays", "hits", "t-sum", "Mrays/s 1T", "1T CPU", all
+        "{:<8} {:>11} {:>11} {:>22} {:>11} {:>11} {all}",
+        "set", "rays", "hits", "t-sum", "Mrays/s 1T", "1T CPU"
     );
+    let column = |v: f64| {
+        if many {
+            format!("{v:>11.3}")
+        } else {
+            String::new()
+        }
+    };
+    let dash = if many { "-" } else { "" };
     let entries = r.sets.entries();
     for (name, e) in &entries {
         let _ = writeln!(
             s,
-            "{:<8} {:>11} {:>11} {:>22.6} {:>11.3} {:>11.3} {:>11.3}",
+            "{:<8} {:>11} {:>11} {:>22.6} {:>11.3} {:>11.3} {}",
             name,
             thousands(e.rays as u64),
             thousands(e.hits),
             e.t_sum,
             e.mrays_1t,
             e.mrays_1t_cpu,
-            e.mrays_all
+            column(e.mrays_all)
+        );
+        let _ = writeln!(
+            s,
+            "{:<8} {:>11} {:>11} {:>22} {:>11.3} {:>11.3} {dash:>11}",
+            "  batch",
+            "(one call",
+            "of the set)",
+            "same hits",
+            e.mrays_batch_1t,
+            e.mrays_batch_1t_cpu
         );
         let packets = [
             (
@@ -116,12 +152,14 @@ pub fn bench_report(r: &BenchReport) -> String {
             if let (Some(p), Some(c)) = (p, c) {
                 let _ = writeln!(
                     s,
-                    "{:<8} {:>11} {:>11} {:>22} {:>11.3} {:>11.3} {:>11}",
-                    "  packets", rays, tiles, "same hits", p, c, "-"
+                    "{:<8} {:>11} {:>11} {:>22} {:>11.3} {:>11.3} {dash:>11}",
+                    "  packets", rays, tiles, "same hits", p, c
                 );
             }
         }
     }
+    let _ = writeln!(s);
+    let _ = writeln!(s, "{}", BENCH_LEGEND.trim_end());
     if entries.iter().any(|(_, e)| e.counters.is_some()) {
         let _ = writeln!(s);
         let _ = writeln!(
@@ -151,7 +189,8 @@ pub fn bench_report(r: &BenchReport) -> String {
             }
         }
     }
-    s
+    // Columns left empty (one thread) leave no trailing blanks.
+    s.lines().map(|l| l.trim_end().to_owned() + "\n").collect()
 }
 
 /// The statistics, one per line.

@@ -241,9 +241,27 @@ fn human_output_has_a_header_and_a_table() {
         "builder    sah",
         "SAH cost",
         "primary    1,048,576",
+        "  batch    (one call of the set)",
+        "t-sum: the sum of the hit distances",
+        "1T CPU: the same by the thread's CPU time",
     ] {
         assert!(text.contains(needle), "no {needle:?} in:\n{text}");
     }
+    // One thread: no second column of the same figure.
+    let one = sahara(&[
+        "bench",
+        obj.to_str().unwrap(),
+        "--runs",
+        "1",
+        "--sets",
+        "primary",
+        "--threads",
+        "1",
+    ]);
+    let text = String::from_utf8(one.stdout).unwrap();
+    let header = text.lines().find(|l| l.starts_with("set ")).unwrap();
+    assert_eq!(header.matches("Mrays/s").count(), 1, "{header}");
+    assert!(text.lines().all(|l| l == l.trim_end()), "trailing blanks:\n{text}");
     fs::remove_dir_all(dir).unwrap();
 }
 

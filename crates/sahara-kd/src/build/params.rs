@@ -152,9 +152,10 @@ pub struct BuildParams {
     /// Default false.
     pub compact_leaves: bool,
     /// Derive wide nodes (three binary levels in one 64-byte node, walked
-    /// with SIMD) for the single-ray queries and batches. The binary nodes
-    /// stay the reference form; the wide ones add about as many bytes
-    /// again (figures in `docs/performance.md`). Default true.
+    /// with SIMD) for the batches of incoherent rays; single rays, packets
+    /// and coherent batches walk the binary nodes, which stay the
+    /// reference form. The wide nodes make a tree some 8-10% larger
+    /// (figures in `docs/accelerator.md`). Default true.
     pub wide_nodes: bool,
 }
 
