@@ -261,7 +261,10 @@ fn human_output_has_a_header_and_a_table() {
     let text = String::from_utf8(one.stdout).unwrap();
     let header = text.lines().find(|l| l.starts_with("set ")).unwrap();
     assert_eq!(header.matches("Mrays/s").count(), 1, "{header}");
-    assert!(text.lines().all(|l| l == l.trim_end()), "trailing blanks:\n{text}");
+    assert!(
+        text.lines().all(|l| l == l.trim_end()),
+        "trailing blanks:\n{text}"
+    );
     fs::remove_dir_all(dir).unwrap();
 }
 
