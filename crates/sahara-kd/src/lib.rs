@@ -18,7 +18,7 @@
 //! assert_eq!((hit.t, hit.tri), (5.0, 0));
 //! ```
 //!
-//! The crate's rooms, each importing only those above it in this list:
+//! The crate's parts, each importing only those before it in this list:
 //! `math` (rays, boxes, triangles, clipping, float slack) and `simd`
 //! (instruction-set levels and dispatch); `isect` (the watertight test and
 //! hit records); `leaf` (leaf storage and the leaf tests) and `build` (the
@@ -40,11 +40,10 @@ mod stats;
 mod test_support;
 mod validate;
 
-pub use build::{AxisRule, BuildParams, Builder, BuiltNode, PositionRule, Primitive, MAX_DEPTH};
+pub use build::{AxisRule, BuildParams, Builder, PositionRule, Primitive, MAX_DEPTH};
 pub use isect::{intersect_ray_triangle, Hit, TriangleHit};
 pub use kd::{
-    BoxTree, Counters, KdTree, LeafStorage, NoCounters, Node, TraversalCounters, MAX_NODE_FIELD,
-    PACKET, PACKET16,
+    BoxTree, Counters, KdTree, LeafStorage, NoCounters, Node, TraversalCounters, PACKET, PACKET16,
 };
 pub use leaf::{TriangleBlock, TriangleLeaves};
 pub use math::slack::gamma;

@@ -16,7 +16,7 @@ mod wide;
 pub use batch::BatchWalk;
 pub use counters::{Counters, NoCounters, TraversalCounters};
 pub use leaves::LeafStorage;
-pub use node::{Node, MAX_NODE_FIELD};
+pub use node::Node;
 pub use packet::{PACKET, PACKET16};
 
 use crate::build::BuildParams;
