@@ -7,11 +7,11 @@ use std::time::Duration;
 
 use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use sahara_formats::camera::read_sidecar;
 use sahara_formats::image_out::{write_image, Pixels};
 use sahara_formats::mesh_scene::{load_mesh_scene_with, CameraChoice};
 use sahara_formats::scene_load::{load_scene_with_sky, FileSettings};
 use sahara_formats::sky::Sky;
+use sahara_readers::camera::read_sidecar;
 use sahara_render::render::UNLIMITED_SPP;
 use sahara_render::{
     builtin, render_watched, Camera, Integrator, Preview, Progress, RenderResult, RenderSettings,

@@ -1,7 +1,7 @@
 //! glTF: external/embedded buffers, GLB, node hierarchies, materials, errors.
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use sahara_formats::gltf::{load_gltf, GltfImage, GltfMaterial};
+use sahara_readers::gltf::{load_gltf, GltfImage, GltfMaterial};
 
 use crate::common::TempDir;
 
@@ -272,14 +272,14 @@ fn load_mesh_merges_every_node_use_in_scene_order_with_its_transform() {
   "scene": 0"#;
     let json = triangle_json(&uri, bin.len(), nodes).replace(r#", "material": 0"#, "");
     let path = dir.write("two.gltf", json);
-    let (mesh, warnings) = sahara_formats::load_mesh_with_warnings(&path).unwrap();
+    let (mesh, warnings) = sahara_readers::load_mesh_with_warnings(&path).unwrap();
     assert!(warnings.is_empty(), "{warnings:?}");
     assert_eq!(mesh.indices.len(), 2);
     let corner = |t: usize, k: usize| mesh.positions[mesh.indices[t][k] as usize];
     // Scene order: node 1 (moved up by 5) first, then node 0 (moved by 10 in x).
     assert_eq!(corner(0, 1), Vec3::new(1., 5., 0.));
     assert_eq!(corner(1, 1), Vec3::new(11., 0., 0.));
-    assert_eq!(sahara_formats::load_mesh(&path).unwrap(), mesh);
+    assert_eq!(sahara_readers::load_mesh(&path).unwrap(), mesh);
 }
 
 /// A GLB file: 12-byte header, JSON chunk (space-padded), BIN chunk (zero-padded).

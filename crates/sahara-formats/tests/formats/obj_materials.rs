@@ -3,9 +3,9 @@
 use std::fs;
 
 use glam::{Vec2, Vec3};
-use sahara_formats::mtl::MtlMaterial;
-use sahara_formats::obj::{load_obj, load_obj_with_materials};
 use sahara_formats::scenes_dir;
+use sahara_readers::mtl::MtlMaterial;
+use sahara_readers::obj::{load_obj, load_obj_with_materials};
 
 use crate::common::{corners, TempDir};
 

@@ -2,12 +2,12 @@
 //! meshes, shapes, lights, motion and errors.
 
 use glam::{Affine3A, Vec3};
-use sahara_formats::gltf::GltfMaterial;
 use sahara_formats::material_map::{gltf_bsdf, mtl_bsdf, phong_roughness};
 use sahara_formats::mesh_scene::load_mesh_scene;
-use sahara_formats::mtl::MtlMaterial;
 use sahara_formats::scene_load::load_scene;
 use sahara_formats::scenes_dir;
+use sahara_readers::gltf::GltfMaterial;
+use sahara_readers::mtl::MtlMaterial;
 use sahara_render::{AlphaMode, Bsdf, Integrator, Light, Placement, Shape};
 
 use crate::common::TempDir;
