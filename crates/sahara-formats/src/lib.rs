@@ -59,17 +59,3 @@ pub fn load_mesh(path: &Path) -> Result<Mesh, FormatError> {
 pub fn load_mesh_with_warnings(path: &Path) -> Result<(Mesh, Vec<String>), FormatError> {
     sahara_readers::load_mesh_with_warnings(path).map(|(mesh, w)| (render_mesh(mesh), w))
 }
-
-/// The shared scene folder: `$SAHARA_SCENES` if set, else `shared/scenes` beside the workspace.
-pub fn scenes_dir() -> std::path::PathBuf {
-    match std::env::var_os("SAHARA_SCENES") {
-        Some(dir) if !dir.is_empty() => std::path::PathBuf::from(dir),
-        _ => {
-            let dir = Path::new(concat!(
-                env!("CARGO_MANIFEST_DIR"),
-                "/../../../shared/scenes"
-            ));
-            dir.canonicalize().unwrap_or_else(|_| dir.to_path_buf())
-        }
-    }
-}

@@ -14,7 +14,7 @@ use sahara_render::texture::{Channel, Wrap};
 use sahara_render::{Bsdf, Light};
 
 use crate::common::TempDir;
-use crate::gltf::{base64, f32s};
+use crate::gltf_data::{base64, f32s};
 
 /// A 2x1 RGBA PNG: an opaque orange texel and a half-transparent blue one.
 fn png() -> Vec<u8> {

@@ -3,11 +3,11 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
-use sahara_formats::{render_mesh, scenes_dir};
+use sahara_formats::render_mesh;
 use sahara_readers::camera::{read_sidecar, sidecar_path};
 use sahara_readers::load_mesh;
 
-use crate::common::corners;
+use crate::common::{corners, scenes_dir};
 
 /// `<scenes>/<name>/<file>`, or `None` (with a note) if the scene set is absent.
 fn scene(name: &str, file: &str) -> Option<PathBuf> {
