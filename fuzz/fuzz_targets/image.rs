@@ -14,7 +14,7 @@ fuzz_target!(|data: &[u8]| {
                 let pixels = i.width as usize * i.height as usize;
                 let (values, per_pixel) = match &i.pixels {
                     Pixels::Rgba8(v) => (v.len(), 4),
-                    Pixels::EncodedRgbaF32(v) => (v.len(), 4),
+                    Pixels::EncodedRgbF32(v) => (v.len(), 3),
                     Pixels::LinearRgbF32(v) => (v.len(), 3),
                 };
                 assert_eq!(values, pixels * per_pixel);

@@ -68,23 +68,16 @@ pub fn linear(raw: RawImage) -> Image {
         width,
         height,
         pixels,
-        has_alpha,
+        alpha,
         ..
     } = raw;
-    let (rgb, alpha) = match pixels {
-        Pixels::Rgba8(rgba) => (
-            rgba.chunks_exact(4)
-                .flat_map(|p| p[..3].iter().map(|&c| srgb8_to_linear(c)))
-                .collect(),
-            alpha8(&rgba, has_alpha),
-        ),
-        Pixels::EncodedRgbaF32(rgba) => (
-            rgba.chunks_exact(4)
-                .flat_map(|p| p[..3].iter().map(|&v| srgb_to_linear(v)))
-                .collect(),
-            has_alpha.then(|| rgba.chunks_exact(4).map(|p| p[3]).collect()),
-        ),
-        Pixels::LinearRgbF32(rgb) => (rgb, None),
+    let rgb = match pixels {
+        Pixels::Rgba8(rgba) => rgba
+            .chunks_exact(4)
+            .flat_map(|p| p[..3].iter().map(|&c| srgb8_to_linear(c)))
+            .collect(),
+        Pixels::EncodedRgbF32(rgb) => rgb.into_iter().map(srgb_to_linear).collect(),
+        Pixels::LinearRgbF32(rgb) => rgb,
     };
     Image {
         width,
@@ -118,11 +111,15 @@ pub fn texture(raw: RawImage, encoding: Encoding) -> Texture {
         height: h,
         format,
         pixels,
-        has_alpha,
+        alpha,
     } = raw;
-    let with_alpha = |t: Texture, alpha: Option<Vec<f32>>| match alpha {
-        Some(a) => t.with_alpha(a),
-        None => t,
+    let has_alpha = alpha.is_some();
+    let float = |rgb: Vec<Vec3>| {
+        let t = Texture::new(w, h, rgb);
+        match alpha {
+            Some(a) => t.with_alpha(a),
+            None => t,
+        }
     };
     match pixels {
         // TGA textures are float textures (8-bit PNG and JPEG keep their codes).
@@ -131,11 +128,11 @@ pub fn texture(raw: RawImage, encoding: Encoding) -> Texture {
                 Encoding::Srgb => srgb8_to_linear(c),
                 Encoding::Linear => f32::from(c) / 255.0,
             };
-            let rgb = rgba
-                .chunks_exact(4)
-                .map(|t| Vec3::new(value(t[0]), value(t[1]), value(t[2])))
-                .collect();
-            with_alpha(Texture::new(w, h, rgb), alpha8(&rgba, has_alpha))
+            float(
+                rgba.chunks_exact(4)
+                    .map(|t| Vec3::new(value(t[0]), value(t[1]), value(t[2])))
+                    .collect(),
+            )
         }
         Pixels::Rgba8(rgba) => {
             let texels = rgba
@@ -144,30 +141,17 @@ pub fn texture(raw: RawImage, encoding: Encoding) -> Texture {
                 .collect();
             Texture::from_rgba8(w, h, texels, encoding, has_alpha)
         }
-        Pixels::EncodedRgbaF32(rgba) => {
+        Pixels::EncodedRgbF32(rgb) => {
             let decode = |v: f32| match encoding {
                 Encoding::Linear => v,
                 Encoding::Srgb => srgb_to_linear(v),
             };
-            let rgb = rgba
-                .chunks_exact(4)
-                .map(|t| Vec3::new(decode(t[0]), decode(t[1]), decode(t[2])))
-                .collect();
-            let alpha = has_alpha.then(|| rgba.chunks_exact(4).map(|t| t[3]).collect());
-            with_alpha(Texture::new(w, h, rgb), alpha)
+            float(
+                rgb.chunks_exact(3)
+                    .map(|t| Vec3::new(decode(t[0]), decode(t[1]), decode(t[2])))
+                    .collect(),
+            )
         }
-        Pixels::LinearRgbF32(rgb) => {
-            Texture::new(w, h, rgb.chunks_exact(3).map(Vec3::from_slice).collect())
-        }
+        Pixels::LinearRgbF32(rgb) => float(rgb.chunks_exact(3).map(Vec3::from_slice).collect()),
     }
-}
-
-/// The alpha channel of 8-bit RGBA codes as opacities in `[0, 1]`, if the
-/// image has one.
-fn alpha8(rgba: &[u8], has_alpha: bool) -> Option<Vec<f32>> {
-    has_alpha.then(|| {
-        rgba.chunks_exact(4)
-            .map(|p| f32::from(p[3]) / 255.0)
-            .collect()
-    })
 }

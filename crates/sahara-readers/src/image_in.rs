@@ -52,9 +52,9 @@ pub enum Pixels {
     /// 8-bit codes, four a pixel (R, G, B, A; A is 255 when the file has
     /// no alpha): 8-bit PNG, JPEG and TGA. Colour files store sRGB codes.
     Rgba8(Vec<u8>),
-    /// Values in `[0, 1]`, four a pixel (R, G, B, A), encoded as the file
+    /// Values in `[0, 1]`, three a pixel (R, G, B), encoded as the file
     /// encodes them (sRGB for colours): 16-bit PNG and JPEG.
-    EncodedRgbaF32(Vec<f32>),
+    EncodedRgbF32(Vec<f32>),
     /// Linear floats, three a pixel (R, G, B), no alpha: Radiance HDR,
     /// OpenEXR and PFM.
     LinearRgbF32(Vec<f32>),
@@ -71,8 +71,11 @@ pub struct RawImage {
     pub format: ImageFormat,
     /// The pixel values.
     pub pixels: Pixels,
-    /// Whether the file has an alpha channel (else the A values are 1).
-    pub has_alpha: bool,
+    /// The alpha channel as opacities in `[0, 1]` (`width * height`
+    /// values), if the file has one. Alpha is linear whatever the colour
+    /// encoding, so it is given as a fraction; 8-bit codes stay in
+    /// [`Pixels::Rgba8`] too.
+    pub alpha: Option<Vec<f32>>,
 }
 
 /// Reads an image file (PNG, JPEG, HDR, EXR, TGA or PFM) as stored; see [`decode_raw`].
@@ -102,7 +105,7 @@ fn decode_any(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
             height,
             format: ImageFormat::Exr,
             pixels: Pixels::LinearRgbF32(rgb),
-            has_alpha: false,
+            alpha: None,
         });
     }
     if bytes.starts_with(&[0xAB, b'K', b'T', b'X', b' ', b'2', b'0', 0xBB]) {
@@ -151,21 +154,51 @@ fn decode_any(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
         .decode()
         .map_err(|e| FormatError::in_file(name, format!("cannot decode {format:?} image: {e}")))?;
     let (width, height) = (decoded.width(), decoded.height());
-    let has_alpha = decoded.color().has_alpha();
-    let pixels = if ours == ImageFormat::Hdr {
-        Pixels::LinearRgbF32(decoded.into_rgb32f().into_raw())
-    } else if is_8bit(decoded.color()) {
-        Pixels::Rgba8(decoded.into_rgba8().into_raw())
+    let color = decoded.color();
+    let (pixels, alpha) = if ours == ImageFormat::Hdr {
+        (Pixels::LinearRgbF32(decoded.into_rgb32f().into_raw()), None)
+    } else if is_8bit(color) {
+        // The image crate turns a grey-and-alpha image's alpha into
+        // fractions a little differently from `a / 255` (in the last bit
+        // for some codes); taken as it gives them, so images do not change.
+        let alpha = match color {
+            image::ColorType::La8 => Some(alpha_of(decoded.to_rgba32f().into_raw())),
+            _ => None,
+        };
+        let rgba = decoded.into_rgba8().into_raw();
+        let alpha = color
+            .has_alpha()
+            .then(|| alpha.unwrap_or_else(|| alpha_fractions(&rgba)));
+        (Pixels::Rgba8(rgba), alpha)
     } else {
-        Pixels::EncodedRgbaF32(decoded.into_rgba32f().into_raw())
+        let rgba = decoded.into_rgba32f().into_raw();
+        let rgb = rgba
+            .chunks_exact(4)
+            .flat_map(|p| &p[..3])
+            .copied()
+            .collect();
+        let alpha = color.has_alpha().then(|| alpha_of(rgba));
+        (Pixels::EncodedRgbF32(rgb), alpha)
     };
     Ok(RawImage {
         width,
         height,
         format: ours,
         pixels,
-        has_alpha,
+        alpha,
     })
+}
+
+/// The fourth value of each pixel of float RGBA.
+fn alpha_of(rgba: Vec<f32>) -> Vec<f32> {
+    rgba.chunks_exact(4).map(|p| p[3]).collect()
+}
+
+/// The alpha codes of 8-bit RGBA as fractions, `a / 255`.
+pub(crate) fn alpha_fractions(rgba: &[u8]) -> Vec<f32> {
+    rgba.chunks_exact(4)
+        .map(|p| f32::from(p[3]) / 255.0)
+        .collect()
 }
 
 /// True for the 8-bit colour types.

@@ -143,7 +143,7 @@ pub(super) fn decode(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> 
         height,
         format: ImageFormat::Pfm,
         pixels: Pixels::LinearRgbF32(rgb),
-        has_alpha: false,
+        alpha: None,
     })
 }
 
@@ -168,7 +168,7 @@ mod tests {
         // Two rows of one pixel: the file's first row is the image's bottom.
         let b = pfm("PF\n1 2\n-1\n", &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0], true);
         let i = decode_raw(&b, "x.pfm").unwrap();
-        assert_eq!((i.width, i.height, i.has_alpha), (1, 2, false));
+        assert_eq!((i.width, i.height, i.alpha), (1, 2, None));
         assert_eq!(
             i.pixels,
             Pixels::LinearRgbF32(vec![4.0, 5.0, 6.0, 1.0, 2.0, 3.0])

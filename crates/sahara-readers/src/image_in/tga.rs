@@ -6,7 +6,7 @@
 //!
 //! The pixels come out as their 8-bit codes (RGBA).
 
-use super::{check_size, ImageFormat, Pixels, RawImage};
+use super::{alpha_fractions, check_size, ImageFormat, Pixels, RawImage};
 use crate::error::FormatError;
 
 /// Length of the fixed header.
@@ -214,8 +214,8 @@ pub(super) fn decode(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> 
         width,
         height,
         format: ImageFormat::Tga,
+        alpha: has_alpha.then(|| alpha_fractions(&rgba)),
         pixels: Pixels::Rgba8(rgba),
-        has_alpha,
     })
 }
 
@@ -244,8 +244,17 @@ mod tests {
             .flat_map(|p| &p[..3])
             .copied()
             .collect();
-        let alpha = rgba.chunks_exact(4).map(|p| p[3]).collect();
-        (rgb, i.has_alpha.then_some(alpha))
+        let alpha: Vec<u8> = rgba.chunks_exact(4).map(|p| p[3]).collect();
+        if let Some(a) = &i.alpha {
+            assert_eq!(
+                a,
+                &alpha
+                    .iter()
+                    .map(|&c| f32::from(c) / 255.0)
+                    .collect::<Vec<_>>()
+            );
+        }
+        (rgb, i.alpha.is_some().then_some(alpha))
     }
 
     #[test]
