@@ -1,4 +1,5 @@
-//! The one error type of the readers (and of `sahara-formats`, which re-exports it): what went wrong, in which file, where.
+//! The one error type of the readers (and of `sahara-formats`, which
+//! re-exports it): what went wrong, in which file, where.
 //!
 //! Every message is a single line of the form `<file>: <where>: <what>` so a
 //! person can go straight to the offending spot.

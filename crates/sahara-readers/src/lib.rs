@@ -5,7 +5,8 @@
 //!   with [`load_mesh`];
 //! - images: [`image_in`] (PNG, JPEG, Radiance HDR, OpenEXR, TGA and PFM,
 //!   as their stored values: 8-bit codes or floats, saying which);
-//! - [`camera`] sidecars (JSON).
+//! - [`camera`] sidecars (JSON);
+//! - [`fan`]: the fan triangulation of polygons that the mesh formats share.
 //!
 //! Everything comes out as plain data: [`TriangleMesh`], attribute structs
 //! such as [`obj::ObjScene`], [`ply::PlyMesh`] and [`gltf::GltfScene`],
@@ -17,7 +18,8 @@
 //! fan-triangulated as `(v0, vi, vi+1)`, so triangle number `k` is the
 //! `k`-th triangle of the file after triangulation.
 //!
-//! Every error is a [`FormatError`]: one line naming the file and the place.
+//! Every error is a [`FormatError`]: one line naming the file and the place
+//! ([`one_line`] keeps quoted input from breaking that promise).
 
 #![warn(missing_docs)]
 
