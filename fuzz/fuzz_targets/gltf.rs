@@ -2,7 +2,7 @@
 //! indices in range, lights and cameras that convert, or a one-line error
 //! naming the file.
 //!
-//! `sahara_formats::gltf` has no in-memory entry point, so each input is
+//! `sahara_readers::gltf` has no in-memory entry point, so each input is
 //! written to a file in a fresh private folder (in /dev/shm when there is one)
 //! and loaded from there; relative buffer and image URIs resolve inside that
 //! empty folder.
@@ -12,8 +12,9 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use libfuzzer_sys::fuzz_target;
-use sahara_formats::gltf::load_gltf;
+use sahara_formats::gltf_scene::{gltf_camera, gltf_light};
 use sahara_fuzz::{check_error, check_mesh};
+use sahara_readers::gltf::load_gltf;
 
 fn input_path() -> &'static PathBuf {
     static PATH: OnceLock<PathBuf> = OnceLock::new();
@@ -49,10 +50,10 @@ fuzz_target!(|data: &[u8]| {
             }
             // Lights and cameras convert whatever the file's numbers.
             for light in &scene.lights {
-                let _ = light.to_light(glam::Mat4::IDENTITY);
+                let _ = gltf_light(light, glam::Mat4::IDENTITY);
             }
             for camera in &scene.cameras {
-                let _ = camera.to_camera();
+                let _ = gltf_camera(camera);
             }
         }
         Err(e) => check_error(&e, &name),

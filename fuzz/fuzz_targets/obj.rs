@@ -3,8 +3,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use sahara_formats::obj::parse_obj;
 use sahara_fuzz::{check_error, check_mesh};
+use sahara_readers::obj::parse_obj;
 
 fuzz_target!(|data: &[u8]| {
     match parse_obj(data, "fuzz.obj") {

@@ -4,8 +4,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use sahara_formats::ply::parse_ply;
 use sahara_fuzz::{check_error, check_mesh};
+use sahara_readers::ply::parse_ply;
 
 fuzz_target!(|data: &[u8]| {
     match parse_ply(data, "fuzz.ply") {

@@ -1,8 +1,8 @@
 //! Checks shared by the fuzz targets.
 
-use sahara_formats::FormatError;
+use sahara_readers::FormatError;
 
-/// Asserts the promise of `sahara_formats::error`: every error is one line
+/// Asserts the promise of `sahara_readers::error`: every error is one line
 /// that starts with the file's name.
 pub fn check_error(error: &FormatError, name: &str) {
     let message = error.to_string();

@@ -22,7 +22,7 @@ use glam::Vec3A;
 use obvhs::ray::{Ray as ORay, RayHit};
 use obvhs::triangle::Triangle as OTriangle;
 use obvhs::BvhBuildParams;
-use sahara_kd::Ray;
+use sahara_kd::{Ray, Triangle};
 
 /// What to run.
 struct Args {
@@ -130,10 +130,9 @@ fn measure(rays: &[ORay], runs: usize, trace: impl Fn(&ORay) -> Option<f32>) -> 
 
 fn main() -> Result<()> {
     let a = parse_args()?;
-    let mesh = sahara_formats::load_mesh(&a.mesh)
+    let mesh = sahara_readers::load_mesh(&a.mesh)
         .with_context(|| format!("loading {}", a.mesh.display()))?;
-    let tris: Vec<OTriangle> = mesh
-        .triangles()
+    let tris: Vec<OTriangle> = Triangle::from_indexed(&mesh.positions, &mesh.indices)
         .iter()
         .filter(|t| t.v.iter().all(|v| v.is_finite()))
         .map(|t| OTriangle {

@@ -11,6 +11,8 @@
 //!
 //! `cargo bench -p sahara-bench --bench kdtree`
 
+use std::path::{Path, PathBuf};
+
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize};
 use sahara_bench::runner::PacketSize;
@@ -19,11 +21,20 @@ use sahara_kd::internals::{BatchWalk, Frustum, IndexedBlocks, PacketShear, RaySh
 use sahara_kd::{BuildParams, Builder, KdTree, Ray, TriangleBlock};
 use sahara_render::Mesh;
 
+/// The shared scene folder: `$SAHARA_SCENES` if set, else `shared/scenes`
+/// beside the workspace.
+fn scenes_dir() -> PathBuf {
+    match std::env::var_os("SAHARA_SCENES") {
+        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes"),
+    }
+}
+
 /// Rays per traced batch: enough to leave the caches' warm-up behind.
 const BATCH: usize = 1 << 16;
 
 fn bunny() -> Option<Mesh> {
-    let path = sahara_formats::scenes_dir().join("bunny/bunny.ply");
+    let path = scenes_dir().join("bunny/bunny.ply");
     match sahara_formats::load_mesh(&path) {
         Ok(m) => Some(m),
         Err(e) => {
@@ -60,9 +71,8 @@ fn spread(rays: &[Ray], n: usize) -> Vec<Ray> {
 fn trace(c: &mut Criterion) {
     let Some(mesh) = bunny() else { return };
     let frame = SceneFrame::from_mesh(&mesh).expect("bunny is a valid mesh");
-    let sidecar = sahara_formats::camera::read_sidecar(
-        &sahara_formats::scenes_dir().join("bunny/bunny.camera.json"),
-    );
+    let sidecar =
+        sahara_readers::camera::read_sidecar(&scenes_dir().join("bunny/bunny.camera.json"));
     let camera = match sidecar {
         Ok(s) => ProtocolCamera {
             eye: s.eye,

@@ -16,8 +16,8 @@ use exr::prelude::{
 };
 
 use crate::atomic::write_atomically;
-use crate::error::FormatError;
 use crate::srgb::{linear_to_srgb8, srgb8_to_linear};
+use crate::FormatError;
 
 /// The image file formats this module writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

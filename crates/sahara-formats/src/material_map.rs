@@ -52,13 +52,13 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Affine2, Vec2, Vec3};
-use sahara_render::{Bsdf, Material, Texture};
-use sahara_render::{Channel, Encoding, ScalarMap, TextureMap};
+use sahara_render::{AlphaMode, Bsdf, Material, Texture};
+use sahara_render::{Channel, Encoding, ScalarMap, TextureMap, Wrap};
 use sahara_render::{Clearcoat, NormalMap, OcclusionMap};
 
-use crate::gltf::{GltfImage, GltfMaterial, GltfTexture};
 use crate::image_in::{decode_texture, load_texture};
-use crate::mtl::MtlMaterial;
+use sahara_readers::gltf::{GltfAlphaMode, GltfImage, GltfMaterial, GltfTexture, GltfWrap};
+use sahara_readers::mtl::MtlMaterial;
 
 /// IOR used for MTL glass that gives none (`Ni` <= 1).
 pub const DEFAULT_GLASS_IOR: f32 = 1.5;
@@ -150,6 +150,24 @@ impl TextureCache {
     /// True if no texture was asked for.
     pub fn is_empty(&self) -> bool {
         self.images.is_empty()
+    }
+}
+
+/// A glTF `alphaMode` as the renderer's.
+fn alpha_mode(a: GltfAlphaMode) -> AlphaMode {
+    match a {
+        GltfAlphaMode::Opaque => AlphaMode::Opaque,
+        GltfAlphaMode::Mask { cutoff } => AlphaMode::Mask { cutoff },
+        GltfAlphaMode::Blend => AlphaMode::Blend,
+    }
+}
+
+/// A glTF sampler's wrap mode as the renderer's.
+fn wrap(w: GltfWrap) -> Wrap {
+    match w {
+        GltfWrap::Repeat => Wrap::Repeat,
+        GltfWrap::Clamp => Wrap::Clamp,
+        GltfWrap::MirroredRepeat => Wrap::MirroredRepeat,
     }
 }
 
@@ -265,7 +283,7 @@ pub fn gltf_material(
     let mut out = Material::new(gltf_bsdf(m))
         .with_emission(emission(m.emissive))
         .with_two_sided(m.double_sided)
-        .with_alpha(m.alpha_mode, m.base_color[3].clamp(0.0, 1.0));
+        .with_alpha(alpha_mode(m.alpha_mode), m.base_color[3].clamp(0.0, 1.0));
     out.two_sided_emission = m.double_sided;
     let label = m.name.as_deref().unwrap_or("(unnamed)");
     let mut map = |t: Option<&GltfTexture>, role: &str, encoding: Encoding| {
@@ -280,7 +298,7 @@ pub fn gltf_material(
         let texture = textures.gltf(t, name, encoding, warnings)?;
         Some(
             TextureMap::new(texture)
-                .with_wrap(t.wrap[0], t.wrap[1])
+                .with_wrap(wrap(t.wrap[0]), wrap(t.wrap[1]))
                 .with_uv_set(t.tex_coord as u8)
                 .with_transform(FLIP_V * t.transform * FLIP_V),
         )

@@ -13,9 +13,9 @@ use std::path::{Path, PathBuf};
 use glam::{Mat4, Vec2};
 use sahara_render::{Scene, SceneMesh};
 
-use crate::error::FormatError;
-use crate::gltf::{GltfCamera, GltfLight};
 use crate::material_map::{gltf_material, mtl_material, TextureCache};
+use crate::FormatError;
+use sahara_readers::gltf::{GltfCamera, GltfLight};
 
 /// One scene mesh made from a file, and where the file puts it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,7 +98,7 @@ impl MeshLibrary {
         let loaded = match ext.as_str() {
             "obj" => self.load_obj(scene, path, own_materials)?,
             "ply" => {
-                let mesh = crate::ply::load_ply(path)?;
+                let mesh = crate::render_mesh(sahara_readers::ply::load_ply(path)?);
                 let mesh = scene.add_mesh(mesh);
                 LoadedFile {
                     parts: vec![MeshPart {
@@ -132,10 +132,10 @@ impl MeshLibrary {
         path: &Path,
         own_materials: bool,
     ) -> Result<LoadedFile, FormatError> {
-        let obj = crate::obj::load_obj_with_materials(path)?;
+        let obj = sahara_readers::obj::load_obj_with_materials(path)?;
         self.warnings.extend(obj.warnings);
         let mut mesh = SceneMesh {
-            mesh: obj.mesh,
+            mesh: crate::render_mesh(obj.mesh),
             normals: obj.normals,
             uvs: obj.uvs,
             ..SceneMesh::default()
@@ -173,7 +173,7 @@ impl MeshLibrary {
         path: &Path,
         own_materials: bool,
     ) -> Result<LoadedFile, FormatError> {
-        let g = crate::gltf::load_gltf(path)?;
+        let g = sahara_readers::gltf::load_gltf(path)?;
         let name = path.display().to_string();
         self.warnings.extend(g.warnings);
         let mut emissive = false;
@@ -199,7 +199,7 @@ impl MeshLibrary {
             .into_iter()
             .map(|m| {
                 scene.add_mesh(SceneMesh {
-                    mesh: m.mesh,
+                    mesh: crate::render_mesh(m.mesh),
                     normals: m.normals,
                     uvs: flip(m.uvs),
                     uvs1: flip(m.uvs1),

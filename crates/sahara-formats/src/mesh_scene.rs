@@ -13,10 +13,11 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use sahara_render::{Camera, Instance, Placement, Scene};
 
-use crate::camera::{read_sidecar, sidecar_path};
-use crate::error::FormatError;
+use crate::gltf_scene::{gltf_camera, gltf_light};
 use crate::mesh_library::MeshLibrary;
 use crate::sky::{self, Sky, SkyUsed};
+use crate::FormatError;
+use sahara_readers::camera::{read_sidecar, sidecar_path};
 
 pub use crate::sky::{DEFAULT_SKY, DEFAULT_SUN, DEFAULT_SUN_DIRECTION};
 
@@ -96,7 +97,7 @@ pub fn load_mesh_scene_with(
         });
     }
     for l in &file.lights {
-        scene.add_light(l.to_light(glam::Mat4::IDENTITY));
+        scene.add_light(gltf_light(l, glam::Mat4::IDENTITY));
     }
     scene.generate_tangents();
     let sidecar = sidecar_path(path);
@@ -107,9 +108,9 @@ pub fn load_mesh_scene_with(
             p.display().to_string(),
         ))
     };
-    let named = |c: &crate::gltf::GltfCamera| {
+    let named = |c: &sahara_readers::gltf::GltfCamera| {
         (
-            c.to_camera(),
+            gltf_camera(c),
             format!(
                 "{name}: camera '{}'",
                 c.name.as_deref().unwrap_or("(unnamed)")

@@ -21,7 +21,7 @@ use exr::prelude::{
 use sahara_render::{IntegratorKind, PixelSum, PixelWindow, SumBuffer, ToneMap};
 
 use crate::atomic::write_atomically;
-use crate::error::FormatError;
+use crate::FormatError;
 
 /// The value of `sahara:format` in a part file.
 const FORMAT: &str = "sahara render part 1";

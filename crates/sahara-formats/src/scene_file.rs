@@ -64,7 +64,7 @@ use std::path::{Path, PathBuf};
 use glam::{Mat4, Quat, Vec3};
 use sahara_render::{Filter, Integrator, SamplerKind, Shape, ToneMap};
 
-use crate::error::FormatError;
+use crate::FormatError;
 
 /// A parsed and checked scene file.
 #[derive(Clone, Debug, PartialEq)]
@@ -388,30 +388,5 @@ pub fn load_scene_file(path: &Path) -> Result<SceneFile, FormatError> {
 
 /// Parses and checks scene TOML held in memory; `name` is used in errors, paths resolve against `folder`.
 pub fn parse_scene_file(text: &str, name: &str, folder: &Path) -> Result<SceneFile, FormatError> {
-    resolve::resolve(text, name, folder).map_err(one_line)
-}
-
-/// `error` with line breaks in its message shown as `\n` (and trailing ones
-/// dropped), keeping the promise that every error is one line.
-///
-/// Messages quote the input (the toml and gltf crates quote values, the
-/// image crate ends some messages with a newline), and a value can hold line
-/// breaks: fuzzing found `name = """distribution` + newlines in a scene file
-/// and a truncated JPEG giving multi-line errors. Used by the scene-file,
-/// glTF and image readers (it would sit better in `error.rs`).
-pub(crate) fn one_line(error: FormatError) -> FormatError {
-    let fix = |message: String| {
-        let trimmed = message.trim_end();
-        if trimmed.contains(['\n', '\r']) {
-            trimmed
-                .replace("\r\n", "\\n")
-                .replace('\n', "\\n")
-                .replace('\r', "\\r")
-        } else if trimmed.len() != message.len() {
-            trimmed.to_owned()
-        } else {
-            message
-        }
-    };
-    error.map_message(fix)
+    resolve::resolve(text, name, folder).map_err(sahara_readers::one_line)
 }

@@ -30,7 +30,7 @@ use sahara_render::{
     Bsdf, Camera, Environment, Instance, Light, Material, Scene, Texture, TextureMap,
 };
 
-use crate::error::FormatError;
+use crate::gltf_scene::gltf_light;
 use crate::image_in::load_rgb_f32;
 use crate::material_map::TextureCache;
 use crate::mesh_library::{file_key, MeshLibrary};
@@ -39,6 +39,7 @@ use crate::scene_file::{
     Placement as PlacementSpec, SceneFile, ShapeSpec,
 };
 use crate::sky::Sky;
+use crate::FormatError;
 
 pub use placement::{placement, srt};
 pub use settings::{FileCrop, FileSettings};
@@ -113,7 +114,7 @@ pub fn build_scene(file: &SceneFile, name: &str) -> Result<LoadedScene, FormatEr
                 // (where it starts, if it moves).
                 let at = placement(&o.placement, Mat4::IDENTITY).at(0.0);
                 for l in &f.lights {
-                    scene.add_light(l.to_light(Mat4::from(at)));
+                    scene.add_light(gltf_light(l, Mat4::from(at)));
                 }
                 if matches!(o.placement, PlacementSpec::Motion { .. })
                     && material.map_or(f.emissive, |m| is_emissive(&scene, m))

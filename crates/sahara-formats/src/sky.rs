@@ -20,8 +20,8 @@ use glam::Vec3;
 use sahara_render::luminance;
 use sahara_render::{Environment, Light, Scene, Texture};
 
-use crate::error::FormatError;
 use crate::image_in::load_rgb_f32;
+use crate::FormatError;
 
 /// Radiance of the default sky.
 pub const DEFAULT_SKY: Vec3 = Vec3::new(0.55, 0.6, 0.7);

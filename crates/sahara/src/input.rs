@@ -5,7 +5,7 @@ use std::path::Path;
 use anyhow::{anyhow, Context, Result};
 use sahara_bench::report::CameraReport;
 use sahara_bench::{ProtocolCamera, SceneFrame};
-use sahara_formats::camera::{read_sidecar, sidecar_path, CameraSidecar};
+use sahara_readers::camera::{read_sidecar, sidecar_path, CameraSidecar};
 use sahara_render::Mesh;
 
 /// Load a mesh (`.obj`, `.ply`, `.gltf`, `.glb`; a glTF scene's meshes

@@ -5,10 +5,10 @@
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
-use sahara_formats::camera::read_sidecar;
 use sahara_formats::mesh_scene::{load_mesh_scene_with, CameraChoice};
 use sahara_formats::scene_load::{load_scene_with_sky, FileSettings};
 use sahara_formats::sky::Sky;
+use sahara_readers::camera::read_sidecar;
 use sahara_render::{builtin, Camera, Scene};
 
 /// A scene to render, with what its file says about rendering it.

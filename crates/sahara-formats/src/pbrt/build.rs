@@ -31,8 +31,8 @@ use super::subdivision::smooth_normals;
 use super::textures::{with_opacity, Textures};
 use super::warnings::Warnings;
 use super::PbrtScene;
-use crate::error::FormatError;
 use crate::scene_load::{shapes::add_placed_shape, FileCrop, FileSettings, LoadedScene};
+use crate::FormatError;
 
 /// Deepest chain of `mix` materials followed.
 const MAX_MIX_DEPTH: usize = 16;

@@ -6,7 +6,7 @@ use std::io::Read;
 use std::path::Path;
 use std::sync::Arc;
 
-use crate::error::FormatError;
+use crate::FormatError;
 
 /// Largest file (after decompression) read, in bytes: a guard against a
 /// gzip bomb, far above any real scene file.

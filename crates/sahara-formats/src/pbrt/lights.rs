@@ -26,8 +26,8 @@ use super::envmap::to_lat_long;
 use super::spectrum::Use;
 use super::textures::rgb_of;
 use super::warnings::Warnings;
-use crate::error::FormatError;
 use crate::image_in::load_rgb_f32;
+use crate::FormatError;
 
 /// A spectrum parameter of a light as RGB (default white).
 fn light_rgb(e: &Entity, name: &str, w: &mut Warnings) -> Result<Vec3, FormatError> {

@@ -31,7 +31,7 @@ use super::params::SpectrumParam;
 use super::spectrum::{self, Use};
 use super::textures::{rgb_of, spectral_samples, Textures, Tint};
 use super::warnings::Warnings;
-use crate::error::FormatError;
+use crate::FormatError;
 
 /// What a pbrt material becomes.
 #[derive(Clone, Debug, PartialEq)]

@@ -38,8 +38,8 @@ mod tests;
 
 use std::path::Path;
 
-use crate::error::FormatError;
 use crate::scene_load::LoadedScene;
+use crate::FormatError;
 
 /// A pbrt scene ready to render (the film's `cropwindow` or
 /// `pixelbounds` is in its settings' `crop`).

@@ -8,7 +8,7 @@
 use std::cell::Cell;
 
 use super::lexer::Loc;
-use crate::error::FormatError;
+use crate::FormatError;
 
 /// The values of one parameter.
 #[derive(Clone, Debug, PartialEq)]

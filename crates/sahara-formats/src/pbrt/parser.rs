@@ -20,7 +20,7 @@ use super::description::{
 use super::lexer::{read_maybe_gz, Lexer, Loc, Token, TokenKind};
 use super::params::{Param, ParamList, Values};
 use super::warnings::Warnings;
-use crate::error::FormatError;
+use crate::FormatError;
 
 /// Deepest `Include` nesting accepted (a file including itself is caught by this).
 const MAX_INCLUDE_DEPTH: usize = 32;

@@ -22,9 +22,9 @@ use super::description::Entity;
 use super::lexer::read_maybe_gz;
 use super::subdivision::{loop_subdivide, smooth_normals};
 use super::warnings::Warnings;
-use crate::error::FormatError;
-use crate::fan::fan_triangulate;
-use crate::ply::parse_ply_with_attributes;
+use crate::FormatError;
+use sahara_readers::fan::fan_triangulate;
+use sahara_readers::ply::parse_ply_with_attributes;
 
 /// Largest number of triangles a shape may make (subdivision, tessellation).
 const MAX_TRIANGLES: u64 = 1 << 24;

@@ -27,9 +27,9 @@ use super::description::{Entity, TextureDecl};
 use super::params::{FloatParam, SpectrumParam};
 use super::spectrum::{self, Use};
 use super::warnings::Warnings;
-use crate::error::FormatError;
 use crate::image_in::load_image;
 use crate::srgb::linear_to_srgb8;
+use crate::FormatError;
 
 /// A colour, optionally times an image.
 #[derive(Clone, Debug, PartialEq)]

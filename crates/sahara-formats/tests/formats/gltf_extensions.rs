@@ -5,15 +5,16 @@
 //! is said; non-finite vertices.
 
 use glam::{Affine2, Mat4, Vec2, Vec3, Vec4};
-use sahara_formats::gltf::{load_gltf, GltfLightKind, LUMENS_PER_WATT};
+use sahara_formats::gltf_scene::{gltf_camera, gltf_light, LUMENS_PER_WATT};
 use sahara_formats::material_map::{gltf_material, TextureCache};
 use sahara_formats::mesh_scene::{load_mesh_scene, load_mesh_scene_with, CameraChoice};
 use sahara_formats::sky::{Sky, SkyUsed};
+use sahara_readers::gltf::{load_gltf, GltfLightKind, GltfWrap};
 use sahara_render::{Bsdf, Light};
 use sahara_render::{Channel, Wrap};
 
 use crate::common::TempDir;
-use crate::gltf::{base64, f32s};
+use crate::gltf_data::{base64, f32s};
 
 /// A 2x1 RGBA PNG: an opaque orange texel and a half-transparent blue one.
 fn png() -> Vec<u8> {
@@ -122,12 +123,12 @@ fn every_role_attribute_light_and_camera_is_read() {
     );
     let m = &g.materials[0];
     let base = m.base_color_texture.as_ref().unwrap();
-    assert_eq!(base.wrap, [Wrap::Clamp, Wrap::MirroredRepeat]);
+    assert_eq!(base.wrap, [GltfWrap::Clamp, GltfWrap::MirroredRepeat]);
     assert_eq!((base.tex_coord, base.transform), (0, Affine2::IDENTITY));
     let mr = m.metallic_roughness_texture.as_ref().unwrap();
     assert_eq!(
         (mr.tex_coord, mr.wrap),
-        (1, [Wrap::MirroredRepeat, Wrap::Repeat])
+        (1, [GltfWrap::MirroredRepeat, GltfWrap::Repeat])
     );
     let (normal, scale) = m.normal_texture.as_ref().unwrap();
     assert_eq!((normal.tex_coord, *scale), (1, 0.75));
@@ -144,10 +145,10 @@ fn every_role_attribute_light_and_camera_is_read() {
     assert_eq!(g.lights.len(), 3);
     assert_eq!(g.lights[0].kind, GltfLightKind::Point);
     assert_eq!(
-        g.lights[0].to_light(Mat4::IDENTITY),
+        gltf_light(&g.lights[0], Mat4::IDENTITY),
         Light::point(Vec3::new(1.0, 2.0, 3.0), Vec3::new(1.0, 0.5, 0.25))
     );
-    match g.lights[1].to_light(Mat4::IDENTITY) {
+    match gltf_light(&g.lights[1], Mat4::IDENTITY) {
         Light::Spot {
             position,
             direction,
@@ -165,13 +166,13 @@ fn every_role_attribute_light_and_camera_is_read() {
         other => panic!("{other:?}"),
     }
     assert_eq!(
-        g.lights[2].to_light(Mat4::IDENTITY),
+        gltf_light(&g.lights[2], Mat4::IDENTITY),
         Light::directional(Vec3::NEG_Z, Vec3::splat(10.0))
     );
     // Perspective cameras by name; the orthographic one skipped, said so.
     let names: Vec<_> = g.cameras.iter().map(|c| c.name.clone().unwrap()).collect();
     assert_eq!(names, ["front", "top"]);
-    let top = g.cameras[1].to_camera();
+    let top = gltf_camera(&g.cameras[1]);
     assert!(
         (top.forward - Vec3::NEG_Y).length() < 1e-5
             && (top.vfov_deg - 1f32.to_degrees()).abs() < 1e-4

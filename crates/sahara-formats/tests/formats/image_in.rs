@@ -2,7 +2,7 @@
 
 use std::fs;
 
-use sahara_formats::image_in::{decode_rgb_f32, load_rgb_f32};
+use sahara_formats::image_in::{decode_rgb_f32, load_image, load_rgb_f32};
 use sahara_formats::image_out::{write_exr, write_png};
 
 use crate::common::TempDir;
@@ -24,6 +24,26 @@ fn png_is_decoded_from_srgb_to_linear() {
     let expected = [0.0, 0.215_86, 1.0, 0.003_035_3, 1.0, 0.0];
     for (got, want) in rgb.iter().zip(expected) {
         assert!(close(*got, want, 2e-5), "{rgb:?}");
+    }
+}
+
+#[test]
+fn png_alpha_is_the_fraction_the_image_crate_gives() {
+    // Every code, grey-and-alpha and RGBA: the image crate's fractions for
+    // the two differ in the last bit for some codes, and loading keeps them.
+    let dir = TempDir::new("tex-alpha");
+    let grey = image::GrayAlphaImage::from_fn(256, 1, |x, _| image::LumaA([7, x as u8]));
+    let rgba = image::RgbaImage::from_fn(256, 1, |x, _| image::Rgba([7, 8, 9, x as u8]));
+    for (name, img) in [
+        ("ga.png", image::DynamicImage::ImageLumaA8(grey)),
+        ("rgba.png", image::DynamicImage::ImageRgba8(rgba)),
+    ] {
+        let path = dir.0.join(name);
+        img.save(&path).unwrap();
+        let want: Vec<f32> = img.to_rgba32f().pixels().map(|p| p.0[3]).collect();
+        let got = load_image(&path).unwrap().alpha.unwrap();
+        let bits = |v: &[f32]| v.iter().map(|a| a.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&got), bits(&want), "{name}");
     }
 }
 

@@ -1,14 +1,13 @@
-//! Tests for `sahara-formats`: meshes, materials, glTF, scene files and their conversion to renderer scenes, images, camera sidecars and the shared scenes.
+//! Tests for `sahara-formats`: glTF extensions, scene files and their conversion to renderer scenes, images in and out, and the shared scenes.
 
-mod camera;
+// Shared with `sahara-readers`' tests (one copy of the helpers).
+#[path = "../../../sahara-readers/tests/readers/common.rs"]
 mod common;
-mod gltf;
+#[path = "../../../sahara-readers/tests/readers/gltf_data.rs"]
+mod gltf_data;
 mod gltf_extensions;
 mod image_in;
 mod image_out;
-mod obj;
-mod obj_materials;
-mod ply;
 mod scene_file;
 mod scene_load;
 mod scenes;

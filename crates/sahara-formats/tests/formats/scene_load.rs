@@ -2,16 +2,15 @@
 //! meshes, shapes, lights, motion and errors.
 
 use glam::{Affine3A, Vec3};
-use sahara_formats::gltf::GltfMaterial;
 use sahara_formats::material_map::{gltf_bsdf, mtl_bsdf, phong_roughness};
 use sahara_formats::mesh_scene::load_mesh_scene;
-use sahara_formats::mtl::MtlMaterial;
 use sahara_formats::scene_load::load_scene;
-use sahara_formats::scenes_dir;
+use sahara_readers::gltf::GltfMaterial;
+use sahara_readers::mtl::MtlMaterial;
 use sahara_render::{AlphaMode, Bsdf, Integrator, Light, Placement, Shape};
 
-use crate::common::TempDir;
-use crate::gltf::{base64, triangle_buffer, triangle_json};
+use crate::common::{scenes_dir, TempDir};
+use crate::gltf_data::{base64, triangle_buffer, triangle_json};
 
 const QUAD_OBJ: &str = "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl MAT\nf 1/1 2/2 3/3 4/4\n";
 

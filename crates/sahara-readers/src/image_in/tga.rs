@@ -4,11 +4,10 @@
 //! crate so that a damaged file is reported at its byte offset and the
 //! header's size is checked before any pixel memory is allocated.
 //!
-//! 8-bit colours are sRGB-encoded and become linear; alpha stays linear.
+//! The pixels come out as their 8-bit codes (RGBA).
 
-use super::{check_size, Image};
+use super::{alpha_fractions, check_size, ImageFormat, Pixels, RawImage};
 use crate::error::FormatError;
-use crate::srgb::srgb8_to_linear;
 
 /// Length of the fixed header.
 const HEADER: usize = 18;
@@ -73,7 +72,7 @@ fn rgba(b: &[u8], depth: u8, grey: bool) -> [u8; 4] {
 }
 
 /// Decodes a TGA file.
-pub(super) fn decode(bytes: &[u8], name: &str) -> Result<Image, FormatError> {
+pub(super) fn decode(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
     let bad = |offset: usize, message: String| FormatError::at_byte(name, offset as u64, message);
     let Some(h) = bytes.get(..HEADER) else {
         return Err(bad(
@@ -202,31 +201,27 @@ pub(super) fn decode(bytes: &[u8], name: &str) -> Result<Image, FormatError> {
     } else {
         alpha_bits > 0 && matches!(depth, 16 | 32)
     };
-    let mut rgb = Vec::with_capacity(pixels * 3);
-    let mut alpha = Vec::with_capacity(if has_alpha { pixels } else { 0 });
+    let mut rgba = Vec::with_capacity(pixels * 4);
     for y in 0..hgt {
         let sy = if top { y } else { hgt - 1 - y };
         for x in 0..w {
             let sx = if right { w - 1 - x } else { x };
-            let p = out[sy * w + sx];
-            rgb.extend(p[..3].iter().map(|&c| srgb8_to_linear(c)));
-            if has_alpha {
-                alpha.push(f32::from(p[3]) / 255.0);
-            }
+            let [r, g, b, a] = out[sy * w + sx];
+            rgba.extend([r, g, b, if has_alpha { a } else { 255 }]);
         }
     }
-    Ok(Image {
+    Ok(RawImage {
         width,
         height,
-        rgb,
-        alpha: has_alpha.then_some(alpha),
+        format: ImageFormat::Tga,
+        alpha: has_alpha.then(|| alpha_fractions(&rgba)),
+        pixels: Pixels::Rgba8(rgba),
     })
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::decode_image;
-    use crate::srgb::srgb8_to_linear;
+    use super::super::{decode_raw, Pixels, RawImage};
 
     fn header(kind: u8, w: u16, h: u16, depth: u8, descriptor: u8, map: (u16, u8)) -> Vec<u8> {
         let mut b = vec![0, u8::from(map.0 > 0), kind, 0, 0];
@@ -239,18 +234,36 @@ mod tests {
         b
     }
 
-    fn lin(v: &[u8]) -> Vec<f32> {
-        v.iter().map(|&c| srgb8_to_linear(c)).collect()
+    /// The RGB codes and, if the image has alpha, the alpha codes.
+    fn codes(i: &RawImage) -> (Vec<u8>, Option<Vec<u8>>) {
+        let Pixels::Rgba8(rgba) = &i.pixels else {
+            panic!("TGA pixels are 8-bit codes");
+        };
+        let rgb = rgba
+            .chunks_exact(4)
+            .flat_map(|p| &p[..3])
+            .copied()
+            .collect();
+        let alpha: Vec<u8> = rgba.chunks_exact(4).map(|p| p[3]).collect();
+        if let Some(a) = &i.alpha {
+            assert_eq!(
+                a,
+                &alpha
+                    .iter()
+                    .map(|&c| f32::from(c) / 255.0)
+                    .collect::<Vec<_>>()
+            );
+        }
+        (rgb, i.alpha.is_some().then_some(alpha))
     }
 
     #[test]
     fn raw_bottom_up_rows_are_flipped_and_bgr_swapped() {
         let mut b = header(2, 1, 2, 24, 0, (0, 0));
         b.extend([1, 2, 3, 4, 5, 6]); // bottom pixel, then top (B, G, R)
-        let i = decode_image(&b, "x.tga").unwrap();
+        let i = decode_raw(&b, "x.tga").unwrap();
         assert_eq!((i.width, i.height), (1, 2));
-        assert_eq!(i.rgb, lin(&[6, 5, 4, 3, 2, 1]));
-        assert_eq!(i.alpha, None);
+        assert_eq!(codes(&i), (vec![6, 5, 4, 3, 2, 1], None));
     }
 
     #[test]
@@ -258,25 +271,29 @@ mod tests {
         // 32 bits, top-down, 8 alpha bits: a run of 2, then 1 raw pixel.
         let mut b = header(10, 3, 1, 32, 0x28, (0, 0));
         b.extend([0x81, 10, 20, 30, 255, 0x00, 1, 2, 3, 0]);
-        let i = decode_image(&b, "r.tga").unwrap();
-        assert_eq!(i.rgb, lin(&[30, 20, 10, 30, 20, 10, 3, 2, 1]));
-        assert_eq!(i.alpha, Some(vec![1.0, 1.0, 0.0]));
+        let i = decode_raw(&b, "r.tga").unwrap();
+        assert_eq!(
+            codes(&i),
+            (
+                vec![30, 20, 10, 30, 20, 10, 3, 2, 1],
+                Some(vec![255, 255, 0])
+            )
+        );
         // Colour map of two 24-bit entries, 8-bit indices.
         let mut b = header(1, 2, 1, 8, 0x20, (2, 24));
         b.extend([0, 0, 255, 255, 0, 0, 1, 0]);
-        let i = decode_image(&b, "m.tga").unwrap();
-        assert_eq!(i.rgb, lin(&[0, 0, 255, 255, 0, 0]));
+        let i = decode_raw(&b, "m.tga").unwrap();
+        assert_eq!(codes(&i), (vec![0, 0, 255, 255, 0, 0], None));
         // 16-bit grey: value and alpha.
         let mut b = header(3, 1, 1, 16, 0x20, (0, 0));
         b.extend([128, 51]);
-        let i = decode_image(&b, "g.tga").unwrap();
-        assert_eq!(i.rgb, lin(&[128, 128, 128]));
-        assert_eq!(i.alpha, Some(vec![0.2]));
+        let i = decode_raw(&b, "g.tga").unwrap();
+        assert_eq!(codes(&i), (vec![128, 128, 128], Some(vec![51])));
     }
 
     #[test]
     fn bad_files_are_errors_at_their_byte() {
-        let err = |b: &[u8]| decode_image(b, "x.tga").unwrap_err().to_string();
+        let err = |b: &[u8]| decode_raw(b, "x.tga").unwrap_err().to_string();
         assert_eq!(
             err(&[0; 5]),
             "x.tga: byte 5: TGA header ends early (5 of 18 bytes)"

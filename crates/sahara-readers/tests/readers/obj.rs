@@ -1,8 +1,8 @@
 //! OBJ: fan order across objects, relative indices, errors with lines.
 
 use glam::Vec3;
-use sahara_formats::obj::{load_obj, parse_obj};
-use sahara_formats::{load_mesh, FormatError};
+use sahara_readers::obj::{load_obj, parse_obj};
+use sahara_readers::{load_mesh, FormatError};
 
 use crate::common::{corners, TempDir};
 

@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use sahara_formats::camera::{read_sidecar, sidecar_path, CameraSidecar};
-use sahara_formats::FormatError;
+use sahara_readers::camera::{read_sidecar, sidecar_path, CameraSidecar};
+use sahara_readers::FormatError;
 
 use crate::common::TempDir;
 

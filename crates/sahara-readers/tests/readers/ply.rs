@@ -3,8 +3,8 @@
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use sahara_formats::ply::parse_ply;
-use sahara_formats::FormatError;
+use sahara_readers::ply::parse_ply;
+use sahara_readers::FormatError;
 
 /// Body encoding of a test file.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -16,8 +16,8 @@ use std::collections::{HashMap, HashSet};
 use std::fs;
 use std::path::{Path, PathBuf};
 
+use crate::TriangleMesh;
 use glam::{Vec2, Vec3};
-use sahara_render::Mesh;
 
 use super::{locate, obj_load_options, tobj_source};
 use crate::error::FormatError;
@@ -28,7 +28,7 @@ use crate::mtl::MtlMaterial;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ObjScene {
     /// Positions (one per distinct `v/vt/vn` triple) and triangles (file order, fan-triangulated).
-    pub mesh: Mesh,
+    pub mesh: TriangleMesh,
     /// Per-vertex normals, parallel to `mesh.positions`, if the file has `vn` lines.
     ///
     /// A corner without a normal in a file that has some takes tobj's
@@ -172,7 +172,7 @@ fn warn_unknown_materials(
 
 /// The geometry part of [`ObjScene`] and how many triangles each tobj model gave.
 struct Built {
-    mesh: Mesh,
+    mesh: TriangleMesh,
     normals: Option<Vec<Vec3>>,
     uvs: Option<Vec<Vec2>>,
     triangles_per_model: Vec<usize>,
@@ -189,7 +189,7 @@ fn build(models: &[tobj::Model], name: &str) -> Result<Built, FormatError> {
     let has_uvs = models.iter().any(|m| !m.mesh.texcoord_indices.is_empty());
     let has_normals = models.iter().any(|m| !m.mesh.normal_indices.is_empty());
     let mut out = Built {
-        mesh: Mesh::default(),
+        mesh: TriangleMesh::default(),
         normals: has_normals.then(Vec::new),
         uvs: has_uvs.then(Vec::new),
         triangles_per_model: Vec::with_capacity(models.len()),

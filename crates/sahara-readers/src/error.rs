@@ -1,4 +1,5 @@
-//! The one error type of this crate: what went wrong, in which file, where.
+//! The one error type of the readers (and of `sahara-formats`, which
+//! re-exports it): what went wrong, in which file, where.
 //!
 //! Every message is a single line of the form `<file>: <where>: <what>` so a
 //! person can go straight to the offending spot.
@@ -147,4 +148,29 @@ fn unsupported_mesh(extension: &str) -> String {
     } else {
         format!("unsupported mesh file extension {extension:?}; {expected}")
     }
+}
+
+/// `error` with line breaks in its message shown as `\n` (and trailing ones
+/// dropped), keeping the promise that every error is one line.
+///
+/// Messages quote the input (the toml and gltf crates quote values, the
+/// image crate ends some messages with a newline), and a value can hold line
+/// breaks: fuzzing found `name = """distribution` + newlines in a scene file
+/// and a truncated JPEG giving multi-line errors. Used by the glTF and image
+/// readers here and by `sahara-formats`' scene-file reader.
+pub fn one_line(error: FormatError) -> FormatError {
+    let fix = |message: String| {
+        let trimmed = message.trim_end();
+        if trimmed.contains(['\n', '\r']) {
+            trimmed
+                .replace("\r\n", "\\n")
+                .replace('\n', "\\n")
+                .replace('\r', "\\r")
+        } else if trimmed.len() != message.len() {
+            trimmed.to_owned()
+        } else {
+            message
+        }
+    };
+    error.map_message(fix)
 }

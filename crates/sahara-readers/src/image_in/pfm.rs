@@ -4,7 +4,7 @@
 //! bottom, each value times |scale| (as pbrt reads them). No crate reads
 //! them; the format is a dozen lines.
 
-use super::{check_size, Image};
+use super::{check_size, ImageFormat, Pixels, RawImage};
 use crate::error::FormatError;
 
 /// The next whitespace-separated header token after `*at`, and its offset.
@@ -37,7 +37,7 @@ pub(super) fn is_pfm(bytes: &[u8]) -> bool {
 }
 
 /// Decodes a PFM file (linear values, as stored; a grey map is expanded to RGB).
-pub(super) fn decode(bytes: &[u8], name: &str) -> Result<Image, FormatError> {
+pub(super) fn decode(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
     let mut at = 0;
     let (magic, _) = token(bytes, &mut at, name, "PF or Pf")?;
     let channels = match magic {
@@ -138,17 +138,18 @@ pub(super) fn decode(bytes: &[u8], name: &str) -> Result<Image, FormatError> {
             rgb.extend_from_slice(&v);
         }
     }
-    Ok(Image {
+    Ok(RawImage {
         width,
         height,
-        rgb,
+        format: ImageFormat::Pfm,
+        pixels: Pixels::LinearRgbF32(rgb),
         alpha: None,
     })
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::decode_image;
+    use super::super::{decode_raw, Pixels};
 
     fn pfm(header: &str, values: &[f32], little: bool) -> Vec<u8> {
         let mut b = header.as_bytes().to_vec();
@@ -166,18 +167,23 @@ mod tests {
     fn rows_run_from_the_bottom_and_values_are_scaled() {
         // Two rows of one pixel: the file's first row is the image's bottom.
         let b = pfm("PF\n1 2\n-1\n", &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0], true);
-        let i = decode_image(&b, "x.pfm").unwrap();
-        assert_eq!((i.width, i.height), (1, 2));
-        assert_eq!(i.rgb, vec![4.0, 5.0, 6.0, 1.0, 2.0, 3.0]);
-        assert_eq!(i.alpha, None);
+        let i = decode_raw(&b, "x.pfm").unwrap();
+        assert_eq!((i.width, i.height, i.alpha), (1, 2, None));
+        assert_eq!(
+            i.pixels,
+            Pixels::LinearRgbF32(vec![4.0, 5.0, 6.0, 1.0, 2.0, 3.0])
+        );
         let b = pfm("Pf 2 1 2.0\n", &[0.25, 1.5], false);
-        let i = decode_image(&b, "g.pfm").unwrap();
-        assert_eq!(i.rgb, vec![0.5, 0.5, 0.5, 3.0, 3.0, 3.0]);
+        let i = decode_raw(&b, "g.pfm").unwrap();
+        assert_eq!(
+            i.pixels,
+            Pixels::LinearRgbF32(vec![0.5, 0.5, 0.5, 3.0, 3.0, 3.0])
+        );
     }
 
     #[test]
     fn bad_files_are_errors_at_their_byte() {
-        let err = |b: &[u8]| decode_image(b, "x.pfm").unwrap_err().to_string();
+        let err = |b: &[u8]| decode_raw(b, "x.pfm").unwrap_err().to_string();
         assert_eq!(
             err(&pfm("PF\n2 2\n-1\n", &[0.0; 11], true)),
             "x.pfm: byte 54: PFM data ends early: 2x2x3 floats need 48 bytes, found 44"

@@ -25,10 +25,9 @@ use std::collections::HashMap;
 use std::fs;
 use std::path::{Path, PathBuf};
 
+use crate::TriangleMesh;
 use ::gltf::mesh::Mode;
 use glam::{Affine2, Mat4, Quat, Vec2, Vec3, Vec4};
-use sahara_render::Mesh;
-use sahara_render::Wrap;
 use serde_json::Value;
 
 use crate::error::FormatError;
@@ -57,7 +56,7 @@ pub struct GltfMesh {
     /// The mesh's name in the file, if any.
     pub name: Option<String>,
     /// Positions and triangles (primitives in file order).
-    pub mesh: Mesh,
+    pub mesh: TriangleMesh,
     /// Per-vertex normals, parallel to `mesh.positions`, if every primitive has them.
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex `TEXCOORD_0`, parallel to `mesh.positions`, if any primitive has them (others get 0, 0).
@@ -124,7 +123,7 @@ pub struct GltfMaterial {
     pub thickness: f32,
     /// How the base colour's alpha cuts the surface (`alphaMode`, with
     /// `alphaCutoff` for `MASK`).
-    pub alpha_mode: sahara_render::AlphaMode,
+    pub alpha_mode: GltfAlphaMode,
 }
 
 impl GltfMaterial {
@@ -148,9 +147,36 @@ impl GltfMaterial {
             specular_color: [1.0; 3],
             transmission: 0.0,
             thickness: 0.0,
-            alpha_mode: sahara_render::AlphaMode::Opaque,
+            alpha_mode: GltfAlphaMode::Opaque,
         }
     }
+}
+
+/// How a material's alpha cuts the surface (glTF's `alphaMode`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum GltfAlphaMode {
+    /// `OPAQUE`: alpha is ignored.
+    #[default]
+    Opaque,
+    /// `MASK`: the surface is absent where alpha is below `cutoff`.
+    Mask {
+        /// `alphaCutoff` (0.5 without it).
+        cutoff: f32,
+    },
+    /// `BLEND`: alpha is the surface's opacity.
+    Blend,
+}
+
+/// A sampler's wrap mode along one texture axis (glTF's `wrapS`, `wrapT`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum GltfWrap {
+    /// `REPEAT`: the image tiles the plane.
+    #[default]
+    Repeat,
+    /// `CLAMP_TO_EDGE`: the edge texels extend outwards.
+    Clamp,
+    /// `MIRRORED_REPEAT`: the image tiles the plane, every other tile mirrored.
+    MirroredRepeat,
 }
 
 /// `KHR_materials_clearcoat`: a clear coat over the material.
@@ -179,7 +205,7 @@ pub struct GltfTexture {
     /// Which `TEXCOORD_n` set (0 and 1 are loaded).
     pub tex_coord: u32,
     /// The sampler's wrap modes along u (`wrapS`) and v (`wrapT`).
-    pub wrap: [Wrap; 2],
+    pub wrap: [GltfWrap; 2],
     /// `KHR_texture_transform`, in glTF's uv space (v running down the
     /// image); the identity without it.
     pub transform: Affine2,
@@ -232,52 +258,6 @@ pub struct GltfLight {
     pub transform: Mat4,
 }
 
-/// Luminous efficacy taken for `KHR_lights_punctual` lights: 683 lm/W,
-/// the efficacy at 555 nm that defines the candela.
-pub const LUMENS_PER_WATT: f32 = 683.0;
-
-impl GltfCamera {
-    /// The camera as the renderer's (aspect 1: the caller sets it from the
-    /// image size, keeping the vertical field of view).
-    pub fn to_camera(&self) -> sahara_render::Camera {
-        let eye = self.transform.transform_point3(Vec3::ZERO);
-        let forward = self.transform.transform_vector3(Vec3::NEG_Z);
-        let up = self.transform.transform_vector3(Vec3::Y);
-        sahara_render::Camera::look_at(eye, eye + forward, up, self.yfov.to_degrees(), 1.0)
-    }
-}
-
-impl GltfLight {
-    /// The light as the renderer's, placed by `placement` times the node's
-    /// transform. glTF's photometric intensity becomes radiometric at
-    /// [`LUMENS_PER_WATT`] (candela to W/sr, lux to W/m²), as Blender reads
-    /// and writes it, while emission (`emissiveFactor` times its strength)
-    /// is radiance as it stands (docs/lighting.md says why). `range` is
-    /// not used: light falls off with the square of the distance, as the
-    /// glTF specification asks of renderers that ignore it.
-    pub fn to_light(&self, placement: Mat4) -> sahara_render::Light {
-        let xf = placement * self.transform;
-        let power = Vec3::from_array(self.color).max(Vec3::ZERO) * self.intensity.max(0.0)
-            / LUMENS_PER_WATT;
-        let position = xf.transform_point3(Vec3::ZERO);
-        let axis = xf.transform_vector3(Vec3::NEG_Z).normalize_or(Vec3::NEG_Z);
-        match self.kind {
-            GltfLightKind::Point => sahara_render::Light::point(position, power),
-            GltfLightKind::Spot {
-                inner_cone_angle,
-                outer_cone_angle,
-            } => sahara_render::Light::spot(
-                position,
-                position + axis,
-                power,
-                inner_cone_angle.to_degrees(),
-                outer_cone_angle.to_degrees(),
-            ),
-            GltfLightKind::Directional => sahara_render::Light::directional(axis, power),
-        }
-    }
-}
-
 /// Where a texture's image is: a file, or bytes inside the glTF.
 #[derive(Clone, Debug, PartialEq)]
 pub enum GltfImage {
@@ -294,7 +274,7 @@ pub enum GltfImage {
 
 /// Loads a `.gltf` or `.glb` file (the format is recognised by content).
 pub fn load_gltf(path: &Path) -> Result<GltfScene, FormatError> {
-    load(path).map_err(crate::scene_file::one_line)
+    load(path).map_err(crate::one_line)
 }
 
 fn load(path: &Path) -> Result<GltfScene, FormatError> {
@@ -839,11 +819,11 @@ impl Loader<'_> {
                 .map_or(0.0, |t| t.transmission_factor()),
             thickness: material.volume().map_or(0.0, |v| v.thickness_factor()),
             alpha_mode: match material.alpha_mode() {
-                ::gltf::material::AlphaMode::Opaque => sahara_render::AlphaMode::Opaque,
-                ::gltf::material::AlphaMode::Mask => sahara_render::AlphaMode::Mask {
+                ::gltf::material::AlphaMode::Opaque => GltfAlphaMode::Opaque,
+                ::gltf::material::AlphaMode::Mask => GltfAlphaMode::Mask {
                     cutoff: material.alpha_cutoff().unwrap_or(0.5),
                 },
-                ::gltf::material::AlphaMode::Blend => sahara_render::AlphaMode::Blend,
+                ::gltf::material::AlphaMode::Blend => GltfAlphaMode::Blend,
             },
         };
         let id = self.scene.materials.len() as u32;
@@ -872,9 +852,9 @@ impl Loader<'_> {
             )
         })?;
         let wrap = |w: ::gltf::texture::WrappingMode| match w {
-            ::gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
-            ::gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
-            ::gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+            ::gltf::texture::WrappingMode::ClampToEdge => GltfWrap::Clamp,
+            ::gltf::texture::WrappingMode::MirroredRepeat => GltfWrap::MirroredRepeat,
+            ::gltf::texture::WrappingMode::Repeat => GltfWrap::Repeat,
         };
         let sampler = texture.sampler();
         let image = texture.source();

@@ -3,11 +3,10 @@
 use std::fs;
 
 use glam::{Vec2, Vec3};
-use sahara_formats::mtl::MtlMaterial;
-use sahara_formats::obj::{load_obj, load_obj_with_materials};
-use sahara_formats::scenes_dir;
+use sahara_readers::mtl::MtlMaterial;
+use sahara_readers::obj::{load_obj, load_obj_with_materials};
 
-use crate::common::{corners, TempDir};
+use crate::common::{corners, scenes_dir, TempDir};
 
 #[test]
 fn cornell_box_materials_and_ids() {

@@ -1,10 +1,11 @@
-//! Helpers shared by the tests: temporary folders and triangle corners.
+//! Helpers shared by the tests: temporary folders, triangle corners and the
+//! shared scene folder. `sahara-formats`' tests include this file by path.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::Vec3;
-use sahara_render::Mesh;
+use sahara_readers::TriangleMesh;
 
 /// A fresh, empty folder under the system temp dir, removed on drop.
 pub struct TempDir(pub PathBuf);
@@ -13,10 +14,8 @@ impl TempDir {
     pub fn new(tag: &str) -> TempDir {
         static NEXT: AtomicUsize = AtomicUsize::new(0);
         let n = NEXT.fetch_add(1, Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!(
-            "sahara-formats-test-{}-{tag}-{n}",
-            std::process::id()
-        ));
+        let dir =
+            std::env::temp_dir().join(format!("sahara-test-{}-{tag}-{n}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).unwrap();
         TempDir(dir)
@@ -37,9 +36,18 @@ impl Drop for TempDir {
 }
 
 /// The corner coordinates of every triangle, in triangle order.
-pub fn corners(mesh: &Mesh) -> Vec<[Vec3; 3]> {
+pub fn corners(mesh: &TriangleMesh) -> Vec<[Vec3; 3]> {
     mesh.indices
         .iter()
         .map(|t| t.map(|i| mesh.positions[i as usize]))
         .collect()
+}
+
+/// The shared scene folder: `$SAHARA_SCENES` if set, else `shared/scenes`
+/// beside the workspace.
+pub fn scenes_dir() -> PathBuf {
+    match std::env::var_os("SAHARA_SCENES") {
+        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes"),
+    }
 }
