@@ -226,16 +226,20 @@ fn stats_json_has_the_tree_statistics() {
 fn human_output_has_a_header_and_a_table() {
     let dir = temp_dir("human");
     let obj = write_quad_scene(&dir);
-    let out = sahara(&[
-        "bench",
-        obj.to_str().unwrap(),
-        "--runs",
-        "1",
-        "--sets",
-        "primary",
-    ]);
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let bench = |extra: &[&str]| {
+        let base = [
+            "bench",
+            obj.to_str().unwrap(),
+            "--runs",
+            "1",
+            "--sets",
+            "primary",
+        ];
+        let out = sahara(&[&base[..], extra].concat());
+        assert!(out.status.success());
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let text = bench(&[]);
     for needle in [
         "triangles  2",
         "builder    sah",
@@ -248,17 +252,7 @@ fn human_output_has_a_header_and_a_table() {
         assert!(text.contains(needle), "no {needle:?} in:\n{text}");
     }
     // One thread: no second column of the same figure.
-    let one = sahara(&[
-        "bench",
-        obj.to_str().unwrap(),
-        "--runs",
-        "1",
-        "--sets",
-        "primary",
-        "--threads",
-        "1",
-    ]);
-    let text = String::from_utf8(one.stdout).unwrap();
+    let text = bench(&["--threads", "1"]);
     let header = text.lines().find(|l| l.starts_with("set ")).unwrap();
     assert_eq!(header.matches("Mrays/s").count(), 1, "{header}");
     assert!(
