@@ -57,10 +57,19 @@ pub(crate) fn load_input(
     if path.is_dir() {
         bail!("{}: is a folder; {EXPECTED}", path.display());
     }
+    if !path.exists() {
+        bail!("{}: not found", path.display());
+    }
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
+    if let Some(what) = sniff(path) {
+        bail!(
+            "{}: is {what}, not a scene or mesh file; {EXPECTED}",
+            path.display()
+        );
+    }
     // A `FormatError`'s message already names the file and place.
     let pbrt = sahara_formats::pbrt::is_pbrt_path(path);
     let (scene, file, warnings) = match ext.as_str() {
@@ -87,6 +96,9 @@ pub(crate) fn load_input(
             let camera = camera.map_or(CameraChoice::Auto, CameraChoice::from_arg);
             let m = load_mesh_scene_with(path, &camera, sky.as_ref().unwrap_or(&Sky::Auto))
                 .map_err(flat)?;
+            if m.scene.meshes.iter().all(|m| m.mesh.indices.is_empty()) {
+                bail!("{}: the mesh has no triangles", path.display());
+            }
             eprintln!("camera: {}; light: {}", m.camera_source, m.sky);
             (m.scene, None, m.warnings)
         }
@@ -103,6 +115,33 @@ pub(crate) fn load_input(
         description: path.display().to_string(),
         warnings,
     })
+}
+
+/// What a file is, by its first bytes, when it is a kind Sahara never
+/// takes as a scene or mesh (an image, an archive, a program): a renamed
+/// PNG would otherwise be reported as a broken glTF or OBJ.
+fn sniff(path: &Path) -> Option<&'static str> {
+    use std::io::Read;
+    let mut head = [0u8; 16];
+    let n = std::fs::File::open(path)
+        .and_then(|mut f| f.read(&mut head))
+        .ok()?;
+    let head = &head[..n];
+    const KINDS: [(&[u8], &str); 9] = [
+        (b"\x89PNG\r\n\x1a\n", "a PNG image"),
+        (b"\xff\xd8\xff", "a JPEG image"),
+        (b"\x76\x2f\x31\x01", "an OpenEXR image"),
+        (b"#?RADIANCE", "a Radiance HDR image"),
+        (b"#?RGBE", "a Radiance HDR image"),
+        (b"GIF8", "a GIF image"),
+        (b"%PDF", "a PDF document"),
+        (b"PK\x03\x04", "a ZIP archive"),
+        (b"\x7fELF", "a program (ELF)"),
+    ];
+    KINDS
+        .iter()
+        .find(|(magic, _)| head.starts_with(magic))
+        .map(|&(_, what)| what)
 }
 
 /// The scene's name: the file name without its extension (`scene.pbrt.gz`

@@ -531,6 +531,54 @@ fn spp_is_the_samples_per_pixel_rendered_whatever_the_pass_size() {
 }
 
 #[test]
+fn files_that_are_not_scenes_are_refused_saying_what_they_are() {
+    let dir = temp_dir("not-scenes");
+    let png =
+        fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/images/bunny_dof.png"))
+            .unwrap();
+    let fake_glb = dir.join("model.glb");
+    let fake_obj = dir.join("model.obj");
+    fs::write(&fake_glb, &png).unwrap();
+    fs::write(&fake_obj, &png).unwrap();
+    let empty = dir.join("empty.obj");
+    fs::write(&empty, "# only a comment\n").unwrap();
+    let two = dir.join("two.obj");
+    fs::write(&two, "v 0 0 0\nv 1 0 0\nf 1 2\n").unwrap();
+    let cargo = dir.join("Cargo.toml");
+    fs::write(
+        &cargo,
+        "[package]\nname = \"x\"\n[profile.release]\ndebug = 1\n",
+    )
+    .unwrap();
+    let missing = dir.join("scene");
+    for (path, what) in [
+        (&fake_glb, "is a PNG image, not a scene or mesh file"),
+        (&fake_obj, "is a PNG image, not a scene or mesh file"),
+        (&empty, "the mesh has no triangles"),
+        (&two, "the mesh has no triangles"),
+        (&cargo, "not a Sahara scene file"),
+        (&missing, "not found"),
+    ] {
+        let out = dir.join("out.png");
+        let o = sahara(&[
+            "render",
+            path.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(
+            err.contains(path.to_str().unwrap()) && err.contains(what),
+            "{err}"
+        );
+        assert!(!out.exists(), "an image was written for {}", path.display());
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_path_without_a_usable_extension_says_what_it_is() {
     let dir = temp_dir("no-ext");
     let bare = dir.join("scene");

@@ -22,6 +22,7 @@ const MAX_FILM_SIDE: i64 = 65536;
 /// Parses `text` and checks every value.
 pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile, FormatError> {
     let ctx = Ctx { text, name, folder };
+    refuse_other_toml(text, name)?;
     let raw: RawScene = toml::from_str(text).map_err(|e| match e.span() {
         Some(span) => ctx.at(span, e.message().trim_end()),
         None => FormatError::in_file(name, e.message().trim_end()),
@@ -95,6 +96,40 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
         },
         film: ctx.film(film.get_ref())?,
     })
+}
+
+/// The top-level keys of a scene file (those of `RawScene`).
+const SCENE_KEYS: [&str; 9] = [
+    "sky",
+    "camera",
+    "material",
+    "object",
+    "light",
+    "integrator",
+    "sampler",
+    "filter",
+    "film",
+];
+
+/// Refuses a TOML file that holds none of a scene file's tables (a
+/// `Cargo.toml`, say) in one line that says so, rather than blaming its
+/// first unknown key.
+fn refuse_other_toml(text: &str, name: &str) -> Result<(), FormatError> {
+    let Ok(table) = text.parse::<toml::Table>() else {
+        return Ok(());
+    };
+    if table.is_empty() || table.keys().any(|k| SCENE_KEYS.contains(&k.as_str())) {
+        return Ok(());
+    }
+    let keys: Vec<&str> = table.keys().map(String::as_str).take(4).collect();
+    Err(FormatError::in_file(
+        name,
+        format!(
+            "not a Sahara scene file: it has none of a scene's tables ([camera], [film], [[object]], ...) but {}{}",
+            keys.join(", "),
+            if table.len() > keys.len() { ", ..." } else { "" }
+        ),
+    ))
 }
 
 /// 1-based line and column (in characters) of byte `offset` of `text`.
