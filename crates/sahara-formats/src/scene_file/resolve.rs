@@ -23,9 +23,12 @@ const MAX_FILM_SIDE: i64 = 65536;
 pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile, FormatError> {
     let ctx = Ctx { text, name, folder };
     refuse_other_toml(text, name)?;
-    let raw: RawScene = toml::from_str(text).map_err(|e| match e.span() {
-        Some(span) => ctx.at(span, e.message().trim_end()),
-        None => FormatError::in_file(name, e.message().trim_end()),
+    let raw: RawScene = toml::from_str(text).map_err(|e| {
+        let message = in_words(e.message().trim_end());
+        match e.span() {
+            Some(span) => ctx.at(span, message),
+            None => FormatError::in_file(name, message),
+        }
     })?;
     let camera = raw
         .camera
@@ -96,6 +99,19 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
         },
         film: ctx.film(film.get_ref())?,
     })
+}
+
+/// A serde message with Rust's type names (`expected f32`) in a user's
+/// words (`expected a number`).
+fn in_words(message: &str) -> String {
+    [
+        ("expected f32", "expected a number"),
+        ("expected i64", "expected a whole number"),
+        ("expected a boolean", "expected true or false"),
+        ("expected a sequence", "expected a list [...]"),
+    ]
+    .iter()
+    .fold(message.to_owned(), |m, (rust, words)| m.replace(rust, words))
 }
 
 /// The top-level keys of a scene file (those of `RawScene`).
