@@ -111,7 +111,9 @@ fn in_words(message: &str) -> String {
         ("expected a sequence", "expected a list [...]"),
     ]
     .iter()
-    .fold(message.to_owned(), |m, (rust, words)| m.replace(rust, words))
+    .fold(message.to_owned(), |m, (rust, words)| {
+        m.replace(rust, words)
+    })
 }
 
 /// The top-level keys of a scene file (those of `RawScene`).
