@@ -48,12 +48,13 @@
 //! height = 480
 //! exposure = 0                   # stops: pixels are scaled by 2^exposure
 //! tonemap = "clamp"              # clamp | filmic
-//! output = "out.png"             # .png or .exr, relative to this scene file
+//! output = "out.png"             # .png or .exr, relative to the working folder
 //! ```
 //!
 //! Unknown keys, keys that do not apply to an entry's `type`, and values
 //! out of range are errors; every error names the file, the line and column.
-//! All file paths are resolved relative to the scene file's folder.
+//! Input file paths are resolved relative to the scene file's folder; the
+//! output relative to the working folder (unless absolute).
 
 mod raw;
 mod resolve;
@@ -375,7 +376,8 @@ pub struct FilmSpec {
     pub exposure: f32,
     /// Tone mapping for 8-bit output (default clamp).
     pub tonemap: ToneMap,
-    /// Output image (`.png` or `.exr`), resolved; `None` if not given.
+    /// Output image (`.png` or `.exr`) as given: relative to the working
+    /// folder unless absolute; `None` if not given.
     pub output: Option<PathBuf>,
 }
 

@@ -368,7 +368,7 @@ fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
             } else {
                 "wrote part"
             },
-            path.display(),
+            where_is(&path).display(),
             done.start,
             done.end,
             p.samples.start,
@@ -400,7 +400,7 @@ fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
         } else {
             "wrote"
         },
-        output.path.display(),
+        where_is(&output.path).display(),
         if s.passes == 0 {
             format!(
                 "first pass interrupted, {} of {pixels} pixels finished (the rest black)",
@@ -428,6 +428,15 @@ fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
         );
     }
     Ok(finish)
+}
+
+/// Where `path` is, for the log: a relative path with the working folder
+/// in front, so the log says where the file went.
+fn where_is(path: &std::path::Path) -> PathBuf {
+    match std::env::current_dir() {
+        Ok(dir) if path.is_relative() => dir.join(path),
+        _ => path.to_path_buf(),
+    }
 }
 
 /// `"s"` unless `n` is 1.

@@ -199,9 +199,13 @@ fn command_line_options_override_the_scene_file() {
          [film]\nwidth = 12\nheight = 6\noutput = \"from_file.png\"\n",
     )
     .unwrap();
-    let out = sahara(&["render", scene.to_str().unwrap(), "--spp", "1"]);
+    let out = std::process::Command::new(common::SAHARA)
+        .args(["render", scene.to_str().unwrap(), "--spp", "1"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{}", stderr(&out));
-    // The file's size and output (relative to the scene file) hold...
+    // The file's size and output (in the working folder) hold...
     let (w, h, _) = load_rgb_f32(&dir.join("from_file.png")).unwrap();
     assert_eq!((w, h), (12, 6));
     // ...unless given on the command line.
@@ -527,6 +531,34 @@ fn spp_is_the_samples_per_pixel_rendered_whatever_the_pass_size() {
         };
         assert!(log.contains(&format!(": {passes}, {spp} spp,")), "{log}");
     }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_scene_files_output_goes_to_the_working_folder() {
+    let dir = temp_dir("output-folder");
+    let scenes = dir.join("scenes");
+    let work = dir.join("work");
+    fs::create_dir_all(&scenes).unwrap();
+    fs::create_dir_all(&work).unwrap();
+    let scene = scenes.join("s.toml");
+    fs::write(
+        &scene,
+        "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 8\nheight = 4\n\
+         output = \"out.png\"\n[sampler]\nspp = 1\n",
+    )
+    .unwrap();
+    let o = std::process::Command::new(common::SAHARA)
+        .args(["render", scene.to_str().unwrap()])
+        .current_dir(&work)
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(work.join("out.png").is_file(), "{err}");
+    assert!(!scenes.join("out.png").exists(), "{err}");
+    let shown = work.canonicalize().unwrap().join("out.png");
+    assert!(err.contains(&format!("wrote {}", shown.display())), "{err}");
     let _ = fs::remove_dir_all(&dir);
 }
 

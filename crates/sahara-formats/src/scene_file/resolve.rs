@@ -1085,7 +1085,9 @@ impl Ctx<'_> {
         let output = match &f.output {
             None => None,
             Some(o) => {
-                let path = self.folder.join(o.get_ref());
+                // Relative to the working folder, as a command line's
+                // output: a scene file in a shared folder does not write there.
+                let path = PathBuf::from(o.get_ref());
                 ImageFormat::from_path(&path).map_err(|_| {
                     self.at(
                         o.span(),

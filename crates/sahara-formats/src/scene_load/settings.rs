@@ -27,7 +27,8 @@ pub struct FileSettings {
     pub exposure: f32,
     /// Tone map for 8-bit output.
     pub tonemap: ToneMap,
-    /// Output image, resolved relative to the scene file, if the file names one.
+    /// Output image as the file names it (relative to the working folder
+    /// unless absolute), if it names one.
     pub output: Option<PathBuf>,
     /// The part of the image to render, if the file asks for one.
     pub crop: Option<FileCrop>,

@@ -342,7 +342,7 @@ fn a_complete_scene_parses_into_the_expected_values() {
             height: 240,
             exposure: -1.,
             tonemap: ToneMap::Filmic,
-            output: Some(at("renders/out.EXR"))
+            output: Some(PathBuf::from("renders/out.EXR"))
         }
     );
 }
