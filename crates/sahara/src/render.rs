@@ -147,8 +147,11 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
     if piece.is_none() {
         settings.window = file_window;
     }
-    // Checked again: the output may come from the scene file.
-    check_output(&output, piece.is_some())?;
+    // The output named by the scene file (the command line's was checked
+    // by `check_args`).
+    if args.output.is_none() {
+        check_output(&output, piece.is_some())?;
+    }
     // Refuse a render that would not fit, with what it would need.
     let triangles: u64 = scene
         .meshes

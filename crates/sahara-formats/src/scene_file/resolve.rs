@@ -22,8 +22,11 @@ const MAX_FILM_SIDE: i64 = 65536;
 /// Parses `text` and checks every value.
 pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile, FormatError> {
     let ctx = Ctx { text, name, folder };
-    refuse_other_toml(text, name)?;
     let raw: RawScene = toml::from_str(text).map_err(|e| {
+        // Only a file that is not a scene is read a second time, to say so.
+        if let Err(other) = refuse_other_toml(text, name) {
+            return other;
+        }
         let message = in_words(e.message().trim_end());
         match e.span() {
             Some(span) => ctx.at(span, message),
