@@ -160,6 +160,9 @@ pub enum MaterialKind {
         k: Vec3,
         /// Perceptual roughness in [0, 1].
         roughness: f32,
+        /// `multiple_scattering` (default true): add the light that
+        /// bounces between microfacets.
+        multiple_scattering: bool,
     },
     /// The glTF metallic-roughness model.
     MetallicRoughness {

@@ -209,13 +209,17 @@ fn material_of(
 
 fn material_kind_of(m: &MaterialSpec) -> Material {
     match &m.kind {
-        MaterialKind::ComplexConductor { eta, k, roughness } => {
-            Material::new(Bsdf::ComplexConductor {
-                eta: *eta,
-                k: *k,
-                roughness: *roughness,
-            })
-        }
+        MaterialKind::ComplexConductor {
+            eta,
+            k,
+            roughness,
+            multiple_scattering,
+        } => Material::new(Bsdf::ComplexConductor {
+            eta: *eta,
+            k: *k,
+            roughness: *roughness,
+            multiple_scattering: *multiple_scattering,
+        }),
         MaterialKind::MetallicRoughness {
             base_color,
             metallic,

@@ -198,10 +198,12 @@ fn conductor_metal(
 /// A conductor of colour `metal` and `roughness`.
 fn conductor(metal: Metal, roughness: f32) -> Material {
     match metal {
+        // pbrt-v4's conductor scatters once between microfacets.
         Metal::Index(eta, k) => Material::new(Bsdf::ComplexConductor {
             eta: eta.max(Vec3::ZERO),
             k: k.max(Vec3::ZERO),
             roughness,
+            multiple_scattering: false,
         }),
         Metal::Reflectance(r) => tinted(
             Bsdf::Conductor {
@@ -389,6 +391,7 @@ pub(crate) fn map_material(
                     eta: Vec3::ONE,
                     k: Vec3::splat(1e4),
                     roughness: 0.0,
+                    multiple_scattering: false,
                 },
                 &kr,
             )
@@ -607,7 +610,13 @@ mod tests {
     fn a_conductor_of_given_reflectance_has_it_at_normal_incidence() {
         let (m, w) = material_of("Material \"conductor\" \"rgb reflectance\" [0.9 0.5 0.1]");
         assert!(w.is_empty(), "{w:?}");
-        let Bsdf::ComplexConductor { eta, k, roughness } = m.bsdf else {
+        let Bsdf::ComplexConductor {
+            eta,
+            k,
+            roughness,
+            multiple_scattering: false,
+        } = m.bsdf
+        else {
             panic!("{:?}", m.bsdf)
         };
         assert_eq!((eta, roughness), (Vec3::ONE, 0.0));
@@ -644,7 +653,8 @@ mod tests {
             Bsdf::ComplexConductor {
                 eta: Vec3::new(0.2, 0.3, 0.4),
                 k: Vec3::new(2.0, 1.5, 1.0),
-                roughness: 0.0
+                roughness: 0.0,
+                multiple_scattering: false,
             }
         );
         assert!(

@@ -400,7 +400,7 @@ fn pbrt_and_toml_scenes_render_the_same_spheres_disc_light_and_camera() {
                 Transform [1 0 0 0  0 0 1 0  0 -1 0 0  0 3 5 1] Shape \"disk\" \"float radius\" 1 AttributeEnd\n";
     let toml = "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, 1]\nvfov = 40\n\
                 [[material]]\nname = \"red\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.2, 0.2]\n\
-                [[material]]\nname = \"gold\"\ntype = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.1]\nroughness = 0.5\n\
+                [[material]]\nname = \"gold\"\ntype = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.1]\nroughness = 0.5\nmultiple_scattering = false\n\
                 [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 5]\nradius = 1\nmaterial = \"red\"\n\
                 [[object]]\ntype = \"sphere\"\ncenter = [1.25, -0.5, 4]\nradius = 0.5\nmaterial = \"gold\"\n\
                 [[light]]\ntype = \"area\"\nshape = \"disc\"\ncenter = [0, 3, 5]\nnormal = [0, -1, 0]\nradius = 1\nradiance = [4, 4, 4]\n\
@@ -470,7 +470,7 @@ fn the_fuzz_seed_with_every_directive_loads() {
         Vec3::new(36.1267, 2.3372, 1.7213),
     );
     assert!(scene.materials.iter().any(|m| matches!(m.bsdf,
-        sahara_render::Bsdf::ComplexConductor { eta: e, k: kk, roughness } if e == eta && kk == k && roughness == 0.1f32.sqrt().sqrt())));
+        sahara_render::Bsdf::ComplexConductor { eta: e, k: kk, roughness, multiple_scattering: false } if e == eta && kk == k && roughness == 0.1f32.sqrt().sqrt())));
     assert!(
         w.iter()
             .any(|l| l.contains("material 'mix': the blend is replaced")),

@@ -82,6 +82,7 @@ pub(super) struct RawMaterial {
     pub metal: Opt<String>,
     pub eta: Opt<V3>,
     pub k: Opt<V3>,
+    pub multiple_scattering: Opt<bool>,
     pub base_color: Opt<V3>,
     pub metallic: Opt<f32>,
     pub specular: Opt<f32>,

@@ -405,6 +405,7 @@ impl Ctx<'_> {
             ("metal", span(&m.metal)),
             ("eta", span(&m.eta)),
             ("k", span(&m.k)),
+            ("multiple_scattering", span(&m.multiple_scattering)),
             ("base_color", span(&m.base_color)),
             ("metallic", span(&m.metallic)),
             ("specular", span(&m.specular)),
@@ -415,7 +416,15 @@ impl Ctx<'_> {
         ];
         let allowed: &[&str] = match kind {
             MaterialType::Diffuse => &["albedo", "texture", "two_sided"],
-            MaterialType::Conductor => &["color", "metal", "eta", "k", "roughness", "two_sided"],
+            MaterialType::Conductor => &[
+                "color",
+                "metal",
+                "eta",
+                "k",
+                "multiple_scattering",
+                "roughness",
+                "two_sided",
+            ],
             MaterialType::Mirror => &["color", "two_sided"],
             MaterialType::Dielectric => &["ior"],
             MaterialType::RoughDielectric => &["ior", "roughness"],
@@ -568,6 +577,7 @@ impl Ctx<'_> {
             ("metal", span(&m.metal)),
             ("eta", span(&m.eta).or(span(&m.k))),
         ];
+        let multiple_scattering = m.multiple_scattering.as_ref().is_none_or(|b| *b.get_ref());
         let mut seen = given.iter().filter_map(|(k, s)| s.clone().map(|s| (*k, s)));
         if let (Some((a, _)), Some((b, at))) = (seen.next(), seen.next()) {
             return Err(self.at(
@@ -586,7 +596,12 @@ impl Ctx<'_> {
                     ),
                 ));
             };
-            return Ok(MaterialKind::ComplexConductor { eta, k, roughness });
+            return Ok(MaterialKind::ComplexConductor {
+                eta,
+                k,
+                roughness,
+                multiple_scattering,
+            });
         }
         if m.eta.is_some() || m.k.is_some() {
             let what = "a conductor given by its index";
@@ -605,7 +620,20 @@ impl Ctx<'_> {
                     format!("`k` {k} must not be negative"),
                 ));
             }
-            return Ok(MaterialKind::ComplexConductor { eta, k, roughness });
+            return Ok(MaterialKind::ComplexConductor {
+                eta,
+                k,
+                roughness,
+                multiple_scattering,
+            });
+        }
+        if let Some(at) = span(&m.multiple_scattering) {
+            return Err(self.at(
+                at,
+                "`multiple_scattering` applies to a conductor given by `metal` or by `eta` and `k` \
+                 (the `color` form scatters once)"
+                    .to_string(),
+            ));
         }
         Ok(MaterialKind::Conductor {
             color: self.reflectance(&m.color, "color", Vec3::splat(0.9))?,

@@ -653,7 +653,7 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
          [[material]]\nname = \"c\"\ntype = \"coated_diffuse\"\n\
          [[material]]\nname = \"d\"\ntype = \"thin_dielectric\"\nior = 1.52\n\
          [[material]]\nname = \"e\"\ntype = \"conductor\"\nmetal = \"gold\"\nroughness = 0.1\n\
-         [[material]]\nname = \"f\"\ntype = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.1]\n",
+         [[material]]\nname = \"f\"\ntype = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.1]\nmultiple_scattering = false\n",
     );
     assert_eq!(
         m[0].kind,
@@ -699,7 +699,8 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
         MaterialKind::ComplexConductor {
             eta,
             k,
-            roughness: 0.1
+            roughness: 0.1,
+            multiple_scattering: true,
         }
     );
     assert_eq!(
@@ -707,7 +708,8 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
         MaterialKind::ComplexConductor {
             eta: Vec3::new(0.2, 0.9, 1.1),
             k: Vec3::new(3.9, 2.4, 2.1),
-            roughness: 0.2
+            roughness: 0.2,
+            multiple_scattering: false,
         }
     );
 }
@@ -729,6 +731,13 @@ fn bad_conductor_and_layered_keys_are_errors_at_the_value() {
         "[[material]]\nname = \"m\"\ntype = \"conductor\"\neta = [1, 1, 1]\n",
     ));
     assert!(m.contains("`k`"), "{m}");
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"conductor\"\ncolor = [1, 1, 1]\nmultiple_scattering = false\n",
+    ));
+    assert!(
+        m.contains("line 11:") && m.contains("`multiple_scattering` applies to"),
+        "{m}"
+    );
     let m = error_of(&with_head(
         "[[material]]\nname = \"m\"\ntype = \"metallic_roughness\"\nmetallic = 2\n",
     ));

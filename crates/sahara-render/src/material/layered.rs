@@ -189,8 +189,15 @@ impl Layered {
     }
 
     /// A conductor of complex index `eta + i k` (Fresnel times `tint`),
-    /// with the energy of multiple scattering between microfacets added.
-    pub fn conductor(eta: Vec3, k: Vec3, tint: Vec3, roughness: f32) -> Self {
+    /// with the energy of multiple scattering between microfacets added if
+    /// `multiple_scattering`.
+    pub fn conductor(
+        eta: Vec3,
+        k: Vec3,
+        tint: Vec3,
+        roughness: f32,
+        multiple_scattering: bool,
+    ) -> Self {
         let fresnel = Fresnel::Conductor { eta, k, tint };
         let mut l = Self {
             roughness,
@@ -198,8 +205,10 @@ impl Layered {
             fresnel,
             terms: [None, None],
         };
-        let f_avg = albedo::schlick_fresnel_avg(fresnel.f0());
-        l.terms[0] = Some(l.multiple_scattering(f_avg, 1.0));
+        if multiple_scattering {
+            let f_avg = albedo::schlick_fresnel_avg(fresnel.f0());
+            l.terms[0] = Some(l.multiple_scattering(f_avg, 1.0));
+        }
         l
     }
 
