@@ -397,7 +397,7 @@ fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
     let secs = s.render_time.as_secs_f64();
     let pixels = u64::from(result.film.width) * u64::from(result.film.height);
     eprintln!(
-        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {:.3} CPU s, {} rays, {:.2} Mrays/s{}",
+        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {:.3} CPU s, {} rays, {:.2} Mrays/s{}{}",
         if partial {
             "wrote PARTIAL image"
         } else {
@@ -418,6 +418,15 @@ fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
         s.render_cpu_time.as_secs_f64(),
         s.rays(),
         s.rays() as f64 / secs.max(1e-9) / 1e6,
+        s.time_split
+            .shares()
+            .map(|(t, sh, rest)| format!(
+                " (tracing {:.0}%, shading {:.0}%, the rest {:.0}%)",
+                t * 100.0,
+                sh * 100.0,
+                rest * 100.0
+            ))
+            .unwrap_or_default(),
         if s.nan_samples > 0 {
             format!(", {} NaN samples dropped", s.nan_samples)
         } else {

@@ -8,6 +8,8 @@
 //! bit for bit; what changes is that the tree sees rays in batches, which
 //! lets coherent ones share a traversal.
 
+use std::time::{Duration, Instant};
+
 use sahara_kd::{Ray, PACKET16};
 
 use super::state::{Deferred, PathState};
@@ -39,6 +41,16 @@ pub(crate) struct Wavefront {
     queries: Vec<ShadowQuery>,
     answers: Vec<bool>,
     world: WorldBuffers,
+    /// Time spent finding hits and answering shadow rays, and in the
+    /// paths' steps, since the last [`Wavefront::take_times`].
+    tracing: Duration,
+    shading: Duration,
+}
+
+/// What a stretch of a round's time went to.
+enum Lap {
+    Tracing,
+    Shading,
 }
 
 /// A stand-in ray for the ordering of contributions without a shadow ray.
@@ -74,6 +86,25 @@ fn octant_order(rays: &[Ray], order: &mut Vec<u32>) {
 }
 
 impl Wavefront {
+    /// The time spent tracing and shading since the last call, and resets
+    /// both (a clock read per batch, not per ray: too rare to cost).
+    pub fn take_times(&mut self) -> (Duration, Duration) {
+        (
+            std::mem::take(&mut self.tracing),
+            std::mem::take(&mut self.shading),
+        )
+    }
+
+    /// Adds the time since `clock` to `what`; the clock for the next lap.
+    fn lap(&mut self, clock: Instant, what: Lap) -> Instant {
+        let now = Instant::now();
+        match what {
+            Lap::Tracing => self.tracing += now - clock,
+            Lap::Shading => self.shading += now - clock,
+        }
+        now
+    }
+
     /// Traces every path of `paths` to its end with `integrator` (one of
     /// the stepped ones), leaving each sample's radiance in its `l`.
     /// Consecutive runs of [`PACKET16`] paths start with one camera packet
@@ -91,6 +122,9 @@ impl Wavefront {
         self.live.clear();
         self.live.extend(0..paths.len() as u32);
         let mut first = true;
+        // Each stretch of the round is timed as tracing or shading: the
+        // clock is read a few times per round of the whole batch.
+        let mut clock = Instant::now();
         while !self.live.is_empty() {
             self.rays.clear();
             self.times.clear();
@@ -100,6 +134,7 @@ impl Wavefront {
             }
             self.hits.clear();
             self.hits.resize(self.live.len(), None);
+            clock = self.lap(clock, Lap::Shading);
             if first {
                 for ((r, t), h) in self
                     .rays
@@ -133,6 +168,7 @@ impl Wavefront {
                     self.hits[j as usize] = *h;
                 }
             }
+            clock = self.lap(clock, Lap::Tracing);
             // Every live path's step.
             self.deferred.clear();
             self.owner.clear();
@@ -150,6 +186,7 @@ impl Wavefront {
                     self.next.push(i);
                 }
             }
+            clock = self.lap(clock, Lap::Shading);
             // The shadow rays, grouped by octant, then their contributions
             // in the order made.
             self.rays.clear();
@@ -172,6 +209,7 @@ impl Wavefront {
             self.answers.clear();
             self.answers.resize(self.queries.len(), true);
             world.visible_batch(&self.queries, &mut self.answers, &mut self.world);
+            clock = self.lap(clock, Lap::Tracing);
             for (&j, &v) in self.order.iter().zip(&self.answers) {
                 self.visible[j as usize] = v;
             }
@@ -180,6 +218,7 @@ impl Wavefront {
             }
             std::mem::swap(&mut self.live, &mut self.next);
         }
+        self.lap(clock, Lap::Shading);
     }
 }
 

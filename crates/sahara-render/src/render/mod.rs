@@ -152,12 +152,54 @@ pub struct RenderStats {
     /// CPU time of all threads spent rendering passes (zero where the
     /// platform does not report it).
     pub render_cpu_time: Duration,
+    /// Where the render threads' time went (path-tracing integrators).
+    pub time_split: TimeSplit,
     /// True if the render stopped on cancel or time limit before `passes`.
     pub stopped_early: bool,
     /// Pixels finished (with all `spp` samples of the pass) in a first pass
     /// stopped by cancel; 0 otherwise. The image holds these pixels and is
     /// black elsewhere.
     pub first_pass_pixels: u64,
+}
+
+/// Where the render threads' time went, summed over the threads: finding
+/// hits and answering shadow rays (the kd-tree walks and the instance
+/// layer), the paths' steps between them (surface interaction, textures,
+/// BSDF and light sampling, MIS), and the rest of each tile (camera rays,
+/// the sampler's set-up, splatting into the film). Measured for the
+/// integrators that trace paths in batches (`path`); zero for the others.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TimeSplit {
+    /// Time in the batch traversals.
+    pub tracing: Duration,
+    /// Time in the paths' steps.
+    pub shading: Duration,
+    /// Time in tiles altogether (tracing and shading included).
+    pub total: Duration,
+}
+
+impl TimeSplit {
+    /// The shares of tracing, shading and the rest of the total, in
+    /// `[0, 1]`; `None` when nothing was measured.
+    pub fn shares(&self) -> Option<(f64, f64, f64)> {
+        let total = self.total.as_secs_f64();
+        if self.tracing.is_zero() || total <= 0.0 {
+            return None;
+        }
+        let (t, s) = (
+            self.tracing.as_secs_f64() / total,
+            self.shading.as_secs_f64() / total,
+        );
+        Some((t, s, (1.0 - t - s).max(0.0)))
+    }
+}
+
+impl std::ops::AddAssign for TimeSplit {
+    fn add_assign(&mut self, o: Self) {
+        self.tracing += o.tracing;
+        self.shading += o.shading;
+        self.total += o.total;
+    }
 }
 
 impl RenderStats {
@@ -228,6 +270,7 @@ struct TileOut {
     /// Over the tile plus the margin, clipped to the window.
     sums: SumBuffer,
     stats: TraceStats,
+    split: TimeSplit,
     nan: u64,
     negative: u64,
     /// Pixels rendered, in render order (all of them unless stopped).
@@ -396,6 +439,7 @@ pub fn render_watched(
         for out in outs.into_iter().flatten() {
             sums.add(&out.sums);
             stats.trace += out.stats;
+            stats.time_split += out.split;
             stats.nan_samples += out.nan;
             stats.negative_samples += out.negative;
         }
@@ -490,9 +534,11 @@ fn render_tile(
     }
     .grow(m, w, h)
     .intersect(window);
+    let tile_start = Instant::now();
     let mut out = TileOut {
         sums: SumBuffer::new(reach.x0, reach.y0, reach.width(), reach.height()),
         stats: TraceStats::default(),
+        split: TimeSplit::default(),
         nan: 0,
         negative: 0,
         pixels_done: 0,
@@ -541,7 +587,9 @@ fn render_tile(
             }
             out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
         }
+        (out.split.tracing, out.split.shading) = strip.wavefront.take_times();
     });
+    out.split.total = tile_start.elapsed();
     out
 }
 
