@@ -401,3 +401,124 @@ fn the_time_split_covers_the_path_tracer_only() {
     let r = render(&scene, &settings(16, 16, 4, ao), &|_| {});
     assert_eq!(r.stats.time_split.shares(), None);
 }
+
+/// A sphere before a wall, the auxiliary images asked for.
+fn aux_scene() -> (Scene, sahara_render::RenderSettings) {
+    let cam = Camera::look_at(Vec3::ZERO, Vec3::Z, Vec3::Y, 40.0, 1.0);
+    let mut scene = Scene::new(cam);
+    let wall = scene.add_material(Material::diffuse(Vec3::new(0.3, 0.5, 0.7)));
+    let ball = scene.add_material(Material::conductor(Vec3::new(0.9, 0.6, 0.2), 0.4));
+    scene.add_shape(
+        Shape::Quad {
+            corner: Vec3::new(-20.0, -20.0, 8.0),
+            edge_u: Vec3::new(0.0, 40.0, 0.0),
+            edge_v: Vec3::new(40.0, 0.0, 0.0),
+        },
+        wall,
+    );
+    scene.add_shape(
+        Shape::Sphere {
+            center: Vec3::new(0.0, 0.0, 4.0),
+            radius: 1.0,
+        },
+        ball,
+    );
+    scene.lights.push(Light::Point {
+        position: Vec3::new(0.0, 3.0, 0.0),
+        intensity: Vec3::splat(10.0),
+    });
+    let mut s = settings(16, 16, 8, Integrator::default());
+    s.aux = true;
+    (scene, s)
+}
+
+/// The albedo, normal and depth images hold what each pixel sees: the
+/// wall's colour, normal and distance at the corners, the sphere's at the
+/// centre, within what averaging over the pixel's samples allows.
+#[test]
+fn aux_images_are_the_albedo_normal_and_depth_of_what_pixels_see() {
+    let (scene, s) = aux_scene();
+    let r = run(&scene, &s);
+    let aux = r.aux.expect("asked for");
+    let img = &aux.images;
+    let at = |x: u32, y: u32| (y * 16 + x) as usize;
+    // The ray through a pixel's centre.
+    let centre_ray = |x: u32, y: u32| {
+        let film = glam::Vec2::new((x as f32 + 0.5) / 16.0, (y as f32 + 0.5) / 16.0);
+        scene
+            .camera
+            .generate_ray(film, glam::Vec2::splat(0.5), 0.5)
+            .0
+    };
+    for (x, y) in [(0, 0), (15, 0), (0, 15), (15, 15)] {
+        let k = at(x, y);
+        assert!(
+            (img.albedo[k] - Vec3::new(0.3, 0.5, 0.7))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+        assert!(
+            (img.normal[k] - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-5,
+            "{}",
+            img.normal[k]
+        );
+        let want = 8.0 / centre_ray(x, y).dir.z;
+        assert!(
+            (img.depth[k] / want - 1.0).abs() < 0.01,
+            "{} vs {want}",
+            img.depth[k]
+        );
+    }
+    for (x, y) in [(7, 7), (8, 8), (7, 8)] {
+        let k = at(x, y);
+        assert!(
+            (img.albedo[k] - Vec3::new(0.9, 0.6, 0.2))
+                .abs()
+                .max_element()
+                < 1e-6
+        );
+        let ray = centre_ray(x, y);
+        // The near intersection with the unit sphere at (0, 0, 4).
+        let oc = ray.origin - Vec3::new(0.0, 0.0, 4.0);
+        let b = oc.dot(ray.dir);
+        let t = -b - (b * b - (oc.length_squared() - 1.0)).sqrt();
+        let n = (ray.origin + t * ray.dir - Vec3::new(0.0, 0.0, 4.0)).normalize();
+        assert!(
+            (img.depth[k] / t - 1.0).abs() < 0.01,
+            "{} vs {t}",
+            img.depth[k]
+        );
+        assert!(
+            (img.normal[k] - n).length() < 0.05,
+            "{} vs {n}",
+            img.normal[k]
+        );
+    }
+    // Without the request, nothing is made.
+    let mut plain = s.clone();
+    plain.aux = false;
+    assert!(run(&scene, &plain).aux.is_none());
+}
+
+/// The auxiliary sums are the same bits whatever the thread count, and
+/// asking for them leaves the beauty image as it was.
+#[test]
+fn aux_sums_do_not_depend_on_threads_and_leave_the_image_alone() {
+    let (scene, s) = aux_scene();
+    let in_pool = |threads: usize, s: &sahara_render::RenderSettings| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| render(&scene, s, &|_| {}))
+    };
+    let (one, two) = (in_pool(1, &s), in_pool(2, &s));
+    assert_eq!(
+        one.aux.as_ref().unwrap().sums,
+        two.aux.as_ref().unwrap().sums
+    );
+    let mut plain = s.clone();
+    plain.aux = false;
+    assert_eq!(in_pool(2, &plain).sums, two.sums);
+}

@@ -124,6 +124,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
             ..Default::default()
         },
         cost,
+        aux: None,
     };
     let out = Output {
         path: args.output.clone(),

@@ -82,16 +82,20 @@ impl PixelSum {
     /// arrived; negative estimates (from the negative lobes of some
     /// filters) become zero, since radiance is not negative.
     pub fn value(&self) -> Vec3 {
+        self.mean().max(Vec3::ZERO)
+    }
+
+    /// The weighted mean, with its sign (zero where no weight arrived).
+    pub fn mean(&self) -> Vec3 {
         if self.weight <= 0 {
             return Vec3::ZERO;
         }
         let w = float(self.weight);
-        let v = Vec3::new(
+        Vec3::new(
             (float(self.rgb[0]) / w) as f32,
             (float(self.rgb[1]) / w) as f32,
             (float(self.rgb[2]) / w) as f32,
-        );
-        v.max(Vec3::ZERO)
+        )
     }
 }
 
@@ -128,7 +132,8 @@ impl SumBuffer {
         self.index(x, y).map(|k| &self.sums[k])
     }
 
-    fn index(&self, x: u32, y: u32) -> Option<usize> {
+    /// The index in `sums` of pixel `(x, y)`, if it is inside.
+    pub(crate) fn index(&self, x: u32, y: u32) -> Option<usize> {
         let (i, j) = (x.checked_sub(self.x0)?, y.checked_sub(self.y0)?);
         (i < self.width && j < self.height).then(|| j as usize * self.width as usize + i as usize)
     }

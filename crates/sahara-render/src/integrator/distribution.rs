@@ -28,8 +28,10 @@ pub(crate) fn step(
     let world = ctx.world;
     let ray = st.ray;
     let Some(hit) = hit else {
+        let le = world.env_radiance(ray.dir);
+        st.aux.escape(le);
         if st.prev_delta {
-            st.l += st.beta * world.env_radiance(ray.dir);
+            st.l += st.beta * le;
         }
         return false;
     };
@@ -37,6 +39,7 @@ pub(crate) fn step(
         return true;
     }
     let sh = Shading::new(world, &hit, ray.dir);
+    st.aux.surface(&sh, &hit, ray.dir, st.depth);
     if st.prev_delta {
         st.l += st.beta * sh.emitted;
     }

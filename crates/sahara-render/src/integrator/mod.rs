@@ -21,7 +21,7 @@ use crate::sampler::PixelSampler;
 use crate::texture::footprint::UvFootprint;
 use crate::world::{ShadowQuery, SurfaceHit, World};
 use state::Deferred;
-pub(crate) use state::PathState;
+pub(crate) use state::{AuxSample, PathState};
 
 /// Which estimator computes a pixel sample's radiance.
 #[derive(Clone, Copy, Debug, PartialEq)]

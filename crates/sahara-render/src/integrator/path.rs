@@ -29,6 +29,7 @@ pub(crate) fn step(
     let Some(hit) = hit else {
         if world.has_environment() {
             let le = world.env_radiance(ray.dir);
+            st.aux.escape(le);
             let w = if st.prev_delta {
                 1.0
             } else {
@@ -42,6 +43,7 @@ pub(crate) fn step(
         return true;
     }
     let sh = Shading::new(world, &hit, ray.dir);
+    st.aux.surface(&sh, &hit, ray.dir, st.depth);
     {
         let le = sh.emitted;
         if le != Vec3::ZERO {

@@ -47,6 +47,61 @@ pub(crate) struct PathState {
     /// more than one scattering passes (applied to `beta` once the
     /// emission at the next vertex is counted).
     pub occlusion: f32,
+    /// What a denoiser is told about this sample.
+    pub aux: AuxSample,
+}
+
+/// What a denoiser is told about one sample (Intel Open Image Denoise's
+/// conventions): the albedo and the shading normal of the first surface
+/// the path meets that is not a perfect mirror or smooth glass (through
+/// those, the surface seen in them), and the camera distance of the first
+/// hit. A path that escapes first gets the environment's colour (clamped
+/// to `[0, 1]`) as albedo and a zero normal; its distance is 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct AuxSample {
+    /// Albedo in `[0, 1]`.
+    pub albedo: Vec3,
+    /// World-space shading normal, facing the arriving ray.
+    pub normal: Vec3,
+    /// Distance from the camera to the first hit, along the ray.
+    pub depth: f32,
+    /// Still looking for the surface.
+    pub open: bool,
+}
+
+impl AuxSample {
+    /// Records the surface `sh` of `hit`, met after `depth` scatterings by a
+    /// ray of direction `dir`.
+    #[inline]
+    pub fn surface(
+        &mut self,
+        sh: &super::Shading,
+        hit: &crate::world::SurfaceHit,
+        dir: Vec3,
+        depth: u32,
+    ) {
+        if !self.open {
+            return;
+        }
+        if depth == 0 {
+            self.depth = hit.t * dir.length();
+        }
+        if !sh.bsdf.is_delta() {
+            self.albedo = sh.bsdf.albedo();
+            let n = sh.frame.n;
+            self.normal = if n.dot(sh.wo_world) < 0.0 { -n } else { n };
+            self.open = false;
+        }
+    }
+
+    /// Records an escape into the environment of radiance `le`.
+    #[inline]
+    pub fn escape(&mut self, le: Vec3) {
+        if self.open {
+            self.albedo = le.clamp(Vec3::ZERO, Vec3::ONE);
+            self.open = false;
+        }
+    }
 }
 
 impl PathState {
@@ -66,6 +121,10 @@ impl PathState {
             light_sum: Vec3::ZERO,
             pass_throughs: 0,
             occlusion: 1.0,
+            aux: AuxSample {
+                open: true,
+                ..AuxSample::default()
+            },
         }
     }
 

@@ -549,6 +549,22 @@ impl PointBsdf {
         }
     }
 
+    /// The surface's colour as a denoiser's albedo, in `[0, 1]`: a diffuse
+    /// reflectance or base colour, a metal's reflectance at normal
+    /// incidence, white for glass.
+    pub fn albedo(&self) -> Vec3 {
+        let c = match self.bsdf {
+            Bsdf::Diffuse { albedo } | Bsdf::CoatedDiffuse { albedo, .. } => albedo * self.tint,
+            Bsdf::Conductor { color, .. } | Bsdf::Mirror { color } => color * self.tint,
+            Bsdf::ComplexConductor { eta, k, .. } => fresnel::conductor(1.0, eta, k) * self.tint,
+            Bsdf::MetallicRoughness { base_color, .. } => base_color * self.tint,
+            Bsdf::Dielectric { .. }
+            | Bsdf::RoughDielectric { .. }
+            | Bsdf::ThinDielectric { .. } => Vec3::ONE,
+        };
+        c.clamp(Vec3::ZERO, Vec3::ONE)
+    }
+
     /// Value and density for `(wo, wi)` (see [`Bsdf::eval`]).
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> BsdfEval {

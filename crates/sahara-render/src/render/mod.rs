@@ -25,7 +25,7 @@ use crate::film::sums::{filter_margin, SumBuffer};
 use crate::film::window::PixelWindow;
 use crate::film::{heat_color, Film};
 use crate::integrator::wavefront::Wavefront;
-use crate::integrator::{defaults, Context, Integrator, PathState, TraceStats};
+use crate::integrator::{defaults, AuxSample, Context, Integrator, PathState, TraceStats};
 use crate::math::hash::hash2;
 use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
 use crate::scene::Scene;
@@ -73,6 +73,9 @@ pub struct RenderSettings {
     /// passes: sample `k` is index `k % pass_spp` of pass `k / pass_spp`
     /// (None: `0..spp`). The passes rendered are those the range meets.
     pub samples: Option<std::ops::Range<u32>>,
+    /// Also make the images a denoiser and compositing use: albedo, normal
+    /// and depth ([`AuxImages`]; the path and distribution integrators).
+    pub aux: bool,
 }
 
 /// The `spp` of a render bounded by its time limit only.
@@ -108,6 +111,7 @@ impl Default for RenderSettings {
             cost_scale: None,
             window: None,
             samples: None,
+            aux: false,
         }
     }
 }
@@ -241,6 +245,88 @@ pub struct RenderResult {
     pub stats: RenderStats,
     /// Raw per-pixel work of the `cost` view.
     pub cost: Option<CostMaps>,
+    /// The albedo, normal and depth images and their sums, when
+    /// [`RenderSettings::aux`] asks for them.
+    pub aux: Option<Aux>,
+}
+
+/// The auxiliary images of a render and the exact sums they come from.
+/// Each sample adds to its own pixel alone (a box over the pixel, whatever
+/// the reconstruction filter): these images say what the pixel shows, not
+/// how its light is filtered.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Aux {
+    /// The images of the window.
+    pub images: AuxImages,
+    /// Their exact sums: albedo, normal, and the depth in the first channel.
+    pub sums: [SumBuffer; 3],
+}
+
+/// What a denoiser (and a compositor) is told about each pixel, averaged
+/// over its samples: the albedo and shading normal of the first surface
+/// that is not a perfect mirror or smooth glass (seen through those), and
+/// the camera distance of the first hit. Where a sample escapes, the
+/// albedo is the environment's colour clamped to `[0, 1]`, the normal zero
+/// and the distance 0 (Intel Open Image Denoise's conventions).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AuxImages {
+    /// Albedo in `[0, 1]` per pixel.
+    pub albedo: Vec<Vec3>,
+    /// World-space shading normal per pixel (an average: shorter than 1
+    /// where the pixel's samples disagree).
+    pub normal: Vec<Vec3>,
+    /// Camera distance per pixel.
+    pub depth: Vec<f32>,
+}
+
+impl Aux {
+    fn new(x0: u32, y0: u32, width: u32, height: u32) -> Self {
+        let b = || SumBuffer::new(x0, y0, width, height);
+        Self {
+            images: AuxImages {
+                albedo: Vec::new(),
+                normal: Vec::new(),
+                depth: Vec::new(),
+            },
+            sums: [b(), b(), b()],
+        }
+    }
+
+    /// Adds one sample of pixel `(x, y)`.
+    #[inline]
+    fn add_sample(&mut self, x: u32, y: u32, a: &AuxSample) {
+        let [albedo, normal, depth] = &mut self.sums;
+        if let Some(k) = albedo.index(x, y) {
+            albedo.sums[k].add_sample(a.albedo, 1.0);
+            normal.sums[k].add_sample(a.normal, 1.0);
+            depth.sums[k].add_sample(Vec3::new(a.depth, 0.0, 0.0), 1.0);
+        }
+    }
+
+    /// Adds `other`'s sums.
+    fn add(&mut self, other: &Aux) {
+        for (a, b) in self.sums.iter_mut().zip(&other.sums) {
+            a.add(b);
+        }
+    }
+
+    /// The images from the sums, black where `finished` says a pixel was
+    /// not finished.
+    fn develop(&mut self, finished: Option<&[bool]>) {
+        let keep = |k: usize| finished.is_none_or(|f| f[k]);
+        let mean = |b: &SumBuffer| -> Vec<Vec3> {
+            b.sums
+                .iter()
+                .enumerate()
+                .map(|(k, p)| if keep(k) { p.mean() } else { Vec3::ZERO })
+                .collect()
+        };
+        self.images = AuxImages {
+            albedo: mean(&self.sums[0]),
+            normal: mean(&self.sums[1]),
+            depth: mean(&self.sums[2]).iter().map(|d| d.x).collect(),
+        };
+    }
 }
 
 /// A tile of pixels `[x0, x1) x [y0, y1)`.
@@ -271,6 +357,7 @@ struct TileOut {
     sums: SumBuffer,
     stats: TraceStats,
     split: TimeSplit,
+    aux: Option<Aux>,
     nan: u64,
     negative: u64,
     /// Pixels rendered, in render order (all of them unless stopped).
@@ -319,6 +406,9 @@ pub fn render_watched(
         })
         .collect();
     let mut sums = SumBuffer::new(window.x0, window.y0, window.width(), window.height());
+    let mut aux = settings
+        .aux
+        .then(|| Aux::new(window.x0, window.y0, window.width(), window.height()));
     let mut stats = RenderStats {
         build_time,
         ..Default::default()
@@ -440,6 +530,9 @@ pub fn render_watched(
             sums.add(&out.sums);
             stats.trace += out.stats;
             stats.time_split += out.split;
+            if let (Some(a), Some(o)) = (&mut aux, &out.aux) {
+                a.add(o);
+            }
             stats.nan_samples += out.nan;
             stats.negative_samples += out.negative;
         }
@@ -454,7 +547,7 @@ pub fn render_watched(
                 let mut snapshot = stats;
                 snapshot.render_time = render_start.elapsed();
                 snapshot.stopped_early = true;
-                (p.show)(&finish(sums.clone(), None, snapshot, settings));
+                (p.show)(&finish(sums.clone(), aux.clone(), None, snapshot, settings));
                 last_preview = Instant::now();
             }
         }
@@ -464,16 +557,20 @@ pub fn render_watched(
     }
     stats.render_time = render_start.elapsed();
     stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
-    finish(sums, finished.as_deref(), stats, settings)
+    finish(sums, aux, finished.as_deref(), stats, settings)
 }
 
 /// The image of the sums so far (black where `finished` says a pixel was not).
 fn finish(
     sums: SumBuffer,
+    mut aux: Option<Aux>,
     finished: Option<&[bool]>,
     stats: RenderStats,
     settings: &RenderSettings,
 ) -> RenderResult {
+    if let Some(a) = &mut aux {
+        a.develop(finished);
+    }
     let mut film = Film::new(sums.width, sums.height);
     for (k, (p, s)) in film.pixels.iter_mut().zip(&sums.sums).enumerate() {
         let keep = finished.is_none_or(|f| f[k]);
@@ -486,6 +583,7 @@ fn finish(
         sums,
         stats,
         cost,
+        aux,
     }
 }
 
@@ -539,6 +637,16 @@ fn render_tile(
         sums: SumBuffer::new(reach.x0, reach.y0, reach.width(), reach.height()),
         stats: TraceStats::default(),
         split: TimeSplit::default(),
+        aux: s.aux.then(|| {
+            let own = PixelWindow {
+                x0: t.x0,
+                x1: t.x1,
+                y0: t.y0,
+                y1: t.y1,
+            }
+            .intersect(window);
+            Aux::new(own.x0, own.y0, own.width(), own.height())
+        }),
         nan: 0,
         negative: 0,
         pixels_done: 0,
@@ -568,6 +676,10 @@ fn render_tile(
                 for x in t.x0..t.x1 {
                     for _ in indices.clone() {
                         let pos = strip.pos[k];
+                        if let Some(aux) = &mut out.aux {
+                            let a = strip.aux[k];
+                            aux.add_sample(x, y, &a);
+                        }
                         let mut l = strip.radiance[k];
                         k += 1;
                         // Guard, count, never hide: a NaN or infinite sample is
@@ -608,6 +720,8 @@ struct Strip {
     paths: Vec<PathState>,
     /// Where each path's radiance goes in `radiance`.
     slot: Vec<u32>,
+    /// Each sample's auxiliary values (when the settings ask for them).
+    aux: Vec<AuxSample>,
     wavefront: Wavefront,
 }
 
@@ -637,6 +751,10 @@ impl Strip {
         self.pos.resize(n, Vec2::ZERO);
         self.radiance.clear();
         self.radiance.resize(n, Vec3::ZERO);
+        self.aux.clear();
+        if s.aux {
+            self.aux.resize(n, AuxSample::default());
+        }
         // Sample `index` of pixel (x, y): its sampler, film position and
         // camera ray.
         let camera_sample = |x: u32, y: u32, index: u32| {
@@ -703,6 +821,11 @@ impl Strip {
             .trace(&s.integrator, world, stats, &mut self.paths);
         for (p, &k) in self.paths.iter().zip(&self.slot) {
             self.radiance[k as usize] = p.l;
+        }
+        if s.aux {
+            for (p, &k) in self.paths.iter().zip(&self.slot) {
+                self.aux[k as usize] = p.aux;
+            }
         }
     }
 }
