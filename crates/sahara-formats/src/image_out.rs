@@ -89,6 +89,69 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb8: &[u8]) -> Result<()
     png(path, width, height, rgb8, &[])
 }
 
+/// Named channels written beside the beauty in one EXR part, as
+/// `LAYER.CHANNEL` (`albedo.R`, `normal.X`, `depth.Z`): the multi-layer
+/// convention compositors read.
+#[derive(Clone, Copy, Debug)]
+pub struct ExrLayer<'a> {
+    /// The layer's name (`albedo`).
+    pub name: &'a str,
+    /// Its channels' names (`["R", "G", "B"]`).
+    pub channels: &'a [&'a str],
+    /// `width * height * channels.len()` values, interleaved per pixel,
+    /// row-major from the top left.
+    pub values: &'a [f32],
+}
+
+/// Writes a linear float EXR of the beauty (`R`, `G`, `B`: `width * height
+/// * 3` values) and further `layers`, with string attributes, atomically.
+pub fn write_exr_layers(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb_f32: &[f32],
+    layers: &[ExrLayer<'_>],
+    metadata: &[(String, String)],
+) -> Result<(), FormatError> {
+    use exr::prelude::{AnyChannel, AnyChannels, FlatSamples, SmallVec};
+    let name = path.display().to_string();
+    check_len(path, width, height, rgb_f32.len())?;
+    let pixels = width as usize * height as usize;
+    let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    let mut plane = |label: String, values: &[f32], stride: usize, c: usize| {
+        let v: Vec<f32> = (0..pixels).map(|i| values[i * stride + c]).collect();
+        channels.push(AnyChannel::new(label.as_str(), FlatSamples::F32(v)));
+    };
+    for (c, label) in ["R", "G", "B"].iter().enumerate() {
+        plane(label.to_string(), rgb_f32, 3, c);
+    }
+    for layer in layers {
+        let n = layer.channels.len();
+        if n == 0 || layer.values.len() != pixels * n {
+            return Err(FormatError::in_file(
+                &name,
+                format!(
+                    "layer '{}' holds {} values, not {pixels} pixels x {n} channels",
+                    layer.name,
+                    layer.values.len()
+                ),
+            ));
+        }
+        for (c, ch) in layer.channels.iter().enumerate() {
+            plane(format!("{}.{ch}", layer.name), layer.values, n, c);
+        }
+    }
+    let mut layer_attributes = LayerAttributes::default();
+    layer_attributes.other.extend(exr_attributes(&name, metadata)?);
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        layer_attributes,
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(channels),
+    );
+    encode_exr(path, |out| Image::from_layer(layer).write().to_buffered(out))
+}
+
 /// Writes a linear float EXR (`width * height * 3` values) with string attributes, atomically.
 pub fn write_exr(
     path: &Path,
@@ -99,29 +162,7 @@ pub fn write_exr(
 ) -> Result<(), FormatError> {
     let name = path.display().to_string();
     check_len(path, width, height, rgb_f32.len())?;
-    let mut attributes = Vec::with_capacity(metadata.len());
-    for (key, value) in metadata {
-        if RESERVED_EXR_ATTRIBUTES.contains(&key.as_str()) {
-            return Err(FormatError::in_file(
-                &name,
-                format!("metadata key {key:?} is a standard EXR header attribute"),
-            ));
-        }
-        let text = |s: &str| {
-            Text::new_or_none(s).ok_or_else(|| {
-                FormatError::in_file(
-                    &name,
-                    format!(
-                        "metadata {key:?} = {value:?} cannot be stored as EXR text (Latin-1 only)"
-                    ),
-                )
-            })
-        };
-        if key.is_empty() {
-            return Err(FormatError::in_file(&name, "metadata key is empty"));
-        }
-        attributes.push((text(key)?, AttributeValue::Text(text(value)?)));
-    }
+    let attributes = exr_attributes(&name, metadata)?;
     let w = width as usize;
     let pixel = |p: ExrVec2<usize>| {
         let i = 3 * (p.y() * w + p.x());
@@ -135,11 +176,49 @@ pub fn write_exr(
         Encoding::SMALL_LOSSLESS,
         SpecificChannels::rgb(pixel),
     );
-    let image = Image::from_layer(layer);
+    encode_exr(path, |out| Image::from_layer(layer).write().to_buffered(out))
+}
+
+/// The metadata as EXR text attributes.
+fn exr_attributes(
+    name: &str,
+    metadata: &[(String, String)],
+) -> Result<Vec<(Text, AttributeValue)>, FormatError> {
+    let mut attributes = Vec::with_capacity(metadata.len());
+    for (key, value) in metadata {
+        if RESERVED_EXR_ATTRIBUTES.contains(&key.as_str()) {
+            return Err(FormatError::in_file(
+                name,
+                format!("metadata key {key:?} is a standard EXR header attribute"),
+            ));
+        }
+        let text = |s: &str| {
+            Text::new_or_none(s).ok_or_else(|| {
+                FormatError::in_file(
+                    name,
+                    format!(
+                        "metadata {key:?} = {value:?} cannot be stored as EXR text (Latin-1 only)"
+                    ),
+                )
+            })
+        };
+        if key.is_empty() {
+            return Err(FormatError::in_file(name, "metadata key is empty"));
+        }
+        attributes.push((text(key)?, AttributeValue::Text(text(value)?)));
+    }
+    Ok(attributes)
+}
+
+/// Encodes an image with `encode`, puts its header in a stable order and
+/// writes it atomically.
+fn encode_exr(
+    path: &Path,
+    encode: impl FnOnce(&mut std::io::Cursor<Vec<u8>>) -> exr::error::UnitResult,
+) -> Result<(), FormatError> {
+    let name = path.display().to_string();
     let mut bytes = std::io::Cursor::new(Vec::new());
-    image
-        .write()
-        .to_buffered(&mut bytes)
+    encode(&mut bytes)
         .map_err(|e| FormatError::in_file(&name, format!("cannot encode EXR: {e}")))?;
     let mut bytes = bytes.into_inner();
     // The encoder writes the custom attributes in hash-map order, which

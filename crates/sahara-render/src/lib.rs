@@ -74,8 +74,8 @@ pub use film::Film;
 pub use math::warp::luminance;
 pub use render::digest::frame_digest;
 pub use render::{
-    cost_maps, render, render_watched, Aux, AuxImages, CostMaps, Preview, Progress, RenderResult,
-    RenderStats, TimeSplit,
+    cost_maps, render, render_watched, Aov, Aux, AuxImages, CostMaps, Preview, Progress,
+    RenderResult, RenderStats, TimeSplit,
 };
 
 /// Internals for the repository's tests and benchmarks: the scene prepared

@@ -9,7 +9,7 @@ use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
 use sahara_bench::SetKind;
 use sahara_kd::{BuildParams, Builder};
 use sahara_render::Mesh;
-use sahara_render::{FilterKind, IntegratorKind, Named, SamplerKind, ToneMap};
+use sahara_render::{Aov, FilterKind, IntegratorKind, Named, SamplerKind, ToneMap};
 
 /// Default timed runs per set.
 pub const DEFAULT_RUNS: usize = 3;
@@ -171,6 +171,11 @@ pub struct RenderArgs {
     /// complete, do not render it again (for retried farm tasks).
     #[arg(long)]
     pub skip_existing: bool,
+    /// Render passes to write as layers of the EXR beside the beauty,
+    /// comma-separated: albedo (albedo.R/G/B), normal (normal.X/Y/Z, world
+    /// space), depth (depth.Z, camera distance); needs an .exr output.
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = NameParser::<Aov>::new())]
+    pub aov: Vec<Aov>,
 }
 
 /// Parses a setting through the renderer's name table, so `--help` lists

@@ -131,6 +131,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         settings: &settings,
         exposure: first.exposure,
         tonemap,
+        aovs: &[],
     };
     out.write(&result, !partial.is_empty(), true)?;
     eprintln!(

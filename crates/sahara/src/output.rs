@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Context, Result};
 use sahara_formats::atomic::check_writable;
-use sahara_formats::image_out::{write_image, ImageFormat, Pixels};
-use sahara_render::{Integrator, RenderResult, RenderSettings, ToneMap};
+use sahara_formats::image_out::{write_exr_layers, write_image, ExrLayer, ImageFormat, Pixels};
+use sahara_render::{Aov, AuxImages, Integrator, Named, RenderResult, RenderSettings, ToneMap};
 
 /// Checks, before anything is loaded or rendered, that `path` names an
 /// image Sahara writes (`.png` or `.exr`, or `.exr` only for a part) in a
@@ -61,6 +61,8 @@ pub(crate) struct Output<'a> {
     pub(crate) settings: &'a RenderSettings,
     pub(crate) exposure: f32,
     pub(crate) tonemap: ToneMap,
+    /// Render passes written as layers beside the beauty (EXR only).
+    pub(crate) aovs: &'a [Aov],
 }
 
 impl Output<'_> {
@@ -112,10 +114,40 @@ impl Output<'_> {
             ("sahara:partial".to_string(), partial.to_string()),
             ("sahara:finished_pixels".to_string(), finished.to_string()),
         ];
-        write_image(&self.path, width, height, pixels, &metadata)
+        let written = match (&result.aux, self.aovs.is_empty()) {
+            (Some(aux), false) if exr => {
+                let layers = aov_layers(self.aovs, &aux.images);
+                let layers: Vec<ExrLayer> = layers
+                    .iter()
+                    .map(|(aov, channels, values)| ExrLayer {
+                        name: aov.name(),
+                        channels,
+                        values,
+                    })
+                    .collect();
+                write_exr_layers(&self.path, width, height, &rgb, &layers, &metadata)
+            }
+            _ => write_image(&self.path, width, height, pixels, &metadata),
+        };
+        written
             .map_err(|e| anyhow!("{e}"))
             .context("cannot write the output image")
     }
+}
+
+/// Each pass's channel names and values, interleaved per pixel.
+fn aov_layers(aovs: &[Aov], images: &AuxImages) -> Vec<(Aov, &'static [&'static str], Vec<f32>)> {
+    let flat = |v: &[glam::Vec3]| v.iter().flat_map(|p| p.to_array()).collect::<Vec<f32>>();
+    let mut aovs = aovs.to_vec();
+    aovs.sort();
+    aovs.dedup();
+    aovs.into_iter()
+        .map(|aov| match aov {
+            Aov::Albedo => (aov, &["R", "G", "B"][..], flat(&images.albedo)),
+            Aov::Normal => (aov, &["X", "Y", "Z"][..], flat(&images.normal)),
+            Aov::Depth => (aov, &["Z"][..], images.depth.clone()),
+        })
+        .collect()
 }
 
 /// The nearest and farthest distance in a depth image (0 is no hit).

@@ -18,7 +18,9 @@ use std::time::{Duration, Instant};
 use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use sahara_render::UNLIMITED_SPP;
-use sahara_render::{render_watched, Preview, Progress, RenderResult, RenderSettings, ToneMap};
+use sahara_render::{
+    render_watched, Integrator, Preview, Progress, RenderResult, RenderSettings, ToneMap,
+};
 
 use crate::cli::RenderArgs;
 use crate::memory;
@@ -86,6 +88,29 @@ fn check_args(args: &RenderArgs) -> Result<()> {
     part::check_args(args)?;
     if let Some(output) = &args.output {
         check_output(output, part::is_part(args))?;
+        check_aov_output(args, output)?;
+    }
+    if !args.aov.is_empty() && part::is_part(args) {
+        bail!(
+            "--aov cannot be used with --part, --crop or --samples: part files carry the \
+             beauty's sums only"
+        );
+    }
+    Ok(())
+}
+
+/// Render passes are layers of an EXR: refused for any other output.
+fn check_aov_output(args: &RenderArgs, output: &std::path::Path) -> Result<()> {
+    if !args.aov.is_empty()
+        && !output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        bail!(
+            "--aov writes render passes as layers of an EXR file: the output {} is not one \
+             (use -o NAME.exr)",
+            output.display()
+        );
     }
     Ok(())
 }
@@ -103,6 +128,8 @@ struct Job {
     output_existed: bool,
     /// The piece of the frame a part renders, with the frame's digest.
     piece: Option<(Piece, String)>,
+    /// Render passes written beside the beauty.
+    aovs: Vec<sahara_render::Aov>,
 }
 
 /// Settles the settings (command line over scene file over defaults) and
@@ -151,6 +178,19 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
     // by `check_args`).
     if args.output.is_none() {
         check_output(&output, piece.is_some())?;
+        check_aov_output(args, &output)?;
+    }
+    settings.aux = !args.aov.is_empty();
+    if settings.aux
+        && !matches!(
+            settings.integrator,
+            Integrator::Path { .. } | Integrator::Distribution { .. }
+        )
+    {
+        bail!(
+            "--aov needs an integrator that traces paths (path or distribution), not {}",
+            settings.integrator.name()
+        );
     }
     // Refuse a render that would not fit, with what it would need.
     let triangles: u64 = scene
@@ -200,6 +240,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         output_existed: output.exists(),
         output,
         piece,
+        aovs: args.aov.clone(),
     }))
 }
 
@@ -327,6 +368,7 @@ impl Job {
             settings: &self.settings,
             exposure: self.exposure,
             tonemap: self.tonemap,
+            aovs: &self.aovs,
         }
     }
 

@@ -978,3 +978,110 @@ fn a_pbrt_crop_window_renders_those_pixels_of_the_whole_frame() {
     }
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// The channels of an EXR file by name, as floats.
+fn exr_channels(path: &Path) -> std::collections::BTreeMap<String, Vec<f32>> {
+    let image = exr::prelude::read_all_flat_layers_from_file(path).unwrap();
+    let mut out = std::collections::BTreeMap::new();
+    for layer in &image.layer_data {
+        for ch in &layer.channel_data.list {
+            out.insert(
+                ch.name.to_string(),
+                ch.sample_data.values_as_f32().collect(),
+            );
+        }
+    }
+    out
+}
+
+/// `--aov` writes the passes as named layers beside the beauty, which stays
+/// as it is without them; the albedo of the built-in Cornell box's walls is
+/// their reflectance, its normals are unit vectors, its depths positive.
+#[test]
+fn render_passes_are_layers_of_the_exr() {
+    let dir = temp_dir("aov");
+    let (with, without) = (dir.join("with.exr"), dir.join("without.exr"));
+    let args = ["render", "--width", "24", "--height", "24", "--spp", "4"];
+    let out = sahara(
+        &[
+            &args[..],
+            &["--aov", "albedo,normal,depth", "-o", with.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = sahara(&[&args[..], &["-o", without.to_str().unwrap()]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let a = exr_channels(&with);
+    let b = exr_channels(&without);
+    let names: Vec<&str> = a.keys().map(String::as_str).collect();
+    assert_eq!(
+        names,
+        [
+            "B", "G", "R", "albedo.B", "albedo.G", "albedo.R", "depth.Z", "normal.X", "normal.Y",
+            "normal.Z"
+        ]
+    );
+    for c in ["R", "G", "B"] {
+        assert_eq!(a[c], b[c], "the beauty's {c} changed");
+    }
+    let n = 24 * 24;
+    assert!(a["albedo.R"].iter().all(|v| (0.0..=1.0).contains(v)));
+    assert!(
+        a["depth.Z"].iter().all(|&d| d > 0.0),
+        "the box is closed around the camera's view"
+    );
+    let length = |k: usize| {
+        (a["normal.X"][k].powi(2) + a["normal.Y"][k].powi(2) + a["normal.Z"][k].powi(2)).sqrt()
+    };
+    assert!((0..n).all(|k| length(k) <= 1.0 + 1e-4));
+    // Pixels on an edge average two normals, and those at the open front of
+    // the box average a wall's with the zero of samples that escape; the
+    // others are whole.
+    let unit = (0..n).filter(|&k| (length(k) - 1.0).abs() < 1e-3).count();
+    assert!(unit > n / 2, "{unit} of {n} unit normals");
+    // The middle of the back wall (below the ceiling, above the boxes)
+    // faces the camera.
+    let k = 6 * 24 + 12;
+    let normal = [a["normal.X"][k], a["normal.Y"][k], a["normal.Z"][k]];
+    assert!((normal[2] + 1.0).abs() < 1e-3, "{normal:?}");
+}
+
+#[test]
+fn render_passes_need_an_exr_and_a_path_tracer() {
+    let dir = temp_dir("aov-errors");
+    let png = dir.join("x.png");
+    let out = sahara(&["render", "--aov", "albedo", "-o", png.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("is not one (use -o NAME.exr)"),
+        "{}",
+        stderr(&out)
+    );
+    let exr = dir.join("x.exr");
+    let out = sahara(&[
+        "render",
+        "--aov",
+        "depth",
+        "--integrator",
+        "ao",
+        "--spp",
+        "1",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("--aov needs an integrator that traces paths"),
+        "{}",
+        stderr(&out)
+    );
+    let out = sahara(&["render", "--aov", "uv", "-o", exr.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("albedo, normal or depth"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(!exr.exists() && !png.exists());
+}
