@@ -142,14 +142,18 @@ pub fn write_exr_layers(
         }
     }
     let mut layer_attributes = LayerAttributes::default();
-    layer_attributes.other.extend(exr_attributes(&name, metadata)?);
+    layer_attributes
+        .other
+        .extend(exr_attributes(&name, metadata)?);
     let layer = Layer::new(
         (width as usize, height as usize),
         layer_attributes,
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(channels),
     );
-    encode_exr(path, |out| Image::from_layer(layer).write().to_buffered(out))
+    encode_exr(path, |out| {
+        Image::from_layer(layer).write().to_buffered(out)
+    })
 }
 
 /// Writes a linear float EXR (`width * height * 3` values) with string attributes, atomically.
@@ -176,7 +180,9 @@ pub fn write_exr(
         Encoding::SMALL_LOSSLESS,
         SpecificChannels::rgb(pixel),
     );
-    encode_exr(path, |out| Image::from_layer(layer).write().to_buffered(out))
+    encode_exr(path, |out| {
+        Image::from_layer(layer).write().to_buffered(out)
+    })
 }
 
 /// The metadata as EXR text attributes.

@@ -176,6 +176,12 @@ pub struct RenderArgs {
     /// space), depth (depth.Z, camera distance); needs an .exr output.
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = NameParser::<Aov>::new())]
     pub aov: Vec<Aov>,
+    /// Denoise the image with Intel Open Image Denoise, guided by the
+    /// albedo and normal of what each pixel sees (the library is loaded
+    /// when found: `pip install pyoidn`, or OIDN_DIR); an EXR keeps the
+    /// noisy image as the layer `noisy` (noisy.R/G/B).
+    #[arg(long)]
+    pub denoise: bool,
 }
 
 /// Parses a setting through the renderer's name table, so `--help` lists

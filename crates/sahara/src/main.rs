@@ -9,6 +9,7 @@
 mod bench;
 mod cli;
 mod demo_scene;
+mod denoise;
 mod human;
 mod input;
 mod memory;

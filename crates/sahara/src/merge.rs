@@ -132,6 +132,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         exposure: first.exposure,
         tonemap,
         aovs: &[],
+        noisy: None,
     };
     out.write(&result, !partial.is_empty(), true)?;
     eprintln!(

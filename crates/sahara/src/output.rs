@@ -63,6 +63,9 @@ pub(crate) struct Output<'a> {
     pub(crate) tonemap: ToneMap,
     /// Render passes written as layers beside the beauty (EXR only).
     pub(crate) aovs: &'a [Aov],
+    /// The image before denoising (linear RGB), written as the layer
+    /// `noisy` of an EXR.
+    pub(crate) noisy: Option<&'a [f32]>,
 }
 
 impl Output<'_> {
@@ -114,20 +117,29 @@ impl Output<'_> {
             ("sahara:partial".to_string(), partial.to_string()),
             ("sahara:finished_pixels".to_string(), finished.to_string()),
         ];
-        let written = match (&result.aux, self.aovs.is_empty()) {
-            (Some(aux), false) if exr => {
-                let layers = aov_layers(self.aovs, &aux.images);
-                let layers: Vec<ExrLayer> = layers
-                    .iter()
-                    .map(|(aov, channels, values)| ExrLayer {
-                        name: aov.name(),
-                        channels,
-                        values,
-                    })
-                    .collect();
-                write_exr_layers(&self.path, width, height, &rgb, &layers, &metadata)
-            }
-            _ => write_image(&self.path, width, height, pixels, &metadata),
+        let passes = match &result.aux {
+            Some(aux) => aov_layers(self.aovs, &aux.images),
+            None => Vec::new(),
+        };
+        let mut layers: Vec<ExrLayer> = passes
+            .iter()
+            .map(|(aov, channels, values)| ExrLayer {
+                name: aov.name(),
+                channels,
+                values,
+            })
+            .collect();
+        if let Some(noisy) = self.noisy {
+            layers.push(ExrLayer {
+                name: "noisy",
+                channels: &["R", "G", "B"],
+                values: noisy,
+            });
+        }
+        let written = if exr && !layers.is_empty() {
+            write_exr_layers(&self.path, width, height, &rgb, &layers, &metadata)
+        } else {
+            write_image(&self.path, width, height, pixels, &metadata)
         };
         written
             .map_err(|e| anyhow!("{e}"))

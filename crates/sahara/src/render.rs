@@ -19,7 +19,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use sahara_render::UNLIMITED_SPP;
 use sahara_render::{
-    render_watched, Integrator, Preview, Progress, RenderResult, RenderSettings, ToneMap,
+    render_watched, Filter, FilterKind, Integrator, Preview, Progress, RenderResult,
+    RenderSettings, ToneMap,
 };
 
 use crate::cli::RenderArgs;
@@ -64,8 +65,12 @@ pub fn run(args: &RenderArgs) -> Result<Finish> {
     let Some(job) = plan(args, input)? else {
         return Ok(Finish::Done);
     };
-    let result = render_frame(args, &job)?;
-    save(&job, &result)
+    let mut result = render_frame(args, &job)?;
+    let noisy = match &job.denoiser {
+        Some(d) => crate::denoise::apply(d, &mut result)?,
+        None => None,
+    };
+    save(&job, &result, noisy.as_deref())
 }
 
 /// Checks the options that need no scene, before anything is loaded: a
@@ -90,11 +95,13 @@ fn check_args(args: &RenderArgs) -> Result<()> {
         check_output(output, part::is_part(args))?;
         check_aov_output(args, output)?;
     }
-    if !args.aov.is_empty() && part::is_part(args) {
-        bail!(
-            "--aov cannot be used with --part, --crop or --samples: part files carry the \
-             beauty's sums only"
-        );
+    for (given, name) in [(!args.aov.is_empty(), "--aov"), (args.denoise, "--denoise")] {
+        if given && part::is_part(args) {
+            bail!(
+                "{name} cannot be used with --part, --crop or --samples: part files carry the \
+                 beauty's sums only"
+            );
+        }
     }
     Ok(())
 }
@@ -130,6 +137,8 @@ struct Job {
     piece: Option<(Piece, String)>,
     /// Render passes written beside the beauty.
     aovs: Vec<sahara_render::Aov>,
+    /// The denoiser, with `--denoise`.
+    denoiser: Option<sahara_denoise::Denoiser>,
 }
 
 /// Settles the settings (command line over scene file over defaults) and
@@ -180,7 +189,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         check_output(&output, piece.is_some())?;
         check_aov_output(args, &output)?;
     }
-    settings.aux = !args.aov.is_empty();
+    settings.aux = !args.aov.is_empty() || args.denoise;
     if settings.aux
         && !matches!(
             settings.integrator,
@@ -188,10 +197,41 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         )
     {
         bail!(
-            "--aov needs an integrator that traces paths (path or distribution), not {}",
+            "{} needs an integrator that traces paths (path or distribution), not {}",
+            if args.aov.is_empty() {
+                "--denoise"
+            } else {
+                "--aov"
+            },
             settings.integrator.name()
         );
     }
+    // A filter wider than a pixel shares each sample between neighbours:
+    // their noise is then correlated, which the denoiser (trained on
+    // independent pixels) takes for detail and keeps. Figures in
+    // docs/clean-image.md.
+    if args.denoise {
+        match args.filter {
+            None => {
+                settings.filter = Filter::from(FilterKind::Box);
+                eprintln!(
+                    "denoise: box filter (a wider one correlates the noise of neighbouring \
+                     pixels, which the denoiser then keeps; --filter chooses another)"
+                );
+            }
+            Some(kind) if kind != FilterKind::Box => eprintln!(
+                "warning: --denoise with the {kind} filter: its noise is correlated between \
+                 pixels, which the denoiser keeps (the box filter denoises best)"
+            ),
+            Some(_) => {}
+        }
+    }
+    // The library is found before the render, not after it.
+    let denoiser = if args.denoise {
+        Some(crate::denoise::load()?)
+    } else {
+        None
+    };
     // Refuse a render that would not fit, with what it would need.
     let triangles: u64 = scene
         .meshes
@@ -241,6 +281,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         output,
         piece,
         aovs: args.aov.clone(),
+        denoiser,
     }))
 }
 
@@ -369,6 +410,7 @@ impl Job {
             exposure: self.exposure,
             tonemap: self.tonemap,
             aovs: &self.aovs,
+            noisy: None,
         }
     }
 
@@ -384,7 +426,7 @@ impl Job {
 }
 
 /// Writes the image (or the part file) and says what was written.
-fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
+fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finish> {
     let s = &result.stats;
     let partial = job.interrupted(result);
     let finish = if partial {
@@ -427,7 +469,8 @@ fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
     if s.passes == 0 && s.first_pass_pixels == 0 {
         bail!("stopped before the first pixel was finished: no image written");
     }
-    let output = job.output_at(partial);
+    let mut output = job.output_at(partial);
+    output.noisy = noisy;
     output.write(result, partial, true)?;
     if !partial {
         // A preview written beside the earlier image is stale now.

@@ -1085,3 +1085,102 @@ fn render_passes_need_an_exr_and_a_path_tracer() {
     );
     assert!(!exr.exists() && !png.exists());
 }
+
+/// Root-mean-square difference over the pixels the reference shows below
+/// 1 (the light's own pixels, far brighter, would decide it alone).
+fn rmse_below_one(a: &[f32], reference: &[f32]) -> f64 {
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for (p, r) in a.chunks(3).zip(reference.chunks(3)) {
+        if r.iter().all(|&v| v < 1.0) {
+            sum += p
+                .iter()
+                .zip(r)
+                .map(|(x, y)| f64::from(x - y).powi(2))
+                .sum::<f64>();
+            n += 3;
+        }
+    }
+    (sum / n.max(1) as f64).sqrt()
+}
+
+/// `--denoise` brings a noisy render much closer to a converged one, keeps
+/// the noisy image as a layer, and is refused where it cannot work. Skipped
+/// (said so) where Open Image Denoise is not installed, unless
+/// `SAHARA_REQUIRE_OIDN` is set, as CI sets it.
+#[test]
+fn denoising_lowers_the_error_of_a_noisy_render() {
+    let dir = temp_dir("denoise");
+    let (noisy, reference) = (dir.join("noisy.exr"), dir.join("reference.exr"));
+    let args = [
+        "render", "--width", "64", "--height", "64", "--filter", "box",
+    ];
+    let out = sahara(
+        &[
+            &args[..],
+            &["--spp", "8", "--denoise", "-o", noisy.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    if !out.status.success() && stderr(&out).contains("Open Image Denoise not found") {
+        assert!(
+            std::env::var_os("SAHARA_REQUIRE_OIDN").is_none(),
+            "SAHARA_REQUIRE_OIDN is set: {}",
+            stderr(&out)
+        );
+        eprintln!("skipped: Open Image Denoise is not installed here (pip install pyoidn)");
+        return;
+    }
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("denoised with Open Image Denoise"),
+        "{}",
+        stderr(&out)
+    );
+    let out = sahara(
+        &[
+            &args[..],
+            &["--spp", "512", "-o", reference.to_str().unwrap()],
+        ]
+        .concat(),
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let a = exr_channels(&noisy);
+    let r = exr_channels(&reference);
+    let rgb = |m: &std::collections::BTreeMap<String, Vec<f32>>, prefix: &str| -> Vec<f32> {
+        let c = |n: &str| &m[&format!("{prefix}{n}")];
+        let (r, g, b) = (c("R"), c("G"), c("B"));
+        (0..r.len()).flat_map(|k| [r[k], g[k], b[k]]).collect()
+    };
+    let reference = rgb(&r, "");
+    let before = rmse_below_one(&rgb(&a, "noisy."), &reference);
+    let after = rmse_below_one(&rgb(&a, ""), &reference);
+    assert!(after < 0.6 * before, "denoised {after} vs noisy {before}");
+    // Refused where it cannot work, before any rendering.
+    let out = sahara(&[
+        "render",
+        "--denoise",
+        "--integrator",
+        "normals",
+        "-o",
+        noisy.to_str().unwrap(),
+    ]);
+    assert!(
+        stderr(&out).contains("--denoise needs an integrator that traces paths"),
+        "{}",
+        stderr(&out)
+    );
+    let part = dir.join("p.exr");
+    let out = sahara(&[
+        "render",
+        "--denoise",
+        "--part",
+        "0/2",
+        "-o",
+        part.to_str().unwrap(),
+    ]);
+    assert!(
+        stderr(&out).contains("--denoise cannot be used with --part"),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -27,11 +27,11 @@ use crate::film::window::PixelWindow;
 use crate::film::{heat_color, Film};
 use crate::integrator::wavefront::Wavefront;
 use crate::integrator::{defaults, AuxSample, Context, Integrator, PathState, TraceStats};
-pub use aux::{Aov, Aux, AuxImages};
 use crate::math::hash::hash2;
 use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
 use crate::scene::Scene;
 use crate::world::World;
+pub use aux::{Aov, Aux, AuxImages};
 
 /// How to render.
 #[derive(Clone, Debug)]
