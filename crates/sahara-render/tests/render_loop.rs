@@ -522,3 +522,40 @@ fn aux_sums_do_not_depend_on_threads_and_leave_the_image_alone() {
     plain.aux = false;
     assert_eq!(in_pool(2, &plain).sums, two.sums);
 }
+
+/// The depth view and the depth pass average the distances of the samples
+/// that hit: at a sphere's silhouette no pixel comes nearer than the
+/// sphere's nearest point (misses are not averaged in as 0), and a pixel no
+/// sample hit is 0.
+#[test]
+fn depth_never_mixes_misses_into_hits() {
+    let cam = Camera::look_at(Vec3::ZERO, Vec3::Z, Vec3::Y, 30.0, 1.0);
+    let mut scene = Scene::new(cam);
+    let m = scene.add_material(Material::diffuse(Vec3::splat(0.5)));
+    scene.add_shape(
+        Shape::Sphere {
+            center: Vec3::new(0.0, 0.0, 5.0),
+            radius: 1.0,
+        },
+        m,
+    );
+    scene.lights.push(Light::Point {
+        position: Vec3::new(0.0, 3.0, 0.0),
+        intensity: Vec3::splat(10.0),
+    });
+    let nearest = 4.0 - 1e-3;
+    let farthest = (5.0f32 * 5.0 - 1.0).sqrt() + 1e-3;
+    let check = |d: &[f32]| {
+        let hit = d.iter().filter(|&&v| v > 0.0).count();
+        assert!(hit > 0 && hit < d.len(), "{hit} of {}", d.len());
+        for &v in d {
+            assert!(v == 0.0 || (nearest..=farthest).contains(&v), "{v}");
+        }
+    };
+    let r = run(&scene, &settings(24, 24, 8, Integrator::Depth));
+    check(&r.film.pixels.iter().map(|p| p.x).collect::<Vec<_>>());
+    let mut s = settings(24, 24, 8, Integrator::default());
+    s.aux = true;
+    let r = run(&scene, &s);
+    check(&r.aux.unwrap().images.depth);
+}

@@ -74,7 +74,11 @@ impl Aux {
         if let Some(k) = albedo.index(x, y) {
             albedo.sums[k].add_sample(a.albedo, 1.0);
             normal.sums[k].add_sample(a.normal, 1.0);
-            depth.sums[k].add_sample(Vec3::new(a.depth, 0.0, 0.0), 1.0);
+            // The mean distance of the samples that hit: a miss (0) mixed
+            // in would pull silhouettes towards the camera.
+            if a.depth > 0.0 {
+                depth.sums[k].add_sample(Vec3::new(a.depth, 0.0, 0.0), 1.0);
+            }
         }
     }
 

@@ -575,6 +575,7 @@ fn render_tile(
         pixels_done: 0,
     };
     let stepped = s.integrator.is_stepped();
+    let depth_view = matches!(s.integrator, Integrator::Depth);
     let rows = if stepped { STRIP_ROWS } else { 1 };
     // The strip's buffers, kept by the thread from tile to tile.
     STRIP.with_borrow_mut(|strip| {
@@ -605,6 +606,13 @@ fn render_tile(
                         }
                         let mut l = strip.radiance[k];
                         k += 1;
+                        // The depth view averages the distances of the
+                        // samples that hit (a miss is 0, never a hit):
+                        // mixing misses in would draw a near halo at every
+                        // silhouette. A pixel no sample hit stays 0.
+                        if depth_view && l == Vec3::ZERO {
+                            continue;
+                        }
                         // Guard, count, never hide: a NaN or infinite sample is
                         // a bug somewhere; it is zeroed so one cannot ruin a
                         // pixel, and reported in the statistics.
