@@ -50,10 +50,10 @@ pub struct Aux<'a> {
     ///
     /// It pays where the auxiliary buffers are visibly noisy and the frame
     /// is final: it removes the residual noise they would leave and keeps
-    /// texture detail sharper. It is expensive: at Open Image Denoise's
-    /// default quality the albedo and normal networks are larger than the
-    /// beauty's, and on a 2-core CPU denoising with prefiltering took 7 to
-    /// 12 times as long as without (`docs/clean-image.md`). With clean
+    /// texture detail sharper. It is expensive: three networks run instead
+    /// of one, each (at Open Image Denoise's default, highest quality)
+    /// larger than the one without prefiltering; on a 2-core CPU it took 7
+    /// to 12 times as long (`docs/clean-image.md`). With clean
     /// buffers it gains nothing: set [`Aux::clean_aux`] instead. It applies
     /// only when both albedo and normal are given (Open Image Denoise has no
     /// clean-albedo-only mode); otherwise it is ignored.
