@@ -38,9 +38,9 @@ pub struct Aux<'a> {
     pub normal: Option<&'a [f32]>,
     /// The albedo and normal are free of noise (Open Image Denoise's
     /// `cleanAux`): sharper results, but any noise in them stays in the
-    /// output. Set it only for noise-free buffers, e.g. without depth of
-    /// field or motion blur and with a pixel's samples agreeing on the
-    /// surface. It matters only when both albedo and normal are given.
+    /// output. Set it only for noise-free buffers, e.g. rendered without
+    /// depth of field or motion blur. It matters only when both albedo and
+    /// normal are given.
     pub clean_aux: bool,
     /// Denoise the albedo and normal first, each with its own filter, then
     /// denoise the beauty with them as clean (`cleanAux`), as Open Image
@@ -48,13 +48,15 @@ pub struct Aux<'a> {
     /// (averaged over a pixel's samples, which see different surfaces
     /// through depth of field or motion blur).
     ///
-    /// It pays where the auxiliary buffers are visibly noisy: it removes
-    /// the residual noise they would leave and keeps texture detail sharper.
-    /// It costs two more filter runs (on the CPU, the albedo and normal
-    /// filters together take about as long again as the beauty's). With
-    /// clean buffers it gains nothing: set [`Aux::clean_aux`] instead. It
-    /// applies only when both albedo and normal are given (Open Image
-    /// Denoise has no clean-albedo-only mode); otherwise it is ignored.
+    /// It pays where the auxiliary buffers are visibly noisy and the frame
+    /// is final: it removes the residual noise they would leave and keeps
+    /// texture detail sharper. It is expensive: three networks run instead
+    /// of one, each (at Open Image Denoise's default, highest quality)
+    /// larger than the one without prefiltering; on a 2-core CPU it took 7
+    /// to 12 times as long (`docs/clean-image.md`). With clean
+    /// buffers it gains nothing: set [`Aux::clean_aux`] instead. It applies
+    /// only when both albedo and normal are given (Open Image Denoise has no
+    /// clean-albedo-only mode); otherwise it is ignored.
     pub prefilter_aux: bool,
 }
 

@@ -1,23 +1,10 @@
-//! Finding and loading the Open Image Denoise library.
+//! Finding and loading the Open Image Denoise library, in the order the
+//! crate's documentation gives: `OIDN_DIR`, the system loader, `pyoidn`.
 //!
-//! The places, in order (the first library that loads wins):
-//!
-//! 1. `OIDN_DIR`: the library file itself, or a folder holding it, or a
-//!    folder with it in `lib/` (`bin/` on Windows), such as an unpacked
-//!    Open Image Denoise release;
-//! 2. the system loader's own search path (`LD_LIBRARY_PATH`, the system's
-//!    library folders): `libOpenImageDenoise.so.2`, then
-//!    `libOpenImageDenoise.so`;
-//! 3. the `pyoidn` Python package, whose `oidn/lib/` holds the official
-//!    binaries: first the interpreter `SAHARA_PYTHON` names, asked where the
-//!    package is; then the active virtual environment (`VIRTUAL_ENV`), read
-//!    directly; then `python3` on `PATH`, asked; last the `site-packages` of
-//!    every other `python3*` on `PATH` and the user's `~/.local`, read
-//!    directly.
-//!
-//! Asking an interpreter (`importlib.util.find_spec`, which does not import
-//! the package) costs one process start, some tens of milliseconds; it
-//! happens only when the first two places fail, and at most twice.
+//! Asking an interpreter where `pyoidn` is (`importlib.util.find_spec`,
+//! which does not import the package) costs one process start, some tens
+//! of milliseconds; it happens only when the places before it fail, and at
+//! most twice.
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
