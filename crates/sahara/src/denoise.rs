@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Result};
 use sahara_denoise::{Aux, Denoiser, Image};
-use sahara_render::RenderResult;
+use sahara_render::{RenderResult, Scene};
 
 /// Finds and loads the denoiser, before anything is rendered: a missing
 /// library is said in one line with how to get it.
@@ -14,11 +14,26 @@ pub(crate) fn load() -> Result<Denoiser> {
     Ok(d)
 }
 
+/// True where a pixel's samples see different surfaces beyond its edges:
+/// through a lens that blurs (depth of field) or while things move
+/// (motion blur). The albedo and normal are then noisy images themselves.
+pub(crate) fn guides_are_noisy(scene: &Scene) -> bool {
+    let c = &scene.camera;
+    c.lens_radius > 0.0
+        || (c.shutter_close > c.shutter_open
+            && scene.instances.iter().any(|i| i.placement.is_moving()))
+}
+
 /// Denoises `result`'s image in place and returns the noisy one (linear
 /// RGB), or `None` with the reason said when there is nothing to denoise
 /// (a first pass stopped before every pixel had its samples: the black
-/// pixels would smear into the rest).
-pub(crate) fn apply(denoiser: &Denoiser, result: &mut RenderResult) -> Result<Option<Vec<f32>>> {
+/// pixels would smear into the rest). `noisy_guides`: denoise the albedo
+/// and normal first ([`guides_are_noisy`]).
+pub(crate) fn apply(
+    denoiser: &Denoiser,
+    result: &mut RenderResult,
+    noisy_guides: bool,
+) -> Result<Option<Vec<f32>>> {
     if result.stats.passes == 0 {
         eprintln!("denoise: skipped, the first pass was stopped before every pixel was finished");
         return Ok(None);
@@ -36,11 +51,13 @@ pub(crate) fn apply(denoiser: &Denoiser, result: &mut RenderResult) -> Result<Op
         color: &noisy,
         hdr: true,
     };
-    // A pixel's albedo and normal are means over its samples: noisy where
-    // they see different surfaces (edges, depth of field, motion blur), so
-    // they are denoised first, as Open Image Denoise advises for final frames.
+    // A pixel's albedo and normal are means over its samples. Under depth
+    // of field or motion blur they are noisy, and are denoised first, as
+    // Open Image Denoise advises; that costs several times the beauty's
+    // filter (docs/clean-image.md), so sharp, still frames pass them as
+    // they are (their only noise, at edges, the network tolerates).
     let guide = Aux {
-        prefilter_aux: true,
+        prefilter_aux: noisy_guides,
         ..Aux::albedo_normal(&albedo, &normal)
     };
     let start = Instant::now();

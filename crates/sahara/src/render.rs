@@ -67,7 +67,10 @@ pub fn run(args: &RenderArgs) -> Result<Finish> {
     };
     let mut result = render_frame(args, &job)?;
     let noisy = match &job.denoiser {
-        Some(d) => crate::denoise::apply(d, &mut result)?,
+        Some(d) => {
+            let noisy_guides = crate::denoise::guides_are_noisy(&job.scene);
+            crate::denoise::apply(d, &mut result, noisy_guides)?
+        }
         None => None,
     };
     save(&job, &result, noisy.as_deref())
