@@ -365,7 +365,7 @@ fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
         };
         let done = part::write(&path, &record, &job.settings, result)?;
         eprintln!(
-            "{} {}: samples {}..{} of {}..{}, {:.2} s render (+{:.0} ms tree builds), {} rays",
+            "{} {}: samples {}..{} of {}..{}, {:.2} s render (+{:.0} ms tree builds: {}), {} rays",
             if partial {
                 "wrote PARTIAL part"
             } else {
@@ -378,6 +378,7 @@ fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
             p.samples.end,
             s.render_time.as_secs_f64(),
             s.build_time.as_secs_f64() * 1e3,
+            s.layout,
             s.rays()
         );
         return Ok(finish);
@@ -397,7 +398,7 @@ fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
     let secs = s.render_time.as_secs_f64();
     let pixels = u64::from(result.film.width) * u64::from(result.film.height);
     eprintln!(
-        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {:.3} CPU s, {} rays, {:.2} Mrays/s{}",
+        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds: {}), {:.3} CPU s, {} rays, {:.2} Mrays/s{}",
         if partial {
             "wrote PARTIAL image"
         } else {
@@ -415,6 +416,7 @@ fn save(job: &Job, result: &RenderResult) -> Result<Finish> {
         s.spp,
         secs,
         s.build_time.as_secs_f64() * 1e3,
+        s.layout,
         s.render_cpu_time.as_secs_f64(),
         s.rays(),
         s.rays() as f64 / secs.max(1e-9) / 1e6,
