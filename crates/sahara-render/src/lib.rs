@@ -39,6 +39,7 @@ mod texture;
 mod world;
 
 // The scene model.
+pub use accel::AccelLayout;
 pub use scene::builtin;
 pub use scene::camera::Camera;
 pub use scene::instance::{Instance, Placement, Srt};

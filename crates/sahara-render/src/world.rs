@@ -131,13 +131,22 @@ pub struct World<'a> {
 impl<'a> World<'a> {
     /// Builds trees and lights.
     pub fn new(scene: &'a Scene, params: &BuildParams) -> Self {
-        let accel = Accel::build(&scene.meshes, &scene.instances, params);
-        let (center, radius) = bounding_sphere(&accel);
         let SceneLights {
             lights,
             instance_light,
             env,
         } = SceneLights::gather(scene);
+        // The analytic emitters' shadow rays ignore the emitter's own
+        // instance, which therefore keeps a tree of its own.
+        let ignorable: Vec<u32> = lights
+            .iter()
+            .filter_map(|l| match l {
+                LightSource::Area(a) => a.instance,
+                _ => None,
+            })
+            .collect();
+        let accel = Accel::build(&scene.meshes, &scene.instances, params, &ignorable);
+        let (center, radius) = bounding_sphere(&accel);
         let select = Distribution1D::new(lights.iter().map(|l| l.power(radius)).collect());
         Self {
             scene,

@@ -32,7 +32,8 @@ pub enum Command {
     /// Run the ray-casting benchmark protocol (docs/bench-protocol.md) on a mesh.
     #[command(long_about = BENCH_ABOUT)]
     Bench(BenchArgs),
-    /// Build a kd-tree over a mesh and print its statistics and build time.
+    /// Build a kd-tree over a mesh and print its statistics and build time;
+    /// of a scene file, how many trees and instances its render builds.
     Stats(StatsArgs),
     /// Render a scene (built-in Cornell box, a mesh file, or a scene file) to PNG or EXR.
     Render(RenderArgs),
@@ -389,7 +390,8 @@ impl Default for BenchOptions {
 #[derive(Debug, Args)]
 pub struct StatsArgs {
     /// The mesh (.obj, .ply, .gltf or .glb; a glTF scene's meshes are merged
-    /// in scene order).
+    /// in scene order), or a scene file (.toml, .pbrt, .pbrt.gz): then the
+    /// trees and instances a render of it builds.
     pub mesh: PathBuf,
     /// The tree to build.
     #[command(flatten)]

@@ -452,7 +452,7 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
         };
         let done = part::write(&path, &record, &job.settings, result)?;
         eprintln!(
-            "{} {}: samples {}..{} of {}..{}, {:.2} s render (+{:.0} ms tree builds), {} rays",
+            "{} {}: samples {}..{} of {}..{}, {:.2} s render (+{:.0} ms tree builds), {}, {} rays",
             if partial {
                 "wrote PARTIAL part"
             } else {
@@ -465,6 +465,7 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
             p.samples.end,
             s.render_time.as_secs_f64(),
             s.build_time.as_secs_f64() * 1e3,
+            s.layout,
             s.rays()
         );
         return Ok(finish);
@@ -485,7 +486,7 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
     let secs = s.render_time.as_secs_f64();
     let pixels = u64::from(result.film.width) * u64::from(result.film.height);
     eprintln!(
-        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {:.3} CPU s, {} rays, {:.2} Mrays/s{}{}",
+        "{} {}: {}, {} spp, {:.2} s render (+{:.0} ms tree builds), {}, {:.3} CPU s, {} rays, {:.2} Mrays/s{}{}",
         if partial {
             "wrote PARTIAL image"
         } else {
@@ -503,6 +504,7 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
         s.spp,
         secs,
         s.build_time.as_secs_f64() * 1e3,
+        s.layout,
         s.render_cpu_time.as_secs_f64(),
         s.rays(),
         s.rays() as f64 / secs.max(1e-9) / 1e6,

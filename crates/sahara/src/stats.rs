@@ -1,15 +1,24 @@
-//! `sahara stats`: a tree's statistics and build time.
+//! `sahara stats`: a tree's statistics and build time; for a scene file,
+//! the trees and instances its acceleration structure was built from.
 
-use anyhow::{Context, Result};
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
 use sahara_bench::report::StatsReport;
 use sahara_bench::runner::{build_timed, Pools};
+use sahara_render::internals::World;
+use serde::Serialize;
 
 use crate::cli::StatsArgs;
 use crate::human;
 use crate::input::load_mesh;
 
-/// `sahara stats MESH ...`.
+/// `sahara stats MESH ...`, or `sahara stats SCENE ...`.
 pub fn run(args: &StatsArgs) -> Result<()> {
+    if is_scene_file(&args.mesh) {
+        return run_scene(args);
+    }
     let mesh = args.tree.select(load_mesh(&args.mesh)?);
     let threads = args
         .threads
@@ -41,6 +50,103 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         );
     } else {
         print!("{}", human::stats_report(&report));
+    }
+    Ok(())
+}
+
+/// A scene file (TOML or pbrt) rather than a mesh.
+fn is_scene_file(path: &Path) -> bool {
+    sahara_formats::pbrt::is_pbrt_path(path)
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+}
+
+/// What `sahara stats` says of a scene: how its acceleration structure
+/// was organised (see `docs/accelerator.md`).
+#[derive(Debug, Serialize)]
+pub struct SceneStatsReport {
+    /// The scene file.
+    pub scene: String,
+    /// Builder name.
+    pub builder: String,
+    /// Best time to build the trees and the lights, milliseconds.
+    pub build_ms: f64,
+    /// Builds timed.
+    pub build_runs: usize,
+    /// Instances in all.
+    pub instances: usize,
+    /// Instances whose triangles went into the one world-space tree.
+    pub merged_instances: usize,
+    /// Instances traced in two levels (shared meshes, moving instances,
+    /// analytic emitters).
+    pub two_level_instances: usize,
+    /// Kd-trees built: the world tree, if any, and one per mesh of the
+    /// two-level instances.
+    pub trees: usize,
+    /// Triangles in the world tree.
+    pub world_triangles: usize,
+    /// Triangles of all instances (an instanced mesh counted once per
+    /// instance).
+    pub instanced_triangles: u64,
+    /// Bytes held by the trees.
+    pub memory_bytes: usize,
+}
+
+/// `sahara stats SCENE ...`: builds the scene's trees as a render does.
+fn run_scene(args: &StatsArgs) -> Result<()> {
+    if args.tree.subset.is_some() {
+        bail!("--subset applies to meshes, not to scene files");
+    }
+    let input = crate::scene_input::load_input(Some(&args.mesh), None, None)?;
+    crate::warnings::print(&input.warnings);
+    let threads = args
+        .threads
+        .map_or_else(Pools::available_threads, usize::from);
+    let pools = Pools::new(threads).context("cannot start the thread pool")?;
+    let params = args.tree.params();
+    let scene = &input.scene;
+    eprintln!(
+        "building the {} trees of {} ({})...",
+        args.tree.builder.name(),
+        input.description,
+        human::count(args.runs, "build")
+    );
+    let mut best = f64::INFINITY;
+    let mut world = None;
+    for _ in 0..args.runs.max(1) {
+        let start = Instant::now();
+        let w = pools.all.install(|| World::new(scene, &params));
+        best = best.min(start.elapsed().as_secs_f64() * 1e3);
+        world = Some(w);
+    }
+    let world = world.expect("at least one build");
+    let accel = &world.accel;
+    let layout = accel.layout();
+    let report = SceneStatsReport {
+        scene: args.mesh.display().to_string(),
+        builder: args.tree.builder.name(),
+        build_ms: best,
+        build_runs: args.runs.max(1),
+        instances: layout.instances,
+        merged_instances: layout.merged,
+        two_level_instances: accel.two_level_count(),
+        trees: layout.trees,
+        world_triangles: accel.world_triangles(),
+        instanced_triangles: scene
+            .instances
+            .iter()
+            .map(|i| scene.meshes[i.mesh as usize].mesh.triangle_count() as u64)
+            .sum(),
+        memory_bytes: accel.tree_bytes(),
+    };
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&report).context("cannot format the report")?
+        );
+    } else {
+        print!("{}", human::scene_stats_report(&report, threads));
     }
     Ok(())
 }

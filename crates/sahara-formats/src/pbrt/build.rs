@@ -7,8 +7,10 @@
 //!   analytically.
 //! - Each object (`ObjectBegin`) is one mesh holding all its shapes (their
 //!   transforms applied, a material per triangle), built once; each
-//!   `ObjectInstance` adds an instance of it: one kd-tree per object, one
-//!   over the instances.
+//!   `ObjectInstance` adds an instance of it: one kd-tree per object
+//!   instanced more than once, one over the instances (the renderer puts
+//!   an object used once, as the rest of the static geometry, into its
+//!   world tree).
 //! - Camera: pbrt's camera space has +x to the image's right, +y up and +z
 //!   forward; the camera's transform is used as it is, so mirroring
 //!   transforms (`Scale -1 1 1`) mirror the image as in pbrt.

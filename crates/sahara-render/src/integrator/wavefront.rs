@@ -291,15 +291,22 @@ mod tests {
             },
             Some(mirror),
         ));
+        // Instances of one mesh, which stay two-level (a mesh of its own
+        // each would go into the world tree).
+        let small = scene.add_mesh(
+            Shape::Sphere {
+                center: Vec3::ZERO,
+                radius: 0.3,
+            }
+            .to_mesh(),
+        );
         for k in 0..extra {
             let a = k as f32 * 0.7;
-            scene.add_shape(
-                Shape::Sphere {
-                    center: Vec3::new(3.0 * a.cos(), -0.7, 3.0 * a.sin()),
-                    radius: 0.3,
-                },
-                [floor, rough, glass][k % 3],
-            );
+            scene.add_instance(Instance::new(
+                small,
+                glam::Affine3A::from_translation(Vec3::new(3.0 * a.cos(), -0.7, 3.0 * a.sin())),
+                Some([floor, rough, glass][k % 3]),
+            ));
         }
         scene.add_light(Light::point(Vec3::new(2.0, 3.0, -2.0), Vec3::splat(10.0)));
         scene.add_light(Light::directional(
@@ -319,7 +326,8 @@ mod tests {
         for extra in [0, 12] {
             let scene = scene(extra);
             let world = World::new(&scene, &BuildParams::default());
-            assert_eq!(world.accel.instance_count() > 8, extra > 0);
+            assert_eq!(world.accel.two_level_count() > 8, extra > 0);
+            assert!(world.accel.merged_count() > 0);
             for integrator in ["path", "distribution"] {
                 let integrator = Integrator::named(integrator).unwrap();
                 let (w, h, spp) = (12u32, 10u32, 3u32);

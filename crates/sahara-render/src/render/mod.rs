@@ -20,6 +20,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use sahara_kd::BuildParams;
 
+use crate::accel::AccelLayout;
 use crate::cpu_time::process_cpu_time;
 use crate::film::filter::Filter;
 use crate::film::sums::{filter_margin, SumBuffer};
@@ -153,6 +154,8 @@ pub struct RenderStats {
     pub negative_samples: u64,
     /// Time to build the acceleration structures and lights.
     pub build_time: Duration,
+    /// The trees built for the scene's instances.
+    pub layout: AccelLayout,
     /// Time spent rendering passes.
     pub render_time: Duration,
     /// CPU time of all threads spent rendering passes (zero where the
@@ -334,6 +337,7 @@ pub fn render_watched(
         .then(|| Aux::new(window.x0, window.y0, window.width(), window.height()));
     let mut stats = RenderStats {
         build_time,
+        layout: world.accel.layout(),
         ..Default::default()
     };
     let render_start = Instant::now();
