@@ -47,14 +47,20 @@ pub fn scene_stats_report(r: &crate::stats::SceneStatsReport, threads: usize) ->
         thousands(r.two_level_instances as u64)
     );
     let world = usize::from(r.world_triangles > 0);
-    let _ = writeln!(
-        s,
-        "trees      {}: {} world tree ({} triangles), {} per two-level mesh",
-        thousands(r.trees as u64),
-        world,
-        thousands(r.world_triangles as u64),
+    let meshes = format!(
+        "{} of two-level meshes",
         thousands((r.trees - world) as u64)
     );
+    let _ = if world > 0 {
+        writeln!(
+            s,
+            "trees      {}: the world tree ({} triangles) and {meshes}",
+            thousands(r.trees as u64),
+            thousands(r.world_triangles as u64),
+        )
+    } else {
+        writeln!(s, "trees      {}: {meshes}", thousands(r.trees as u64))
+    };
     let _ = writeln!(
         s,
         "triangles  {} (instanced)",

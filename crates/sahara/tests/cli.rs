@@ -438,3 +438,68 @@ fn bench_help_points_at_the_repository_protocol() {
     assert!(help.contains("docs/bench-protocol.md"), "{help}");
     assert!(!help.contains("shared/bench"), "{help}");
 }
+
+#[test]
+fn stats_of_a_scene_file_says_how_many_trees_and_instances_it_built() {
+    let dir = temp_dir("stats-scene");
+    // Two unique static meshes (merged into the world tree), a mesh used
+    // twice and an emissive sphere sampled analytically (both two-level).
+    let obj = write_quad_scene(&dir);
+    let scene = dir.join("scene.toml");
+    fs::write(
+        &scene,
+        format!(
+            r#"[camera]
+eye = [0, 0, -5]
+target = [0, 0, 0]
+
+[film]
+width = 8
+height = 8
+
+[[material]]
+name = "lamp"
+type = "emission"
+radiance = [4, 4, 4]
+
+[[object]]
+type = "mesh"
+file = "{obj}"
+
+[[object]]
+type = "box"
+min = [-1, -1, 2]
+max = [1, 1, 3]
+
+[[object]]
+type = "sphere"
+center = [0, 3, 0]
+radius = 0.5
+material = "lamp"
+
+[[object]]
+type = "mesh"
+file = "{obj}"
+transform = {{ translate = [0, 0, 1] }}
+"#,
+            obj = obj.display()
+        ),
+    )
+    .unwrap();
+    let scene = scene.to_str().unwrap();
+    let j = stdout_json(&sahara(&["stats", scene, "--json"]));
+    assert_eq!(j["instances"], 4, "{j}");
+    assert_eq!(j["merged_instances"], 1, "{j}");
+    assert_eq!(j["two_level_instances"], 3, "{j}");
+    // The world tree, the shared mesh's tree and the sphere's.
+    assert_eq!(j["trees"], 3, "{j}");
+    assert_eq!(j["world_triangles"], 12, "{j}");
+    let out = sahara(&["stats", scene]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("instances  4: 1 merged into the world tree, 3 two-level"),
+        "{text}"
+    );
+    fs::remove_dir_all(dir).unwrap();
+}
