@@ -20,7 +20,9 @@
 
 #![warn(missing_docs)]
 
+pub mod assembly;
 pub mod atomic;
+pub mod description;
 pub mod gltf_scene;
 pub mod image_in;
 pub mod image_out;
