@@ -25,12 +25,10 @@
 
 mod settings;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use glam::Affine3A;
 use sahara_render::{Camera, Environment, Light, Material, SceneMesh, Shape, Srt};
-
-use crate::sky::Sky;
 
 pub use settings::{FileCrop, FileSettings};
 
@@ -57,7 +55,7 @@ pub struct SceneDescription {
     /// Light from infinitely far away, if the file gives it.
     pub environment: Option<Environment>,
     /// What lights the scene besides its own lights (the `auto` rule of
-    /// [`crate::sky`] is applied by the assembly).
+    /// [`crate::assembly::sky`] is applied by the assembly).
     pub sky: Sky,
     /// How the file asks to be rendered (`None`: a file that does not
     /// say, as a bare mesh).
@@ -167,5 +165,31 @@ impl ObjectPlacement {
     /// True if the object moves.
     pub fn is_moving(&self) -> bool {
         matches!(self, ObjectPlacement::Moving { .. })
+    }
+}
+
+/// What lights a scene besides its own lights.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Sky {
+    /// The default sky and sun if the scene's own lights are weak.
+    Auto,
+    /// The default sky and sun.
+    Default,
+    /// Nothing.
+    None,
+    /// An equirectangular environment map.
+    Map(PathBuf),
+}
+
+impl Sky {
+    /// `auto`, `default`, `none`, or an image file's path (relative paths
+    /// taken from `base`).
+    pub fn parse(s: &str, base: &Path) -> Sky {
+        match s {
+            "auto" => Sky::Auto,
+            "default" => Sky::Default,
+            "none" => Sky::None,
+            path => Sky::Map(base.join(path)),
+        }
     }
 }

@@ -4,7 +4,7 @@
 //! glTF file's lights. The camera is, in order: the one asked for (a
 //! sidecar file, or a glTF camera by name), the `<stem>.camera.json`
 //! sidecar, the glTF file's first camera, else one that frames the mesh's
-//! bounds from above and to the side. The sky follows [`crate::sky`]
+//! bounds from above and to the side. The sky follows [`crate::assembly::sky`]
 //! (`auto` unless told otherwise: the default sky and sun when the file's
 //! own lights are weak).
 
@@ -13,13 +13,14 @@ use std::path::{Path, PathBuf};
 use sahara_render::{Camera, Scene};
 
 use crate::assembly::assemble;
+use crate::assembly::sky::SkyUsed;
+use crate::description::Sky;
 use crate::description::{CameraRequest, Geometry, Object, ObjectPlacement, SceneDescription};
-use crate::sky::{Sky, SkyUsed};
 use crate::FormatError;
 use sahara_readers::camera::{read_sidecar, sidecar_path};
 
+pub use crate::assembly::sky::{DEFAULT_SKY, DEFAULT_SUN, DEFAULT_SUN_DIRECTION};
 pub use crate::assembly::AUTO_VFOV_DEG;
-pub use crate::sky::{DEFAULT_SKY, DEFAULT_SUN, DEFAULT_SUN_DIRECTION};
 
 /// Which camera a mesh file is seen by.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

@@ -25,6 +25,7 @@ use sahara_render::{
 };
 
 use crate::assembly::assemble;
+use crate::description::Sky;
 use crate::description::{
     CameraRequest, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
 };
@@ -34,7 +35,6 @@ use crate::scene_file::{
     load_scene_file, CameraSpec, EnvironmentSpec, LightSpec, MaterialKind, MaterialSpec, SceneFile,
     ShapeSpec,
 };
-use crate::sky::Sky;
 use crate::FormatError;
 
 pub use placement::{placement, srt};

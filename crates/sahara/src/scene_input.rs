@@ -7,9 +7,9 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Result};
 use sahara_formats::assembly::assemble;
 use sahara_formats::description::FileSettings;
+use sahara_formats::description::Sky;
 use sahara_formats::mesh_scene::{read_mesh_scene, CameraChoice};
 use sahara_formats::scene_load::read_scene;
-use sahara_formats::sky::Sky;
 use sahara_readers::camera::read_sidecar;
 use sahara_render::{builtin, Camera, Scene};
 
@@ -44,7 +44,7 @@ pub(crate) fn load_input(
             eprintln!("camera: {file}");
         }
         if let Some(sky) = &sky {
-            sahara_formats::sky::apply(&mut scene, sky).map_err(flat)?;
+            sahara_formats::assembly::sky::apply(&mut scene, sky).map_err(flat)?;
         }
         return Ok(Input {
             scene,
