@@ -1,11 +1,13 @@
 //! `sahara-formats`: scenes for the renderer, and images out.
 //!
-//! - scenes: [`scene_file`] (TOML, documented in `docs/scene-format.md`),
-//!   [`pbrt`] (pbrt-v4 scenes);
-//! - to the renderer: [`scene_load`] (a scene file as a `sahara_render::Scene`),
-//!   [`mesh_scene`] (a bare mesh file as one), sharing [`mesh_library`] (each
-//!   mesh file loaded once), [`material_map`] (MTL / glTF materials) and
-//!   [`gltf_scene`] (glTF cameras and lights);
+//! - scenes, each read into a [`description::SceneDescription`]:
+//!   [`scene_file`] (TOML, documented in `docs/scene-format.md`) with
+//!   [`scene_load`] (its description), [`pbrt`] (pbrt-v4 scenes),
+//!   [`mesh_scene`] (a bare mesh file as a scene);
+//! - to the renderer: [`assembly`] (a description as a
+//!   `sahara_render::Scene`: the sky rule, the automatic camera), using
+//!   [`mesh_library`] (each mesh file loaded once), [`material_map`]
+//!   (MTL / glTF materials) and [`gltf_scene`] (glTF cameras and lights);
 //! - images: [`image_out`] (PNG/EXR via [`atomic`] replacement), [`image_in`]
 //!   (textures and environment maps as linear colour);
 //! - render parts: [`part_file`] (a piece of a frame and its exact sums, as EXR);
@@ -20,7 +22,9 @@
 
 #![warn(missing_docs)]
 
+pub mod assembly;
 pub mod atomic;
+pub mod description;
 pub mod gltf_scene;
 pub mod image_in;
 pub mod image_out;
@@ -31,7 +35,6 @@ pub mod part_file;
 pub mod pbrt;
 pub mod scene_file;
 pub mod scene_load;
-pub mod sky;
 pub mod srgb;
 
 use std::path::Path;

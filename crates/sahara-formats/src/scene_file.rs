@@ -72,7 +72,7 @@ use crate::FormatError;
 pub struct SceneFile {
     /// What lights the scene besides its lights (`sky = "auto"`,
     /// `"default"`, `"none"` or an image file; `none` when absent).
-    pub sky: crate::sky::Sky,
+    pub sky: crate::description::Sky,
     /// The camera.
     pub camera: CameraSpec,
     /// Named materials, in file order.

@@ -1,48 +1,43 @@
-//! Scene files as renderer scenes: a [`SceneFile`] becomes a
-//! [`sahara_render::Scene`] plus the file's render settings.
+//! Scene files as descriptions: a [`SceneFile`] becomes a
+//! [`SceneDescription`] (assembled by [`crate::assembly`] into a
+//! renderer scene with the file's render settings).
 //!
-//! - Mesh files are loaded once each by a [`MeshLibrary`], however many
-//!   objects use them: objects only add instances (glTF nodes add one
-//!   instance per node, placed by the object's transform times the node's).
-//! - An object with `material = "name"` overrides a mesh's own materials;
-//!   without it a mesh keeps its MTL / glTF materials (mapped as
-//!   [`crate::material_map`] describes) and a PLY or a built-in shape gets
-//!   the grey default.
-//! - `motion` gives a moving instance (`Placement::Moving`) interpolated
-//!   over the shutter interval.
-//! - Built-in shapes and area lights go through [`Scene::add_shape`] where
-//!   possible, so emissive quads, discs and spheres are sampled
-//!   analytically (see [`shapes`]).
-//! - Problems that still allow rendering (a missing MTL file or texture)
-//!   are warnings in [`LoadedScene::warnings`].
+//! - `[[object]]`s are objects in file order: a mesh file (its own
+//!   materials unless the object names one; a PLY or a built-in shape
+//!   gets the grey default), or a built-in shape; `motion` gives a moving
+//!   placement, interpolated over the shutter interval.
+//! - `[[material]]`s are the description's materials in file order, their
+//!   textures read here (a texture that cannot be read is a warning).
+//! - `[[light]]`s: point, spot and directional lights as they are; an area
+//!   light is a shape in world space whose material emits (its named
+//!   material's surface, or black); an environment is the description's.
 
 mod placement;
-pub mod settings;
-pub mod shapes;
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use sahara_render::Encoding;
 use sahara_render::{
-    Bsdf, Camera, Environment, Instance, Light, Material, Scene, Texture, TextureMap,
+    Bsdf, Camera, Environment, Light, Material, Scene, Shape, Texture, TextureMap,
 };
 
-use crate::gltf_scene::gltf_light;
+use crate::assembly::assemble;
+use crate::description::Sky;
+use crate::description::{
+    CameraRequest, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
+};
 use crate::image_in::load_rgb_f32;
 use crate::material_map::TextureCache;
-use crate::mesh_library::{file_key, MeshLibrary};
 use crate::scene_file::{
-    load_scene_file, CameraSpec, EnvironmentSpec, LightSpec, MaterialKind, MaterialSpec,
-    Placement as PlacementSpec, SceneFile, ShapeSpec,
+    load_scene_file, CameraSpec, EnvironmentSpec, LightSpec, MaterialKind, MaterialSpec, SceneFile,
+    ShapeSpec,
 };
-use crate::sky::Sky;
 use crate::FormatError;
 
 pub use placement::{placement, srt};
-pub use settings::{FileCrop, FileSettings};
 
 /// A scene ready to render, with how its file asks for it to be rendered.
 #[derive(Clone, Debug)]
@@ -63,109 +58,87 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, FormatError> {
 /// Reads a scene file as [`load_scene`] does, lit by `sky` instead of the
 /// file's `sky` key if given.
 pub fn load_scene_with_sky(path: &Path, sky: Option<&Sky>) -> Result<LoadedScene, FormatError> {
-    let mut file = load_scene_file(path)?;
+    let mut desc = read_scene(path)?;
     if let Some(sky) = sky {
-        file.sky = sky.clone();
+        desc.sky = sky.clone();
     }
-    build_scene(&file, &path.display().to_string())
+    loaded(desc)
+}
+
+/// Reads a scene file as a description (meshes, textures and maps read
+/// relative to it).
+pub fn read_scene(path: &Path) -> Result<SceneDescription, FormatError> {
+    describe(&load_scene_file(path)?, &path.display().to_string())
 }
 
 /// Builds the scene of a parsed scene file; `name` (the scene file) is used in messages.
 pub fn build_scene(file: &SceneFile, name: &str) -> Result<LoadedScene, FormatError> {
-    let settings =
-        FileSettings::from_specs(&file.integrator, &file.sampler, &file.filter, &file.film);
-    let aspect = settings.width as f32 / settings.height as f32;
-    let mut scene = Scene::new(camera_of(&file.camera, aspect));
-    let mut library = MeshLibrary::new();
+    loaded(describe(file, name)?)
+}
 
-    let mut named = HashMap::new();
-    let mut textures = TextureCache::new();
-    for m in &file.materials {
-        let id = scene.add_material(material_of(m, &mut textures, &mut library.warnings, name));
-        named.insert(m.name.as_str(), id);
-    }
-    // Files some object shows with their own materials.
-    let own: HashSet<_> = file
-        .objects
-        .iter()
-        .filter(|o| o.material.is_none())
-        .filter_map(|o| match &o.shape {
-            ShapeSpec::Mesh { path } => Some(file_key(path)),
-            _ => None,
-        })
-        .collect();
-    let mut moving_emitters = 0;
-    for (k, o) in file.objects.iter().enumerate() {
-        // The resolver checked that the name exists.
-        let material = o.material.as_deref().and_then(|n| named.get(n).copied());
-        match &o.shape {
-            ShapeSpec::Mesh { path } => {
-                let f = library
-                    .load(&mut scene, path, own.contains(&file_key(path)))
-                    .map_err(|e| FormatError::in_file(name, format!("object {}: {e}", k + 1)))?;
-                for part in &f.parts {
-                    scene.add_instance(Instance {
-                        mesh: part.mesh,
-                        placement: placement(&o.placement, part.transform),
-                        material: material.or(f.material),
-                    });
-                }
-                // A glTF file's lights, where the object puts the file
-                // (where it starts, if it moves).
-                let at = placement(&o.placement, Mat4::IDENTITY).at(0.0);
-                for l in &f.lights {
-                    scene.add_light(gltf_light(l, Mat4::from(at)));
-                }
-                if matches!(o.placement, PlacementSpec::Motion { .. })
-                    && material.map_or(f.emissive, |m| is_emissive(&scene, m))
-                {
-                    moving_emitters += 1;
-                }
-            }
-            spec => {
-                let shape = shapes::shape_of(spec).expect("not a mesh");
-                let material = match material {
-                    Some(m) => m,
-                    None => library.default_material(&mut scene),
-                };
-                if matches!(o.placement, PlacementSpec::Motion { .. })
-                    && is_emissive(&scene, material)
-                {
-                    moving_emitters += 1;
-                }
-                shapes::add_placed_shape(
-                    &mut scene,
-                    shape,
-                    placement(&o.placement, Mat4::IDENTITY),
-                    material,
-                );
-            }
-        }
-    }
-    if moving_emitters > 0 {
-        library.warnings.push(format!(
-            "{name}: {moving_emitters} moving object(s) emit light: they are seen, but not sampled as lights"
-        ));
-    }
-    for l in &file.lights {
-        add_light(&mut scene, l, &named, name)?;
-    }
-    scene.generate_tangents();
-    crate::sky::apply(&mut scene, &file.sky)
-        .map_err(|e| FormatError::in_file(name, format!("sky: {e}")))?;
-    // A scene without light is reported by `Scene::diagnostics`, with the
-    // other problems of the finished scene.
-    let warnings = std::mem::take(&mut library.warnings);
+/// The assembled scene of a description that has settings.
+fn loaded(desc: SceneDescription) -> Result<LoadedScene, FormatError> {
+    let a = assemble(desc)?;
     Ok(LoadedScene {
-        scene,
-        settings,
-        warnings,
+        scene: a.scene,
+        settings: a.settings.expect("a scene file has settings"),
+        warnings: a.warnings,
     })
 }
 
-/// True if material `id` of `scene` emits.
-fn is_emissive(scene: &Scene, id: u32) -> bool {
-    scene.materials[id as usize].is_emissive()
+/// The render settings of a parsed scene file.
+pub fn settings_of(file: &SceneFile) -> FileSettings {
+    FileSettings {
+        integrator: file.integrator,
+        sampler: file.sampler.kind,
+        spp: file.sampler.spp,
+        seed: file.sampler.seed,
+        filter: file.filter,
+        width: file.film.width,
+        height: file.film.height,
+        exposure: file.film.exposure,
+        tonemap: file.film.tonemap,
+        output: file.film.output.clone(),
+        crop: None,
+    }
+}
+
+/// The description of a parsed scene file; `name` (the scene file) is
+/// used in messages.
+pub fn describe(file: &SceneFile, name: &str) -> Result<SceneDescription, FormatError> {
+    let settings = settings_of(file);
+    let aspect = settings.width as f32 / settings.height as f32;
+    let mut desc = SceneDescription::new(name);
+    desc.camera = CameraRequest::Given {
+        camera: camera_of(&file.camera, aspect),
+        source: String::new(),
+    };
+    desc.settings = Some(settings);
+    desc.sky = file.sky.clone();
+    let mut named = HashMap::new();
+    let mut textures = TextureCache::new();
+    for m in &file.materials {
+        let material = material_of(m, &mut textures, &mut desc.warnings, name);
+        let id = desc.add_material(material);
+        named.insert(m.name.as_str(), id);
+    }
+    for o in &file.objects {
+        // The resolver checked that the name exists.
+        let material = o.material.as_deref().and_then(|n| named.get(n).copied());
+        let geometry = match &o.shape {
+            ShapeSpec::Mesh { path } => Geometry::File(path.clone()),
+            ShapeSpec::Builtin(shape) => Geometry::Shape(*shape),
+        };
+        desc.objects.push(Object {
+            geometry,
+            placement: placement(&o.placement),
+            material,
+        });
+    }
+    for l in &file.lights {
+        add_light(&mut desc, l, &named, name)?;
+    }
+    Ok(desc)
 }
 
 /// The thin-lens camera of `[camera]`.
@@ -270,7 +243,7 @@ fn material_kind_of(m: &MaterialSpec) -> Material {
 /// (and texture) besides emitting its own radiance; without one its surface
 /// is black but for the emission.
 fn add_light(
-    scene: &mut Scene,
+    desc: &mut SceneDescription,
     l: &LightSpec,
     named: &HashMap<&str, u32>,
     name: &str,
@@ -279,43 +252,47 @@ fn add_light(
         LightSpec::Point {
             position,
             intensity,
-        } => scene.add_light(Light::point(*position, *intensity)),
+        } => desc.lights.push(Light::point(*position, *intensity)),
         LightSpec::Spot {
             position,
             target,
             intensity,
             inner_deg,
             outer_deg,
-        } => scene.add_light(Light::spot(
+        } => desc.lights.push(Light::spot(
             *position, *target, *intensity, *inner_deg, *outer_deg,
         )),
         LightSpec::Directional {
             direction,
             irradiance,
-        } => scene.add_light(Light::directional(*direction, *irradiance)),
+        } => desc
+            .lights
+            .push(Light::directional(*direction, *irradiance)),
         LightSpec::Area {
             shape,
             radiance,
             two_sided,
             material,
         } => {
+            let shape = area_shape(shape).ok_or_else(|| {
+                FormatError::in_file(name, "an area light's shape is quad, disc or sphere")
+            })?;
             // The resolver checked that the name exists.
             let surface = material.as_deref().and_then(|n| named.get(n));
             let mut m = match surface {
-                Some(&id) => scene.materials[id as usize]
-                    .clone()
-                    .with_emission(*radiance),
+                Some(&id) => desc.materials[id as usize].clone().with_emission(*radiance),
                 None => Material::emitter(*radiance),
             };
             m.two_sided_emission = *two_sided;
-            let m = scene.add_material(m);
-            let shape = shapes::shape_of(shape).ok_or_else(|| {
-                FormatError::in_file(name, "an area light's shape is quad, disc or sphere")
-            })?;
-            scene.add_shape(shape, m);
+            let m = desc.add_material(m);
+            desc.objects.push(Object {
+                geometry: Geometry::Shape(shape),
+                placement: ObjectPlacement::World,
+                material: Some(m),
+            });
         }
         LightSpec::Environment(EnvironmentSpec::Constant(c)) => {
-            scene.environment = Some(Environment::Constant(*c));
+            desc.environment = Some(Environment::Constant(*c));
         }
         LightSpec::Environment(EnvironmentSpec::Map { path, scale }) => {
             let (w, h, rgb) = load_rgb_f32(path)?;
@@ -326,11 +303,19 @@ fn add_light(
                 ));
             }
             let texels = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
-            scene.environment = Some(Environment::Map {
+            desc.environment = Some(Environment::Map {
                 texture: Arc::new(Texture::new(w, h, texels)),
                 scale: *scale,
             });
         }
     }
     Ok(())
+}
+
+/// The shape of an area light (`None` for a mesh file).
+fn area_shape(spec: &ShapeSpec) -> Option<Shape> {
+    match *spec {
+        ShapeSpec::Mesh { .. } => None,
+        ShapeSpec::Builtin(shape) => Some(shape),
+    }
 }

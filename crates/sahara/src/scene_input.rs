@@ -5,9 +5,11 @@
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
-use sahara_formats::mesh_scene::{load_mesh_scene_with, CameraChoice};
-use sahara_formats::scene_load::{load_scene_with_sky, FileSettings};
-use sahara_formats::sky::Sky;
+use sahara_formats::assembly::assemble;
+use sahara_formats::description::FileSettings;
+use sahara_formats::description::Sky;
+use sahara_formats::mesh_scene::{read_mesh_scene, CameraChoice};
+use sahara_formats::scene_load::read_scene;
 use sahara_readers::camera::read_sidecar;
 use sahara_render::{builtin, Camera, Scene};
 
@@ -42,7 +44,7 @@ pub(crate) fn load_input(
             eprintln!("camera: {file}");
         }
         if let Some(sky) = &sky {
-            sahara_formats::sky::apply(&mut scene, sky).map_err(flat)?;
+            sahara_formats::assembly::sky::apply(&mut scene, sky).map_err(flat)?;
         }
         return Ok(Input {
             scene,
@@ -72,35 +74,21 @@ pub(crate) fn load_input(
     }
     // A `FormatError`'s message already names the file and place.
     let pbrt = sahara_formats::pbrt::is_pbrt_path(path);
-    let (scene, file, warnings) = match ext.as_str() {
+    let mesh = matches!(ext.as_str(), "obj" | "ply" | "gltf" | "glb");
+    let mut desc = match ext.as_str() {
         _ if pbrt && camera.is_some() => bail!(
             "{}: --camera applies to meshes and the built-in scene; a pbrt file has its own Camera",
             path.display()
         ),
-        _ if pbrt => {
-            let mut p = sahara_formats::pbrt::load_pbrt(path).map_err(flat)?;
-            if let Some(sky) = &sky {
-                sahara_formats::sky::apply(&mut p.loaded.scene, sky).map_err(flat)?;
-            }
-            (p.loaded.scene, Some(p.loaded.settings), p.loaded.warnings)
-        }
+        _ if pbrt => sahara_formats::pbrt::read_pbrt(path).map_err(flat)?,
         "toml" if camera.is_some() => bail!(
             "{}: --camera applies to meshes and the built-in scene; a scene file has its own [camera]",
             path.display()
         ),
-        "toml" => {
-            let l = load_scene_with_sky(path, sky.as_ref()).map_err(flat)?;
-            (l.scene, Some(l.settings), l.warnings)
-        }
-        "obj" | "ply" | "gltf" | "glb" => {
+        "toml" => read_scene(path).map_err(flat)?,
+        _ if mesh => {
             let camera = camera.map_or(CameraChoice::Auto, CameraChoice::from_arg);
-            let m = load_mesh_scene_with(path, &camera, sky.as_ref().unwrap_or(&Sky::Auto))
-                .map_err(flat)?;
-            if m.scene.meshes.iter().all(|m| m.mesh.indices.is_empty()) {
-                bail!("{}: the mesh has no triangles", path.display());
-            }
-            eprintln!("camera: {}; light: {}", m.camera_source, m.sky);
-            (m.scene, None, m.warnings)
+            read_mesh_scene(path, &camera).map_err(flat)?
         }
         "" => bail!(
             "{}: the file name has no extension; {EXPECTED}",
@@ -108,6 +96,17 @@ pub(crate) fn load_input(
         ),
         _ => bail!("{}: cannot render .{ext} files; {EXPECTED}", path.display()),
     };
+    if let Some(sky) = sky {
+        desc.sky = sky;
+    }
+    let a = assemble(desc).map_err(flat)?;
+    if mesh {
+        if a.scene.meshes.iter().all(|m| m.mesh.indices.is_empty()) {
+            bail!("{}: the mesh has no triangles", path.display());
+        }
+        eprintln!("camera: {}; light: {}", a.camera_source, a.sky);
+    }
+    let (scene, file, warnings) = (a.scene, a.settings, a.warnings);
     Ok(Input {
         scene,
         file,

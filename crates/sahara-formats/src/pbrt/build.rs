@@ -1,16 +1,18 @@
-//! A [`Description`] as a Sahara scene with its render settings.
+//! A [`Description`] of a pbrt file as a [`SceneDescription`] with its
+//! render settings.
 //!
-//! - Each shape outside an object is a mesh with an instance placed by its
+//! - Each shape outside an object is an object of its own, placed by its
 //!   transform (moving when the transforms at the two `TransformTimes`
-//!   differ); full spheres and discs with a similarity transform are
-//!   Sahara's exact shapes, so that as emitters they are sampled
-//!   analytically.
+//!   differ): a full sphere or disc that does not move is a built-in
+//!   shape (kept exact under a similarity transform, so that as an
+//!   emitter it is sampled analytically), anything else a mesh.
 //! - Each object (`ObjectBegin`) is one mesh holding all its shapes (their
 //!   transforms applied, a material per triangle), built once; each
-//!   `ObjectInstance` adds an instance of it: one kd-tree per object
+//!   `ObjectInstance` is an object showing it: one kd-tree per object
 //!   instanced more than once, one over the instances (the renderer puts
 //!   an object used once, as the rest of the static geometry, into its
 //!   world tree).
+//! - Materials are mapped on first use, in that order.
 //! - Camera: pbrt's camera space has +x to the image's right, +y up and +z
 //!   forward; the camera's transform is used as it is, so mirroring
 //!   transforms (`Scale -1 1 1`) mirror the image as in pbrt.
@@ -21,8 +23,7 @@ use std::path::Path;
 use glam::{Affine3A, DMat3, DMat4, DVec3, Mat4, Vec3};
 use sahara_render::SceneMesh;
 use sahara_render::{
-    AlphaMode, Camera, Filter, Instance, Integrator, Material, Placement, SamplerKind, Scene,
-    Shape, Srt, TextureMap, ToneMap,
+    AlphaMode, Camera, Filter, Integrator, Material, SamplerKind, Shape, Srt, TextureMap, ToneMap,
 };
 
 use super::description::{Description, Entity, MaterialRef, ShapeDecl, Xform};
@@ -32,8 +33,9 @@ use super::shapes::shape_geometry;
 use super::subdivision::smooth_normals;
 use super::textures::{with_opacity, Textures};
 use super::warnings::Warnings;
-use super::PbrtScene;
-use crate::scene_load::{shapes::add_placed_shape, FileCrop, FileSettings, LoadedScene};
+use crate::description::{
+    CameraRequest, FileCrop, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
+};
 use crate::FormatError;
 
 /// Deepest chain of `mix` materials followed.
@@ -69,7 +71,7 @@ impl Materials<'_> {
     /// `None` if the shape is not there at all (alpha 0).
     fn cut(
         &mut self,
-        scene: &mut Scene,
+        scene: &mut SceneDescription,
         material: u32,
         e: &Entity,
         w: &mut Warnings,
@@ -109,7 +111,7 @@ impl Materials<'_> {
     /// The Sahara material of `r`, or `None` for pbrt's `interface`.
     fn resolve(
         &mut self,
-        scene: &mut Scene,
+        scene: &mut SceneDescription,
         r: &MaterialRef,
         w: &mut Warnings,
     ) -> Result<Option<u32>, FormatError> {
@@ -134,7 +136,7 @@ impl Materials<'_> {
 
     fn named(
         &mut self,
-        scene: &mut Scene,
+        scene: &mut SceneDescription,
         name: &str,
         loc: &super::lexer::Loc,
         w: &mut Warnings,
@@ -162,7 +164,7 @@ impl Materials<'_> {
 
     fn map(
         &mut self,
-        scene: &mut Scene,
+        scene: &mut SceneDescription,
         e: &Entity,
         w: &mut Warnings,
         depth: usize,
@@ -259,9 +261,9 @@ fn srt(m: &DMat4) -> Srt {
 
 /// Where something with transform `x` is over the shutter `[open, close]`,
 /// given `TransformTimes` `times`.
-fn placement(x: &Xform, times: (f64, f64), shutter: (f64, f64)) -> Placement {
+fn placement(x: &Xform, times: (f64, f64), shutter: (f64, f64)) -> ObjectPlacement {
     if !x.is_animated() {
-        return Placement::Static(Affine3A::from_mat4(x.m[0].as_mat4()));
+        return ObjectPlacement::Static(Affine3A::from_mat4(x.m[0].as_mat4()));
     }
     let (a, b) = (srt(&x.m[0]), srt(&x.m[1]));
     let span = times.1 - times.0;
@@ -273,7 +275,7 @@ fn placement(x: &Xform, times: (f64, f64), shutter: (f64, f64)) -> Placement {
         };
         a.interpolate(&b, s as f32)
     };
-    Placement::Moving {
+    ObjectPlacement::Moving {
         open: at(shutter.0),
         close: at(shutter.1),
     }
@@ -743,16 +745,22 @@ fn oriented_geometry(
     Ok(Some((mesh, exact)))
 }
 
-/// Builds the scene of `desc`, read from a file in `folder`.
+/// The scene description of `desc`, read from the file `name` in `folder`.
 pub(crate) fn build(
     desc: &Description,
+    name: &str,
     folder: &Path,
     w: &mut Warnings,
-) -> Result<PbrtScene, FormatError> {
+) -> Result<SceneDescription, FormatError> {
     let settings = settings(desc, folder, w)?;
     let aspect = f64::from(settings.width) / f64::from(settings.height);
     let (camera, shutter) = camera(desc, aspect, w)?;
-    let mut scene = Scene::new(camera);
+    let mut scene = SceneDescription::new(name);
+    scene.camera = CameraRequest::Given {
+        camera,
+        source: String::new(),
+    };
+    scene.settings = Some(settings);
     let mut materials = Materials {
         desc,
         textures: Textures::new(&desc.textures),
@@ -803,16 +811,13 @@ pub(crate) fn build(
             }
         };
         let placement = placement(&s.xform, times, shutter);
-        if let (Some(shape), Placement::Static(_)) = (exact, placement) {
-            add_placed_shape(&mut scene, shape, placement, material);
-            continue;
-        }
-        if mesh.mesh.indices.is_empty() {
-            continue;
-        }
-        let id = scene.add_mesh(mesh);
-        scene.add_instance(Instance {
-            mesh: id,
+        let geometry = match (exact, placement) {
+            (Some(shape), ObjectPlacement::Static(_)) => Geometry::Shape(shape),
+            _ if mesh.mesh.indices.is_empty() => continue,
+            _ => Geometry::Mesh(scene.add_mesh(mesh)),
+        };
+        scene.objects.push(Object {
+            geometry,
             placement,
             material: Some(material),
         });
@@ -834,8 +839,8 @@ pub(crate) fn build(
             }
         };
         let Some(mesh) = mesh else { continue };
-        scene.add_instance(Instance {
-            mesh,
+        scene.objects.push(Object {
+            geometry: Geometry::Mesh(mesh),
             placement: placement(&inst.xform, times, shutter),
             material: None,
         });
@@ -849,19 +854,13 @@ pub(crate) fn build(
         add_light(&mut scene, l, w)?;
         unknown_params(&l.entity, "light", w);
     }
-    Ok(PbrtScene {
-        loaded: LoadedScene {
-            scene,
-            settings,
-            warnings: Vec::new(),
-        },
-    })
+    Ok(scene)
 }
 
 /// The one mesh of an object: its shapes with their transforms applied,
 /// a material per triangle; `None` if nothing in it is rendered.
 fn object_mesh(
-    scene: &mut Scene,
+    scene: &mut SceneDescription,
     shapes: &[ShapeDecl],
     materials: &mut Materials,
     w: &mut Warnings,

@@ -19,13 +19,14 @@
 use std::sync::Arc;
 
 use glam::{DMat3, DMat4, DVec3, Vec3};
-use sahara_render::{Environment, Light, Scene, Texture};
+use sahara_render::{Environment, Light, Texture};
 
 use super::description::{Entity, LightDecl};
 use super::envmap::to_lat_long;
 use super::spectrum::Use;
 use super::textures::rgb_of;
 use super::warnings::Warnings;
+use crate::description::SceneDescription;
 use crate::image_in::load_rgb_f32;
 use crate::FormatError;
 
@@ -55,7 +56,7 @@ fn v3(p: [f64; 3]) -> DVec3 {
 
 /// Adds the light `l` to `scene`.
 pub(crate) fn add_light(
-    scene: &mut Scene,
+    scene: &mut SceneDescription,
     l: &LightDecl,
     w: &mut Warnings,
 ) -> Result<(), FormatError> {
@@ -79,7 +80,7 @@ pub(crate) fn add_light(
                 i
             };
             let from = e.params.triple("from", [0.0; 3])?;
-            scene.add_light(Light::point(point(v3(from)), i));
+            scene.lights.push(Light::point(point(v3(from)), i));
         }
         "spot" => {
             let i = light_rgb(e, "I", w)? * scale(e, w)?;
@@ -106,7 +107,7 @@ pub(crate) fn add_light(
                 "spot light: pbrt's smoothstep falloff becomes Sahara's spot falloff",
                 &e.loc,
             );
-            scene.add_light(Light::spot(
+            scene.lights.push(Light::spot(
                 point(from),
                 point(to),
                 i,
@@ -130,7 +131,7 @@ pub(crate) fn add_light(
                     .loc
                     .error("distant light: 'from' and 'to' are the same point"));
             }
-            scene.add_light(Light::directional(dir, l_rgb));
+            scene.lights.push(Light::directional(dir, l_rgb));
         }
         "infinite" => {
             let s = scale(e, w)?;

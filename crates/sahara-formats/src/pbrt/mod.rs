@@ -8,8 +8,8 @@
 //! - [`lexer`]: tokens with line and column; [`params`]: typed parameter
 //!   lists; [`parser`]: the directives, graphics state and transforms,
 //!   into a [`description`] of the file.
-//! - The mapping to Sahara: [`build`] (camera, settings, shapes, objects
-//!   and instances), [`shapes`] (with [`subdivision`]), [`materials`] (the
+//! - The mapping to Sahara's [`SceneDescription`]: [`build`] (camera,
+//!   settings, shapes, objects and instances), [`shapes`] (with [`subdivision`]), [`materials`] (the
 //!   one material table), [`textures`], [`lights`] (with [`envmap`]),
 //!   [`spectrum`] (spectra to RGB).
 //! - Every error is one line, `file: line L: column C: what`; everything
@@ -38,6 +38,8 @@ mod tests;
 
 use std::path::Path;
 
+use crate::assembly::assemble;
+use crate::description::SceneDescription;
 use crate::scene_load::LoadedScene;
 use crate::FormatError;
 
@@ -61,14 +63,17 @@ pub fn is_pbrt_path(path: &Path) -> bool {
 /// Reads a pbrt file (and the files it includes, meshes and images) and
 /// builds its scene.
 pub fn load_pbrt(path: &Path) -> Result<PbrtScene, FormatError> {
+    assembled(read_pbrt(path)?)
+}
+
+/// Reads a pbrt file (and the files it includes, meshes and images) as
+/// a scene description.
+pub fn read_pbrt(path: &Path) -> Result<SceneDescription, FormatError> {
     let mut w = warnings::Warnings::default();
     let desc = parser::parse_file(path, &mut w)?;
     let folder = path.parent().unwrap_or(Path::new(""));
-    finish(
-        build::build(&desc, folder, &mut w)?,
-        w,
-        &path.display().to_string(),
-    )
+    let name = path.display().to_string();
+    Ok(described(build::build(&desc, &name, folder, &mut w)?, w))
 }
 
 /// Parses and builds a pbrt file held in memory; `name` is used in
@@ -76,14 +81,27 @@ pub fn load_pbrt(path: &Path) -> Result<PbrtScene, FormatError> {
 pub fn parse_pbrt(text: &[u8], name: &str, folder: &Path) -> Result<PbrtScene, FormatError> {
     let mut w = warnings::Warnings::default();
     let desc = parser::parse_bytes(text.to_vec(), name, folder, &mut w)?;
-    finish(build::build(&desc, folder, &mut w)?, w, name)
+    assembled(described(build::build(&desc, name, folder, &mut w)?, w))
 }
 
-fn finish(mut s: PbrtScene, w: warnings::Warnings, name: &str) -> Result<PbrtScene, FormatError> {
-    s.loaded.warnings = w.into_lines();
-    s.loaded
-        .scene
+/// The description with the reader's warnings, one line per kind.
+fn described(mut desc: SceneDescription, w: warnings::Warnings) -> SceneDescription {
+    desc.warnings = w.into_lines();
+    desc
+}
+
+/// The assembled scene, checked.
+fn assembled(desc: SceneDescription) -> Result<PbrtScene, FormatError> {
+    let name = desc.name.clone();
+    let a = assemble(desc)?;
+    a.scene
         .validate()
-        .map_err(|e| FormatError::in_file(name, e))?;
-    Ok(s)
+        .map_err(|e| FormatError::in_file(&name, e))?;
+    Ok(PbrtScene {
+        loaded: LoadedScene {
+            scene: a.scene,
+            settings: a.settings.expect("a pbrt file has settings"),
+            warnings: a.warnings,
+        },
+    })
 }

@@ -264,7 +264,7 @@ fn object_instances_share_one_mesh() {
 
 #[test]
 fn film_crop_windows_and_pixel_bounds_follow_pbrt_v4() {
-    use crate::scene_load::FileCrop;
+    use crate::description::FileCrop;
     use sahara_render::PixelWindow;
     let film = |extra: &str| {
         let text = format!(
@@ -461,7 +461,9 @@ fn the_fuzz_seed_with_every_directive_loads() {
         .any(|m| m.is_emissive() && m.two_sided_emission));
     assert_eq!(
         s.loaded.settings.crop,
-        Some(crate::scene_load::FileCrop::Fractions([0.0, 1.0, 0.0, 1.0]))
+        Some(crate::description::FileCrop::Fractions([
+            0.0, 1.0, 0.0, 1.0
+        ]))
     );
     // The mix picks gold (amount 0.3 < 0.5): the conductor of gold's
     // named spectra, and says so.

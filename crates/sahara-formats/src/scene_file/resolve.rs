@@ -13,8 +13,8 @@ use toml::Spanned;
 
 use super::raw::*;
 use super::*;
+use crate::description::Sky;
 use crate::image_out::ImageFormat;
-use crate::sky::Sky;
 
 /// Largest film width or height.
 const MAX_FILM_SIDE: i64 = 65536;

@@ -1,8 +1,9 @@
-//! Scene-file transforms and motion as renderer placements.
+//! Scene-file transforms and motion as object placements.
 
 use glam::{Affine3A, Mat4, Quat};
-use sahara_render::{Placement, Srt};
+use sahara_render::Srt;
 
+use crate::description::ObjectPlacement;
 use crate::scene_file::{Placement as PlacementSpec, TransformSpec};
 
 /// The scale-rotation-translation of a transform.
@@ -14,33 +15,17 @@ pub fn srt(t: &TransformSpec) -> Srt {
     }
 }
 
-/// The placement of an object whose geometry sits at `inner` in its file
-/// (identity, or a glTF node's transform) and that the scene places by `spec`.
-///
-/// A moving object with a non-identity `inner` has `open * inner` and
-/// `close * inner` split into scale, rotation and translation (a shear is lost).
-pub fn placement(spec: &PlacementSpec, inner: Mat4) -> Placement {
-    let identity = inner == Mat4::IDENTITY;
+/// The placement an object's `transform` or `motion` gives.
+pub fn placement(spec: &PlacementSpec) -> ObjectPlacement {
     match spec {
-        PlacementSpec::Static(t) => Placement::Static(Affine3A::from_mat4(t.matrix() * inner)),
-        PlacementSpec::Motion { open, close } if identity => Placement::Moving {
+        // The product with the identity makes -0 entries +0, as scene
+        // files have always been placed (the same images, bit for bit).
+        PlacementSpec::Static(t) => {
+            ObjectPlacement::Static(Affine3A::from_mat4(t.matrix() * Mat4::IDENTITY))
+        }
+        PlacementSpec::Motion { open, close } => ObjectPlacement::Moving {
             open: srt(open),
             close: srt(close),
         },
-        PlacementSpec::Motion { open, close } => {
-            let split = |t: &TransformSpec| {
-                let (scale, rotation, translation) =
-                    (t.matrix() * inner).to_scale_rotation_translation();
-                Srt {
-                    scale,
-                    rotation,
-                    translation,
-                }
-            };
-            Placement::Moving {
-                open: split(open),
-                close: split(close),
-            }
-        }
     }
 }

@@ -5,10 +5,11 @@
 //! is said; non-finite vertices.
 
 use glam::{Affine2, Mat4, Vec2, Vec3, Vec4};
+use sahara_formats::assembly::sky::SkyUsed;
+use sahara_formats::description::Sky;
 use sahara_formats::gltf_scene::{gltf_camera, gltf_light, LUMENS_PER_WATT};
 use sahara_formats::material_map::{gltf_material, TextureCache};
 use sahara_formats::mesh_scene::{load_mesh_scene, load_mesh_scene_with, CameraChoice};
-use sahara_formats::sky::{Sky, SkyUsed};
 use sahara_readers::gltf::{load_gltf, GltfLightKind, GltfWrap};
 use sahara_render::{Bsdf, Light};
 use sahara_render::{Channel, Wrap};

@@ -475,7 +475,7 @@ fn the_scene_files_sky_key_adds_what_it_names() {
     assert_eq!(
         s.environment,
         Some(sahara_render::Environment::Constant(
-            sahara_formats::sky::DEFAULT_SKY
+            sahara_formats::assembly::sky::DEFAULT_SKY
         ))
     );
     let s = scene("sky = \"default\"").unwrap().scene;

@@ -1,12 +1,12 @@
-//! A scene file's render settings as renderer values.
+//! How a scene file asks to be rendered, in the renderer's values.
 
 use std::path::PathBuf;
 
 use sahara_render::{Filter, Integrator, PixelWindow, SamplerKind, ToneMap};
 
-use crate::scene_file::{FilmSpec, SamplerSpec};
-
-/// How a scene file asks to be rendered (`[integrator]`, `[sampler]`, `[filter]`, `[film]`).
+/// How a scene file asks to be rendered: light transport, sampling,
+/// filter and film (a TOML file's `[integrator]`, `[sampler]`, `[filter]`
+/// and `[film]`; pbrt's `Integrator`, `Sampler`, `PixelFilter` and `Film`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FileSettings {
     /// Light transport with its parameters.
@@ -60,30 +60,6 @@ impl FileCrop {
                     y1: clip(y1, height).max(y0),
                 }
             }
-        }
-    }
-}
-
-impl FileSettings {
-    /// The settings of a parsed scene file.
-    pub fn from_specs(
-        integrator: &Integrator,
-        sampler: &SamplerSpec,
-        filter: &Filter,
-        film: &FilmSpec,
-    ) -> Self {
-        Self {
-            integrator: *integrator,
-            sampler: sampler.kind,
-            spp: sampler.spp,
-            seed: sampler.seed,
-            filter: *filter,
-            width: film.width,
-            height: film.height,
-            exposure: film.exposure,
-            tonemap: film.tonemap,
-            output: film.output.clone(),
-            crop: None,
         }
     }
 }

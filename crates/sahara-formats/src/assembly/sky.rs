@@ -1,5 +1,5 @@
-//! What lights a scene besides its own lights: `--sky` and the scene
-//! file's `sky` key.
+//! What lights a scene besides its own lights, as the description's
+//! [`Sky`] asks (`--sky`, a scene file's `sky` key):
 //!
 //! - `default`: Sahara's default sky (a constant blue-grey environment)
 //!   and sun (a directional light from above and in front);
@@ -13,13 +13,14 @@
 //!
 //! The rule and the units are documented for users in docs/lighting.md.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::Vec3;
 use sahara_render::luminance;
 use sahara_render::{Environment, Light, Scene, Texture};
 
+use crate::description::Sky;
 use crate::image_in::load_rgb_f32;
 use crate::FormatError;
 
@@ -34,32 +35,6 @@ pub const DEFAULT_SUN: Vec3 = Vec3::splat(2.5);
 /// when their power is below this fraction of what the default sun and
 /// sky shed on the scene's bounding sphere.
 pub const WEAK_FRACTION: f32 = 0.05;
-
-/// What lights a scene besides its own lights.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Sky {
-    /// The default sky and sun if the scene's own lights are weak.
-    Auto,
-    /// The default sky and sun.
-    Default,
-    /// Nothing.
-    None,
-    /// An equirectangular environment map.
-    Map(PathBuf),
-}
-
-impl Sky {
-    /// `auto`, `default`, `none`, or an image file's path (relative paths
-    /// taken from `base`).
-    pub fn parse(s: &str, base: &Path) -> Sky {
-        match s {
-            "auto" => Sky::Auto,
-            "default" => Sky::Default,
-            "none" => Sky::None,
-            path => Sky::Map(base.join(path)),
-        }
-    }
-}
 
 /// What [`apply`] did.
 #[derive(Clone, Debug, PartialEq, Eq)]

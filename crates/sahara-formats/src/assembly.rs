@@ -1,0 +1,345 @@
+//! A [`SceneDescription`] as a renderer [`Scene`]: the one step every
+//! scene reader's output goes through.
+//!
+//! - Materials are numbered as the description numbers them; a mesh
+//!   file's own materials (and the grey default, for geometry without
+//!   one) follow, added when first needed.
+//! - Mesh files are loaded once each by a [`MeshLibrary`], however many
+//!   objects show them; objects only add instances (a glTF file one per
+//!   node, placed by the object's placement times the node's). A file's
+//!   materials are loaded if some object shows it with them; its lights
+//!   come where the object puts the file (where it starts, if it moves).
+//! - A static built-in shape whose transform maps it onto a shape of the
+//!   same kind (any affine map for a quad; uniform scale for a disc or
+//!   sphere; no rotation for a box) is transformed exactly and added with
+//!   [`Scene::add_shape`], so an emissive quad, disc or sphere is sampled
+//!   analytically as an area light; other shapes become a tessellated
+//!   mesh with an instance transform.
+//! - The camera is the description's, a named camera of its mesh files,
+//!   or, when it leaves the choice to the assembly, the files' first
+//!   camera, else the automatic one ([`camera`]).
+//! - The sky follows [`sky`]: with `auto`, the default sky and sun
+//!   light the scene only if its own lights are weak.
+//! - Moving emissive objects are seen but not sampled as lights; that is
+//!   a warning.
+
+pub mod camera;
+pub mod sky;
+
+use std::collections::HashSet;
+
+use glam::{Affine3A, Mat4, Vec3};
+use sahara_readers::gltf::GltfCamera;
+use sahara_render::{Camera, Instance, Placement, Scene, Shape, Srt};
+
+use crate::description::{
+    CameraRequest, FileSettings, Geometry, ObjectPlacement, SceneDescription,
+};
+use crate::gltf_scene::{gltf_camera, gltf_light};
+use crate::mesh_library::{file_key, MeshLibrary};
+use crate::FormatError;
+use camera::has_finite_triangles;
+use sky::SkyUsed;
+
+pub use camera::{auto_camera, AUTO_VFOV_DEG};
+
+/// A scene ready to render, with what assembling it decided.
+#[derive(Clone, Debug)]
+pub struct AssembledScene {
+    /// The scene (the camera's aspect as the description gave it, 1 for
+    /// a camera the assembly chose: the caller sets it from the image
+    /// size).
+    pub scene: Scene,
+    /// How the file asks to be rendered, if it says.
+    pub settings: Option<FileSettings>,
+    /// Where the camera came from: the description's source for a given
+    /// camera, a glTF camera (`file: camera 'name'`), or `auto`.
+    pub camera_source: String,
+    /// What lights the scene besides its own lights.
+    pub sky: SkyUsed,
+    /// Problems that did not stop loading, one line each, naming the
+    /// file: the reader's, then the assembly's.
+    pub warnings: Vec<String>,
+}
+
+/// Assembles the scene `desc` describes.
+pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
+    let name = desc.name.clone();
+    let mut warnings = desc.warnings;
+    let placeholder = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, AUTO_VFOV_DEG, 1.0);
+    let mut scene = Scene::new(match &desc.camera {
+        CameraRequest::Given { camera, .. } => *camera,
+        _ => placeholder,
+    });
+    scene.materials = desc.materials;
+    let mut meshes: Vec<Option<u32>> = vec![None; desc.meshes.len()];
+    let mut inline = desc.meshes.into_iter().map(Some).collect::<Vec<_>>();
+    let mut library = MeshLibrary::new();
+    let mut cameras: Vec<GltfCamera> = Vec::new();
+    // Files some object shows with their own materials.
+    let own: HashSet<_> = desc
+        .objects
+        .iter()
+        .filter(|o| o.material.is_none())
+        .filter_map(|o| match &o.geometry {
+            Geometry::File(path) => Some(file_key(path)),
+            _ => None,
+        })
+        .collect();
+    let mut moving_emitters = 0;
+    for (k, o) in desc.objects.iter().enumerate() {
+        let emits = match &o.geometry {
+            Geometry::File(path) => {
+                let first = library.file_count();
+                let f = library
+                    .load(&mut scene, path, own.contains(&file_key(path)))
+                    .map_err(|e| {
+                        if path.display().to_string() == name {
+                            e
+                        } else {
+                            FormatError::in_file(&name, format!("object {}: {e}", k + 1))
+                        }
+                    })?;
+                if library.file_count() > first {
+                    cameras.extend(f.cameras.iter().cloned());
+                }
+                for part in &f.parts {
+                    scene.add_instance(Instance {
+                        mesh: part.mesh,
+                        placement: placed(&o.placement, part.transform),
+                        material: o.material.or(f.material),
+                    });
+                }
+                // The file's lights, where the object puts the file
+                // (where it starts, if it moves).
+                let at = Mat4::from(placed(&o.placement, Mat4::IDENTITY).at(0.0));
+                for l in &f.lights {
+                    scene.add_light(gltf_light(l, at));
+                }
+                o.material.map_or(f.emissive, |m| is_emissive(&scene, m))
+            }
+            Geometry::Shape(shape) => {
+                let material = match o.material {
+                    Some(m) => m,
+                    None => library.default_material(&mut scene),
+                };
+                add_placed_shape(&mut scene, *shape, &o.placement, material);
+                is_emissive(&scene, material)
+            }
+            Geometry::Mesh(i) => {
+                let i = *i as usize;
+                let mesh = match meshes[i] {
+                    Some(id) => id,
+                    None => {
+                        let id = scene.add_mesh(inline[i].take().expect("added once"));
+                        meshes[i] = Some(id);
+                        id
+                    }
+                };
+                scene.add_instance(Instance {
+                    mesh,
+                    placement: placed(&o.placement, Mat4::IDENTITY),
+                    material: o.material,
+                });
+                match o.material {
+                    Some(m) => is_emissive(&scene, m),
+                    None => scene.meshes[mesh as usize]
+                        .material_ids
+                        .as_ref()
+                        .is_some_and(|ids| ids.iter().any(|&m| is_emissive(&scene, m))),
+                }
+            }
+        };
+        if o.placement.is_moving() && emits {
+            moving_emitters += 1;
+        }
+    }
+    warnings.append(&mut library.warnings);
+    if moving_emitters > 0 {
+        warnings.push(format!(
+            "{name}: {moving_emitters} moving object(s) emit light: they are seen, but not sampled as lights"
+        ));
+    }
+    for l in desc.lights {
+        scene.add_light(l);
+    }
+    if let Some(env) = desc.environment {
+        scene.environment = Some(env);
+    }
+    scene.generate_tangents();
+    let (camera, camera_source) = match desc.camera {
+        CameraRequest::Given { camera, source } => (camera, source),
+        CameraRequest::Named(want) => match cameras
+            .iter()
+            .find(|c| c.name.as_deref() == Some(want.as_str()))
+        {
+            Some(c) => (gltf_camera(c), camera_name(&name, c)),
+            None => {
+                let names: Vec<String> = cameras
+                    .iter()
+                    .map(|c| format!("'{}'", c.name.as_deref().unwrap_or("(unnamed)")))
+                    .collect();
+                return Err(FormatError::in_file(
+                    &name,
+                    if names.is_empty() {
+                        format!("no camera named '{want}': the file has no cameras (and no file {want} exists)")
+                    } else {
+                        format!(
+                            "no camera named '{want}' (the file's cameras: {})",
+                            names.join(", ")
+                        )
+                    },
+                ));
+            }
+        },
+        CameraRequest::Automatic => match cameras.first() {
+            Some(c) => (gltf_camera(c), camera_name(&name, c)),
+            None if !has_finite_triangles(&scene) => {
+                warnings.push(format!(
+                    "{name}: every triangle has a NaN or infinite corner: nothing to frame; \
+                     the camera looks at the origin from +Z"
+                ));
+                (
+                    Camera::look_at(
+                        Vec3::new(0.0, 0.0, 5.0),
+                        Vec3::ZERO,
+                        Vec3::Y,
+                        AUTO_VFOV_DEG,
+                        1.0,
+                    ),
+                    "auto (nothing to frame)".into(),
+                )
+            }
+            None => (auto_camera(&scene, &name)?, "auto".into()),
+        },
+    };
+    scene.camera = camera;
+    let sky = sky::apply(&mut scene, &desc.sky)
+        .map_err(|e| FormatError::in_file(&name, format!("sky: {e}")))?;
+    Ok(AssembledScene {
+        scene,
+        settings: desc.settings,
+        camera_source,
+        sky,
+        warnings,
+    })
+}
+
+/// What the log calls a glTF camera of the file `name`.
+fn camera_name(name: &str, c: &GltfCamera) -> String {
+    format!(
+        "{name}: camera '{}'",
+        c.name.as_deref().unwrap_or("(unnamed)")
+    )
+}
+
+/// True if material `id` of `scene` emits.
+fn is_emissive(scene: &Scene, id: u32) -> bool {
+    scene.materials[id as usize].is_emissive()
+}
+
+/// The placement of geometry that sits at `inner` in its file (identity,
+/// or a glTF node's transform) and that the scene places by `placement`.
+///
+/// A moving object with a non-identity `inner` has `open * inner` and
+/// `close * inner` split into scale, rotation and translation (a shear is lost).
+pub fn placed(placement: &ObjectPlacement, inner: Mat4) -> Placement {
+    let identity = inner == Mat4::IDENTITY;
+    match *placement {
+        ObjectPlacement::World => Placement::Static(Affine3A::from_mat4(inner)),
+        ObjectPlacement::Static(m) if identity => Placement::Static(m),
+        ObjectPlacement::Static(m) => Placement::Static(Affine3A::from_mat4(Mat4::from(m) * inner)),
+        ObjectPlacement::Moving { open, close } if identity => Placement::Moving { open, close },
+        ObjectPlacement::Moving { open, close } => {
+            let split = |t: &Srt| {
+                let m = Mat4::from_scale_rotation_translation(t.scale, t.rotation, t.translation);
+                let (scale, rotation, translation) = (m * inner).to_scale_rotation_translation();
+                Srt {
+                    scale,
+                    rotation,
+                    translation,
+                }
+            };
+            Placement::Moving {
+                open: split(&open),
+                close: split(&close),
+            }
+        }
+    }
+}
+
+/// `shape` under the affine map `m`, if it is again a shape of its kind.
+pub fn transformed(shape: Shape, m: &Affine3A) -> Option<Shape> {
+    let lin = m.matrix3;
+    let cols = [lin.x_axis, lin.y_axis, lin.z_axis].map(Vec3::from);
+    let lens = cols.map(Vec3::length);
+    let uniform = lens.iter().all(|&l| (l - lens[0]).abs() <= 1e-5 * lens[0])
+        && cols[0].dot(cols[1]).abs() <= 1e-5 * lens[0] * lens[0]
+        && cols[1].dot(cols[2]).abs() <= 1e-5 * lens[0] * lens[0]
+        && cols[0].dot(cols[2]).abs() <= 1e-5 * lens[0] * lens[0];
+    let s = lens[0];
+    Some(match shape {
+        Shape::Quad {
+            corner,
+            edge_u,
+            edge_v,
+        } => Shape::Quad {
+            corner: m.transform_point3(corner),
+            edge_u: m.transform_vector3(edge_u),
+            edge_v: m.transform_vector3(edge_v),
+        },
+        Shape::Disc {
+            center,
+            normal,
+            radius,
+        } if uniform => Shape::Disc {
+            center: m.transform_point3(center),
+            normal: (m.transform_vector3(normal) * m.matrix3.determinant().signum()).normalize(),
+            radius: radius * s,
+        },
+        Shape::Sphere { center, radius } if uniform => Shape::Sphere {
+            center: m.transform_point3(center),
+            radius: radius * s,
+        },
+        Shape::Box { min, max } => {
+            let off_diagonal = [lin.x_axis.y, lin.x_axis.z, lin.y_axis.x]
+                .into_iter()
+                .chain([lin.y_axis.z, lin.z_axis.x, lin.z_axis.y])
+                .any(|v| v.abs() > 1e-6 * s);
+            if off_diagonal {
+                return None;
+            }
+            let (a, b) = (m.transform_point3(min), m.transform_point3(max));
+            Shape::Box {
+                min: a.min(b),
+                max: a.max(b),
+            }
+        }
+        _ => return None,
+    })
+}
+
+/// Adds `shape` placed by `placement` with `material`: exact where the
+/// placement keeps it a shape of its kind, else tessellated with an
+/// instance transform. Returns its instance.
+fn add_placed_shape(
+    scene: &mut Scene,
+    shape: Shape,
+    placement: &ObjectPlacement,
+    material: u32,
+) -> u32 {
+    let placement = match *placement {
+        ObjectPlacement::World => return scene.add_shape(shape, material),
+        ObjectPlacement::Static(m) => match transformed(shape, &m) {
+            Some(exact) => return scene.add_shape(exact, material),
+            None => Placement::Static(m),
+        },
+        ObjectPlacement::Moving { open, close } => Placement::Moving { open, close },
+    };
+    let mesh = scene.add_mesh(shape.to_mesh());
+    scene.add_instance(Instance {
+        mesh,
+        placement,
+        material: Some(material),
+    })
+}
