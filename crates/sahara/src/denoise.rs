@@ -7,6 +7,8 @@ use anyhow::{anyhow, Result};
 use sahara_denoise::{Aux, Denoiser, Image};
 use sahara_render::{RenderResult, Scene};
 
+use crate::output::flat;
+
 /// Finds and loads the denoiser, before anything is rendered: a missing
 /// library is said in one line with how to get it.
 pub(crate) fn load() -> Result<Denoiser> {
@@ -42,7 +44,6 @@ pub(crate) fn apply(
         .aux
         .as_ref()
         .ok_or_else(|| anyhow!("--denoise: the render made no albedo and normal"))?;
-    let flat = |v: &[glam::Vec3]| v.iter().flat_map(|p| p.to_array()).collect::<Vec<f32>>();
     let (albedo, normal) = (flat(&aux.images.albedo), flat(&aux.images.normal));
     let noisy = result.film.to_rgb_f32();
     let image = Image {

@@ -147,9 +147,13 @@ impl Output<'_> {
     }
 }
 
+/// Vectors as interleaved floats.
+pub(crate) fn flat(v: &[glam::Vec3]) -> Vec<f32> {
+    v.iter().flat_map(|p| p.to_array()).collect()
+}
+
 /// Each pass's channel names and values, interleaved per pixel.
 fn aov_layers(aovs: &[Aov], images: &AuxImages) -> Vec<(Aov, &'static [&'static str], Vec<f32>)> {
-    let flat = |v: &[glam::Vec3]| v.iter().flat_map(|p| p.to_array()).collect::<Vec<f32>>();
     let mut aovs = aovs.to_vec();
     aovs.sort();
     aovs.dedup();

@@ -57,6 +57,21 @@ pub struct RawHit {
     pub v: f32,
 }
 
+impl RawHit {
+    /// Tree hit `h` as a hit of instance `instance` (its triangle index
+    /// counted in the tree the hit came from).
+    #[inline]
+    pub(crate) fn of(h: &Hit, instance: u32) -> Self {
+        Self {
+            t: h.t,
+            instance,
+            tri: h.tri,
+            u: h.u,
+            v: h.v,
+        }
+    }
+}
+
 /// How a scene's geometry was organised: how many kd-trees were built for
 /// how many instances, and how many of those went into the world tree.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -342,11 +357,8 @@ impl Accel {
         // (an instance without triangles starts where the next one does).
         let k = self.merged_first.partition_point(|&f| f <= h.tri) - 1;
         RawHit {
-            t: h.t,
-            instance: self.merged[k],
             tri: h.tri - self.merged_first[k],
-            u: h.u,
-            v: h.v,
+            ..RawHit::of(h, self.merged[k])
         }
     }
 
@@ -398,13 +410,7 @@ impl Accel {
             if !Self::replaces(best, &h, i) {
                 return None;
             }
-            best = Some(RawHit {
-                t: h.t,
-                instance: i,
-                tri: h.tri,
-                u: h.u,
-                v: h.v,
-            });
+            best = Some(RawHit::of(&h, i));
             Some(reach(h.t))
         });
         best
@@ -450,13 +456,7 @@ impl Accel {
                 if !Self::replaces(out[k], &h, i) {
                     continue;
                 }
-                out[k] = Some(RawHit {
-                    t: h.t,
-                    instance: i,
-                    tri: h.tri,
-                    u: h.u,
-                    v: h.v,
-                });
+                out[k] = Some(RawHit::of(&h, i));
             }
         }
     }
@@ -509,13 +509,7 @@ impl Accel {
                 if !Self::replaces(*o, &h, i) {
                     continue;
                 }
-                *o = Some(RawHit {
-                    t: h.t,
-                    instance: i,
-                    tri: h.tri,
-                    u: h.u,
-                    v: h.v,
-                });
+                *o = Some(RawHit::of(&h, i));
             }
         }
     }

@@ -179,13 +179,7 @@ fn oracle_closest(
         let (tris, r) = oracle_hit(accel, meshes, instances, i, ray, s);
         if let Some(h) = brute::closest_hit(&tris, &r) {
             if best.is_none_or(|b| h.t < b.t) {
-                best = Some(RawHit {
-                    t: h.t,
-                    instance: i,
-                    tri: h.tri,
-                    u: h.u,
-                    v: h.v,
-                });
+                best = Some(RawHit::of(&h, i));
             }
         }
     }

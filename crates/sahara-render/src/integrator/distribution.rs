@@ -28,10 +28,12 @@ pub(crate) fn step(
     let world = ctx.world;
     let ray = st.ray;
     let Some(hit) = hit else {
-        let le = world.env_radiance(ray.dir);
-        st.aux.escape(le);
-        if st.prev_delta {
-            st.l += st.beta * le;
+        if st.prev_delta || st.aux.open {
+            let le = world.env_radiance(ray.dir);
+            st.aux.escape(le);
+            if st.prev_delta {
+                st.l += st.beta * le;
+            }
         }
         return false;
     };

@@ -65,7 +65,8 @@ pub(crate) struct AuxSample {
     pub normal: Vec3,
     /// Distance from the camera to the first hit, along the ray.
     pub depth: f32,
-    /// Still looking for the surface.
+    /// Still looking for the surface (false from the start when nobody
+    /// asked for the values).
     pub open: bool,
 }
 
@@ -121,11 +122,16 @@ impl PathState {
             light_sum: Vec3::ZERO,
             pass_throughs: 0,
             occlusion: 1.0,
-            aux: AuxSample {
-                open: true,
-                ..AuxSample::default()
-            },
+            aux: AuxSample::default(),
         }
+    }
+
+    /// This path with its auxiliary values recorded as it goes, if `on`
+    /// (otherwise [`AuxSample`]'s checks end at once).
+    #[inline]
+    pub fn with_aux(mut self, on: bool) -> Self {
+        self.aux.open = on;
+        self
     }
 
     /// Applies a deferred contribution, `visible` telling whether its

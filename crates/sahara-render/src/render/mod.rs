@@ -747,7 +747,8 @@ impl Strip {
                         let k = slot_of(x, y, index);
                         self.pos[k] = pos;
                         self.slot.push(k as u32);
-                        self.paths.push(PathState::new(ray, time, sampler));
+                        self.paths
+                            .push(PathState::new(ray, time, sampler).with_aux(s.aux));
                     }
                 }
             }
