@@ -65,7 +65,7 @@ pub use film::filter::{Filter, FilterKind};
 pub use film::ToneMap;
 pub use integrator::{defaults, Integrator, IntegratorKind, TraceStats};
 pub use names::{one_of, Named, Parameter, UnknownName};
-pub use render::{RenderSettings, UNLIMITED_SPP};
+pub use render::{Adaptive, AdaptiveStats, RenderSettings, UNLIMITED_SPP};
 pub use sampler::SamplerKind;
 
 // Rendering, and what comes out: the image, its exact sums, pieces of a frame.

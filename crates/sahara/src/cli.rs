@@ -89,6 +89,16 @@ pub struct RenderArgs {
     /// be [default: the scene file's, else 64; with --time-limit, no cap].
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
     pub spp: Option<u32>,
+    /// Adaptive sampling: a pixel stops taking samples once its estimated
+    /// noise is below T (relative to the square root of its brightness, as
+    /// Cycles' noise threshold: 0.01 is a good start, lower is cleaner),
+    /// and --spp becomes the cap; pixels are tested after each pass.
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    pub noise_threshold: Option<f32>,
+    /// With --noise-threshold: samples every pixel takes before it is
+    /// first tested [default: 16].
+    #[arg(long, value_name = "N", requires = "noise_threshold", value_parser = clap::value_parser!(u32).range(2..=1 << 20))]
+    pub min_spp: Option<u32>,
     /// Samples per pixel in each progressive pass [default: min(spp, 8)].
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
     pub pass_spp: Option<u32>,

@@ -68,7 +68,17 @@ fn argument_error(e: clap::Error) -> ExitCode {
         e.exit();
     }
     let text = e.render().to_string();
-    let first = text.lines().next().unwrap_or("error: invalid arguments");
+    let mut lines = text.lines();
+    let mut first = lines
+        .next()
+        .unwrap_or("error: invalid arguments")
+        .to_string();
+    // A first line that ends in a colon ("the following required arguments
+    // were not provided:") is followed by what it names, one per line.
+    if first.ends_with(':') {
+        let named: Vec<&str> = lines.map(str::trim).take_while(|l| !l.is_empty()).collect();
+        first = format!("{first} {}", named.join(", "));
+    }
     // `sahara scene.toml`, as pbrt and Mitsuba take a scene: say how.
     let hint = match (e.kind(), std::env::args().nth(1)) {
         (ErrorKind::InvalidSubcommand, Some(arg)) if std::path::Path::new(&arg).exists() => {

@@ -125,6 +125,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         },
         cost,
         aux: None,
+        samples: None,
     };
     let out = Output {
         path: args.output.clone(),

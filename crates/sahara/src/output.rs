@@ -129,6 +129,17 @@ impl Output<'_> {
                 values,
             })
             .collect();
+        let samples: Option<Vec<f32>> = result
+            .samples
+            .as_ref()
+            .map(|n| n.iter().map(|&n| n as f32).collect());
+        if let Some(samples) = &samples {
+            layers.push(ExrLayer {
+                name: "samples",
+                channels: &["Y"],
+                values: samples,
+            });
+        }
         if let Some(noisy) = self.noisy {
             layers.push(ExrLayer {
                 name: "noisy",

@@ -93,6 +93,18 @@ fn check_args(args: &RenderArgs) -> Result<()> {
     if args.exposure.is_some_and(|e| !e.is_finite()) {
         bail!("--exposure must be a finite number of stops");
     }
+    if let Some(t) = args.noise_threshold {
+        if !(t > 0.0 && t.is_finite()) {
+            bail!("--noise-threshold must be a positive number (0.01 is a good start)");
+        }
+        if args.samples.is_some() || args.split == Some(crate::cli::Split::Samples) {
+            bail!(
+                "--noise-threshold cannot be used with sample ranges (--samples, --split \
+                 samples): a pixel's decision to stop needs all its samples; split the frame \
+                 by tiles instead"
+            );
+        }
+    }
     part::check_args(args)?;
     if let Some(output) = &args.output {
         check_output(output, part::is_part(args))?;
@@ -335,7 +347,7 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
     }
     let threads = pool.current_num_threads();
     eprintln!(
-        "rendering {} at {}x{}, {} ({}), {} spp in passes of {}, {threads} thread{}",
+        "rendering {} at {}x{}, {} ({}), {} spp in passes of {}{}, {threads} thread{}",
         job.description,
         settings.width,
         settings.height,
@@ -347,6 +359,13 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
             settings.spp.to_string()
         },
         settings.pass_size(),
+        settings
+            .adaptive
+            .map(|a| format!(
+                " (adaptive: noise threshold {}, at least {} spp)",
+                a.threshold, a.min_spp
+            ))
+            .unwrap_or_default(),
         plural(threads as u64),
     );
     // Started after the line above, so that it does not draw over it.
@@ -523,6 +542,18 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
             String::new()
         }
     );
+    if let Some(a) = &s.adaptive {
+        eprintln!(
+            "adaptive: {} samples, {:.1}% of the {} spp budget; {} of {} pixels ({:.1}%) \
+             stopped below the noise threshold",
+            a.samples,
+            100.0 * a.samples as f64 / a.budget.max(1) as f64,
+            s.spp,
+            a.converged,
+            a.pixels,
+            100.0 * a.converged as f64 / a.pixels.max(1) as f64
+        );
+    }
     if partial && job.output_existed {
         eprintln!(
             "{}: left as it was (the partial image is beside it)",

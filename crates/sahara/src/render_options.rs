@@ -9,7 +9,7 @@ use anyhow::{bail, Result};
 use sahara_formats::description::FileSettings;
 use sahara_kd::BuildParams;
 use sahara_render::UNLIMITED_SPP;
-use sahara_render::{Filter, Integrator, RenderSettings, ToneMap};
+use sahara_render::{Adaptive, Filter, Integrator, RenderSettings, ToneMap};
 
 use crate::cli::RenderArgs;
 
@@ -78,6 +78,10 @@ pub fn resolve(
         .clone()
         .or_else(|| file.and_then(|f| f.output.clone()))
         .unwrap_or_else(|| PathBuf::from(format!("{name}.png")));
+    let adaptive = args.noise_threshold.map(|threshold| Adaptive {
+        threshold,
+        min_spp: args.min_spp.unwrap_or(Adaptive::DEFAULT_MIN_SPP),
+    });
     let time_limit = match args.time_limit {
         Some(t) if !(t > 0.0 && t.is_finite()) => {
             bail!("--time-limit must be a positive number of seconds")
@@ -100,6 +104,7 @@ pub fn resolve(
             build: args
                 .builder
                 .map_or_else(BuildParams::default, BuildParams::new),
+            adaptive,
             ..Default::default()
         },
         exposure,

@@ -1086,6 +1086,88 @@ fn render_passes_need_an_exr_and_a_path_tracer() {
     assert!(!exr.exists() && !png.exists());
 }
 
+/// `--noise-threshold`: the log says what adaptive sampling did, and the
+/// EXR holds the samples each pixel took, between the minimum and the cap
+/// in whole passes, adding up to the logged count.
+#[test]
+fn adaptive_sampling_logs_its_samples_and_writes_them_as_a_layer() {
+    let dir = temp_dir("adaptive");
+    let exr = dir.join("a.exr");
+    let out = sahara(&[
+        "render",
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--spp",
+        "48",
+        "--noise-threshold",
+        "0.05",
+        "--min-spp",
+        "8",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let log = stderr(&out);
+    assert!(
+        log.contains("(adaptive: noise threshold 0.05, at least 8 spp)"),
+        "{log}"
+    );
+    let line = log
+        .lines()
+        .find(|l| l.starts_with("adaptive: "))
+        .unwrap_or_else(|| panic!("no adaptive line in {log}"));
+    let logged: u64 = line["adaptive: ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    let layers = exr_channels(&exr);
+    let samples = &layers["samples.Y"];
+    assert_eq!(samples.len(), 24 * 24);
+    assert!(samples
+        .iter()
+        .all(|&n| (8.0..=48.0).contains(&n) && n % 8.0 == 0.0));
+    assert!(samples.iter().any(|&n| n < 48.0), "no pixel stopped");
+    assert_eq!(samples.iter().map(|&n| n as u64).sum::<u64>(), logged);
+}
+
+#[test]
+fn adaptive_sampling_refuses_sample_ranges_and_bad_thresholds() {
+    let dir = temp_dir("adaptive-errors");
+    let exr = dir.join("part.exr");
+    for (args, says) in [
+        (
+            &["--noise-threshold", "0.01", "--samples", "0..8"][..],
+            "cannot be used with sample ranges",
+        ),
+        (
+            &[
+                "--noise-threshold",
+                "0.01",
+                "--part",
+                "1/2",
+                "--split",
+                "samples",
+            ][..],
+            "cannot be used with sample ranges",
+        ),
+        (&["--noise-threshold", "0"][..], "must be a positive number"),
+        (
+            &["--noise-threshold", "nan"][..],
+            "must be a positive number",
+        ),
+        (&["--min-spp", "4"][..], "--noise-threshold"),
+    ] {
+        let out = sahara(&[&["render", "-o", exr.to_str().unwrap()][..], args].concat());
+        assert!(!out.status.success(), "{args:?}");
+        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
+    }
+    assert!(!exr.exists());
+}
+
 /// Root-mean-square difference over the pixels the reference shows below
 /// 1 (the light's own pixels, far brighter, would decide it alone).
 fn rmse_below_one(a: &[f32], reference: &[f32]) -> f64 {

@@ -9,6 +9,7 @@
 //! threads, the order tiles finish in, or the split of the frame into
 //! windows and sample ranges rendered separately and added up.
 
+pub mod adaptive;
 pub mod aux;
 pub mod digest;
 
@@ -32,6 +33,8 @@ use crate::math::hash::hash2;
 use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
 use crate::scene::Scene;
 use crate::world::World;
+pub use adaptive::{Adaptive, AdaptiveStats};
+use adaptive::{Convergence, TileSums};
 pub use aux::{Aov, Aux, AuxImages};
 
 /// How to render.
@@ -79,6 +82,10 @@ pub struct RenderSettings {
     /// Also make the images a denoiser and compositing use: albedo, normal
     /// and depth ([`AuxImages`]; the path and distribution integrators).
     pub aux: bool,
+    /// Adaptive sampling: pixels stop once their noise is low enough, and
+    /// `spp` is a cap (None: every pixel takes `spp`). Not with `samples`
+    /// (a pixel's decisions need all its samples), which it is ignored with.
+    pub adaptive: Option<Adaptive>,
 }
 
 /// The `spp` of a render bounded by its time limit only.
@@ -115,6 +122,7 @@ impl Default for RenderSettings {
             window: None,
             samples: None,
             aux: false,
+            adaptive: None,
         }
     }
 }
@@ -169,6 +177,8 @@ pub struct RenderStats {
     /// stopped by cancel; 0 otherwise. The image holds these pixels and is
     /// black elsewhere.
     pub first_pass_pixels: u64,
+    /// What adaptive sampling did, when it was on.
+    pub adaptive: Option<AdaptiveStats>,
 }
 
 /// Where the render threads' time went, summed over the threads: finding
@@ -253,6 +263,9 @@ pub struct RenderResult {
     /// The albedo, normal and depth images and their sums, when
     /// [`RenderSettings::aux`] asks for them.
     pub aux: Option<Aux>,
+    /// With adaptive sampling, the samples each pixel of the window took
+    /// (rows top to bottom).
+    pub samples: Option<Vec<u32>>,
 }
 
 /// A tile of pixels `[x0, x1) x [y0, y1)`.
@@ -284,6 +297,8 @@ struct TileOut {
     stats: TraceStats,
     split: TimeSplit,
     aux: Option<Aux>,
+    /// With adaptive sampling, the tile's pixels' own samples.
+    own: Option<TileSums>,
     nan: u64,
     negative: u64,
     /// Pixels rendered, in render order (all of them unless stopped).
@@ -335,6 +350,10 @@ pub fn render_watched(
     let mut aux = settings
         .aux
         .then(|| Aux::new(window.x0, window.y0, window.width(), window.height()));
+    let mut convergence = match (settings.adaptive, &settings.samples) {
+        (Some(a), None) => Some(Convergence::new(region, a)),
+        _ => None,
+    };
     let mut stats = RenderStats {
         build_time,
         layout: world.accel.layout(),
@@ -400,6 +419,7 @@ pub fn render_watched(
                     &window,
                     pass,
                     indices.clone(),
+                    convergence.as_ref(),
                     &stop_pixel,
                 );
                 if out.pixels_done < tile.pixels() {
@@ -462,6 +482,9 @@ pub fn render_watched(
             }
             stats.nan_samples += out.nan;
             stats.negative_samples += out.negative;
+            if let (Some(c), Some(o)) = (&mut convergence, &out.own) {
+                c.add(o);
+            }
         }
         if !complete {
             stats.stopped_early = true;
@@ -469,14 +492,26 @@ pub fn render_watched(
         }
         stats.passes += 1;
         stats.spp += indices.len() as u32;
+        // Every pixel below the threshold: the render is complete.
+        let all_converged = convergence.as_mut().is_some_and(|c| c.update() == 0);
         if let Some(p) = preview.as_mut() {
             if n + 1 < passes && last_preview.elapsed() >= p.every {
                 let mut snapshot = stats;
                 snapshot.render_time = render_start.elapsed();
                 snapshot.stopped_early = true;
-                (p.show)(&finish(sums.clone(), aux.clone(), None, snapshot, settings));
+                (p.show)(&finish(
+                    sums.clone(),
+                    aux.clone(),
+                    None,
+                    snapshot,
+                    settings,
+                    None,
+                ));
                 last_preview = Instant::now();
             }
+        }
+        if all_converged {
+            break;
         }
     }
     if finished.is_some() {
@@ -484,7 +519,9 @@ pub fn render_watched(
     }
     stats.render_time = render_start.elapsed();
     stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
-    finish(sums, aux, finished.as_deref(), stats, settings)
+    stats.adaptive = convergence.as_ref().map(|c| c.stats(&window, stats.spp));
+    let samples = convergence.as_ref().map(|c| c.samples(&window));
+    finish(sums, aux, finished.as_deref(), stats, settings, samples)
 }
 
 /// The image of the sums so far (black where `finished` says a pixel was not).
@@ -494,6 +531,7 @@ fn finish(
     finished: Option<&[bool]>,
     stats: RenderStats,
     settings: &RenderSettings,
+    samples: Option<Vec<u32>>,
 ) -> RenderResult {
     if let Some(a) = &mut aux {
         a.develop(finished);
@@ -511,6 +549,7 @@ fn finish(
         stats,
         cost,
         aux,
+        samples,
     }
 }
 
@@ -547,6 +586,7 @@ fn render_tile(
     window: &PixelWindow,
     pass: u32,
     indices: std::ops::Range<u32>,
+    convergence: Option<&Convergence>,
     stop: &dyn Fn() -> bool,
 ) -> TileOut {
     let (w, h) = (s.width.max(1), s.height.max(1));
@@ -574,10 +614,12 @@ fn render_tile(
             .intersect(window);
             Aux::new(own.x0, own.y0, own.width(), own.height())
         }),
+        own: convergence.map(|_| TileSums::new(t.x0, t.x1, t.y0, t.y1)),
         nan: 0,
         negative: 0,
         pixels_done: 0,
     };
+    let active = |x: u32, y: u32| convergence.is_none_or(|c| c.is_active(x, y));
     let stepped = s.integrator.is_stepped();
     let depth_view = matches!(s.integrator, Integrator::Depth);
     let rows = if stepped { STRIP_ROWS } else { 1 };
@@ -588,6 +630,10 @@ fn render_tile(
                 return;
             }
             let y1 = (y0 + rows).min(t.y1);
+            if convergence.is_some_and(|c| !c.any_active(t.x0, t.x1, y0, y1)) {
+                out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
+                continue;
+            }
             strip.render(
                 world,
                 s,
@@ -597,11 +643,16 @@ fn render_tile(
                 y1,
                 pass,
                 indices.clone(),
+                &active,
                 &mut out.stats,
             );
             let mut k = 0;
             for y in y0..y1 {
                 for x in t.x0..t.x1 {
+                    if !active(x, y) {
+                        k += indices.len();
+                        continue;
+                    }
                     for _ in indices.clone() {
                         let pos = strip.pos[k];
                         if let Some(aux) = &mut out.aux {
@@ -615,6 +666,9 @@ fn render_tile(
                         // mixing misses in would draw a near halo at every
                         // silhouette. A pixel no sample hit stays 0.
                         if depth_view && l == Vec3::ZERO {
+                            if let Some(own) = &mut out.own {
+                                own.at(x, y).add(l);
+                            }
                             continue;
                         }
                         // Guard, count, never hide: a NaN or infinite sample is
@@ -627,6 +681,9 @@ fn render_tile(
                         if l.min_element() < 0.0 {
                             out.negative += 1;
                             l = l.max(Vec3::ZERO);
+                        }
+                        if let Some(own) = &mut out.own {
+                            own.at(x, y).add(l);
                         }
                         out.sums.splat(&s.filter, m, x, y, pos, l);
                     }
@@ -674,6 +731,7 @@ impl Strip {
         y1: u32,
         pass: u32,
         indices: std::ops::Range<u32>,
+        active: &dyn Fn(u32, u32) -> bool,
         stats: &mut TraceStats,
     ) {
         let (w, h) = (s.width.max(1), s.height.max(1));
@@ -717,6 +775,9 @@ impl Strip {
         if !s.integrator.is_stepped() {
             for y in y0..y1 {
                 for x in x0..x1 {
+                    if !active(x, y) {
+                        continue;
+                    }
                     for index in indices.clone() {
                         let (sampler, pos, ray, time) = camera_sample(x, y, index);
                         let mut ctx = Context {
@@ -743,6 +804,9 @@ impl Strip {
             for index in indices.clone() {
                 for y in by..(by + 4).min(y1) {
                     for x in bx..(bx + 4).min(x1) {
+                        if !active(x, y) {
+                            continue;
+                        }
                         let (sampler, pos, ray, time) = camera_sample(x, y, index);
                         let k = slot_of(x, y, index);
                         self.pos[k] = pos;

@@ -1,0 +1,308 @@
+//! Adaptive sampling: pixels stop taking samples once their noise is
+//! below a threshold, and the render's time goes to the others.
+//!
+//! A pixel's noise is the standard error of its mean, estimated from the
+//! sample variance of its own samples (before the reconstruction filter),
+//! relative to the square root of its brightness, so that it follows the
+//! noise a viewer sees after tone mapping rather than the absolute
+//! variance (bright pixels are not held back for noise no one can see):
+//!
+//! `error = sqrt(2/π) (se_R + se_G + se_B) / (1e-4 + sqrt(R + G + B))`,
+//! with `se_c = sqrt(var_c / n)` and `R, G, B` the pixel's mean.
+//!
+//! Cycles estimates the same quantity from two interleaved half-buffers,
+//! `|I - A|` of the whole mean `I` and the odd samples' mean `A`, whose
+//! expected value is `sqrt(2/π)` standard errors: the factor keeps its
+//! thresholds' meaning. The halves' difference is one draw per channel,
+//! though, and pixels stopped on a lucky draw: on the Cornell box at equal
+//! samples it rendered no better than uniform sampling (docs/clean-image.md),
+//! while the variance of `n` samples is a steady estimate. With Sobol
+//! samples, whose means converge faster than `σ / sqrt(n)`, the estimate
+//! errs on the safe side.
+//!
+//! The test runs after each pass once a pixel has `min_spp` samples; a
+//! converged pixel takes no more. Each pixel is judged by its own samples
+//! only, never by its neighbours': so a window of the frame rendered alone
+//! (a farm tile) makes the same decisions as the whole frame, and the
+//! frame split into tiles and merged is the frame rendered whole, bit for
+//! bit. The sums are in `f64`, added in sample order per pixel, and so do
+//! not depend on the number of threads either.
+
+use glam::Vec3;
+
+use crate::film::window::PixelWindow;
+
+/// The expected difference of two half-buffers' means, in standard errors
+/// of the whole mean: `sqrt(2/π)`, which keeps Cycles' threshold scale.
+const HALVES: f64 = 0.797_884_560_802_865_4;
+
+/// Adaptive sampling: stop a pixel once its estimated noise is below
+/// `threshold` (the render's `spp` is then a cap).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Adaptive {
+    /// The noise at which a pixel stops (see the module's formula; Cycles'
+    /// default is 0.01, lower is cleaner and slower).
+    pub threshold: f32,
+    /// Samples every pixel takes before it is first tested.
+    pub min_spp: u32,
+}
+
+impl Adaptive {
+    /// The minimum samples of [`Adaptive::min_spp`] when none is given.
+    pub const DEFAULT_MIN_SPP: u32 = 16;
+}
+
+/// What adaptive sampling did, over the window's pixels.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct AdaptiveStats {
+    /// Samples taken.
+    pub samples: u64,
+    /// Samples the window's pixels would have taken without it (the pixels
+    /// times the passes' samples per pixel).
+    pub budget: u64,
+    /// Pixels that stopped below the threshold before the cap.
+    pub converged: u64,
+    /// Pixels of the window.
+    pub pixels: u64,
+}
+
+/// One pixel's own samples: their sums and sums of squares, per channel.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct PixelSums {
+    all: [f64; 3],
+    squares: [f64; 3],
+    count: u32,
+}
+
+impl PixelSums {
+    /// Adds a sample of radiance `l`.
+    #[inline]
+    pub(crate) fn add(&mut self, l: Vec3) {
+        for (c, v) in l.to_array().into_iter().enumerate() {
+            let v = f64::from(v);
+            self.all[c] += v;
+            self.squares[c] += v * v;
+        }
+        self.count += 1;
+    }
+
+    /// Adds another run of the same pixel's samples (later in order).
+    fn merge(&mut self, o: &PixelSums) {
+        for c in 0..3 {
+            self.all[c] += o.all[c];
+            self.squares[c] += o.squares[c];
+        }
+        self.count += o.count;
+    }
+
+    /// The noise estimate of the module's formula (infinite with fewer
+    /// than two samples).
+    pub(crate) fn error(&self) -> f64 {
+        if self.count < 2 {
+            return f64::INFINITY;
+        }
+        let n = f64::from(self.count);
+        let (mut standard_error, mut mean) = (0.0, 0.0);
+        for c in 0..3 {
+            let m = self.all[c] / n;
+            let variance = ((self.squares[c] - n * m * m) / (n - 1.0)).max(0.0);
+            standard_error += (variance / n).sqrt();
+            mean += m;
+        }
+        HALVES * standard_error / (1e-4 + mean.max(0.0).sqrt())
+    }
+}
+
+/// Which pixels of the rendered region still take samples, and their
+/// sums so far.
+#[derive(Clone, Debug)]
+pub(crate) struct Convergence {
+    /// The pixels rendered: the window and the filter's margin around it.
+    region: PixelWindow,
+    settings: Adaptive,
+    sums: Vec<PixelSums>,
+    active: Vec<bool>,
+    /// Pixels that stopped below the threshold.
+    converged: Vec<bool>,
+}
+
+impl Convergence {
+    /// Every pixel of `region` active.
+    pub(crate) fn new(region: PixelWindow, settings: Adaptive) -> Self {
+        let n = region.pixels() as usize;
+        Self {
+            region,
+            settings,
+            sums: vec![PixelSums::default(); n],
+            active: vec![true; n],
+            converged: vec![false; n],
+        }
+    }
+
+    fn index(&self, x: u32, y: u32) -> usize {
+        debug_assert!(x >= self.region.x0 && y >= self.region.y0);
+        ((y - self.region.y0) * self.region.width() + (x - self.region.x0)) as usize
+    }
+
+    /// True if pixel `(x, y)` of the region takes samples in this pass.
+    #[inline]
+    pub(crate) fn is_active(&self, x: u32, y: u32) -> bool {
+        self.active[self.index(x, y)]
+    }
+
+    /// True if any pixel of `[x0, x1) x [y0, y1)` takes samples.
+    pub(crate) fn any_active(&self, x0: u32, x1: u32, y0: u32, y1: u32) -> bool {
+        (y0..y1).any(|y| (x0..x1).any(|x| self.is_active(x, y)))
+    }
+
+    /// Adds a tile's per-pixel sums of this pass (`own` over `[x0, x1) x
+    /// [y0, y1)`, rows top to bottom).
+    pub(crate) fn add(&mut self, own: &TileSums) {
+        let mut k = 0;
+        for y in own.y0..own.y1 {
+            for x in own.x0..own.x1 {
+                let i = self.index(x, y);
+                self.sums[i].merge(&own.sums[k]);
+                k += 1;
+            }
+        }
+    }
+
+    /// After a pass: the pixels with at least `min_spp` samples whose
+    /// noise is below the threshold stop. Returns how many remain active.
+    pub(crate) fn update(&mut self) -> usize {
+        let min = self.settings.min_spp.max(2);
+        let threshold = f64::from(self.settings.threshold);
+        let mut left = 0;
+        for ((s, a), c) in self
+            .sums
+            .iter()
+            .zip(&mut self.active)
+            .zip(&mut self.converged)
+        {
+            if *a && s.count >= min && s.error() < threshold {
+                *a = false;
+                *c = true;
+            }
+            left += *a as usize;
+        }
+        left
+    }
+
+    /// The samples each pixel of `window` took, rows top to bottom.
+    pub(crate) fn samples(&self, window: &PixelWindow) -> Vec<u32> {
+        let mut out = Vec::with_capacity(window.pixels() as usize);
+        for y in window.y0..window.y1 {
+            for x in window.x0..window.x1 {
+                out.push(self.sums[self.index(x, y)].count);
+            }
+        }
+        out
+    }
+
+    /// What adaptive sampling did over `window`, whose pixels would each
+    /// have taken `spp` samples without it.
+    pub(crate) fn stats(&self, window: &PixelWindow, spp: u32) -> AdaptiveStats {
+        let mut st = AdaptiveStats {
+            pixels: window.pixels(),
+            budget: window.pixels() * u64::from(spp),
+            ..Default::default()
+        };
+        for y in window.y0..window.y1 {
+            for x in window.x0..window.x1 {
+                let i = self.index(x, y);
+                st.samples += u64::from(self.sums[i].count);
+                st.converged += self.converged[i] as u64;
+            }
+        }
+        st
+    }
+}
+
+/// A tile's per-pixel sums of one pass, `[x0, x1) x [y0, y1)`.
+#[derive(Clone, Debug)]
+pub(crate) struct TileSums {
+    pub(crate) x0: u32,
+    pub(crate) x1: u32,
+    pub(crate) y0: u32,
+    pub(crate) y1: u32,
+    pub(crate) sums: Vec<PixelSums>,
+}
+
+impl TileSums {
+    /// Empty sums over the tile.
+    pub(crate) fn new(x0: u32, x1: u32, y0: u32, y1: u32) -> Self {
+        let n = ((x1 - x0) * (y1 - y0)) as usize;
+        Self {
+            x0,
+            x1,
+            y0,
+            y1,
+            sums: vec![PixelSums::default(); n],
+        }
+    }
+
+    /// Pixel `(x, y)`'s sums.
+    #[inline]
+    pub(crate) fn at(&mut self, x: u32, y: u32) -> &mut PixelSums {
+        let i = ((y - self.y0) * (self.x1 - self.x0) + (x - self.x0)) as usize;
+        &mut self.sums[i]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A constant pixel has no noise; samples alternating between 0 and 1
+    /// in red have a standard error of sqrt(0.25 n / (n - 1) / n).
+    #[test]
+    fn the_error_is_the_standard_error_over_the_brightness() {
+        let mut flat = PixelSums::default();
+        for _ in 0..8 {
+            flat.add(Vec3::splat(0.25));
+        }
+        assert_eq!(flat.error(), 0.0);
+        let mut noisy = PixelSums::default();
+        for k in 0..8 {
+            noisy.add(Vec3::new((k % 2) as f32, 0.0, 0.0));
+        }
+        let se = (0.25f64 * 8.0 / 7.0 / 8.0).sqrt();
+        let want = HALVES * se / (1e-4 + 0.5f64.sqrt());
+        assert!((noisy.error() - want).abs() < 1e-12, "{}", noisy.error());
+        assert_eq!(PixelSums::default().error(), f64::INFINITY);
+        assert!((HALVES - (2.0 / std::f64::consts::PI).sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn only_pixels_with_enough_samples_stop() {
+        let region = PixelWindow {
+            x0: 0,
+            x1: 2,
+            y0: 0,
+            y1: 1,
+        };
+        let mut c = Convergence::new(
+            region,
+            Adaptive {
+                threshold: 0.01,
+                min_spp: 4,
+            },
+        );
+        let mut tile = TileSums::new(0, 2, 0, 1);
+        for k in 0..2 {
+            tile.at(0, 0).add(Vec3::ONE);
+            tile.at(1, 0).add(Vec3::splat(k as f32));
+        }
+        c.add(&tile);
+        assert_eq!(c.update(), 2, "two samples are under the minimum");
+        c.add(&tile);
+        assert_eq!(c.update(), 1);
+        assert!(!c.is_active(0, 0) && c.is_active(1, 0));
+        let st = c.stats(&region, 8);
+        assert_eq!(
+            (st.samples, st.budget, st.converged, st.pixels),
+            (8, 16, 1, 2)
+        );
+    }
+}
