@@ -75,7 +75,7 @@ pub use film::Film;
 pub use math::warp::luminance;
 pub use render::digest::frame_digest;
 pub use render::{
-    cost_maps, render, render_watched, Aov, Aux, AuxImages, CostMaps, Preview, Progress,
+    cost_maps, render, render_watched, Aov, Aux, AuxImages, AuxSums, CostMaps, Preview, Progress,
     RenderResult, RenderStats, TimeSplit,
 };
 

@@ -434,7 +434,7 @@ fn aux_scene() -> (Scene, sahara_render::RenderSettings) {
         intensity: Vec3::splat(10.0),
     });
     let mut s = settings(16, 16, 8, Integrator::default());
-    s.aux = true;
+    s.aovs = <sahara_render::Aov as sahara_render::Named>::ALL.to_vec();
     (scene, s)
 }
 
@@ -475,6 +475,19 @@ fn aux_images_are_the_albedo_normal_and_depth_of_what_pixels_see() {
             "{} vs {want}",
             img.depth[k]
         );
+        // The wall's plane; the uv of a quad runs over [0, 1].
+        assert!(
+            (img.position[k].z - 8.0).abs() < 1e-4,
+            "{}",
+            img.position[k]
+        );
+        let p = centre_ray(x, y).at(want);
+        assert!(
+            (img.position[k] - p).length() < 0.05 * want,
+            "{} vs {p}",
+            img.position[k]
+        );
+        assert!(img.uv[k].min_element() >= 0.0 && img.uv[k].max_element() <= 1.0);
     }
     for (x, y) in [(7, 7), (8, 8), (7, 8)] {
         let k = at(x, y);
@@ -500,10 +513,13 @@ fn aux_images_are_the_albedo_normal_and_depth_of_what_pixels_see() {
             "{} vs {n}",
             img.normal[k]
         );
+        let on_sphere = (img.position[k] - Vec3::new(0.0, 0.0, 4.0)).length();
+        assert!((on_sphere - 1.0).abs() < 0.01, "{on_sphere}");
     }
+    assert!(img.variance.iter().all(|v| v.min_element() >= 0.0));
     // Without the request, nothing is made.
     let mut plain = s.clone();
-    plain.aux = false;
+    plain.aovs.clear();
     assert!(run(&scene, &plain).aux.is_none());
 }
 
@@ -525,7 +541,7 @@ fn aux_sums_do_not_depend_on_threads_and_leave_the_image_alone() {
         two.aux.as_ref().unwrap().sums
     );
     let mut plain = s.clone();
-    plain.aux = false;
+    plain.aovs.clear();
     assert_eq!(in_pool(2, &plain).sums, two.sums);
 }
 
@@ -561,7 +577,47 @@ fn depth_never_mixes_misses_into_hits() {
     let r = run(&scene, &settings(24, 24, 8, Integrator::Depth));
     check(&r.film.pixels.iter().map(|p| p.x).collect::<Vec<_>>());
     let mut s = settings(24, 24, 8, Integrator::default());
-    s.aux = true;
+    s.aovs = vec![sahara_render::Aov::Depth];
     let r = run(&scene, &s);
-    check(&r.aux.unwrap().images.depth);
+    let aux = r.aux.unwrap();
+    check(&aux.images.depth);
+    assert!(
+        aux.images.albedo.is_empty() && aux.sums.albedo.is_none(),
+        "not asked for"
+    );
+}
+
+/// A pixel whose samples each see either an emitter of radiance `E` or
+/// nothing has the variance of a coin: with mean `m` over `n` samples,
+/// the sample variance is `(m E - m^2) n / (n - 1)`, that of the mean
+/// `(m E - m^2) / (n - 1)`.
+#[test]
+fn the_variance_pass_is_that_of_the_pixels_mean() {
+    let cam = Camera::look_at(Vec3::ZERO, Vec3::Z, Vec3::Y, 30.0, 1.0);
+    let mut scene = Scene::new(cam);
+    let e = Vec3::new(2.0, 1.0, 0.5);
+    let m = scene.add_material(Material::emitter(e));
+    scene.add_shape(
+        Shape::Sphere {
+            center: Vec3::new(0.0, 0.0, 5.0),
+            radius: 1.0,
+        },
+        m,
+    );
+    let n = 16;
+    let mut s = settings(24, 24, n, Integrator::default());
+    s.aovs = vec![sahara_render::Aov::Variance];
+    let r = run(&scene, &s);
+    let variance = &r.aux.as_ref().unwrap().images.variance;
+    let mut edge = 0;
+    for (k, v) in variance.iter().enumerate() {
+        let mean = r.film.pixels[k];
+        let want = (mean * e - mean * mean) / (n - 1) as f32;
+        assert!(
+            (*v - want).abs().max_element() <= 1e-5 * e.max_element().powi(2),
+            "{v} vs {want}"
+        );
+        edge += (v.x > 0.0) as usize;
+    }
+    assert!(edge > 10, "{edge} pixels on the silhouette");
 }

@@ -184,7 +184,9 @@ pub struct RenderArgs {
     pub skip_existing: bool,
     /// Render passes to write as layers of the EXR beside the beauty,
     /// comma-separated: albedo (albedo.R/G/B), normal (normal.X/Y/Z, world
-    /// space), depth (depth.Z, camera distance); needs an .exr output.
+    /// space), depth (depth.Z, camera distance), position (position.X/Y/Z,
+    /// world space), uv (uv.U/V), variance (variance.R/G/B, of the pixel's
+    /// estimate); needs an .exr output.
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = NameParser::<Aov>::new())]
     pub aov: Vec<Aov>,
     /// Denoise the image with Intel Open Image Denoise, guided by the

@@ -173,6 +173,13 @@ fn aov_layers(aovs: &[Aov], images: &AuxImages) -> Vec<(Aov, &'static [&'static 
             Aov::Albedo => (aov, &["R", "G", "B"][..], flat(&images.albedo)),
             Aov::Normal => (aov, &["X", "Y", "Z"][..], flat(&images.normal)),
             Aov::Depth => (aov, &["Z"][..], images.depth.clone()),
+            Aov::Position => (aov, &["X", "Y", "Z"][..], flat(&images.position)),
+            Aov::Uv => (
+                aov,
+                &["U", "V"][..],
+                images.uv.iter().flat_map(|v| v.to_array()).collect(),
+            ),
+            Aov::Variance => (aov, &["R", "G", "B"][..], flat(&images.variance)),
         })
         .collect()
 }

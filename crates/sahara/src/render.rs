@@ -19,7 +19,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use sahara_render::UNLIMITED_SPP;
 use sahara_render::{
-    render_watched, Filter, FilterKind, Integrator, Preview, Progress, RenderResult,
+    render_watched, Aov, Filter, FilterKind, Integrator, Preview, Progress, RenderResult,
     RenderSettings, ToneMap,
 };
 
@@ -204,8 +204,13 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         check_output(&output, piece.is_some())?;
         check_aov_output(args, &output)?;
     }
-    settings.aux = !args.aov.is_empty() || args.denoise;
-    if settings.aux
+    settings.aovs = args.aov.clone();
+    if args.denoise {
+        settings.aovs.extend([Aov::Albedo, Aov::Normal]);
+    }
+    settings.aovs.sort();
+    settings.aovs.dedup();
+    if !settings.aovs.is_empty()
         && !matches!(
             settings.integrator,
             Integrator::Path { .. } | Integrator::Distribution { .. }

@@ -1076,10 +1076,10 @@ fn render_passes_need_an_exr_and_a_path_tracer() {
         "{}",
         stderr(&out)
     );
-    let out = sahara(&["render", "--aov", "uv", "-o", exr.to_str().unwrap()]);
+    let out = sahara(&["render", "--aov", "object", "-o", exr.to_str().unwrap()]);
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("albedo, normal or depth"),
+        stderr(&out).contains("albedo, normal, depth, position, uv or variance"),
         "{}",
         stderr(&out)
     );

@@ -54,8 +54,8 @@ pub(crate) struct PathState {
 /// What a denoiser is told about one sample (Intel Open Image Denoise's
 /// conventions): the albedo and the shading normal of the first surface
 /// the path meets that is not a perfect mirror or smooth glass (through
-/// those, the surface seen in them), and the camera distance of the first
-/// hit. A path that escapes first gets the environment's colour (clamped
+/// those, the surface seen in them), and the camera distance, position and
+/// texture coordinates of the first hit. A path that escapes first gets the environment's colour (clamped
 /// to `[0, 1]`) as albedo and a zero normal; its distance is 0.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct AuxSample {
@@ -65,6 +65,10 @@ pub(crate) struct AuxSample {
     pub normal: Vec3,
     /// Distance from the camera to the first hit, along the ray.
     pub depth: f32,
+    /// World position of the first hit.
+    pub position: Vec3,
+    /// Texture coordinates (the first uv set) of the first hit.
+    pub uv: glam::Vec2,
     /// Still looking for the surface (false from the start when nobody
     /// asked for the values).
     pub open: bool,
@@ -86,6 +90,8 @@ impl AuxSample {
         }
         if depth == 0 {
             self.depth = hit.t * dir.length();
+            self.position = hit.p;
+            self.uv = hit.uv;
         }
         if !sh.bsdf.is_delta() {
             self.albedo = sh.bsdf.albedo();

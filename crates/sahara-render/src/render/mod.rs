@@ -35,7 +35,7 @@ use crate::scene::Scene;
 use crate::world::World;
 pub use adaptive::{Adaptive, AdaptiveStats};
 use adaptive::{Convergence, TileSums};
-pub use aux::{Aov, Aux, AuxImages};
+pub use aux::{Aov, Aux, AuxImages, AuxSums};
 
 /// How to render.
 #[derive(Clone, Debug)]
@@ -79,9 +79,10 @@ pub struct RenderSettings {
     /// passes: sample `k` is index `k % pass_spp` of pass `k / pass_spp`
     /// (None: `0..spp`). The passes rendered are those the range meets.
     pub samples: Option<std::ops::Range<u32>>,
-    /// Also make the images a denoiser and compositing use: albedo, normal
-    /// and depth ([`AuxImages`]; the path and distribution integrators).
-    pub aux: bool,
+    /// The render passes to make beside the beauty, the images a denoiser
+    /// and compositing use ([`AuxImages`]; the path and distribution
+    /// integrators); empty: none.
+    pub aovs: Vec<Aov>,
     /// Adaptive sampling: pixels stop once their noise is low enough, and
     /// `spp` is a cap (None: every pixel takes `spp`). Not with `samples`
     /// (a pixel's decisions need all its samples), which it is ignored with.
@@ -121,7 +122,7 @@ impl Default for RenderSettings {
             cost_scale: None,
             window: None,
             samples: None,
-            aux: false,
+            aovs: Vec::new(),
             adaptive: None,
         }
     }
@@ -347,9 +348,15 @@ pub fn render_watched(
         })
         .collect();
     let mut sums = SumBuffer::new(window.x0, window.y0, window.width(), window.height());
-    let mut aux = settings
-        .aux
-        .then(|| Aux::new(window.x0, window.y0, window.width(), window.height()));
+    let mut aux = (!settings.aovs.is_empty()).then(|| {
+        Aux::new(
+            &settings.aovs,
+            window.x0,
+            window.y0,
+            window.width(),
+            window.height(),
+        )
+    });
     let mut convergence = match (settings.adaptive, &settings.samples) {
         (Some(a), None) => Some(Convergence::new(region, a)),
         _ => None,
@@ -604,7 +611,7 @@ fn render_tile(
         sums: SumBuffer::new(reach.x0, reach.y0, reach.width(), reach.height()),
         stats: TraceStats::default(),
         split: TimeSplit::default(),
-        aux: s.aux.then(|| {
+        aux: (!s.aovs.is_empty()).then(|| {
             let own = PixelWindow {
                 x0: t.x0,
                 x1: t.x1,
@@ -612,7 +619,7 @@ fn render_tile(
                 y1: t.y1,
             }
             .intersect(window);
-            Aux::new(own.x0, own.y0, own.width(), own.height())
+            Aux::new(&s.aovs, own.x0, own.y0, own.width(), own.height())
         }),
         own: convergence.map(|_| TileSums::new(t.x0, t.x1, t.y0, t.y1)),
         nan: 0,
@@ -655,25 +662,11 @@ fn render_tile(
                     }
                     for _ in indices.clone() {
                         let pos = strip.pos[k];
-                        if let Some(aux) = &mut out.aux {
-                            let a = strip.aux[k];
-                            aux.add_sample(x, y, &a);
-                        }
-                        let mut l = strip.radiance[k];
-                        k += 1;
-                        // The depth view averages the distances of the
-                        // samples that hit (a miss is 0, never a hit):
-                        // mixing misses in would draw a near halo at every
-                        // silhouette. A pixel no sample hit stays 0.
-                        if depth_view && l == Vec3::ZERO {
-                            if let Some(own) = &mut out.own {
-                                own.at(x, y).add(l);
-                            }
-                            continue;
-                        }
+                        let raw = strip.radiance[k];
                         // Guard, count, never hide: a NaN or infinite sample is
                         // a bug somewhere; it is zeroed so one cannot ruin a
                         // pixel, and reported in the statistics.
+                        let mut l = raw;
                         if !l.is_finite() {
                             out.nan += 1;
                             l = Vec3::ZERO;
@@ -682,8 +675,19 @@ fn render_tile(
                             out.negative += 1;
                             l = l.max(Vec3::ZERO);
                         }
+                        if let Some(aux) = &mut out.aux {
+                            aux.add_sample(x, y, &strip.aux[k], l);
+                        }
                         if let Some(own) = &mut out.own {
                             own.at(x, y).add(l);
+                        }
+                        k += 1;
+                        // The depth view averages the distances of the
+                        // samples that hit (a miss is 0, never a hit):
+                        // mixing misses in would draw a near halo at every
+                        // silhouette. A pixel no sample hit stays 0.
+                        if depth_view && raw == Vec3::ZERO {
+                            continue;
                         }
                         out.sums.splat(&s.filter, m, x, y, pos, l);
                     }
@@ -745,7 +749,8 @@ impl Strip {
         self.radiance.clear();
         self.radiance.resize(n, Vec3::ZERO);
         self.aux.clear();
-        if s.aux {
+        let aux = !s.aovs.is_empty();
+        if aux {
             self.aux.resize(n, AuxSample::default());
         }
         // Sample `index` of pixel (x, y): its sampler, film position and
@@ -812,7 +817,7 @@ impl Strip {
                         self.pos[k] = pos;
                         self.slot.push(k as u32);
                         self.paths
-                            .push(PathState::new(ray, time, sampler).with_aux(s.aux));
+                            .push(PathState::new(ray, time, sampler).with_aux(aux));
                     }
                 }
             }
@@ -822,7 +827,7 @@ impl Strip {
         for (p, &k) in self.paths.iter().zip(&self.slot) {
             self.radiance[k as usize] = p.l;
         }
-        if s.aux {
+        if aux {
             for (p, &k) in self.paths.iter().zip(&self.slot) {
                 self.aux[k as usize] = p.aux;
             }
