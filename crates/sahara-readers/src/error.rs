@@ -174,3 +174,79 @@ pub fn one_line(error: FormatError) -> FormatError {
     };
     error.map_message(fix)
 }
+
+/// A serde message in a user's words: Rust's type names (`expected f32`,
+/// `expected u32`) become `a number` / `a whole number`, and the position
+/// serde_json appends (` at line 1 column 49`) is dropped (the caller
+/// gives it once, in front). Used by the glTF reader here and by
+/// `sahara-formats`' scene-file reader.
+pub fn in_words(message: &str) -> String {
+    let mut m = message.to_owned();
+    if let Some(at) = m.rfind(" at line ") {
+        let tail = &m[at + " at line ".len()..];
+        let mut parts = tail.splitn(3, ' ');
+        let position = (parts.next(), parts.next(), parts.next());
+        let is_number = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+        if let (Some(line), Some("column"), Some(column)) = position {
+            if is_number(line) && is_number(column) {
+                m.truncate(at);
+            }
+        }
+    }
+    let mut m = [
+        ("index into child of root", "an index (a whole number)"),
+        ("expected a boolean", "expected true or false"),
+        ("expected a sequence", "expected a list [...]"),
+    ]
+    .iter()
+    .fold(m, |m, (rust, words)| m.replace(rust, words));
+    for (types, words) in [
+        (&["f32", "f64"][..], "a number"),
+        (
+            &[
+                "u8", "u16", "u32", "u64", "usize", "i8", "i16", "i32", "i64", "isize",
+            ][..],
+            "a whole number",
+        ),
+    ] {
+        for t in types {
+            for end in ["", ",", ")"] {
+                let rust = format!("expected {t}{end}");
+                if m.ends_with(&format!("expected {t}")) || m.contains(&format!("{rust} ")) {
+                    m = m.replace(&rust, &format!("expected {words}{end}"));
+                }
+            }
+        }
+    }
+    m
+}
+
+#[cfg(test)]
+mod words_tests {
+    use super::in_words;
+
+    #[test]
+    fn type_names_and_positions_become_words() {
+        assert_eq!(
+            in_words("invalid type: string \"x\", expected f32 at line 1 column 82"),
+            "invalid type: string \"x\", expected a number"
+        );
+        assert_eq!(
+            in_words(
+                "invalid type: integer `-1`, expected index into child of root at line 1 column 49"
+            ),
+            "invalid type: integer `-1`, expected an index (a whole number)"
+        );
+        assert_eq!(
+            in_words("invalid value: expected u32"),
+            "invalid value: expected a whole number"
+        );
+        assert_eq!(
+            in_words("expected i64 here"),
+            "expected a whole number here"
+        );
+        // Not a position: kept.
+        assert_eq!(in_words("a name at line two"), "a name at line two");
+        assert_eq!(in_words("expected f32x4"), "expected f32x4");
+    }
+}

@@ -436,7 +436,11 @@ fn describe_error(name: &str, error: ::gltf::Error) -> FormatError {
         ::gltf::Error::Deserialize(e) => FormatError::at_line(
             name,
             e.line().max(1),
-            format!("column {}: invalid glTF JSON: {e}", e.column()),
+            format!(
+                "column {}: invalid glTF JSON: {}",
+                e.column(),
+                crate::error::in_words(&e.to_string())
+            ),
         ),
         ::gltf::Error::Validation(problems) => {
             let shown: Vec<String> = problems

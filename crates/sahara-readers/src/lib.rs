@@ -35,7 +35,7 @@ pub mod ply;
 
 use std::path::Path;
 
-pub use error::{one_line, FormatError};
+pub use error::{in_words, one_line, FormatError};
 pub use mesh::TriangleMesh;
 
 /// Loads a mesh, choosing the format by extension (`.obj`, `.ply`, `.gltf` or

@@ -685,6 +685,86 @@ fn the_no_light_warning_is_printed_once() {
     let _ = fs::remove_dir_all(&dir);
 }
 
+/// An area light whose emitting face looks away from everything renders
+/// black: the log says so, and a light turned towards the scene is not
+/// warned about.
+#[test]
+fn a_light_that_faces_away_from_the_scene_is_warned_about() {
+    let dir = temp_dir("away");
+    let scene = |name: &str, edges: &str| {
+        let path = dir.join(name);
+        fs::write(
+            &path,
+            format!(
+                "[camera]\neye = [0, 1, 5]\ntarget = [0, 0, 0]\n\n\
+                 [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n\n\
+                 [[light]]\ntype = \"area\"\nshape = \"quad\"\ncorner = [-1, 3, -1]\n{edges}\n\
+                 radiance = [5, 5, 5]\n\n[film]\nwidth = 8\nheight = 8\n"
+            ),
+        )
+        .unwrap();
+        path
+    };
+    for (name, edges, warned) in [
+        ("up.toml", "edge_u = [0, 0, 2]\nedge_v = [2, 0, 0]", true),
+        ("down.toml", "edge_u = [2, 0, 0]\nedge_v = [0, 0, 2]", false),
+    ] {
+        let path = scene(name, edges);
+        let png = dir.join("x.png");
+        let out = sahara(&[
+            "render",
+            path.to_str().unwrap(),
+            "--spp",
+            "1",
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        let err = stderr(&out);
+        assert!(out.status.success(), "{err}");
+        assert_eq!(
+            err.contains("no light reaches the scene"),
+            warned,
+            "{name}: {err}"
+        );
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A glTF file's JSON errors give the position once and say what was
+/// expected in words, not Rust's type names.
+#[test]
+fn gltf_json_errors_say_what_was_expected_in_words() {
+    let dir = temp_dir("gltf-words");
+    for (json, says) in [
+        (
+            r#"{"asset":{"version":"2.0"},"nodes":[{"translation":[1,"x",2]}]}"#,
+            "expected a number",
+        ),
+        (
+            r#"{"asset":{"version":"2.0"},"scenes":[{"nodes":[-1]}]}"#,
+            "expected an index (a whole number)",
+        ),
+    ] {
+        let path = dir.join("bad.gltf");
+        fs::write(&path, json).unwrap();
+        let out = sahara(&[
+            "render",
+            path.to_str().unwrap(),
+            "-o",
+            dir.join("x.png").to_str().unwrap(),
+        ]);
+        let err = stderr(&out);
+        assert!(!out.status.success());
+        assert!(err.contains(says), "{err}");
+        assert_eq!(err.matches("line 1").count(), 1, "the position once: {err}");
+        assert!(
+            !err.contains("f32") && !err.contains("child of root"),
+            "{err}"
+        );
+    }
+    let _ = fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn a_short_ascii_ply_line_is_reported_at_its_line() {
     let dir = temp_dir("short-ply");

@@ -10,11 +10,12 @@ pub mod shape;
 pub(crate) mod tangents;
 
 use glam::{Affine3A, Vec3};
+use sahara_kd::Aabb;
 
 use crate::light::{Environment, Light};
 use crate::material::Material;
 use crate::scene::camera::Camera;
-use crate::scene::instance::Instance;
+use crate::scene::instance::{Instance, Placement};
 use crate::scene::mesh::SceneMesh;
 use crate::scene::shape::Shape;
 
@@ -240,8 +241,69 @@ impl Scene {
                  the image will be black"
                     .to_string(),
             );
+        } else if self.emitters_face_away() {
+            out.push(
+                "no light reaches the scene: every emitting surface emits from its front face \
+                 only, and each faces away from the rest of the scene (flip its winding, or \
+                 make its emission two-sided)"
+                    .to_string(),
+            );
         }
         out
+    }
+
+    /// True if the scene's only light is emitting surfaces, each static,
+    /// one-sided triangle of which has the box around all the other
+    /// geometry behind its plane: then no light reaches anything but the
+    /// emitters themselves. Moving or two-sided emitters count as
+    /// reaching, as do lights of any other kind.
+    fn emitters_face_away(&self) -> bool {
+        if !self.lights.is_empty() || self.environment.is_some() {
+            return false;
+        }
+        let emits = |i: usize, tri: usize| {
+            let m = &self.materials[self.material_of(i as u32, tri as u32) as usize];
+            m.is_emissive()
+        };
+        // The box around every triangle that does not emit.
+        let mut others = Aabb::EMPTY;
+        for (i, inst) in self.instances.iter().enumerate() {
+            let mesh = &self.meshes[inst.mesh as usize].mesh;
+            for (t, tri) in mesh.indices.iter().enumerate() {
+                if !emits(i, t) {
+                    let b = tri
+                        .iter()
+                        .fold(Aabb::EMPTY, |b, &v| b.grow(mesh.positions[v as usize]));
+                    others = others.union(inst.placement.world_bounds(b));
+                }
+            }
+        }
+        if others.is_empty() {
+            return false;
+        }
+        for (i, inst) in self.instances.iter().enumerate() {
+            let mesh = &self.meshes[inst.mesh as usize].mesh;
+            for (t, tri) in mesh.indices.iter().enumerate() {
+                if !emits(i, t) {
+                    continue;
+                }
+                let m = &self.materials[self.material_of(i as u32, t as u32) as usize];
+                let Placement::Static(xf) = inst.placement else {
+                    return false;
+                };
+                if m.two_sided_emission {
+                    return false;
+                }
+                let [a, b, c] = tri.map(|v| xf.transform_point3(mesh.positions[v as usize]));
+                let n = (b - a).cross(c - a);
+                // The corner of the box farthest along the front normal.
+                let far = Vec3::select(n.cmpgt(Vec3::ZERO), others.max, others.min);
+                if n.dot(far - a) > 0.0 {
+                    return false;
+                }
+            }
+        }
+        true
     }
 
     /// A neutral grey diffuse material, for geometry without one.
