@@ -64,7 +64,7 @@ pub use texture::{
 pub use film::filter::{Filter, FilterKind};
 pub use film::ToneMap;
 pub use integrator::{defaults, Integrator, IntegratorKind, TraceStats};
-pub use names::{one_of, Named, Parameter, UnknownName};
+pub use names::{one_of, Accepts, Named, Parameter, UnknownName};
 pub use render::{Adaptive, AdaptiveStats, RenderSettings, UNLIMITED_SPP};
 pub use sampler::SamplerKind;
 

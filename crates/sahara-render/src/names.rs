@@ -44,25 +44,49 @@ pub struct Parameter {
     pub name: &'static str,
     /// Its value when not given.
     pub default: f32,
-    /// True if it must be greater than 0 (else any finite number).
-    pub positive: bool,
+    /// The values it takes.
+    pub accepts: Accepts,
+}
+
+/// The values a [`Parameter`] takes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Accepts {
+    /// Any finite number.
+    Finite,
+    /// A number greater than 0.
+    Positive,
+    /// A finite number of at least this.
+    AtLeast(f32),
+    /// A whole number of at least this (and at most 2^24, which `f32`
+    /// holds exactly).
+    WholeAtLeast(u32),
 }
 
 impl Parameter {
+    /// True if the parameter takes whole numbers only.
+    pub fn is_whole(&self) -> bool {
+        matches!(self.accepts, Accepts::WholeAtLeast(_))
+    }
+
     /// `value` if the parameter accepts it, else why not (one line).
     pub fn check(&self, value: f32) -> Result<f32, String> {
-        if value.is_finite() && (!self.positive || value > 0.0) {
+        const WHOLE_MAX: f32 = (1 << 24) as f32;
+        let (ok, must) = match self.accepts {
+            Accepts::Finite => (value.is_finite(), "finite".to_string()),
+            Accepts::Positive => (
+                value.is_finite() && value > 0.0,
+                "greater than 0".to_string(),
+            ),
+            Accepts::AtLeast(m) => (value.is_finite() && value >= m, format!("at least {m}")),
+            Accepts::WholeAtLeast(m) => (
+                value.fract() == 0.0 && value >= m as f32 && value <= WHOLE_MAX,
+                format!("a whole number of at least {m}"),
+            ),
+        };
+        if ok {
             Ok(value)
         } else {
-            Err(format!(
-                "`{}` is {value} but must be {}",
-                self.name,
-                if self.positive {
-                    "greater than 0"
-                } else {
-                    "finite"
-                }
-            ))
+            Err(format!("`{}` is {value} but must be {must}", self.name))
         }
     }
 }

@@ -7,7 +7,7 @@
 
 use std::fmt;
 
-use sahara_render::{IntegratorKind, Named, SamplerKind, ShapeKind, ToneMap};
+use sahara_render::{Named, SamplerKind, ShapeKind, ToneMap};
 use serde::{de, Deserialize, Deserializer};
 use toml::Spanned;
 
@@ -29,7 +29,7 @@ pub(super) struct RawScene {
     pub object: Vec<Spanned<RawObject>>,
     #[serde(default)]
     pub light: Vec<Spanned<RawLight>>,
-    pub integrator: Option<Spanned<RawIntegrator>>,
+    pub integrator: Option<Spanned<RawNamedTable>>,
     pub sampler: Option<Spanned<RawSampler>>,
     pub filter: Option<Spanned<RawNamedTable>>,
     pub film: Option<Spanned<RawFilm>>,
@@ -238,18 +238,6 @@ pub(super) struct RawLight {
     pub map: Opt<String>,
     pub scale: Opt<f32>,
     pub material: Opt<String>,
-}
-
-/// `[integrator]`.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawIntegrator {
-    pub name: Spanned<Name<IntegratorKind>>,
-    pub max_depth: Opt<i64>,
-    pub rr_depth: Opt<i64>,
-    pub light_samples: Opt<i64>,
-    pub samples: Opt<i64>,
-    pub distance: Opt<f32>,
 }
 
 /// `[sampler]`.

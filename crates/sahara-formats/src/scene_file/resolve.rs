@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use sahara_render::defaults;
 use sahara_render::{
-    Filter, FilterKind, Integrator, IntegratorKind, Named, SamplerKind, Shape, ShapeKind, ToneMap,
+    Filter, FilterKind, Integrator, IntegratorKind, Named, Parameter, SamplerKind, Shape,
+    ShapeKind, ToneMap,
 };
 use toml::Spanned;
 
@@ -85,7 +86,7 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
         objects,
         lights,
         integrator: match &raw.integrator {
-            Some(i) => ctx.integrator(i.get_ref())?,
+            Some(i) => ctx.integrator(i)?,
             None => Integrator::default(),
         },
         sampler: match &raw.sampler {
@@ -983,52 +984,12 @@ impl Ctx<'_> {
         })
     }
 
-    /// `[integrator]`.
-    fn integrator(&self, i: &RawIntegrator) -> Result<Integrator, FormatError> {
-        let kind = i.name.get_ref().0;
-        let what = format!("the {kind} integrator");
-        let present = [
-            ("max_depth", span(&i.max_depth)),
-            ("rr_depth", span(&i.rr_depth)),
-            ("light_samples", span(&i.light_samples)),
-            ("samples", span(&i.samples)),
-            ("distance", span(&i.distance)),
-        ];
-        let allowed: &[&str] = match kind {
-            IntegratorKind::Distribution => &["max_depth", "light_samples"],
-            IntegratorKind::Path => &["max_depth", "rr_depth"],
-            IntegratorKind::Ao => &["samples", "distance"],
-            IntegratorKind::Normals | IntegratorKind::Depth | IntegratorKind::Cost => &[],
-        };
-        self.only(&present, allowed, &what)?;
-        Ok(match kind {
-            IntegratorKind::Distribution => Integrator::Distribution {
-                max_depth: self.count(&i.max_depth, "max_depth", defaults::MAX_DEPTH, 1)?,
-                light_samples: self.count(
-                    &i.light_samples,
-                    "light_samples",
-                    defaults::LIGHT_SAMPLES,
-                    1,
-                )?,
-            },
-            IntegratorKind::Path => Integrator::Path {
-                max_depth: self.count(&i.max_depth, "max_depth", defaults::MAX_DEPTH, 1)?,
-                rr_depth: self.count(&i.rr_depth, "rr_depth", defaults::RR_DEPTH, 0)?,
-            },
-            IntegratorKind::Normals => Integrator::Normals,
-            IntegratorKind::Depth => Integrator::Depth,
-            IntegratorKind::Ao => Integrator::Ao {
-                samples: self.count(&i.samples, "samples", defaults::AO_SAMPLES, 1)?,
-                distance: self.number(
-                    &i.distance,
-                    "distance",
-                    defaults::AO_DISTANCE,
-                    |d| d >= 0.0,
-                    "at least 0",
-                )?,
-            },
-            IntegratorKind::Cost => Integrator::Cost,
-        })
+    /// `[integrator]`: `name` and the parameters the renderer lists for
+    /// that integrator ([`IntegratorKind::parameters`]), so a new
+    /// integrator or parameter needs no change here.
+    fn integrator(&self, table: &Spanned<RawNamedTable>) -> Result<Integrator, FormatError> {
+        let (kind, values) = self.named_table("integrator", table, IntegratorKind::parameters)?;
+        Ok(Integrator::with_parameters(kind, &values))
     }
 
     /// `[sampler]`.
@@ -1057,28 +1018,48 @@ impl Ctx<'_> {
     /// filter ([`FilterKind::parameters`]), so a new filter needs no change
     /// here.
     fn filter(&self, table: &Spanned<RawNamedTable>) -> Result<Filter, FormatError> {
+        let (kind, values) = self.named_table("filter", table, FilterKind::parameters)?;
+        Ok(Filter::with_parameters(kind, &values))
+    }
+
+    /// A table naming a setting of kind `K` (`name = "..."`) and giving
+    /// values to some of the parameters `parameters` lists for it: the
+    /// kind and every parameter's value, in the list's order (the default
+    /// where not given). A key the kind does not take, a value of the
+    /// wrong type or out of range is an error at its position.
+    fn named_table<K: Named + std::fmt::Display>(
+        &self,
+        what: &str,
+        table: &Spanned<RawNamedTable>,
+        parameters: fn(K) -> &'static [Parameter],
+    ) -> Result<(K, Vec<f32>), FormatError> {
         let t = table.get_ref();
-        let name = t
-            .get("name")
-            .ok_or_else(|| self.at(table.span(), "the [filter] table needs the key `name`"))?;
+        let name = t.get("name").ok_or_else(|| {
+            self.at(
+                table.span(),
+                format!("the [{what}] table needs the key `name`"),
+            )
+        })?;
         let kind = match name.get_ref() {
             toml::Value::String(s) => {
-                FilterKind::from_name(s).map_err(|e| self.at(name.span(), e.to_string()))?
+                K::from_name(s).map_err(|e| self.at(name.span(), e.to_string()))?
             }
             _ => return Err(self.at(name.span(), "`name` must be a string")),
         };
-        let parameters = kind.parameters();
+        let parameters = parameters(kind);
         let keys: Vec<&str> = parameters.iter().map(|p| p.name).collect();
         if let Some((key, value)) = t
             .iter()
             .find(|(key, _)| *key != "name" && !keys.contains(&key.as_str()))
         {
+            let takes = if keys.is_empty() {
+                "it takes no parameters".to_string()
+            } else {
+                format!("its keys: {}", keys.join(", "))
+            };
             return Err(self.at(
                 value.span(),
-                format!(
-                    "the key `{key}` does not apply to the {kind} filter (its keys: {})",
-                    keys.join(", ")
-                ),
+                format!("the key `{key}` does not apply to the {kind} {what} ({takes})"),
             ));
         }
         let values = parameters
@@ -1088,16 +1069,21 @@ impl Ctx<'_> {
                 Some(v) => {
                     let x = match v.get_ref() {
                         toml::Value::Integer(i) => *i as f32,
-                        toml::Value::Float(f) => *f as f32,
+                        toml::Value::Float(f) if !p.is_whole() => *f as f32,
                         _ => {
-                            return Err(self.at(v.span(), format!("`{}` must be a number", p.name)))
+                            let must = if p.is_whole() {
+                                "a whole number"
+                            } else {
+                                "a number"
+                            };
+                            return Err(self.at(v.span(), format!("`{}` must be {must}", p.name)));
                         }
                     };
                     p.check(x).map_err(|why| self.at(v.span(), why))
                 }
             })
             .collect::<Result<Vec<f32>, FormatError>>()?;
-        Ok(Filter::with_parameters(kind, &values))
+        Ok((kind, values))
     }
 
     /// `[film]`.

@@ -440,6 +440,29 @@ fn syntax_errors_and_unknown_keys_give_line_and_column() {
         m.contains("line 9:") && m.contains("max_depth") && m.contains("normals"),
         "{m}"
     );
+    // The integrator's keys come from the renderer's list of its parameters.
+    for (table, says) in [
+        (
+            "name = \"path\"\nmax_depth = 2.5\n",
+            "`max_depth` must be a whole number",
+        ),
+        (
+            "name = \"path\"\nmax_depth = 0\n",
+            "must be a whole number of at least 1",
+        ),
+        (
+            "name = \"path\"\nsamples = 4\n",
+            "(its keys: max_depth, rr_depth)",
+        ),
+        (
+            "name = \"ao\"\ndistance = -1\n",
+            "`distance` is -1 but must be at least 0",
+        ),
+        ("max_depth = 4\n", "needs the key `name`"),
+    ] {
+        let m = error_of(&with_head(&format!("[integrator]\n{table}")));
+        assert!(m.contains(says), "{table}: {m}");
+    }
 
     // Wrong value types.
     let m = error_of(&with_head("[sampler]\nspp = \"many\"\n"));

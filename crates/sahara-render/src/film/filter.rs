@@ -1,6 +1,6 @@
 //! Pixel reconstruction filters (separable, evaluated in pixel units).
 
-use crate::names::{name_table, Named, Parameter};
+use crate::names::{name_table, Accepts, Named, Parameter};
 
 /// A reconstruction filter; pixel estimates are `sum w L / sum w` over the
 /// samples within its radius.
@@ -61,7 +61,7 @@ const fn radius(default: f32) -> Parameter {
     Parameter {
         name: "radius",
         default,
-        positive: true,
+        accepts: Accepts::Positive,
     }
 }
 
@@ -74,7 +74,7 @@ impl FilterKind {
         const THIRD: Parameter = Parameter {
             name: "",
             default: 1.0 / 3.0,
-            positive: false,
+            accepts: Accepts::Finite,
         };
         const BOX: &[Parameter] = &[radius(0.5)];
         const TENT: &[Parameter] = &[radius(1.0)];
@@ -83,7 +83,7 @@ impl FilterKind {
             Parameter {
                 name: "sigma",
                 default: 0.5,
-                positive: true,
+                accepts: Accepts::Positive,
             },
         ];
         const MITCHELL: &[Parameter] = &[

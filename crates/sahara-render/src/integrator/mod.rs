@@ -15,7 +15,7 @@ use crate::material::maps::perturbed_normal;
 use crate::material::NormalMap;
 use crate::material::{BsdfSample, PointBsdf};
 use crate::math::warp::Frame;
-use crate::names::{name_table, Named};
+use crate::names::{name_table, Accepts, Named, Parameter};
 use crate::sampler::dims;
 use crate::sampler::PixelSampler;
 use crate::texture::footprint::UvFootprint;
@@ -113,25 +113,110 @@ name_table!(IntegratorKind, "integrator", {
     IntegratorKind::Cost => "cost",
 });
 
+impl IntegratorKind {
+    /// The parameters of this kind, in the order
+    /// [`Integrator::with_parameters`] takes them, with their defaults
+    /// ([`defaults`]) and the values each takes. Scene files and the pbrt
+    /// reader read an integrator's keys from this list: a new parameter is
+    /// a change here, in `with_parameters` and in [`Integrator::parameters`].
+    pub fn parameters(self) -> &'static [Parameter] {
+        const MAX_DEPTH: Parameter = Parameter {
+            name: "max_depth",
+            default: defaults::MAX_DEPTH as f32,
+            accepts: Accepts::WholeAtLeast(1),
+        };
+        const PATH: &[Parameter] = &[
+            MAX_DEPTH,
+            Parameter {
+                name: "rr_depth",
+                default: defaults::RR_DEPTH as f32,
+                accepts: Accepts::WholeAtLeast(0),
+            },
+        ];
+        const DISTRIBUTION: &[Parameter] = &[
+            MAX_DEPTH,
+            Parameter {
+                name: "light_samples",
+                default: defaults::LIGHT_SAMPLES as f32,
+                accepts: Accepts::WholeAtLeast(1),
+            },
+        ];
+        const AO: &[Parameter] = &[
+            Parameter {
+                name: "samples",
+                default: defaults::AO_SAMPLES as f32,
+                accepts: Accepts::WholeAtLeast(1),
+            },
+            Parameter {
+                name: "distance",
+                default: defaults::AO_DISTANCE,
+                accepts: Accepts::AtLeast(0.0),
+            },
+        ];
+        match self {
+            IntegratorKind::Path => PATH,
+            IntegratorKind::Distribution => DISTRIBUTION,
+            IntegratorKind::Ao => AO,
+            IntegratorKind::Normals | IntegratorKind::Depth | IntegratorKind::Cost => &[],
+        }
+    }
+}
+
 impl From<IntegratorKind> for Integrator {
     /// The integrator of that kind with the parameters of [`defaults`].
     fn from(kind: IntegratorKind) -> Self {
-        match kind {
-            IntegratorKind::Path => Integrator::Path {
-                max_depth: defaults::MAX_DEPTH,
-                rr_depth: defaults::RR_DEPTH,
+        let defaults: Vec<f32> = kind.parameters().iter().map(|p| p.default).collect();
+        Integrator::with_parameters(kind, &defaults)
+    }
+}
+
+impl Integrator {
+    /// The integrator of `kind` with `values`, one for each of
+    /// [`IntegratorKind::parameters`] in its order, each accepted by its
+    /// [`Parameter::check`].
+    ///
+    /// # Panics
+    /// If the number of values is not that of the kind's parameters.
+    pub fn with_parameters(kind: IntegratorKind, values: &[f32]) -> Self {
+        match (kind, values) {
+            (IntegratorKind::Path, &[max_depth, rr_depth]) => Integrator::Path {
+                max_depth: max_depth as u32,
+                rr_depth: rr_depth as u32,
             },
-            IntegratorKind::Distribution => Integrator::Distribution {
-                max_depth: defaults::MAX_DEPTH,
-                light_samples: defaults::LIGHT_SAMPLES,
+            (IntegratorKind::Distribution, &[max_depth, light_samples]) => {
+                Integrator::Distribution {
+                    max_depth: max_depth as u32,
+                    light_samples: light_samples as u32,
+                }
+            }
+            (IntegratorKind::Ao, &[samples, distance]) => Integrator::Ao {
+                samples: samples as u32,
+                distance,
             },
-            IntegratorKind::Normals => Integrator::Normals,
-            IntegratorKind::Depth => Integrator::Depth,
-            IntegratorKind::Ao => Integrator::Ao {
-                samples: defaults::AO_SAMPLES,
-                distance: defaults::AO_DISTANCE,
-            },
-            IntegratorKind::Cost => Integrator::Cost,
+            (IntegratorKind::Normals, &[]) => Integrator::Normals,
+            (IntegratorKind::Depth, &[]) => Integrator::Depth,
+            (IntegratorKind::Cost, &[]) => Integrator::Cost,
+            _ => panic!(
+                "the {kind} integrator takes {} values, not {}",
+                kind.parameters().len(),
+                values.len()
+            ),
+        }
+    }
+
+    /// The values of its kind's [`IntegratorKind::parameters`], in order.
+    pub fn parameters(&self) -> Vec<f32> {
+        match *self {
+            Integrator::Path {
+                max_depth,
+                rr_depth,
+            } => vec![max_depth as f32, rr_depth as f32],
+            Integrator::Distribution {
+                max_depth,
+                light_samples,
+            } => vec![max_depth as f32, light_samples as f32],
+            Integrator::Ao { samples, distance } => vec![samples as f32, distance],
+            Integrator::Normals | Integrator::Depth | Integrator::Cost => Vec::new(),
         }
     }
 }
@@ -584,5 +669,36 @@ mod tests {
             .count();
         let f = open as f32 / n as f32;
         assert!((f - 0.7).abs() < 0.03, "{f}");
+    }
+}
+
+#[cfg(test)]
+mod parameter_tests {
+    use super::*;
+
+    /// Every kind's defaults make its integrator, and its values read back
+    /// in the order of its parameter list.
+    #[test]
+    fn parameters_round_trip_through_the_list() {
+        for &kind in IntegratorKind::ALL {
+            let i = Integrator::from(kind);
+            assert_eq!(i.kind(), kind);
+            let values = i.parameters();
+            assert_eq!(values.len(), kind.parameters().len());
+            assert_eq!(Integrator::with_parameters(kind, &values), i);
+            for (p, v) in kind.parameters().iter().zip(&values) {
+                assert_eq!(p.check(*v), Ok(*v), "{kind} {}", p.name);
+            }
+        }
+        assert_eq!(
+            Integrator::from(IntegratorKind::Path),
+            Integrator::Path {
+                max_depth: defaults::MAX_DEPTH,
+                rr_depth: defaults::RR_DEPTH
+            }
+        );
+        let depth = IntegratorKind::Path.parameters()[0];
+        assert!(depth.check(0.0).is_err() && depth.check(2.5).is_err());
+        assert_eq!(depth.check(3.0), Ok(3.0));
     }
 }
