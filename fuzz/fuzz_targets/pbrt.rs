@@ -13,7 +13,7 @@ fuzz_target!(|data: &[u8]| {
     let folder = Path::new("/nonexistent-sahara-fuzz");
     match parse_pbrt(data, "fuzz.pbrt", folder) {
         Ok(s) => {
-            for m in &s.loaded.scene.meshes {
+            for m in &s.scene.meshes {
                 sahara_fuzz::check_mesh(&m.mesh.positions, &m.mesh.indices);
             }
         }

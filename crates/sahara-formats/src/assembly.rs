@@ -62,6 +62,13 @@ pub struct AssembledScene {
     pub warnings: Vec<String>,
 }
 
+impl AssembledScene {
+    /// True if the default sky and sun were added.
+    pub fn default_light(&self) -> bool {
+        self.sky == SkyUsed::Default
+    }
+}
+
 /// Assembles the scene `desc` describes.
 pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
     let name = desc.name.clone();

@@ -10,10 +10,9 @@
 
 use std::path::{Path, PathBuf};
 
-use sahara_render::{Camera, Scene};
+use sahara_render::Camera;
 
-use crate::assembly::assemble;
-use crate::assembly::sky::SkyUsed;
+use crate::assembly::{assemble, AssembledScene};
 use crate::description::Sky;
 use crate::description::{CameraRequest, Geometry, Object, ObjectPlacement, SceneDescription};
 use crate::FormatError;
@@ -48,30 +47,9 @@ impl CameraChoice {
     }
 }
 
-/// A mesh file made into a scene.
-#[derive(Clone, Debug)]
-pub struct MeshScene {
-    /// The scene (camera aspect 1: the caller sets it from the image size).
-    pub scene: Scene,
-    /// Where the camera came from: the sidecar's path, the glTF camera, or
-    /// `auto`.
-    pub camera_source: String,
-    /// What lights the scene besides its own lights.
-    pub sky: SkyUsed,
-    /// Problems that did not stop loading, one line each, naming the file.
-    pub warnings: Vec<String>,
-}
-
-impl MeshScene {
-    /// True if the default sky and sun were added.
-    pub fn default_light(&self) -> bool {
-        self.sky == SkyUsed::Default
-    }
-}
-
 /// Loads a mesh file with its materials, lights, camera and (if its own
 /// lights are weak) the default sky and sun.
-pub fn load_mesh_scene(path: &Path) -> Result<MeshScene, FormatError> {
+pub fn load_mesh_scene(path: &Path) -> Result<AssembledScene, FormatError> {
     load_mesh_scene_with(path, &CameraChoice::Auto, &Sky::Auto)
 }
 
@@ -81,16 +59,10 @@ pub fn load_mesh_scene_with(
     path: &Path,
     camera: &CameraChoice,
     sky: &Sky,
-) -> Result<MeshScene, FormatError> {
+) -> Result<AssembledScene, FormatError> {
     let mut desc = read_mesh_scene(path, camera)?;
     desc.sky = sky.clone();
-    let a = assemble(desc)?;
-    Ok(MeshScene {
-        scene: a.scene,
-        camera_source: a.camera_source,
-        sky: a.sky,
-        warnings: a.warnings,
-    })
+    assemble(desc)
 }
 
 /// The description of a mesh file as a scene: the file in world space

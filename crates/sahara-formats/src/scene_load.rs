@@ -20,11 +20,9 @@ use std::sync::Arc;
 
 use glam::Vec3;
 use sahara_render::Encoding;
-use sahara_render::{
-    Bsdf, Camera, Environment, Light, Material, Scene, Shape, Texture, TextureMap,
-};
+use sahara_render::{Bsdf, Camera, Environment, Light, Material, Shape, Texture, TextureMap};
 
-use crate::assembly::assemble;
+use crate::assembly::{assemble, AssembledScene};
 use crate::description::Sky;
 use crate::description::{
     CameraRequest, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
@@ -39,30 +37,20 @@ use crate::FormatError;
 
 pub use placement::{placement, srt};
 
-/// A scene ready to render, with how its file asks for it to be rendered.
-#[derive(Clone, Debug)]
-pub struct LoadedScene {
-    /// The scene (camera aspect from the film size).
-    pub scene: Scene,
-    /// Integrator, sampler, filter and film of the file.
-    pub settings: FileSettings,
-    /// Problems that did not stop loading, one line each, naming the file.
-    pub warnings: Vec<String>,
-}
-
-/// Reads a scene file and builds its scene (meshes, textures and maps read relative to it).
-pub fn load_scene(path: &Path) -> Result<LoadedScene, FormatError> {
+/// Reads a scene file and assembles its scene (meshes, textures and maps
+/// read relative to it); its settings are always there.
+pub fn load_scene(path: &Path) -> Result<AssembledScene, FormatError> {
     load_scene_with_sky(path, None)
 }
 
 /// Reads a scene file as [`load_scene`] does, lit by `sky` instead of the
 /// file's `sky` key if given.
-pub fn load_scene_with_sky(path: &Path, sky: Option<&Sky>) -> Result<LoadedScene, FormatError> {
+pub fn load_scene_with_sky(path: &Path, sky: Option<&Sky>) -> Result<AssembledScene, FormatError> {
     let mut desc = read_scene(path)?;
     if let Some(sky) = sky {
         desc.sky = sky.clone();
     }
-    loaded(desc)
+    assemble(desc)
 }
 
 /// Reads a scene file as a description (meshes, textures and maps read
@@ -72,18 +60,8 @@ pub fn read_scene(path: &Path) -> Result<SceneDescription, FormatError> {
 }
 
 /// Builds the scene of a parsed scene file; `name` (the scene file) is used in messages.
-pub fn build_scene(file: &SceneFile, name: &str) -> Result<LoadedScene, FormatError> {
-    loaded(describe(file, name)?)
-}
-
-/// The assembled scene of a description that has settings.
-fn loaded(desc: SceneDescription) -> Result<LoadedScene, FormatError> {
-    let a = assemble(desc)?;
-    Ok(LoadedScene {
-        scene: a.scene,
-        settings: a.settings.expect("a scene file has settings"),
-        warnings: a.warnings,
-    })
+pub fn build_scene(file: &SceneFile, name: &str) -> Result<AssembledScene, FormatError> {
+    assemble(describe(file, name)?)
 }
 
 /// The render settings of a parsed scene file.

@@ -1,4 +1,4 @@
-//! A [`Description`] of a pbrt file as a [`SceneDescription`] with its
+//! A [`Declarations`] of a pbrt file as a [`SceneDescription`] with its
 //! render settings.
 //!
 //! - Each shape outside an object is an object of its own, placed by its
@@ -26,7 +26,7 @@ use sahara_render::{
     AlphaMode, Camera, Filter, Integrator, Material, SamplerKind, Shape, Srt, TextureMap, ToneMap,
 };
 
-use super::description::{Description, Entity, MaterialRef, ShapeDecl, Xform};
+use super::declarations::{Declarations, Entity, MaterialRef, ShapeDecl, Xform};
 use super::lights::{add_light, area_emission};
 use super::materials::{blend, map_material, Mapped};
 use super::shapes::shape_geometry;
@@ -56,7 +56,7 @@ fn unknown_params(e: &Entity, what: &str, w: &mut Warnings) {
 
 /// The materials of the file, mapped on first use.
 struct Materials<'a> {
-    desc: &'a Description,
+    desc: &'a Declarations,
     textures: Textures<'a>,
     anonymous: HashMap<usize, Option<u32>>,
     named: HashMap<String, Option<u32>>,
@@ -283,7 +283,7 @@ fn placement(x: &Xform, times: (f64, f64), shutter: (f64, f64)) -> ObjectPlaceme
 
 /// The camera, and the shutter interval.
 fn camera(
-    desc: &Description,
+    desc: &Declarations,
     aspect: f64,
     w: &mut Warnings,
 ) -> Result<(Camera, (f64, f64)), FormatError> {
@@ -470,7 +470,7 @@ fn film_crop(
 
 /// The render settings of `Film`, `Sampler`, `PixelFilter` and `Integrator`.
 fn settings(
-    desc: &Description,
+    desc: &Declarations,
     folder: &Path,
     w: &mut Warnings,
 ) -> Result<FileSettings, FormatError> {
@@ -747,7 +747,7 @@ fn oriented_geometry(
 
 /// The scene description of `desc`, read from the file `name` in `folder`.
 pub(crate) fn build(
-    desc: &Description,
+    desc: &Declarations,
     name: &str,
     folder: &Path,
     w: &mut Warnings,

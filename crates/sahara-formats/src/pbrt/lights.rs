@@ -21,7 +21,7 @@ use std::sync::Arc;
 use glam::{DMat3, DMat4, DVec3, Vec3};
 use sahara_render::{Environment, Light, Texture};
 
-use super::description::{Entity, LightDecl};
+use super::declarations::{Entity, LightDecl};
 use super::envmap::to_lat_long;
 use super::spectrum::Use;
 use super::textures::rgb_of;

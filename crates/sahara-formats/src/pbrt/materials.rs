@@ -26,7 +26,7 @@
 use glam::Vec3;
 use sahara_render::{AlphaMode, Bsdf, Material};
 
-use super::description::Entity;
+use super::declarations::Entity;
 use super::params::SpectrumParam;
 use super::spectrum::{self, Use};
 use super::textures::{rgb_of, spectral_samples, Textures, Tint};
@@ -584,9 +584,9 @@ mod tests {
             std::path::Path::new("/nonexistent"),
         )
         .unwrap_or_else(|e| panic!("{decl}: {e}"));
-        let scene = &s.loaded.scene;
+        let scene = &s.scene;
         let id = scene.instances[0].material.expect("a material") as usize;
-        (scene.materials[id].clone(), s.loaded.warnings)
+        (scene.materials[id].clone(), s.warnings)
     }
 
     /// Reflectance (mean sample weight) from `cos` to the normal, seen by

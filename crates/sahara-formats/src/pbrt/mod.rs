@@ -20,7 +20,7 @@
 //! `docs/pbrt.md` at the repository root.
 
 mod build;
-mod description;
+mod declarations;
 mod envmap;
 mod lexer;
 mod lights;
@@ -38,18 +38,9 @@ mod tests;
 
 use std::path::Path;
 
-use crate::assembly::assemble;
+use crate::assembly::{assemble, AssembledScene};
 use crate::description::SceneDescription;
-use crate::scene_load::LoadedScene;
 use crate::FormatError;
-
-/// A pbrt scene ready to render (the film's `cropwindow` or
-/// `pixelbounds` is in its settings' `crop`).
-#[derive(Clone, Debug)]
-pub struct PbrtScene {
-    /// The scene, its render settings and the loading warnings.
-    pub loaded: LoadedScene,
-}
 
 /// True if `path` names a pbrt file (`.pbrt` or `.pbrt.gz`, any case).
 pub fn is_pbrt_path(path: &Path) -> bool {
@@ -61,8 +52,9 @@ pub fn is_pbrt_path(path: &Path) -> bool {
 }
 
 /// Reads a pbrt file (and the files it includes, meshes and images) and
-/// builds its scene.
-pub fn load_pbrt(path: &Path) -> Result<PbrtScene, FormatError> {
+/// assembles its scene, checked (its settings are always there; the
+/// film's `cropwindow` or `pixelbounds` is in their `crop`).
+pub fn load_pbrt(path: &Path) -> Result<AssembledScene, FormatError> {
     assembled(read_pbrt(path)?)
 }
 
@@ -78,7 +70,7 @@ pub fn read_pbrt(path: &Path) -> Result<SceneDescription, FormatError> {
 
 /// Parses and builds a pbrt file held in memory; `name` is used in
 /// messages and relative file names resolve against `folder`.
-pub fn parse_pbrt(text: &[u8], name: &str, folder: &Path) -> Result<PbrtScene, FormatError> {
+pub fn parse_pbrt(text: &[u8], name: &str, folder: &Path) -> Result<AssembledScene, FormatError> {
     let mut w = warnings::Warnings::default();
     let desc = parser::parse_bytes(text.to_vec(), name, folder, &mut w)?;
     assembled(described(build::build(&desc, name, folder, &mut w)?, w))
@@ -91,17 +83,11 @@ fn described(mut desc: SceneDescription, w: warnings::Warnings) -> SceneDescript
 }
 
 /// The assembled scene, checked.
-fn assembled(desc: SceneDescription) -> Result<PbrtScene, FormatError> {
+fn assembled(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
     let name = desc.name.clone();
     let a = assemble(desc)?;
     a.scene
         .validate()
         .map_err(|e| FormatError::in_file(&name, e))?;
-    Ok(PbrtScene {
-        loaded: LoadedScene {
-            scene: a.scene,
-            settings: a.settings.expect("a pbrt file has settings"),
-            warnings: a.warnings,
-        },
-    })
+    Ok(a)
 }

@@ -1,5 +1,5 @@
 //! Runs the directives of a pbrt file (and the files it includes) into a
-//! [`Description`]: the graphics state stack, the transforms at the two
+//! [`Declarations`]: the graphics state stack, the transforms at the two
 //! times of `TransformTimes`, named coordinate systems, materials,
 //! textures and object definitions.
 //!
@@ -14,8 +14,8 @@ use std::sync::Arc;
 
 use glam::{DMat4, DVec3};
 
-use super::description::{
-    Description, Entity, InstanceDecl, LightDecl, MaterialRef, ShapeDecl, TextureDecl, Xform,
+use super::declarations::{
+    Declarations, Entity, InstanceDecl, LightDecl, MaterialRef, ShapeDecl, TextureDecl, Xform,
 };
 use super::lexer::{read_maybe_gz, Lexer, Loc, Token, TokenKind};
 use super::params::{Param, ParamList, Values};
@@ -56,13 +56,16 @@ pub(crate) struct Parser<'w> {
     stack: Vec<(State, Block, Loc)>,
     active: [bool; 2],
     named_coordinates: HashMap<String, Xform>,
-    object: Option<(String, Vec<super::description::ShapeDecl>, Loc)>,
-    out: Description,
+    object: Option<(String, Vec<super::declarations::ShapeDecl>, Loc)>,
+    out: Declarations,
     warnings: &'w mut Warnings,
 }
 
 /// Parses the file at `path` and everything it includes.
-pub(crate) fn parse_file(path: &Path, warnings: &mut Warnings) -> Result<Description, FormatError> {
+pub(crate) fn parse_file(
+    path: &Path,
+    warnings: &mut Warnings,
+) -> Result<Declarations, FormatError> {
     let bytes = read_maybe_gz(path)?;
     let folder = path.parent().unwrap_or(Path::new("")).to_path_buf();
     parse_bytes(bytes, &path.display().to_string(), &folder, warnings)
@@ -75,7 +78,7 @@ pub(crate) fn parse_bytes(
     name: &str,
     folder: &Path,
     warnings: &mut Warnings,
-) -> Result<Description, FormatError> {
+) -> Result<Declarations, FormatError> {
     let identity = Xform {
         m: [DMat4::IDENTITY; 2],
     };
@@ -94,9 +97,9 @@ pub(crate) fn parse_bytes(
         active: [true, true],
         named_coordinates: HashMap::new(),
         object: None,
-        out: Description {
+        out: Declarations {
             transform_times: (0.0, 1.0),
-            ..Description::default()
+            ..Declarations::default()
         },
         warnings,
     };

@@ -18,7 +18,7 @@ use glam::{Vec2, Vec3};
 use sahara_render::Shape;
 use sahara_render::{Mesh, SceneMesh};
 
-use super::description::Entity;
+use super::declarations::Entity;
 use super::lexer::read_maybe_gz;
 use super::subdivision::{loop_subdivide, smooth_normals};
 use super::warnings::Warnings;

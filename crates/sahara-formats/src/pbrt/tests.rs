@@ -8,13 +8,13 @@ use std::path::{Path, PathBuf};
 use glam::{DVec3, Vec3};
 use sahara_render::{render, Placement, RenderSettings, Scene};
 
-use super::description::Description;
+use super::declarations::Declarations;
 use super::parser::parse_bytes;
 use super::warnings::Warnings;
 use super::{load_pbrt, parse_pbrt};
 use crate::scene_load::load_scene;
 
-fn parse(text: &str) -> Result<(Description, Warnings), crate::FormatError> {
+fn parse(text: &str) -> Result<(Declarations, Warnings), crate::FormatError> {
     let mut w = Warnings::default();
     let d = parse_bytes(
         text.as_bytes().to_vec(),
@@ -158,7 +158,7 @@ fn unknown_parameters_and_unsupported_features_are_counted_warnings() {
                 Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\nShape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\n\
                 Material \"hair\" Shape \"sphere\"\nLightSource \"point\"";
     let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent")).unwrap();
-    let w = &s.loaded.warnings;
+    let w = &s.warnings;
     assert!(w.contains(&"t.pbrt:1:33: shape 'sphere': unknown parameter \"float wobble\", ignored (2 times; the first here)".to_owned()), "{w:#?}");
     assert!(
         w.contains(
@@ -172,7 +172,7 @@ fn unknown_parameters_and_unsupported_features_are_counted_warnings() {
             .any(|l| l.contains("material 'hair': not supported; replaced by a diffuse material")),
         "{w:#?}"
     );
-    assert_eq!(s.loaded.scene.lights.len(), 1);
+    assert_eq!(s.scene.lights.len(), 1);
 }
 
 #[test]
@@ -198,7 +198,7 @@ fn includes_resolve_from_the_main_folder_then_the_including_file() {
     )
     .unwrap();
     let s = load_pbrt(&dir.join("main.pbrt")).unwrap();
-    let scene = &s.loaded.scene;
+    let scene = &s.scene;
     assert_eq!(scene.lights.len(), 1);
     assert_eq!(scene.meshes.len(), 1);
     let m = &scene.meshes[0];
@@ -211,7 +211,7 @@ fn includes_resolve_from_the_main_folder_then_the_including_file() {
     gz.write_all(&text).unwrap();
     std::fs::write(dir.join("main.pbrt.gz"), gz.finish().unwrap()).unwrap();
     let z = load_pbrt(&dir.join("main.pbrt.gz")).unwrap();
-    assert_eq!(z.loaded.scene, s.loaded.scene);
+    assert_eq!(z.scene, s.scene);
     // A file that includes itself is an error, not a hang.
     std::fs::write(dir.join("loop.pbrt"), "Include \"loop.pbrt\"\n").unwrap();
     let e = load_pbrt(&dir.join("loop.pbrt")).unwrap_err().to_string();
@@ -228,7 +228,7 @@ fn object_instances_share_one_mesh() {
                 AttributeBegin Scale 2 2 2 ObjectInstance \"tri\" AttributeEnd\n\
                 ActiveTransform EndTime Translate 0 1 0 ActiveTransform All ObjectInstance \"tri\"";
     let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent")).unwrap();
-    let scene = &s.loaded.scene;
+    let scene = &s.scene;
     assert_eq!(scene.meshes.len(), 1, "one mesh for the object");
     assert_eq!(scene.instances.len(), 3);
     assert!(scene
@@ -274,8 +274,8 @@ fn film_crop_windows_and_pixel_bounds_follow_pbrt_v4() {
     };
     let window = |extra: &str| {
         let s = film(extra).unwrap();
-        let c = s.loaded.settings.crop.expect("a crop");
-        (c, c.window(100, 50), s.loaded.warnings)
+        let c = s.settings.as_ref().unwrap().crop.expect("a crop");
+        (c, c.window(100, 50), s.warnings)
     };
     // Pairs in either order; pixels from ceil(f * size).
     let (c, win, w) = window("\"float cropwindow\" [0.5 0.25 0.1 0.3]");
@@ -325,7 +325,7 @@ fn camera_fov_is_the_shorter_axis_and_settings_map() {
                 Sampler \"halton\" \"integer pixelsamples\" 8\nIntegrator \"volpath\" \"integer maxdepth\" 7\n\
                 PixelFilter \"box\"\nLookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 60 \"float lensradius\" 0.1 \"float focaldistance\" 5\nWorldBegin";
     let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/scenes")).unwrap();
-    let st = &s.loaded.settings;
+    let st = &s.settings.as_ref().unwrap();
     assert_eq!((st.width, st.height, st.spp), (100, 200, 8));
     assert_eq!(
         st.integrator,
@@ -336,7 +336,7 @@ fn camera_fov_is_the_shorter_axis_and_settings_map() {
     );
     assert_eq!(st.filter, sahara_render::Filter::Box { radius: 0.5 });
     assert_eq!(st.output.as_deref(), Some(Path::new("/scenes/out.exr")));
-    let c = &s.loaded.scene.camera;
+    let c = &s.scene.camera;
     // Portrait: the 60 degrees span the width; tan(v/2) = tan(30) * 2.
     let expect = (2.0 * (30f64.to_radians().tan() * 2.0).atan()).to_degrees() as f32;
     assert!((c.vfov_deg - expect).abs() < 1e-4, "{}", c.vfov_deg);
@@ -372,7 +372,7 @@ fn assert_same_image(pbrt: &str, toml: &str, name: &str, exact: bool) {
     .unwrap();
     let p = load_pbrt(&dir.join("s.pbrt")).unwrap();
     let t = load_scene(&dir.join("s.toml")).unwrap();
-    let (a, b) = (image(&p.loaded.scene, 4), image(&t.scene, 4));
+    let (a, b) = (image(&p.scene, 4), image(&t.scene, 4));
     assert!(
         b.iter().any(|v| v.max_element() > 0.0),
         "the reference image is black"
@@ -435,8 +435,8 @@ fn the_fuzz_seed_with_every_directive_loads() {
     let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds/pbrt/scene.pbrt");
     let text = std::fs::read(&seed).unwrap();
     let s = parse_pbrt(&text, "seed.pbrt", Path::new("/nonexistent")).unwrap();
-    let scene = &s.loaded.scene;
-    let w = &s.loaded.warnings;
+    let scene = &s.scene;
+    let w = &s.warnings;
     assert_eq!(scene.lights.len(), 2, "spot and distant; {w:#?}");
     assert!(matches!(
         scene.environment,
@@ -460,7 +460,7 @@ fn the_fuzz_seed_with_every_directive_loads() {
         .iter()
         .any(|m| m.is_emissive() && m.two_sided_emission));
     assert_eq!(
-        s.loaded.settings.crop,
+        s.settings.as_ref().unwrap().crop,
         Some(crate::description::FileCrop::Fractions([
             0.0, 1.0, 0.0, 1.0
         ]))
@@ -494,7 +494,7 @@ fn an_octahedral_environment_map_becomes_a_lat_long_map_through_the_light_transf
     )
     .unwrap();
     let s = load_pbrt(&dir.join("s.pbrt")).unwrap();
-    let Some(sahara_render::Environment::Map { texture, .. }) = &s.loaded.scene.environment else {
+    let Some(sahara_render::Environment::Map { texture, .. }) = &s.scene.environment else {
         panic!("no map")
     };
     assert_eq!((texture.width, texture.height), (4, 2));
@@ -523,11 +523,8 @@ fn write_pfm(path: &Path, w: u32, h: u32, rgb_top_down: &[[f32; 3]]) {
 fn shape_material(dir: &Path, text: &str) -> (sahara_render::Material, Vec<String>) {
     std::fs::write(dir.join("s.pbrt"), text).unwrap();
     let s = load_pbrt(&dir.join("s.pbrt")).unwrap();
-    let id = s.loaded.scene.instances[0].material.unwrap();
-    (
-        s.loaded.scene.materials[id as usize].clone(),
-        s.loaded.warnings,
-    )
+    let id = s.scene.instances[0].material.unwrap();
+    (s.scene.materials[id as usize].clone(), s.warnings)
 }
 
 #[test]
@@ -656,8 +653,8 @@ fn alpha_textures_cut_shapes_out() {
     // A constant alpha of 0 removes the shape; 0.5 is half transparent.
     std::fs::write(dir.join("s.pbrt"), format!("AttributeBegin {quad} \"float alpha\" 0 AttributeEnd\nAttributeBegin {quad} \"float alpha\" 0.5 AttributeEnd\n")).unwrap();
     let s = load_pbrt(&dir.join("s.pbrt")).unwrap();
-    assert_eq!(s.loaded.scene.instances.len(), 1);
-    let m = &s.loaded.scene.materials[s.loaded.scene.instances[0].material.unwrap() as usize];
+    assert_eq!(s.scene.instances.len(), 1);
+    let m = &s.scene.materials[s.scene.instances[0].material.unwrap() as usize];
     assert_eq!(
         (m.alpha_mode, m.alpha),
         (sahara_render::AlphaMode::Blend, 0.5)
@@ -671,7 +668,7 @@ fn the_fuzz_seed_with_every_material_warns_only_of_what_it_approximates() {
     let seed = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/seeds/pbrt/materials.pbrt");
     let text = std::fs::read(&seed).unwrap();
     let s = parse_pbrt(&text, "seed.pbrt", Path::new("/nonexistent")).unwrap();
-    let w = &s.loaded.warnings;
+    let w = &s.warnings;
     // The approximations, one line each: nothing else is lost.
     let kinds: Vec<&str> = w
         .iter()
@@ -689,7 +686,7 @@ fn the_fuzz_seed_with_every_material_warns_only_of_what_it_approximates() {
         ],
         "{w:#?}"
     );
-    let m = &s.loaded.scene.materials;
+    let m = &s.scene.materials;
     let has = |f: &dyn Fn(&sahara_render::Material) -> bool| m.iter().any(f);
     assert!(has(
         &|m| matches!(m.bsdf, Bsdf::CoatedDiffuse { ior, .. } if ior == 1.4)
@@ -708,5 +705,5 @@ fn the_fuzz_seed_with_every_material_warns_only_of_what_it_approximates() {
         if eta.min_element() >= 0.2 && eta.max_element() <= 0.5 && roughness > 0.4)
     ));
     // 13 shapes: the sphere of alpha 0 is not there.
-    assert_eq!(s.loaded.scene.instances.len(), 12);
+    assert_eq!(s.scene.instances.len(), 12);
 }

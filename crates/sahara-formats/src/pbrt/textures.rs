@@ -23,7 +23,7 @@ use glam::{Affine2, Mat2, Vec2, Vec3};
 use sahara_render::Wrap;
 use sahara_render::{Texture, TextureMap};
 
-use super::description::{Entity, TextureDecl};
+use super::declarations::{Entity, TextureDecl};
 use super::params::{FloatParam, SpectrumParam};
 use super::spectrum::{self, Use};
 use super::warnings::Warnings;

@@ -156,12 +156,12 @@ fn every_bsdf_agrees_with_mitsuba() {
         assert!(loaded.warnings.is_empty(), "{name}: {:?}", loaded.warnings);
         assert_eq!(
             (
-                loaded.settings.width as usize,
-                loaded.settings.height as usize
+                loaded.settings.as_ref().unwrap().width as usize,
+                loaded.settings.as_ref().unwrap().height as usize
             ),
             (size, size)
         );
-        let image = render_image(&loaded.scene, &loaded.settings);
+        let image = render_image(&loaded.scene, loaded.settings.as_ref().unwrap());
         match check(name, &image, &reference, size) {
             Ok(line) => println!("{line}"),
             Err(line) => failures.push(line),
@@ -169,7 +169,7 @@ fn every_bsdf_agrees_with_mitsuba() {
         let pbrt = dir.join(format!("{name}.pbrt"));
         if pbrt.exists() {
             let p = load_pbrt(&pbrt).unwrap();
-            let image = render_image(&p.loaded.scene, &p.loaded.settings);
+            let image = render_image(&p.scene, p.settings.as_ref().unwrap());
             match check(&format!("{name}.pbrt"), &image, &reference, size) {
                 Ok(line) => println!("{line}"),
                 Err(line) => failures.push(line),
@@ -194,7 +194,7 @@ fn a_conductor_with_energy_the_reference_lacks_is_caught() {
     let loaded = load_scene(&path).unwrap();
     let _ = std::fs::remove_dir_all(&tmp);
     let (size, reference) = reference_of(&dir.join("gold_0p3.exr"));
-    let image = render_image(&loaded.scene, &loaded.settings);
+    let image = render_image(&loaded.scene, loaded.settings.as_ref().unwrap());
     let verdict = check("gold_0p3", &image, &reference, size);
     assert!(verdict.is_err(), "not caught: {verdict:?}");
 }

@@ -366,14 +366,26 @@ fn shapes_lights_motion_and_settings_are_converted() {
     assert!(matches!(scene.lights[0], Light::Spot { .. }));
     assert!(scene.environment.is_some());
     assert_eq!(
-        l.settings.integrator,
+        l.settings.as_ref().unwrap().integrator,
         Integrator::Distribution {
             max_depth: 8,
             light_samples: 3
         }
     );
-    assert_eq!((l.settings.spp, l.settings.seed), (7, 9));
-    assert_eq!((l.settings.width, l.settings.height), (8, 4));
+    assert_eq!(
+        (
+            l.settings.as_ref().unwrap().spp,
+            l.settings.as_ref().unwrap().seed
+        ),
+        (7, 9)
+    );
+    assert_eq!(
+        (
+            l.settings.as_ref().unwrap().width,
+            l.settings.as_ref().unwrap().height
+        ),
+        (8, 4)
+    );
     assert!(l.warnings.is_empty(), "{:?}", l.warnings);
     scene.validate().unwrap();
 }
@@ -412,8 +424,16 @@ fn a_scene_file_integrator_without_parameters_gets_the_command_line_defaults() {
             ),
         );
         let l = load_scene(&path).unwrap();
-        assert_eq!(Ok(l.settings.integrator), Integrator::named(name), "{name}");
-        assert_eq!(l.settings.spp, sahara_render::defaults::SPP, "{name}");
+        assert_eq!(
+            Ok(l.settings.as_ref().unwrap().integrator),
+            Integrator::named(name),
+            "{name}"
+        );
+        assert_eq!(
+            l.settings.as_ref().unwrap().spp,
+            sahara_render::defaults::SPP,
+            "{name}"
+        );
     }
 }
 

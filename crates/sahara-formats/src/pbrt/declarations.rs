@@ -42,7 +42,7 @@ impl Xform {
 pub(crate) enum MaterialRef {
     /// pbrt's default (diffuse, reflectance 0.5).
     Default,
-    /// A `Material` directive: index into [`Description::materials`].
+    /// A `Material` directive: index into [`Declarations::materials`].
     Anonymous(usize),
     /// A `NamedMaterial` directive.
     Named(String, Loc),
@@ -92,7 +92,7 @@ pub(crate) struct LightDecl {
 
 /// Everything a pbrt file declares.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct Description {
+pub(crate) struct Declarations {
     /// `Camera` and the world-to-camera transform when it was given.
     pub(crate) camera: Option<(Entity, Xform)>,
     /// `Film`.
