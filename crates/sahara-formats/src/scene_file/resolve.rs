@@ -28,7 +28,7 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
         if let Err(other) = refuse_other_toml(text, name) {
             return other;
         }
-        let message = in_words(e.message().trim_end());
+        let message = sahara_readers::in_words(e.message().trim_end());
         match e.span() {
             Some(span) => ctx.at(span, message),
             None => FormatError::in_file(name, message),
@@ -102,21 +102,6 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
             None => Filter::default(),
         },
         film: ctx.film(film.get_ref())?,
-    })
-}
-
-/// A serde message with Rust's type names (`expected f32`) in a user's
-/// words (`expected a number`).
-fn in_words(message: &str) -> String {
-    [
-        ("expected f32", "expected a number"),
-        ("expected i64", "expected a whole number"),
-        ("expected a boolean", "expected true or false"),
-        ("expected a sequence", "expected a list [...]"),
-    ]
-    .iter()
-    .fold(message.to_owned(), |m, (rust, words)| {
-        m.replace(rust, words)
     })
 }
 
