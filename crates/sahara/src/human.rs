@@ -27,55 +27,12 @@ pub fn count(n: usize, word: &str) -> String {
 }
 
 /// Bytes with a MiB figure.
-fn bytes(n: usize) -> String {
+pub fn bytes(n: usize) -> String {
     format!(
         "{} bytes ({:.2} MiB)",
         thousands(n as u64),
         n as f64 / 1048576.0
     )
-}
-
-/// `sahara stats` of a scene, as text.
-pub fn scene_stats_report(r: &crate::stats::SceneStatsReport, threads: usize) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "scene      {}", r.scene);
-    let _ = writeln!(
-        s,
-        "instances  {}: {} merged into the world tree, {} two-level",
-        thousands(r.instances as u64),
-        thousands(r.merged_instances as u64),
-        thousands(r.two_level_instances as u64)
-    );
-    let world = usize::from(r.world_triangles > 0);
-    let meshes = format!(
-        "{} of two-level meshes",
-        thousands((r.trees - world) as u64)
-    );
-    let _ = if world > 0 {
-        writeln!(
-            s,
-            "trees      {}: the world tree ({} triangles) and {meshes}",
-            thousands(r.trees as u64),
-            thousands(r.world_triangles as u64),
-        )
-    } else {
-        writeln!(s, "trees      {}: {meshes}", thousands(r.trees as u64))
-    };
-    let _ = writeln!(
-        s,
-        "triangles  {} (instanced)",
-        thousands(r.instanced_triangles)
-    );
-    let _ = writeln!(s, "builder    {}", r.builder);
-    let _ = writeln!(
-        s,
-        "build      {:.1} ms, trees and lights (best of {} on {})",
-        r.build_ms,
-        r.build_runs,
-        count(threads, "thread")
-    );
-    let _ = writeln!(s, "memory     {}", bytes(r.memory_bytes));
-    s
 }
 
 /// A vector as `(x y z)`.

@@ -1,6 +1,7 @@
 //! `sahara stats`: a tree's statistics and build time; for a scene file,
 //! the trees and instances its acceleration structure was built from.
 
+use std::fmt::Write;
 use std::path::Path;
 use std::time::Instant;
 
@@ -146,7 +147,54 @@ fn run_scene(args: &StatsArgs) -> Result<()> {
             serde_json::to_string_pretty(&report).context("cannot format the report")?
         );
     } else {
-        print!("{}", human::scene_stats_report(&report, threads));
+        print!("{}", scene_stats_report(&report, threads));
     }
     Ok(())
+}
+
+/// `sahara stats` of a scene, as text.
+fn scene_stats_report(r: &SceneStatsReport, threads: usize) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "scene      {}", r.scene);
+    let _ = writeln!(
+        s,
+        "instances  {}: {} merged into the world tree, {} two-level",
+        human::thousands(r.instances as u64),
+        human::thousands(r.merged_instances as u64),
+        human::thousands(r.two_level_instances as u64)
+    );
+    let world = usize::from(r.world_triangles > 0);
+    let meshes = format!(
+        "{} of two-level meshes",
+        human::thousands((r.trees - world) as u64)
+    );
+    let _ = if world > 0 {
+        writeln!(
+            s,
+            "trees      {}: the world tree ({} triangles) and {meshes}",
+            human::thousands(r.trees as u64),
+            human::thousands(r.world_triangles as u64),
+        )
+    } else {
+        writeln!(
+            s,
+            "trees      {}: {meshes}",
+            human::thousands(r.trees as u64)
+        )
+    };
+    let _ = writeln!(
+        s,
+        "triangles  {} (instanced)",
+        human::thousands(r.instanced_triangles)
+    );
+    let _ = writeln!(s, "builder    {}", r.builder);
+    let _ = writeln!(
+        s,
+        "build      {:.1} ms, trees and lights (best of {} on {})",
+        r.build_ms,
+        r.build_runs,
+        human::count(threads, "thread")
+    );
+    let _ = writeln!(s, "memory     {}", human::bytes(r.memory_bytes));
+    s
 }
