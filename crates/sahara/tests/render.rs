@@ -655,6 +655,20 @@ fn a_mesh_too_large_to_frame_names_the_file() {
     let _ = fs::remove_dir_all(&dir);
 }
 
+/// `sahara render SCENE --spp 1 -o OUTPUT`, and its log.
+fn render_one_sample(scene: &Path, output: &Path) -> (Output, String) {
+    let out = sahara(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--spp",
+        "1",
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    (out, err)
+}
+
 #[test]
 fn the_no_light_warning_is_printed_once() {
     let dir = temp_dir("unlit");
@@ -666,16 +680,7 @@ fn the_no_light_warning_is_printed_once() {
          [film]\nwidth = 4\nheight = 4\n",
     )
     .unwrap();
-    let png = dir.join("dark.png");
-    let out = sahara(&[
-        "render",
-        scene.to_str().unwrap(),
-        "--spp",
-        "1",
-        "-o",
-        png.to_str().unwrap(),
-    ]);
-    let err = stderr(&out);
+    let (out, err) = render_one_sample(&scene, &dir.join("dark.png"));
     assert!(out.status.success(), "{err}");
     assert_eq!(err.matches("has no light").count(), 1, "{err}");
     assert!(
@@ -709,17 +714,7 @@ fn a_light_that_faces_away_from_the_scene_is_warned_about() {
         ("up.toml", "edge_u = [0, 0, 2]\nedge_v = [2, 0, 0]", true),
         ("down.toml", "edge_u = [2, 0, 0]\nedge_v = [0, 0, 2]", false),
     ] {
-        let path = scene(name, edges);
-        let png = dir.join("x.png");
-        let out = sahara(&[
-            "render",
-            path.to_str().unwrap(),
-            "--spp",
-            "1",
-            "-o",
-            png.to_str().unwrap(),
-        ]);
-        let err = stderr(&out);
+        let (out, err) = render_one_sample(&scene(name, edges), &dir.join("x.png"));
         assert!(out.status.success(), "{err}");
         assert_eq!(
             err.contains("no light reaches the scene"),
