@@ -358,7 +358,7 @@ pub enum EnvironmentSpec {
 }
 
 /// `[sampler]`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SamplerSpec {
     /// Which sampler (default sobol).
     pub kind: SamplerKind,
@@ -366,6 +366,8 @@ pub struct SamplerSpec {
     pub spp: u32,
     /// Seed (>= 0, default 0).
     pub seed: u64,
+    /// Adaptive sampling (`noise_threshold`, `min_spp`), if asked for.
+    pub adaptive: Option<sahara_render::Adaptive>,
 }
 
 /// `[film]`.
@@ -382,6 +384,8 @@ pub struct FilmSpec {
     /// Output image (`.png` or `.exr`) as given: relative to the working
     /// folder unless absolute; `None` if not given.
     pub output: Option<PathBuf>,
+    /// Denoise the image (default false).
+    pub denoise: bool,
 }
 
 /// Reads and checks a scene file; paths in it are resolved relative to its folder.

@@ -70,6 +70,7 @@ pub fn settings_of(file: &SceneFile) -> FileSettings {
         integrator: file.integrator,
         sampler: file.sampler.kind,
         spp: file.sampler.spp,
+        adaptive: file.sampler.adaptive,
         seed: file.sampler.seed,
         filter: file.filter,
         width: file.film.width,
@@ -78,6 +79,7 @@ pub fn settings_of(file: &SceneFile) -> FileSettings {
         tonemap: file.film.tonemap,
         output: file.film.output.clone(),
         crop: None,
+        denoise: file.film.denoise,
     }
 }
 

@@ -97,13 +97,7 @@ fn check_args(args: &RenderArgs) -> Result<()> {
         if !(t > 0.0 && t.is_finite()) {
             bail!("--noise-threshold must be a positive number (0.01 is a good start)");
         }
-        if args.samples.is_some() || args.split == Some(crate::cli::Split::Samples) {
-            bail!(
-                "--noise-threshold cannot be used with sample ranges (--samples, --split \
-                 samples): a pixel's decision to stop needs all its samples; split the frame \
-                 by tiles instead"
-            );
-        }
+        refuse_sample_ranges(args, "--noise-threshold")?;
     }
     part::check_args(args)?;
     if let Some(output) = &args.output {
@@ -117,6 +111,17 @@ fn check_args(args: &RenderArgs) -> Result<()> {
                  beauty's sums only"
             );
         }
+    }
+    Ok(())
+}
+
+/// Adaptive sampling cannot split a frame by sample ranges.
+fn refuse_sample_ranges(args: &RenderArgs, what: &str) -> Result<()> {
+    if args.samples.is_some() || args.split == Some(crate::cli::Split::Samples) {
+        bail!(
+            "{what} cannot be used with sample ranges (--samples, --split samples): a pixel's \
+             decision to stop needs all its samples; split the frame by tiles instead"
+        );
     }
     Ok(())
 }
@@ -204,8 +209,20 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         check_output(&output, piece.is_some())?;
         check_aov_output(args, &output)?;
     }
+    // The scene file may ask for adaptive sampling and denoising too.
+    if args.noise_threshold.is_none() && settings.adaptive.is_some() {
+        refuse_sample_ranges(args, "the scene file's noise_threshold")?;
+    }
+    let file_denoise = !args.denoise && file.as_ref().is_some_and(|f| f.denoise);
+    if file_denoise && piece.is_some() {
+        bail!(
+            "the scene file's `denoise` cannot be used with --part, --crop or --samples: part \
+             files carry the beauty's sums only (render the parts without it)"
+        );
+    }
+    let denoise = args.denoise || file_denoise;
     settings.aovs = args.aov.clone();
-    if args.denoise {
+    if denoise {
         settings.aovs.extend([Aov::Albedo, Aov::Normal]);
     }
     settings.aovs.sort();
@@ -218,10 +235,10 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
     {
         bail!(
             "{} needs an integrator that traces paths (path or distribution), not {}",
-            if args.aov.is_empty() {
-                "--denoise"
-            } else {
-                "--aov"
+            match (args.aov.is_empty(), args.denoise) {
+                (false, _) => "--aov",
+                (true, true) => "--denoise",
+                (true, false) => "the scene file's `denoise`",
             },
             settings.integrator.name()
         );
@@ -230,7 +247,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
     // their noise is then correlated, which the denoiser (trained on
     // independent pixels) takes for detail and keeps. Figures in
     // docs/clean-image.md.
-    if args.denoise {
+    if denoise {
         match args.filter {
             None => {
                 settings.filter = Filter::from(FilterKind::Box);
@@ -247,7 +264,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         }
     }
     // The library is found before the render, not after it.
-    let denoiser = if args.denoise {
+    let denoiser = if denoise {
         Some(crate::denoise::load()?)
     } else {
         None

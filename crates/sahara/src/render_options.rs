@@ -78,10 +78,19 @@ pub fn resolve(
         .clone()
         .or_else(|| file.and_then(|f| f.output.clone()))
         .unwrap_or_else(|| PathBuf::from(format!("{name}.png")));
-    let adaptive = args.noise_threshold.map(|threshold| Adaptive {
-        threshold,
-        min_spp: args.min_spp.unwrap_or(Adaptive::DEFAULT_MIN_SPP),
-    });
+    // The command line's threshold over the file's; its minimum, else the
+    // file's, else the default.
+    let from_file = file.and_then(|f| f.adaptive);
+    let adaptive = match args.noise_threshold {
+        Some(threshold) => Some(Adaptive {
+            threshold,
+            min_spp: args
+                .min_spp
+                .or(from_file.map(|a| a.min_spp))
+                .unwrap_or(Adaptive::DEFAULT_MIN_SPP),
+        }),
+        None => from_file,
+    };
     let time_limit = match args.time_limit {
         Some(t) if !(t > 0.0 && t.is_finite()) => {
             bail!("--time-limit must be a positive number of seconds")
@@ -134,6 +143,8 @@ mod tests {
             tonemap: ToneMap::Filmic,
             output: Some(PathBuf::from("out/x.exr")),
             crop: None,
+            adaptive: None,
+            denoise: false,
         }
     }
 

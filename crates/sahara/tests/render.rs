@@ -1209,6 +1209,73 @@ fn adaptive_sampling_logs_its_samples_and_writes_them_as_a_layer() {
     assert_eq!(samples.iter().map(|&n| n as u64).sum::<u64>(), logged);
 }
 
+/// A scene file asks for adaptive sampling in `[sampler]` and for
+/// denoising in `[film]`; the command line's threshold wins, and what
+/// cannot be split over a farm is refused for the file's keys too.
+#[test]
+fn a_scene_file_asks_for_adaptive_sampling_and_denoising() {
+    let dir = temp_dir("file-adaptive");
+    let scene = dir.join("s.toml");
+    let write = |sampler: &str, film: &str| {
+        fs::write(
+            &scene,
+            format!(
+                "[camera]\neye = [0, 1, 5]\ntarget = [0, 0, 0]\n\n\
+                 [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n\n\
+                 [[light]]\ntype = \"point\"\nposition = [0, 4, 2]\nintensity = [20, 20, 20]\n\n\
+                 [sampler]\nspp = 32\n{sampler}\n[film]\nwidth = 16\nheight = 16\n{film}\n"
+            ),
+        )
+        .unwrap();
+    };
+    let exr = dir.join("x.exr");
+    let run = |extra: &[&str]| {
+        let args = [
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                exr.to_str().unwrap(),
+            ][..],
+            extra,
+        ]
+        .concat();
+        let out = sahara(&args);
+        let err = stderr(&out);
+        (out.status.success(), err)
+    };
+    write("noise_threshold = 0.05\nmin_spp = 8", "");
+    let (ok, err) = run(&[]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("(adaptive: noise threshold 0.05, at least 8 spp)"),
+        "{err}"
+    );
+    let (ok, err) = run(&["--noise-threshold", "0.1"]);
+    assert!(
+        ok && err.contains("noise threshold 0.1, at least 8 spp"),
+        "{err}"
+    );
+    let (ok, err) = run(&["--samples", "0..8"]);
+    assert!(
+        !ok && err.contains("the scene file's noise_threshold cannot be used with sample ranges"),
+        "{err}"
+    );
+    write("min_spp = 8", "");
+    let (ok, err) = run(&[]);
+    assert!(
+        !ok && err.contains("`min_spp` needs `noise_threshold`"),
+        "{err}"
+    );
+    write("", "denoise = true");
+    let (ok, err) = run(&["--part", "1/2"]);
+    assert!(
+        !ok && err.contains("the scene file's `denoise` cannot be used with --part"),
+        "{err}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn adaptive_sampling_refuses_sample_ranges_and_bad_thresholds() {
     let dir = temp_dir("adaptive-errors");

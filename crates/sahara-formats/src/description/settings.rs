@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use sahara_render::{Filter, Integrator, PixelWindow, SamplerKind, ToneMap};
+use sahara_render::{Adaptive, Filter, Integrator, PixelWindow, SamplerKind, ToneMap};
 
 /// How a scene file asks to be rendered: light transport, sampling,
 /// filter and film (a TOML file's `[integrator]`, `[sampler]`, `[filter]`
@@ -13,8 +13,10 @@ pub struct FileSettings {
     pub integrator: Integrator,
     /// Sample generator.
     pub sampler: SamplerKind,
-    /// Samples per pixel.
+    /// Samples per pixel (the cap, with adaptive sampling).
     pub spp: u32,
+    /// Adaptive sampling, if the file asks for it.
+    pub adaptive: Option<Adaptive>,
     /// Seed of every random decision.
     pub seed: u64,
     /// Reconstruction filter.
@@ -32,6 +34,8 @@ pub struct FileSettings {
     pub output: Option<PathBuf>,
     /// The part of the image to render, if the file asks for one.
     pub crop: Option<FileCrop>,
+    /// Denoise the image (with Intel Open Image Denoise).
+    pub denoise: bool,
 }
 
 /// The pixels a scene file asks to render (pbrt's film `cropwindow` and

@@ -703,6 +703,7 @@ fn settings(
         integrator,
         sampler,
         spp: spp as u32,
+        adaptive: None,
         seed,
         filter,
         width: width as u32,
@@ -711,6 +712,7 @@ fn settings(
         tonemap: ToneMap::Clamp,
         output,
         crop,
+        denoise: false,
     })
 }
 

@@ -247,6 +247,8 @@ pub(super) struct RawSampler {
     pub name: Opt<Name<SamplerKind>>,
     pub spp: Opt<i64>,
     pub seed: Opt<i64>,
+    pub noise_threshold: Opt<f32>,
+    pub min_spp: Opt<i64>,
 }
 
 /// A table whose keys depend on a setting named in it (`[filter]`: `name`
@@ -263,4 +265,5 @@ pub(super) struct RawFilm {
     pub exposure: Opt<f32>,
     pub tonemap: Opt<Name<ToneMap>>,
     pub output: Opt<String>,
+    pub denoise: Opt<bool>,
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use sahara_render::defaults;
 use sahara_render::{
-    Filter, FilterKind, Integrator, IntegratorKind, Named, Parameter, SamplerKind, Shape,
+    Adaptive, Filter, FilterKind, Integrator, IntegratorKind, Named, Parameter, SamplerKind, Shape,
     ShapeKind, ToneMap,
 };
 use toml::Spanned;
@@ -95,6 +95,7 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
                 kind: SamplerKind::default(),
                 spp: defaults::SPP,
                 seed: 0,
+                adaptive: None,
             },
         },
         filter: match &raw.filter {
@@ -989,6 +990,25 @@ impl Ctx<'_> {
                 ))
             }
         };
+        let adaptive = match (&s.noise_threshold, &s.min_spp) {
+            (None, None) => None,
+            (None, Some(m)) => {
+                return Err(self.at(
+                    m.span(),
+                    "`min_spp` needs `noise_threshold` (adaptive sampling)",
+                ))
+            }
+            (Some(_), min) => Some(Adaptive {
+                threshold: self.number(
+                    &s.noise_threshold,
+                    "noise_threshold",
+                    0.0,
+                    |t| t > 0.0,
+                    "greater than 0",
+                )?,
+                min_spp: self.count(min, "min_spp", Adaptive::DEFAULT_MIN_SPP, 2)?,
+            }),
+        };
         Ok(SamplerSpec {
             kind: s
                 .name
@@ -996,6 +1016,7 @@ impl Ctx<'_> {
                 .map_or_else(SamplerKind::default, |n| n.get_ref().0),
             spp: self.count(&s.spp, "spp", defaults::SPP, 1)?,
             seed,
+            adaptive,
         })
     }
 
@@ -1108,6 +1129,7 @@ impl Ctx<'_> {
                 .as_ref()
                 .map_or_else(ToneMap::default, |t| t.get_ref().0),
             output,
+            denoise: f.denoise.as_ref().is_some_and(|d| *d.get_ref()),
         })
     }
 }
