@@ -324,7 +324,8 @@ fn a_complete_scene_parses_into_the_expected_values() {
         SamplerSpec {
             kind: SamplerKind::Stratified,
             spp: 64,
-            seed: 42
+            seed: 42,
+            adaptive: None,
         }
     );
     assert_eq!(
@@ -342,7 +343,8 @@ fn a_complete_scene_parses_into_the_expected_values() {
             height: 240,
             exposure: -1.,
             tonemap: ToneMap::Filmic,
-            output: Some(PathBuf::from("renders/out.EXR"))
+            output: Some(PathBuf::from("renders/out.EXR")),
+            denoise: false,
         }
     );
 }
