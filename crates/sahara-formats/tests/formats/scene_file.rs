@@ -370,7 +370,8 @@ fn a_minimal_scene_gets_the_documented_defaults() {
         SamplerSpec {
             kind: SamplerKind::Sobol,
             spp: 64,
-            seed: 0
+            seed: 0,
+            adaptive: None,
         }
     );
     assert_eq!(
