@@ -650,9 +650,29 @@ fn render_tile(
                 y1,
                 pass,
                 indices.clone(),
-                &active,
+                convergence,
                 &mut out.stats,
             );
+            if convergence.is_none() && out.aux.is_none() {
+                // The plain render: every pixel, nothing besides the beauty.
+                let mut k = 0;
+                for y in y0..y1 {
+                    for x in t.x0..t.x1 {
+                        for _ in indices.clone() {
+                            let pos = strip.pos[k];
+                            let l = strip.radiance[k];
+                            k += 1;
+                            if depth_view && l == Vec3::ZERO {
+                                continue;
+                            }
+                            let l = guard(l, &mut out.nan, &mut out.negative);
+                            out.sums.splat(&s.filter, m, x, y, pos, l);
+                        }
+                    }
+                }
+                out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
+                continue;
+            }
             let mut k = 0;
             for y in y0..y1 {
                 for x in t.x0..t.x1 {
@@ -663,18 +683,7 @@ fn render_tile(
                     for _ in indices.clone() {
                         let pos = strip.pos[k];
                         let raw = strip.radiance[k];
-                        // Guard, count, never hide: a NaN or infinite sample is
-                        // a bug somewhere; it is zeroed so one cannot ruin a
-                        // pixel, and reported in the statistics.
-                        let mut l = raw;
-                        if !l.is_finite() {
-                            out.nan += 1;
-                            l = Vec3::ZERO;
-                        }
-                        if l.min_element() < 0.0 {
-                            out.negative += 1;
-                            l = l.max(Vec3::ZERO);
-                        }
+                        let l = guard(raw, &mut out.nan, &mut out.negative);
                         if let Some(aux) = &mut out.aux {
                             aux.add_sample(x, y, &strip.aux[k], l);
                         }
@@ -699,6 +708,22 @@ fn render_tile(
     });
     out.split.total = tile_start.elapsed();
     out
+}
+
+/// Guard, count, never hide: a NaN or infinite sample is a bug somewhere;
+/// it is zeroed so one cannot ruin a pixel, and counted in `nan` for the
+/// statistics; a negative component is clamped and counted in `negative`.
+#[inline(always)]
+fn guard(mut l: Vec3, nan: &mut u64, negative: &mut u64) -> Vec3 {
+    if !l.is_finite() {
+        *nan += 1;
+        l = Vec3::ZERO;
+    }
+    if l.min_element() < 0.0 {
+        *negative += 1;
+        l = l.max(Vec3::ZERO);
+    }
+    l
 }
 
 thread_local! {
@@ -735,10 +760,12 @@ impl Strip {
         y1: u32,
         pass: u32,
         indices: std::ops::Range<u32>,
-        active: &dyn Fn(u32, u32) -> bool,
+        convergence: Option<&Convergence>,
         stats: &mut TraceStats,
     ) {
         let (w, h) = (s.width.max(1), s.height.max(1));
+        // With adaptive sampling, the pixels still taking samples.
+        let active = |x: u32, y: u32| convergence.is_none_or(|c| c.is_active(x, y));
         let camera = &world.scene.camera;
         let inv = Vec2::new(1.0 / w as f32, 1.0 / h as f32);
         let spp = s.pass_size();
