@@ -144,10 +144,8 @@ impl Convergence {
         ((y - self.region.y0) * self.region.width() + (x - self.region.x0)) as usize
     }
 
-    /// True if pixel `(x, y)` of the region takes samples in this pass.
-    /// Without a panic path: asked in the render loop for every sample, a
-    /// possible panic there kept the compiler from hoisting the camera's
-    /// set-up out of it (9% of a render without adaptive sampling).
+    /// True if pixel `(x, y)` of the region takes samples in this pass
+    /// (false outside it; no panic path in the render loop).
     #[inline]
     pub(crate) fn is_active(&self, x: u32, y: u32) -> bool {
         let i = (y.wrapping_sub(self.region.y0) as usize)
