@@ -262,7 +262,7 @@ pub struct RenderResult {
     /// Raw per-pixel work of the `cost` view.
     pub cost: Option<CostMaps>,
     /// The albedo, normal and depth images and their sums, when
-    /// [`RenderSettings::aux`] asks for them.
+    /// [`RenderSettings::aovs`] asks for them.
     pub aux: Option<Aux>,
     /// With adaptive sampling, the samples each pixel of the window took
     /// (rows top to bottom).
