@@ -210,15 +210,26 @@ pub fn in_words(message: &str) -> String {
         ),
     ] {
         for t in types {
-            for end in ["", ",", ")"] {
-                let rust = format!("expected {t}{end}");
-                if m.ends_with(&format!("expected {t}")) || m.contains(&format!("{rust} ")) {
-                    m = m.replace(&rust, &format!("expected {words}{end}"));
-                }
-            }
+            m = replace_word(&m, &format!("expected {t}"), &format!("expected {words}"));
         }
     }
     m
+}
+
+/// `text` with every `word` that is not followed by a letter, digit or
+/// `_` (so `f32` but not `f32x4`) replaced by `with`.
+fn replace_word(text: &str, word: &str, with: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find(word) {
+        let after = &rest[at + word.len()..];
+        let whole = !after.starts_with(|c: char| c.is_alphanumeric() || c == '_');
+        out.push_str(&rest[..at]);
+        out.push_str(if whole { with } else { word });
+        rest = after;
+    }
+    out.push_str(rest);
+    out
 }
 
 #[cfg(test)]

@@ -139,19 +139,25 @@ impl Convergence {
         }
     }
 
+    /// The index of pixel `(x, y)` (one past the end outside the region,
+    /// so that a lookup there finds nothing rather than panics).
     fn index(&self, x: u32, y: u32) -> usize {
-        debug_assert!(x >= self.region.x0 && y >= self.region.y0);
-        ((y - self.region.y0) * self.region.width() + (x - self.region.x0)) as usize
+        let (i, j) = (
+            x.wrapping_sub(self.region.x0),
+            y.wrapping_sub(self.region.y0),
+        );
+        if i < self.region.width() && j < self.region.height() {
+            (j * self.region.width() + i) as usize
+        } else {
+            self.active.len()
+        }
     }
 
     /// True if pixel `(x, y)` of the region takes samples in this pass
-    /// (false outside it; no panic path in the render loop).
+    /// (false outside it).
     #[inline]
     pub(crate) fn is_active(&self, x: u32, y: u32) -> bool {
-        let i = (y.wrapping_sub(self.region.y0) as usize)
-            .wrapping_mul(self.region.width() as usize)
-            .wrapping_add(x.wrapping_sub(self.region.x0) as usize);
-        self.active.get(i).copied().unwrap_or(false)
+        self.active.get(self.index(x, y)).copied().unwrap_or(false)
     }
 
     /// True if any pixel of `[x0, x1) x [y0, y1)` takes samples.

@@ -261,46 +261,43 @@ impl Scene {
         if !self.lights.is_empty() || self.environment.is_some() {
             return false;
         }
-        let emits = |i: usize, tri: usize| {
-            let m = &self.materials[self.material_of(i as u32, tri as u32) as usize];
-            m.is_emissive()
-        };
-        // The box around every triangle that does not emit.
+        // One pass over the triangles: the box around those that do not
+        // emit (in each instance's own space, placed once per instance),
+        // and the emitting ones (instance, triangle, material).
         let mut others = Aabb::EMPTY;
+        let mut emitters = Vec::new();
         for (i, inst) in self.instances.iter().enumerate() {
             let mesh = &self.meshes[inst.mesh as usize].mesh;
+            let mut local = Aabb::EMPTY;
             for (t, tri) in mesh.indices.iter().enumerate() {
-                if !emits(i, t) {
-                    let b = tri
+                let m = &self.materials[self.material_of(i as u32, t as u32) as usize];
+                if m.is_emissive() {
+                    emitters.push((inst, tri, m));
+                } else {
+                    local = tri
                         .iter()
-                        .fold(Aabb::EMPTY, |b, &v| b.grow(mesh.positions[v as usize]));
-                    others = others.union(inst.placement.world_bounds(b));
+                        .fold(local, |b, &v| b.grow(mesh.positions[v as usize]));
                 }
             }
+            others = others.union(inst.placement.world_bounds(local));
         }
         if others.is_empty() {
             return false;
         }
-        for (i, inst) in self.instances.iter().enumerate() {
+        for (inst, tri, m) in emitters {
+            let Placement::Static(xf) = inst.placement else {
+                return false;
+            };
+            if m.two_sided_emission {
+                return false;
+            }
             let mesh = &self.meshes[inst.mesh as usize].mesh;
-            for (t, tri) in mesh.indices.iter().enumerate() {
-                if !emits(i, t) {
-                    continue;
-                }
-                let m = &self.materials[self.material_of(i as u32, t as u32) as usize];
-                let Placement::Static(xf) = inst.placement else {
-                    return false;
-                };
-                if m.two_sided_emission {
-                    return false;
-                }
-                let [a, b, c] = tri.map(|v| xf.transform_point3(mesh.positions[v as usize]));
-                let n = (b - a).cross(c - a);
-                // The corner of the box farthest along the front normal.
-                let far = Vec3::select(n.cmpgt(Vec3::ZERO), others.max, others.min);
-                if n.dot(far - a) > 0.0 {
-                    return false;
-                }
+            let [a, b, c] = tri.map(|v| xf.transform_point3(mesh.positions[v as usize]));
+            let n = (b - a).cross(c - a);
+            // The corner of the box farthest along the front normal.
+            let far = Vec3::select(n.cmpgt(Vec3::ZERO), others.max, others.min);
+            if n.dot(far - a) > 0.0 {
+                return false;
             }
         }
         true
