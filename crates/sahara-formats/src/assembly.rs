@@ -41,7 +41,7 @@ use crate::FormatError;
 use camera::has_finite_triangles;
 use sky::SkyUsed;
 
-pub use camera::{auto_camera, AUTO_VFOV_DEG};
+pub use camera::{auto_camera, auto_camera_framing, AUTO_VFOV_DEG};
 
 /// A scene ready to render, with what assembling it decided.
 #[derive(Clone, Debug)]
@@ -217,7 +217,7 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
                     "auto (nothing to frame)".into(),
                 )
             }
-            None => (auto_camera(&scene, &name)?, "auto".into()),
+            None => auto_camera_framing(&scene, &name)?,
         },
     };
     scene.camera = camera;

@@ -17,19 +17,54 @@ pub(crate) fn has_finite_triangles(scene: &Scene) -> bool {
         .any(|i| !scene.meshes[i.mesh as usize].mesh.bounds().is_empty())
 }
 
-/// A camera that sees the whole scene: looking at the centre of its bounds
-/// from above, the front (+Z) and the right (+X), at the distance where the
-/// bounding sphere fills the vertical field of view.
+/// How much larger than everything else a flat object must be for the
+/// automatic camera to leave it out: a ground plane or a sea that dwarfs
+/// the subject would otherwise make it a speck in the frame.
+const GROUND_DWARFS: f32 = 4.0;
+
+/// Thickness, relative to its largest extent, below which an object is flat.
+const FLAT: f32 = 1e-3;
+
+/// A camera that sees the scene (see [`auto_camera_framing`]).
 pub fn auto_camera(scene: &Scene, name: &str) -> Result<Camera, FormatError> {
-    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-    for inst in &scene.instances {
-        let m = &scene.meshes[inst.mesh as usize].mesh;
-        let b = inst.placement.world_bounds(m.bounds());
-        if !b.is_empty() {
-            lo = lo.min(b.min);
-            hi = hi.max(b.max);
-        }
-    }
+    auto_camera_framing(scene, name).map(|(c, _)| c)
+}
+
+/// A camera that sees the scene's objects: looking at the centre of their
+/// bounds from above, the front (+Z) and the right (+X), at the distance
+/// where their bounding sphere fills the vertical field of view; with the
+/// log's words for how it chose. Flat objects (ground planes, water) whose
+/// extent is at least [`GROUND_DWARFS`] times the diagonal of everything
+/// else's bounds are left out of the framing (they still render), so that
+/// the subject fills the frame rather than the plane it stands on.
+pub fn auto_camera_framing(scene: &Scene, name: &str) -> Result<(Camera, String), FormatError> {
+    let bounds: Vec<(Vec3, Vec3)> = scene
+        .instances
+        .iter()
+        .filter_map(|inst| {
+            let m = &scene.meshes[inst.mesh as usize].mesh;
+            let b = inst.placement.world_bounds(m.bounds());
+            (!b.is_empty() && b.min.is_finite() && b.max.is_finite()).then_some((b.min, b.max))
+        })
+        .collect();
+    let union = |it: &mut dyn Iterator<Item = &(Vec3, Vec3)>| {
+        it.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), b| {
+            (lo.min(b.0), hi.max(b.1))
+        })
+    };
+    let is_flat = |b: &(Vec3, Vec3)| {
+        let e = b.1 - b.0;
+        e.min_element() <= FLAT * e.max_element()
+    };
+    let (rest_lo, rest_hi) = union(&mut bounds.iter().filter(|b| !is_flat(b)));
+    let rest_diagonal = (rest_hi - rest_lo).length();
+    let dwarfs = |b: &(Vec3, Vec3)| {
+        rest_diagonal.is_finite()
+            && is_flat(b)
+            && (b.1 - b.0).max_element() >= GROUND_DWARFS * rest_diagonal
+    };
+    let left_out = bounds.iter().filter(|b| dwarfs(b)).count();
+    let (lo, hi) = union(&mut bounds.iter().filter(|b| !dwarfs(b)));
     if !(lo.is_finite() && hi.is_finite()) {
         return Err(FormatError::in_file(
             name,
@@ -52,7 +87,18 @@ pub fn auto_camera(scene: &Scene, name: &str) -> Result<Camera, FormatError> {
             ),
         ));
     }
-    Ok(Camera::look_at(eye, c, Vec3::Y, AUTO_VFOV_DEG, 1.0))
+    let framed = bounds.len() - left_out;
+    let how = match left_out {
+        0 if framed == 1 => "auto (framing the one object)".to_owned(),
+        0 => format!("auto (framing all {framed} objects)"),
+        n => format!(
+            "auto (framing {framed} object{}; {n} flat object{} at least {GROUND_DWARFS} times their \
+             size, a ground or water plane, left out of the framing)",
+            if framed == 1 { "" } else { "s" },
+            if n == 1 { "" } else { "s" }
+        ),
+    };
+    Ok((Camera::look_at(eye, c, Vec3::Y, AUTO_VFOV_DEG, 1.0), how))
 }
 
 #[cfg(test)]
@@ -74,5 +120,49 @@ mod tests {
         let to_centre = (Vec3::splat(2.0) - c.eye).normalize();
         assert!(to_centre.dot(c.forward) > 0.9999);
         assert!(c.eye.distance(Vec3::splat(2.0)) > 3.0f32.sqrt());
+    }
+
+    /// A unit sphere on a square ground plane of side `side`.
+    fn sphere_on_ground(side: f32) -> Scene {
+        let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
+        let m = scene.add_material(Scene::default_material());
+        scene.add_shape(
+            sahara_render::Shape::Sphere {
+                center: Vec3::ZERO,
+                radius: 1.0,
+            },
+            m,
+        );
+        scene.add_shape(
+            sahara_render::Shape::Quad {
+                corner: Vec3::new(-side / 2.0, -1.0, -side / 2.0),
+                edge_u: Vec3::new(side, 0.0, 0.0),
+                edge_v: Vec3::new(0.0, 0.0, side),
+            },
+            m,
+        );
+        scene
+    }
+
+    #[test]
+    fn a_ground_plane_that_dwarfs_the_subject_is_left_out_of_the_framing() {
+        let (c, how) = auto_camera_framing(&sphere_on_ground(1000.0), "t").unwrap();
+        // Framed on the sphere (radius 1): the eye is a few radii away,
+        // not hundreds.
+        assert!(c.eye.length() < 5.0, "{}", c.eye);
+        assert!((c.forward.dot(-c.eye.normalize()) - 1.0).abs() < 1e-4);
+        assert!(
+            how.contains("1 flat object") && how.contains("left out"),
+            "{how}"
+        );
+    }
+
+    #[test]
+    fn a_floor_of_the_subjects_size_is_framed_with_it() {
+        let (c, how) = auto_camera_framing(&sphere_on_ground(3.0), "t").unwrap();
+        assert_eq!(how, "auto (framing all 2 objects)");
+        // Farther than the sphere alone needs (sqrt(3) / sin(22.5 deg) =
+        // 4.5): the floor's corners are in the frame too (6.1).
+        assert!(c.eye.length() > 6.0, "{}", c.eye);
     }
 }

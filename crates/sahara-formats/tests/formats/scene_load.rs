@@ -148,7 +148,7 @@ fn a_glass_mtl_becomes_a_dielectric_in_the_scene() {
         "no emitter: the default sky and sun light it"
     );
     assert!(s.scene.environment.is_some() && s.scene.lights.len() == 1);
-    assert_eq!(s.camera_source, "auto");
+    assert_eq!(s.camera_source, "auto (framing the one object)");
     s.scene.validate().unwrap();
 }
 
