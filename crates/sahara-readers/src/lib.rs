@@ -6,7 +6,9 @@
 //! - images: [`image_in`] (PNG, JPEG, Radiance HDR, OpenEXR, TGA and PFM,
 //!   as their stored values: 8-bit codes or floats, saying which);
 //! - [`camera`] sidecars (JSON);
-//! - [`fan`]: the fan triangulation of polygons that the mesh formats share.
+//! - [`fan`]: the fan triangulation of polygons that the mesh formats share;
+//! - [`sniff`]: files that are images, archives or programs, by their first
+//!   bytes (every mesh load refuses them in words).
 //!
 //! Everything comes out as plain data: [`TriangleMesh`], attribute structs
 //! such as [`obj::ObjScene`], [`ply::PlyMesh`] and [`gltf::GltfScene`],
@@ -32,6 +34,7 @@ mod mesh;
 pub mod mtl;
 pub mod obj;
 pub mod ply;
+pub mod sniff;
 
 use std::path::Path;
 
@@ -51,6 +54,12 @@ pub fn load_mesh(path: &Path) -> Result<TriangleMesh, FormatError> {
 /// the scene, in scene order, with the node's transform applied to its
 /// vertices (so triangle `k` is the same triangle the renderer sees).
 pub fn load_mesh_with_warnings(path: &Path) -> Result<(TriangleMesh, Vec<String>), FormatError> {
+    if let Some(what) = sniff::foreign_kind(path) {
+        return Err(FormatError::in_file(
+            &path.display().to_string(),
+            format!("is {what}, not a mesh (.obj, .ply, .gltf, .glb)"),
+        ));
+    }
     let extension = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())

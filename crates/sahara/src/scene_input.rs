@@ -66,7 +66,7 @@ pub(crate) fn load_input(
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    if let Some(what) = sniff(path) {
+    if let Some(what) = sahara_readers::sniff::foreign_kind(path) {
         bail!(
             "{}: is {what}, not a scene or mesh file; {EXPECTED}",
             path.display()
@@ -114,33 +114,6 @@ pub(crate) fn load_input(
         description: path.display().to_string(),
         warnings,
     })
-}
-
-/// What a file is, by its first bytes, when it is a kind Sahara never
-/// takes as a scene or mesh (an image, an archive, a program): a renamed
-/// PNG would otherwise be reported as a broken glTF or OBJ.
-fn sniff(path: &Path) -> Option<&'static str> {
-    use std::io::Read;
-    let mut head = [0u8; 16];
-    let n = std::fs::File::open(path)
-        .and_then(|mut f| f.read(&mut head))
-        .ok()?;
-    let head = &head[..n];
-    const KINDS: [(&[u8], &str); 9] = [
-        (b"\x89PNG\r\n\x1a\n", "a PNG image"),
-        (b"\xff\xd8\xff", "a JPEG image"),
-        (b"\x76\x2f\x31\x01", "an OpenEXR image"),
-        (b"#?RADIANCE", "a Radiance HDR image"),
-        (b"#?RGBE", "a Radiance HDR image"),
-        (b"GIF8", "a GIF image"),
-        (b"%PDF", "a PDF document"),
-        (b"PK\x03\x04", "a ZIP archive"),
-        (b"\x7fELF", "a program (ELF)"),
-    ];
-    KINDS
-        .iter()
-        .find(|(magic, _)| head.starts_with(magic))
-        .map(|&(_, what)| what)
 }
 
 /// The scene's name: the file name without its extension (`scene.pbrt.gz`

@@ -276,6 +276,29 @@ fn a_missing_mesh_is_an_error_naming_the_file() {
     fs::remove_dir_all(dir).unwrap();
 }
 
+/// An image renamed as a mesh is said to be an image by every command
+/// that loads meshes, in one line naming the file (not "invalid glTF JSON"
+/// or "not valid UTF-8").
+#[test]
+fn bench_and_stats_say_a_renamed_image_is_an_image() {
+    let dir = temp_dir("renamed");
+    for name in ["model.glb", "model.obj", "model.ply"] {
+        let fake = dir.join(name);
+        fs::write(&fake, b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR\0\0\0\x01").unwrap();
+        for cmd in ["bench", "stats"] {
+            let out = sahara(&[cmd, fake.to_str().unwrap()]);
+            assert_eq!(out.status.code(), Some(1));
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_eq!(err.trim_end().lines().count(), 1, "{cmd}: {err}");
+            assert!(
+                err.contains(name) && err.contains("is a PNG image, not a mesh"),
+                "{cmd}: {err}"
+            );
+        }
+    }
+    fs::remove_dir_all(dir).unwrap();
+}
+
 #[test]
 fn an_unknown_builder_is_a_clear_error() {
     let dir = temp_dir("builder");
