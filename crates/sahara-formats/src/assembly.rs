@@ -57,6 +57,10 @@ pub struct AssembledScene {
     pub camera_source: String,
     /// What lights the scene besides its own lights.
     pub sky: SkyUsed,
+    /// With `auto` lighting, the measure that decided it: the scene's own
+    /// lights' power as a share of the default sky and sun's
+    /// ([`sky::own_share`]; weak below [`sky::WEAK_FRACTION`]).
+    pub sky_share: Option<f32>,
     /// Problems that did not stop loading, one line each, naming the
     /// file: the reader's, then the assembly's.
     pub warnings: Vec<String>,
@@ -221,13 +225,14 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
         },
     };
     scene.camera = camera;
-    let sky = sky::apply(&mut scene, &desc.sky)
+    let (sky, sky_share) = sky::apply(&mut scene, &desc.sky)
         .map_err(|e| FormatError::in_file(&name, format!("sky: {e}")))?;
     Ok(AssembledScene {
         scene,
         settings: desc.settings,
         camera_source,
         sky,
+        sky_share,
         warnings,
     })
 }

@@ -104,7 +104,18 @@ pub(crate) fn load_input(
         if a.scene.meshes.iter().all(|m| m.mesh.indices.is_empty()) {
             bail!("{}: the mesh has no triangles", path.display());
         }
-        eprintln!("camera: {}; light: {}", a.camera_source, a.sky);
+        let rule = a.sky_share.map_or_else(String::new, |share| {
+            format!(
+                " (auto: own lights at {share:.3} of the default sky and sun's power, {} {})",
+                if share < sahara_formats::assembly::sky::WEAK_FRACTION {
+                    "below"
+                } else {
+                    "at least"
+                },
+                sahara_formats::assembly::sky::WEAK_FRACTION
+            )
+        });
+        eprintln!("camera: {}; light: {}{rule}", a.camera_source, a.sky);
     }
     let (scene, file, warnings) = (a.scene, a.settings, a.warnings);
     Ok(Input {

@@ -30,41 +30,73 @@ pub fn auto_camera(scene: &Scene, name: &str) -> Result<Camera, FormatError> {
     auto_camera_framing(scene, name).map(|(c, _)| c)
 }
 
-/// A camera that sees the scene's objects: looking at the centre of their
-/// bounds from above, the front (+Z) and the right (+X), at the distance
-/// where their bounding sphere fills the vertical field of view; with the
-/// log's words for how it chose. Flat objects (ground planes, water) whose
-/// extent is at least [`GROUND_DWARFS`] times the diagonal of everything
-/// else's bounds are left out of the framing (they still render), so that
-/// the subject fills the frame rather than the plane it stands on.
-pub fn auto_camera_framing(scene: &Scene, name: &str) -> Result<(Camera, String), FormatError> {
-    let bounds: Vec<(Vec3, Vec3)> = scene
+/// The scene's grounds: per instance, whether it is a flat object (a
+/// ground plane, a sea) whose extent is at least [`GROUND_DWARFS`] times
+/// the diagonal of the bounds of everything that is not flat; and those
+/// bounds (the subject's; empty when everything is flat). The automatic
+/// camera frames what is not ground, and `auto` lighting counts only the
+/// light an emissive ground sheds on the subject.
+pub(crate) fn grounds(scene: &Scene) -> (Vec<bool>, Option<(Vec3, Vec3)>) {
+    let bounds: Vec<Option<(Vec3, Vec3)>> = scene
         .instances
         .iter()
-        .filter_map(|inst| {
+        .map(|inst| {
             let m = &scene.meshes[inst.mesh as usize].mesh;
             let b = inst.placement.world_bounds(m.bounds());
             (!b.is_empty() && b.min.is_finite() && b.max.is_finite()).then_some((b.min, b.max))
         })
         .collect();
-    let union = |it: &mut dyn Iterator<Item = &(Vec3, Vec3)>| {
-        it.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), b| {
-            (lo.min(b.0), hi.max(b.1))
-        })
-    };
     let is_flat = |b: &(Vec3, Vec3)| {
         let e = b.1 - b.0;
         e.min_element() <= FLAT * e.max_element()
     };
-    let (rest_lo, rest_hi) = union(&mut bounds.iter().filter(|b| !is_flat(b)));
-    let rest_diagonal = (rest_hi - rest_lo).length();
-    let dwarfs = |b: &(Vec3, Vec3)| {
-        rest_diagonal.is_finite()
-            && is_flat(b)
-            && (b.1 - b.0).max_element() >= GROUND_DWARFS * rest_diagonal
-    };
-    let left_out = bounds.iter().filter(|b| dwarfs(b)).count();
-    let (lo, hi) = union(&mut bounds.iter().filter(|b| !dwarfs(b)));
+    let (lo, hi) = bounds
+        .iter()
+        .flatten()
+        .filter(|b| !is_flat(b))
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), b| {
+            (lo.min(b.0), hi.max(b.1))
+        });
+    let subject = (lo.is_finite() && hi.is_finite()).then_some((lo, hi));
+    // Without a subject (everything flat) nothing is ground.
+    let diagonal = subject.map(|(lo, hi)| (hi - lo).length());
+    let ground = bounds
+        .iter()
+        .map(|b| match (b, diagonal) {
+            (Some(b), Some(d)) if d.is_finite() => {
+                is_flat(b) && (b.1 - b.0).max_element() >= GROUND_DWARFS * d
+            }
+            _ => false,
+        })
+        .collect();
+    (ground, subject)
+}
+
+/// A camera that sees the scene's objects: looking at the centre of their
+/// bounds from above, the front (+Z) and the right (+X), at the distance
+/// where their bounding sphere fills the vertical field of view; with the
+/// log's words for how it chose. Grounds ([`grounds`]: flat objects at
+/// least [`GROUND_DWARFS`] times the size of everything else) are left out
+/// of the framing (they still render), so that the subject fills the
+/// frame rather than the plane it stands on.
+pub fn auto_camera_framing(scene: &Scene, name: &str) -> Result<(Camera, String), FormatError> {
+    let (ground, _) = grounds(scene);
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    let (mut framed, mut left_out) = (0, 0);
+    for (inst, &g) in scene.instances.iter().zip(&ground) {
+        let m = &scene.meshes[inst.mesh as usize].mesh;
+        let b = inst.placement.world_bounds(m.bounds());
+        if b.is_empty() {
+            continue;
+        }
+        if g {
+            left_out += 1;
+            continue;
+        }
+        framed += 1;
+        lo = lo.min(b.min);
+        hi = hi.max(b.max);
+    }
     if !(lo.is_finite() && hi.is_finite()) {
         return Err(FormatError::in_file(
             name,
@@ -87,7 +119,6 @@ pub fn auto_camera_framing(scene: &Scene, name: &str) -> Result<(Camera, String)
             ),
         ));
     }
-    let framed = bounds.len() - left_out;
     let how = match left_out {
         0 if framed == 1 => "auto (framing the one object)".to_owned(),
         0 => format!("auto (framing all {framed} objects)"),

@@ -5,8 +5,8 @@
 //!   and sun (a directional light from above and in front);
 //! - `none`: nothing; the scene's own lights only;
 //! - `auto`: the default sky and sun if the scene's own lights are weak
-//!   (the rule in [`needs_default`]), else nothing. Mesh files render with
-//!   `auto` unless told otherwise; scene files (TOML, pbrt) with `none`,
+//!   (the rule: [`own_share`] below [`WEAK_FRACTION`]), else nothing.
+//!   Mesh files render with `auto` unless told otherwise; scene files (TOML, pbrt) with `none`,
 //!   since they describe their lighting;
 //! - a file (`.exr`, `.hdr`, `.png`, `.jpg`): an equirectangular
 //!   environment map lights the scene instead, and no sun.
@@ -61,12 +61,22 @@ impl std::fmt::Display for SkyUsed {
 /// (radiance times area times pi, per emitting face), point and spot
 /// lights (intensity times the solid angle they light), directional
 /// lights and the environment (what they shed on the bounding sphere of
-/// radius `radius`).
+/// radius `radius`). An emissive ground (a flat object many times the
+/// size of the rest, such as glowing water: see the automatic camera's
+/// `grounds`) counts at most what it could shed on the rest: most of a
+/// sea's emission goes to the sky and lights nothing the camera sees. The
+/// bound is its emission per unit area over `2π r²` of area, as if it
+/// filled the half of the sky below the bounding sphere (radius `r`) of
+/// everything that is not ground, which then intercepts `2π · π r² · L`
+/// of it per emitting face.
 pub fn own_power(scene: &Scene, radius: f32) -> f32 {
+    let (ground, subject) = super::camera::grounds(scene);
     let mut power = 0.0f64;
     for (i, inst) in scene.instances.iter().enumerate() {
         let mesh = &scene.meshes[inst.mesh as usize];
         let xf = inst.placement.at(0.0);
+        let mut own = 0.0f64;
+        let mut emitting_area = 0.0f64;
         for (t, idx) in mesh.mesh.indices.iter().enumerate() {
             let Some(m) = scene
                 .materials
@@ -86,10 +96,18 @@ pub fn own_power(scene: &Scene, radius: f32) -> f32 {
                     .emission
                     .as_ref()
                     .map_or(1.0, |t| luminance(t.texture.mean()));
-                power +=
+                own +=
                     (area * std::f32::consts::PI * luminance(m.emission) * texture * faces) as f64;
+                emitting_area += area as f64;
             }
         }
+        power += match subject {
+            Some((lo, hi)) if ground[i] && emitting_area > 0.0 => {
+                let r = 0.5 * (hi - lo).length() as f64;
+                own * (2.0 * std::f64::consts::PI * r * r / emitting_area).min(1.0)
+            }
+            _ => own,
+        };
     }
     let sphere = std::f32::consts::PI * radius * radius;
     for l in &scene.lights {
@@ -119,13 +137,6 @@ pub fn default_power(radius: f32) -> f32 {
     sphere * (luminance(DEFAULT_SUN) + 4.0 * std::f32::consts::PI * luminance(DEFAULT_SKY))
 }
 
-/// True if a scene of bounding radius `radius` needs the default sky and
-/// sun to look lit: its own lights shed less than [`WEAK_FRACTION`] of
-/// what those would.
-pub fn needs_default(scene: &Scene, radius: f32) -> bool {
-    own_power(scene, radius) < WEAK_FRACTION * default_power(radius)
-}
-
 /// The bounding radius of the scene's instances (1 if it has none with
 /// finite bounds).
 pub fn scene_radius(scene: &Scene) -> f32 {
@@ -147,18 +158,42 @@ pub fn scene_radius(scene: &Scene) -> f32 {
     }
 }
 
+/// The measure of the `auto` rule: the scene's own lights' power as a
+/// share of what the default sky and sun would shed on it (below
+/// [`WEAK_FRACTION`], they are weak).
+///
+/// Both are measured on the bounding sphere of what is not ground (as the
+/// automatic camera frames it): a large ground plane does not make the
+/// default sky and sun seem stronger than the lights of what stands on it.
+pub fn own_share(scene: &Scene) -> f32 {
+    let r = match super::camera::grounds(scene) {
+        (ground, Some((lo, hi))) if ground.contains(&true) => (0.5 * (hi - lo).length()).max(1e-6),
+        _ => scene_radius(scene),
+    };
+    own_power(scene, r) / default_power(r)
+}
+
 /// Lights `scene` as `sky` says; an environment map that cannot be read
-/// is an error naming it.
-pub fn apply(scene: &mut Scene, sky: &Sky) -> Result<SkyUsed, FormatError> {
+/// is an error naming it. With `auto`, also the rule's measure
+/// ([`own_share`]) that decided.
+pub fn apply(scene: &mut Scene, sky: &Sky) -> Result<(SkyUsed, Option<f32>), FormatError> {
     let add_default = |scene: &mut Scene| {
         scene.environment = Some(Environment::Constant(DEFAULT_SKY));
         scene.add_light(Light::directional(DEFAULT_SUN_DIRECTION, DEFAULT_SUN));
         SkyUsed::Default
     };
     Ok(match sky {
-        Sky::Auto if needs_default(scene, scene_radius(scene)) => add_default(scene),
-        Sky::Auto | Sky::None => SkyUsed::Own,
-        Sky::Default => add_default(scene),
+        Sky::Auto => {
+            let share = own_share(scene);
+            let used = if share < WEAK_FRACTION {
+                add_default(scene)
+            } else {
+                SkyUsed::Own
+            };
+            (used, Some(share))
+        }
+        Sky::None => (SkyUsed::Own, None),
+        Sky::Default => (add_default(scene), None),
         Sky::Map(path) => {
             let (w, h, rgb) = load_rgb_f32(path)?;
             let texels = rgb.chunks_exact(3).map(Vec3::from_slice).collect();
@@ -166,7 +201,72 @@ pub fn apply(scene: &mut Scene, sky: &Sky) -> Result<SkyUsed, FormatError> {
                 texture: Arc::new(Texture::new(w, h, texels)),
                 scale: 1.0,
             });
-            SkyUsed::Map(path.clone())
+            (SkyUsed::Map(path.clone()), None)
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sahara_render::{Camera, Material, Shape};
+
+    /// A unit sphere on a square ground of side 1000 (emitting `ground`,
+    /// upwards), with `lights`.
+    fn sphere_on_a_sea(ground: Vec3, lights: &[Light]) -> Scene {
+        let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
+        let grey = scene.add_material(Material::diffuse(Vec3::splat(0.5)));
+        let sea = scene.add_material(
+            Material::diffuse(Vec3::splat(0.5))
+                .with_emission(ground)
+                .with_two_sided(false),
+        );
+        scene.add_shape(
+            Shape::Sphere {
+                center: Vec3::ZERO,
+                radius: 1.0,
+            },
+            grey,
+        );
+        let side = 1000.0;
+        scene.add_shape(
+            Shape::Quad {
+                corner: Vec3::new(-side / 2.0, -1.0, side / 2.0),
+                edge_u: Vec3::new(side, 0.0, 0.0),
+                edge_v: Vec3::new(0.0, 0.0, -side),
+            },
+            sea,
+        );
+        for l in lights {
+            scene.add_light(*l);
+        }
+        scene
+    }
+
+    #[test]
+    fn a_dim_glowing_sea_does_not_switch_the_sky_off() {
+        // Radiance 0.05 over a million square units: as power, 3000 times
+        // the default sky and sun's on the sphere; what it can shed on the
+        // sphere is 3 % of theirs.
+        let mut scene = sphere_on_a_sea(Vec3::splat(0.05), &[]);
+        let (used, share) = apply(&mut scene, &Sky::Auto).unwrap();
+        let share = share.unwrap();
+        assert_eq!(used, SkyUsed::Default, "share {share}");
+        assert!(share > 0.02 && share < WEAK_FRACTION, "{share}");
+        // A bright one does light the sphere from below.
+        let mut scene = sphere_on_a_sea(Vec3::splat(0.5), &[]);
+        assert_eq!(apply(&mut scene, &Sky::Auto).unwrap().0, SkyUsed::Own);
+    }
+
+    #[test]
+    fn a_lamp_by_the_subject_is_weighed_against_the_sky_on_the_subject_not_on_the_ground() {
+        // A 0.5 W/sr point light: 6.7 % of what the default sky and sun shed
+        // on the sphere's bounds, but a ten-millionth of what they would
+        // shed on the whole ground.
+        let lamp = Light::point(Vec3::new(0.0, 2.0, 2.0), Vec3::splat(0.5));
+        let mut scene = sphere_on_a_sea(Vec3::ZERO, &[lamp]);
+        let (used, share) = apply(&mut scene, &Sky::Auto).unwrap();
+        assert_eq!(used, SkyUsed::Own, "{share:?}");
+        assert!((share.unwrap() - 0.067).abs() < 0.005, "{share:?}");
+    }
 }
