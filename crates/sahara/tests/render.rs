@@ -1416,20 +1416,8 @@ fn the_log_says_why_the_default_sky_was_added() {
     let dir = temp_dir("sky-rule");
     let obj = dir.join("tri.obj");
     fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
-    let out_png = dir.join("tri.png");
-    let out = sahara(&[
-        "render",
-        obj.to_str().unwrap(),
-        "--width",
-        "4",
-        "--height",
-        "4",
-        "--spp",
-        "1",
-        "-o",
-        out_png.to_str().unwrap(),
-    ]);
-    let log = stderr(&out);
+    // 512x512 at 1 sample: a few milliseconds for one triangle.
+    let (out, log) = render_one_sample(&obj, &dir.join("tri.png"));
     assert!(out.status.success(), "{log}");
     assert!(
         log.contains("light: default sky and sun (auto: own lights at 0.000 of the default sky and sun's power, below 0.05)"),
