@@ -498,6 +498,26 @@ impl<'a> World<'a> {
         Some((s, pmf))
     }
 
+    /// One light chosen by power (`u_pick`), as its index and the
+    /// probability of the choice.
+    pub(crate) fn pick_light(&self, u_pick: f32) -> Option<(usize, f32)> {
+        if self.lights.is_empty() {
+            return None;
+        }
+        let (i, pmf) = self.select.sample_discrete(u_pick);
+        (pmf > 0.0).then_some((i, pmf))
+    }
+
+    /// The sampled light that instance `instance` is part of, if any.
+    pub(crate) fn light_of(&self, instance: u32) -> Option<u32> {
+        self.instance_light[instance as usize]
+    }
+
+    /// The environment's light, if the scene has an environment.
+    pub(crate) fn env_light(&self) -> Option<u32> {
+        self.env
+    }
+
     /// Probability that [`World::sample_light`] picks light `i`.
     pub fn light_pmf(&self, i: usize) -> f32 {
         self.select.pmf(i)
@@ -723,7 +743,7 @@ pub const MAX_PASS_THROUGHS: u32 = 64;
 /// meets lets it through (stochastic transparency): a hash of the ray and
 /// the hit, so a render is the same every time.
 #[inline]
-fn pass_through_draw(ray: &Ray, hit: &SurfaceHit, k: u32) -> f32 {
+pub(crate) fn pass_through_draw(ray: &Ray, hit: &SurfaceHit, k: u32) -> f32 {
     let o = ray.origin.to_array().map(f32::to_bits);
     let d = ray.dir.to_array().map(f32::to_bits);
     let a = (o[0] as u64) << 32 | o[1] as u64;

@@ -19,8 +19,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use sahara_render::UNLIMITED_SPP;
 use sahara_render::{
-    render_watched, Aov, Filter, FilterKind, Integrator, Preview, Progress, RenderResult,
-    RenderSettings, ToneMap,
+    render_watched, Aov, Filter, FilterKind, Integrator, PixelWindow, Preview, Progress,
+    RenderResult, RenderSettings, ToneMap,
 };
 
 use crate::cli::RenderArgs;
@@ -115,6 +115,33 @@ fn check_args(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The bidirectional integrators' light tracing adds light anywhere in
+/// the frame, from every pixel's samples: a piece of the frame by pixels
+/// would miss the light of the others, and adaptive sampling would change
+/// how much light tracing each pixel's samples bring. Both are refused.
+fn check_splatting(settings: &RenderSettings, piece: Option<&part::Piece>) -> Result<()> {
+    let integrator = settings.integrator;
+    if !integrator.splats() {
+        return Ok(());
+    }
+    let full = PixelWindow::full(settings.width, settings.height);
+    if piece.is_some_and(|p| p.window != full) {
+        bail!(
+            "the {} integrator's light tracing lands anywhere in the frame: split it by samples \
+             (--split samples, --samples) rather than by pixels (--split tiles, --crop)",
+            integrator.name()
+        );
+    }
+    if settings.adaptive.is_some() {
+        bail!(
+            "adaptive sampling (a noise threshold) needs the path or distribution integrator: \
+             the {} integrator's light tracing adds to pixels that have stopped",
+            integrator.name()
+        );
+    }
+    Ok(())
+}
+
 /// Adaptive sampling cannot split a frame by sample ranges.
 fn refuse_sample_ranges(args: &RenderArgs, what: &str) -> Result<()> {
     if args.samples.is_some() || args.split == Some(crate::cli::Split::Samples) {
@@ -203,6 +230,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
     if piece.is_none() {
         settings.window = file_window;
     }
+    check_splatting(&settings, piece.as_ref())?;
     // The output named by the scene file (the command line's was checked
     // by `check_args`).
     if args.output.is_none() {
@@ -234,7 +262,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         )
     {
         bail!(
-            "{} needs an integrator that traces paths (path or distribution), not {}",
+            "{} needs the path or distribution integrator, not {}",
             match (args.aov.is_empty(), args.denoise) {
                 (false, _) => "--aov",
                 (true, true) => "--denoise",

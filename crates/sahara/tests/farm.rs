@@ -404,3 +404,53 @@ mod random_splits {
         }
     }
 }
+
+/// Bidirectional path tracing splits by samples exactly (its light
+/// tracing lands anywhere in the frame, from every pixel's samples, and
+/// the sums do not depend on the order it arrives in); a split by pixels,
+/// or adaptive sampling, is refused in one line before anything renders.
+#[test]
+fn bdpt_splits_by_samples_exactly_and_refuses_splits_by_pixels() {
+    let dir = temp_dir("farm-bdpt");
+    let bdpt = ["--integrator", "bdpt"];
+    let whole = dir.join("whole.exr");
+    render(&bdpt, &whole);
+    let pieces: Vec<Vec<String>> = split(3, "samples")
+        .into_iter()
+        .map(|mut p| {
+            p.extend(bdpt.iter().map(|s| s.to_string()));
+            p
+        })
+        .collect();
+    let files = parts(&dir, "bdpt", &pieces);
+    let out = dir.join("merged.exr");
+    let m = merge(&files, &out, &[]);
+    assert!(m.status.success(), "{}", stderr(&m));
+    assert!(
+        fs::read(&out).unwrap() == fs::read(&whole).unwrap(),
+        "the merged bdpt frame differs from the whole one"
+    );
+    let o = dir.join("refused.exr");
+    for extra in [
+        &["--part", "0/2", "--split", "tiles"][..],
+        &["--crop", "0,0.5,0,1"][..],
+        &["--noise-threshold", "0.05"][..],
+    ] {
+        let r = sahara(
+            &[
+                &["render"],
+                FRAME,
+                &bdpt,
+                extra,
+                &["-o", o.to_str().unwrap()],
+            ]
+            .concat(),
+        );
+        let e = stderr(&r);
+        assert!(!r.status.success(), "{extra:?} was rendered");
+        assert_eq!(e.trim_end().lines().count(), 1, "{extra:?}: one line: {e}");
+        assert!(e.contains("bdpt"), "{extra:?}: {e}");
+        assert!(!o.exists(), "{extra:?}: an output was written");
+    }
+    fs::remove_dir_all(&dir).unwrap();
+}

@@ -1147,7 +1147,7 @@ fn render_passes_need_an_exr_and_a_path_tracer() {
     ]);
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("--aov needs an integrator that traces paths"),
+        stderr(&out).contains("--aov needs the path or distribution integrator"),
         "{}",
         stderr(&out)
     );
@@ -1389,7 +1389,7 @@ fn denoising_lowers_the_error_of_a_noisy_render() {
         noisy.to_str().unwrap(),
     ]);
     assert!(
-        stderr(&out).contains("--denoise needs an integrator that traces paths"),
+        stderr(&out).contains("--denoise needs the path or distribution integrator"),
         "{}",
         stderr(&out)
     );

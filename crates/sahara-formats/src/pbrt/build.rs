@@ -662,8 +662,25 @@ fn settings(
                     max_depth,
                     rr_depth: 3,
                 },
-                "bdpt" | "mlt" | "sppm" | "lightpath" | "simplepath" | "simplevolpath"
-                | "randomwalk" => {
+                "bdpt" => {
+                    for k in ["visualizestrategies", "visualizeweights"] {
+                        if i.params.bool(k, false)? {
+                            w.add(format!("integrator 'bdpt' {k} is not drawn"), &i.loc);
+                        }
+                    }
+                    Integrator::Bdpt { max_depth }
+                }
+                "lightpath" => Integrator::LightPath { max_depth },
+                "mlt" => {
+                    w.add(
+                        "integrator 'mlt' is rendered by bidirectional path tracing (bdpt), \
+                         which converges to the same image",
+                        &i.loc,
+                    );
+                    i.params.mark_all_used();
+                    Integrator::Bdpt { max_depth }
+                }
+                "sppm" | "simplepath" | "simplevolpath" | "randomwalk" => {
                     w.add(
                         format!(
                             "integrator '{}' is replaced by Sahara's path tracer",

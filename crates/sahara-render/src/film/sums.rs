@@ -69,6 +69,16 @@ impl PixelSum {
         self.weight += fixed(w64);
     }
 
+    /// Adds radiance `l` with filter weight `w` to the radiance sums
+    /// only, not to the weight (light arriving from other pixels' samples).
+    #[inline]
+    pub fn add_radiance(&mut self, l: Vec3, w: f32) {
+        let w64 = w as f64;
+        self.rgb[0] += fixed(l.x as f64 * w64);
+        self.rgb[1] += fixed(l.y as f64 * w64);
+        self.rgb[2] += fixed(l.z as f64 * w64);
+    }
+
     /// Adds another pixel's sums (exactly).
     #[inline]
     pub fn add(&mut self, other: &PixelSum) {
@@ -177,6 +187,50 @@ impl SumBuffer {
                 let wt = wy * w;
                 if wt != 0.0 {
                     self.sums[row + (px - self.x0) as usize].add_sample(l, wt);
+                }
+            }
+        }
+    }
+
+    /// Adds light that arrives at film position `pos` (pixel units) from
+    /// samples of other pixels (light tracing): `f(centre - pos) l` to the
+    /// radiance sums of every pixel of the buffer whose centre lies within
+    /// the filter's radius, nothing to their weights.
+    ///
+    /// A pixel's value is its radiance sum over its weight sum, and the
+    /// weights of one sample per pixel across the image add up, in
+    /// expectation, to the filter's integral at every pixel (to its part
+    /// inside the image at the border, where light tracing's positions end
+    /// too). So a contribution per sample of each pixel, splatted here,
+    /// counts as pbrt's splats do after division by the samples per pixel
+    /// and the filter's integral, with no normalisation of its own; and
+    /// the sums stay exact, so the image still does not depend on the
+    /// order the contributions arrive in.
+    pub fn add_splat(&mut self, filter: &Filter, pos: Vec2, l: Vec3) {
+        if self.width == 0 || self.height == 0 || !pos.is_finite() {
+            return;
+        }
+        let r = filter.radius();
+        let lo = |p: f32, o: u32| ((p - 0.5 - r).ceil().max(o as f32)) as u32;
+        let hi = |p: f32, o: u32, n: u32| (p - 0.5 + r).floor().min((o + n - 1) as f32);
+        let (x0, y0) = (lo(pos.x, self.x0), lo(pos.y, self.y0));
+        let (x1, y1) = (
+            hi(pos.x, self.x0, self.width),
+            hi(pos.y, self.y0, self.height),
+        );
+        if x1 < x0 as f32 || y1 < y0 as f32 {
+            return;
+        }
+        for py in y0..=y1 as u32 {
+            let wy = filter.eval_1d(pos.y - (py as f32 + 0.5));
+            if wy == 0.0 {
+                continue;
+            }
+            let row = (py - self.y0) as usize * self.width as usize;
+            for px in x0..=x1 as u32 {
+                let w = wy * filter.eval_1d(pos.x - (px as f32 + 0.5));
+                if w != 0.0 {
+                    self.sums[row + (px - self.x0) as usize].add_radiance(l, w);
                 }
             }
         }

@@ -1,13 +1,14 @@
 //! Light transport: the distribution ray tracer, the path tracer, and
 //! debug views.
 
+pub(crate) mod bdpt;
 pub mod debug;
 mod distribution;
 mod path;
 mod state;
 pub(crate) mod wavefront;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use sahara_kd::{Ray, TraversalCounters};
 
 use crate::light::LightSample;
@@ -42,6 +43,23 @@ pub enum Integrator {
         max_depth: u32,
         /// Samples per area light (and environment) at every hit.
         light_samples: u32,
+    },
+    /// Bidirectional path tracing: a camera and a light subpath per
+    /// sample, joined in every way, weighted by multiple importance
+    /// sampling (power heuristic); finds caustics and light that arrives
+    /// through small openings. Paths end at `max_depth` scattering events
+    /// (no Russian roulette).
+    Bdpt {
+        /// Largest number of scattering events.
+        max_depth: u32,
+    },
+    /// Light tracing: light subpaths joined to the camera, and the
+    /// emitters the camera sees directly; surfaces seen through mirrors
+    /// or glass stay black. Bidirectional path tracing's light strategy
+    /// alone.
+    LightPath {
+        /// Largest number of scattering events.
+        max_depth: u32,
     },
     /// The shading normal, mapped to `n / 2 + 1/2`.
     Normals,
@@ -94,6 +112,10 @@ pub enum IntegratorKind {
     Path,
     /// [`Integrator::Distribution`].
     Distribution,
+    /// [`Integrator::Bdpt`].
+    Bdpt,
+    /// [`Integrator::LightPath`].
+    LightPath,
     /// [`Integrator::Normals`].
     Normals,
     /// [`Integrator::Depth`].
@@ -107,6 +129,8 @@ pub enum IntegratorKind {
 name_table!(IntegratorKind, "integrator", {
     IntegratorKind::Path => "path",
     IntegratorKind::Distribution => "distribution",
+    IntegratorKind::Bdpt => "bdpt",
+    IntegratorKind::LightPath => "lightpath",
     IntegratorKind::Normals => "normals",
     IntegratorKind::Depth => "depth",
     IntegratorKind::Ao => "ao",
@@ -156,6 +180,7 @@ impl IntegratorKind {
         match self {
             IntegratorKind::Path => PATH,
             IntegratorKind::Distribution => DISTRIBUTION,
+            IntegratorKind::Bdpt | IntegratorKind::LightPath => &[MAX_DEPTH],
             IntegratorKind::Ao => AO,
             IntegratorKind::Normals | IntegratorKind::Depth | IntegratorKind::Cost => &[],
         }
@@ -189,6 +214,12 @@ impl Integrator {
                     light_samples: light_samples as u32,
                 }
             }
+            (IntegratorKind::Bdpt, &[max_depth]) => Integrator::Bdpt {
+                max_depth: max_depth as u32,
+            },
+            (IntegratorKind::LightPath, &[max_depth]) => Integrator::LightPath {
+                max_depth: max_depth as u32,
+            },
             (IntegratorKind::Ao, &[samples, distance]) => Integrator::Ao {
                 samples: samples as u32,
                 distance,
@@ -216,6 +247,9 @@ impl Integrator {
                 light_samples,
             } => vec![max_depth as f32, light_samples as f32],
             Integrator::Ao { samples, distance } => vec![samples as f32, distance],
+            Integrator::Bdpt { max_depth } | Integrator::LightPath { max_depth } => {
+                vec![max_depth as f32]
+            }
             Integrator::Normals | Integrator::Depth | Integrator::Cost => Vec::new(),
         }
     }
@@ -227,6 +261,8 @@ impl Integrator {
         match self {
             Integrator::Path { .. } => IntegratorKind::Path,
             Integrator::Distribution { .. } => IntegratorKind::Distribution,
+            Integrator::Bdpt { .. } => IntegratorKind::Bdpt,
+            Integrator::LightPath { .. } => IntegratorKind::LightPath,
             Integrator::Normals => IntegratorKind::Normals,
             Integrator::Depth => IntegratorKind::Depth,
             Integrator::Ao { .. } => IntegratorKind::Ao,
@@ -280,10 +316,51 @@ pub struct Context<'w, 'a> {
 impl Integrator {
     /// Radiance along a camera ray at `time`, the ray queries answered one
     /// at a time (the render loop answers them in batches, with the same
-    /// result bit for bit: see `wavefront`).
+    /// result bit for bit: see `wavefront`). The bidirectional integrators'
+    /// light tracing contributions land elsewhere on the film: they are
+    /// left out here (see [`Integrator::li_splats`]).
     pub fn li(&self, ctx: &mut Context, ray: &Ray, time: f32) -> Vec3 {
+        self.li_splats(ctx, ray, time, Vec2::ONE, &mut Vec::new())
+    }
+
+    /// True for the integrators whose samples also add light elsewhere on
+    /// the film ([`bdpt::Splat`]): the whole frame must be rendered for
+    /// any pixel to be complete.
+    pub fn splats(&self) -> bool {
+        matches!(self, Integrator::Bdpt { .. } | Integrator::LightPath { .. })
+    }
+
+    /// [`Integrator::li`], with the light tracing contributions of the
+    /// bidirectional integrators pushed to `splats` (`film`: the image's
+    /// size in pixels).
+    pub(crate) fn li_splats(
+        &self,
+        ctx: &mut Context,
+        ray: &Ray,
+        time: f32,
+        film: Vec2,
+        splats: &mut Vec<bdpt::Splat>,
+    ) -> Vec3 {
         ctx.stats.camera_rays += 1;
         match *self {
+            Integrator::Bdpt { max_depth } => bdpt::sample(
+                ctx,
+                ray,
+                time,
+                max_depth,
+                bdpt::Strategies::All,
+                film,
+                splats,
+            ),
+            Integrator::LightPath { max_depth } => bdpt::sample(
+                ctx,
+                ray,
+                time,
+                max_depth,
+                bdpt::Strategies::LightTracing,
+                film,
+                splats,
+            ),
             Integrator::Path { .. } | Integrator::Distribution { .. } => {
                 let world = ctx.world;
                 let mut st = PathState::new(*ray, time, ctx.sampler);

@@ -84,6 +84,17 @@ impl EmissionTextures {
     }
 }
 
+/// The emission texture's factor at barycentric `(b1, b2)` of a mesh
+/// light's triangle with texture `t` (1 without one).
+pub(crate) fn texture_factor(
+    maps: &[TextureMap],
+    t: &Option<(u32, [[Vec2; 3]; 2])>,
+    b1: f32,
+    b2: f32,
+) -> Vec3 {
+    EmissionTextures::at(maps, t, b1, b2)
+}
+
 /// An emitting surface with its radiance.
 #[derive(Clone, Debug)]
 pub struct AreaLight {
@@ -209,13 +220,19 @@ impl AreaLight {
     /// A point on the light as seen from `p`: direction, distance, incident
     /// radiance and solid-angle density.
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
-        let (q, n, pdf_area, le) = match &self.emitter {
+        let (q, n, pdf_area, le, two) = match &self.emitter {
             Emitter::Quad {
                 corner,
                 u: eu,
                 v: ev,
                 n,
-            } => (*corner + *eu * u.x + *ev * u.y, *n, 1.0 / self.area, None),
+            } => (
+                *corner + *eu * u.x + *ev * u.y,
+                *n,
+                1.0 / self.area,
+                None,
+                self.two_sided,
+            ),
             Emitter::Disc {
                 center,
                 frame,
@@ -227,6 +244,7 @@ impl AreaLight {
                     frame.n,
                     1.0 / self.area,
                     None,
+                    self.two_sided,
                 )
             }
             Emitter::Sphere { center, radius } => {
@@ -255,7 +273,7 @@ impl AreaLight {
                 } else {
                     le * EmissionTextures::at(maps, &textures[i], b1, b2)
                 };
-                (q, n, 1.0 / self.area, Some(le))
+                (q, n, 1.0 / self.area, Some(le), two_sided[i])
             }
         };
         let d = q - p;
@@ -280,6 +298,8 @@ impl AreaLight {
             pdf: pdf_area * dist2 / cos,
             delta: false,
             ignore: self.instance,
+            n,
+            two_sided: two,
         })
     }
 
@@ -308,6 +328,8 @@ impl AreaLight {
                 pdf: dist2 / (cos * self.area),
                 delta: false,
                 ignore: self.instance,
+                n,
+                two_sided: self.two_sided,
             });
         }
         let d = d2.sqrt();
@@ -336,6 +358,8 @@ impl AreaLight {
             pdf: 1.0 / (2.0 * PI * one_minus),
             delta: false,
             ignore: self.instance,
+            n,
+            two_sided: self.two_sided,
         })
     }
 

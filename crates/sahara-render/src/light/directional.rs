@@ -16,6 +16,8 @@ pub fn sample(direction: Vec3, irradiance: Vec3) -> Option<LightSample> {
         pdf: 1.0,
         delta: true,
         ignore: None,
+        n: Vec3::ZERO,
+        two_sided: false,
     })
 }
 

@@ -133,6 +133,8 @@ impl EnvLight {
             pdf,
             delta: false,
             ignore: None,
+            n: Vec3::ZERO,
+            two_sided: false,
         })
     }
 

@@ -3,6 +3,7 @@
 
 pub mod area;
 pub mod directional;
+pub(crate) mod emission;
 pub mod environment;
 pub mod point;
 pub mod spot;
@@ -97,6 +98,11 @@ pub struct LightSample {
     /// An instance that cannot block this sample: the convex emitter itself
     /// (its tessellation may lie across the exact surface sampled).
     pub ignore: Option<u32>,
+    /// Unit front normal of the light's surface at the sampled point (zero
+    /// for point, spot and directional lights and the environment).
+    pub n: Vec3,
+    /// Whether the light's surface emits from both faces there.
+    pub two_sided: bool,
 }
 
 /// Any light the integrators sample.

@@ -22,6 +22,8 @@ pub fn sample(position: Vec3, intensity: Vec3, p: Vec3) -> Option<LightSample> {
         pdf: 1.0,
         delta: true,
         ignore: None,
+        n: Vec3::ZERO,
+        two_sided: false,
     })
 }
 

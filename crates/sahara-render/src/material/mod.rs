@@ -590,6 +590,22 @@ impl PointBsdf {
         self.bsdf.is_delta() && self.coat.is_none_or(|c| c.is_smooth())
     }
 
+    /// The factor that turns the value (or sample weight) for `(wo, wi)`
+    /// into that for importance, light travelling from `wo` to `wi`: the
+    /// values here are for radiance, which refraction scales by
+    /// `1 / eta^2` (eta: the index on `wi`'s side over `wo`'s); importance
+    /// is not scaled (Veach 1997, section 5.2).
+    #[inline]
+    pub(crate) fn adjoint_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self.bsdf {
+            Bsdf::Dielectric { ior } | Bsdf::RoughDielectric { ior, .. } if wo.z * wi.z < 0.0 => {
+                let eta = if wo.z > 0.0 { ior } else { 1.0 / ior };
+                eta * eta
+            }
+            _ => 1.0,
+        }
+    }
+
     /// True for an uncoated Lambertian BSDF.
     #[inline]
     pub fn is_diffuse(&self) -> bool {

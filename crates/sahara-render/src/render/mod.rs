@@ -27,6 +27,7 @@ use crate::film::filter::Filter;
 use crate::film::sums::{filter_margin, SumBuffer};
 use crate::film::window::PixelWindow;
 use crate::film::{heat_color, Film};
+use crate::integrator::bdpt::Splat;
 use crate::integrator::wavefront::Wavefront;
 use crate::integrator::{defaults, AuxSample, Context, Integrator, PathState, TraceStats};
 use crate::math::hash::hash2;
@@ -304,6 +305,9 @@ struct TileOut {
     negative: u64,
     /// Pixels rendered, in render order (all of them unless stopped).
     pixels_done: u32,
+    /// Light the tile's samples add elsewhere on the film (bidirectional
+    /// integrators).
+    splats: Vec<Splat>,
 }
 
 /// Renders `scene`; `progress` is called from worker threads as tiles
@@ -348,6 +352,10 @@ pub fn render_watched(
         })
         .collect();
     let mut sums = SumBuffer::new(window.x0, window.y0, window.width(), window.height());
+    // Light tracing's contributions count one light subpath per sample of
+    // every pixel of the image; a window renders the samples of its
+    // region only, whose light subpaths then stand for all of them.
+    let splat_scale = (w as f64 * h as f64 / region.pixels() as f64) as f32;
     let mut aux = (!settings.aovs.is_empty()).then(|| {
         Aux::new(
             &settings.aovs,
@@ -482,6 +490,9 @@ pub fn render_watched(
         }
         for out in outs.into_iter().flatten() {
             sums.add(&out.sums);
+            for splat in &out.splats {
+                sums.add_splat(&settings.filter, splat.pos, splat.l * splat_scale);
+            }
             stats.trace += out.stats;
             stats.time_split += out.split;
             if let (Some(a), Some(o)) = (&mut aux, &out.aux) {
@@ -625,6 +636,7 @@ fn render_tile(
         nan: 0,
         negative: 0,
         pixels_done: 0,
+        splats: Vec::new(),
     };
     let active = |x: u32, y: u32| convergence.is_none_or(|c| c.is_active(x, y));
     let stepped = s.integrator.is_stepped();
@@ -653,6 +665,10 @@ fn render_tile(
                 convergence,
                 &mut out.stats,
             );
+            for mut splat in strip.splats.drain(..) {
+                splat.l = guard(splat.l, &mut out.nan, &mut out.negative);
+                out.splats.push(splat);
+            }
             if convergence.is_none() && out.aux.is_none() {
                 // The plain render: every pixel, nothing besides the beauty.
                 let mut k = 0;
@@ -743,6 +759,8 @@ struct Strip {
     slot: Vec<u32>,
     /// Each sample's auxiliary values (when the settings ask for them).
     aux: Vec<AuxSample>,
+    /// Light the samples add elsewhere on the film.
+    splats: Vec<Splat>,
     wavefront: Wavefront,
 }
 
@@ -805,6 +823,7 @@ impl Strip {
             (((y - y0) * (x1 - x0) + (x - x0)) * per_pixel + index - indices.start) as usize
         };
         if !s.integrator.is_stepped() {
+            let film = Vec2::new(w as f32, h as f32);
             for y in y0..y1 {
                 for x in x0..x1 {
                     if !active(x, y) {
@@ -819,7 +838,9 @@ impl Strip {
                         };
                         let k = slot_of(x, y, index);
                         self.pos[k] = pos;
-                        self.radiance[k] = s.integrator.li(&mut ctx, &ray, time);
+                        self.radiance[k] =
+                            s.integrator
+                                .li_splats(&mut ctx, &ray, time, film, &mut self.splats);
                     }
                 }
             }

@@ -95,6 +95,97 @@ impl Camera {
         (Ray::new(origin, (focus - origin).normalize()), time)
     }
 
+    /// Area of the image rectangle on the plane at unit distance in front
+    /// of the eye.
+    fn image_plane_area(&self) -> f32 {
+        let th = self.tan_half_fov();
+        4.0 * th * th * self.aspect
+    }
+
+    /// Area of the lens (1 for a pinhole, whose one point counts as a unit
+    /// measure in importance and its densities, as in pbrt).
+    fn lens_area(&self) -> f32 {
+        if self.lens_radius > 0.0 {
+            std::f32::consts::PI * self.lens_radius * self.lens_radius
+        } else {
+            1.0
+        }
+    }
+
+    /// The normalised film position (`[0, 1]^2`, from the top-left corner)
+    /// of the ray leaving lens point `lens` along unit `dir`, and the
+    /// cosine of `dir` to the viewing direction; `None` if it misses the
+    /// film. The inverse of [`Camera::generate_ray`].
+    pub(crate) fn film_of(&self, lens: Vec3, dir: Vec3) -> Option<(Vec2, f32)> {
+        let cos = dir.dot(self.forward);
+        if cos <= 0.0 {
+            return None;
+        }
+        // The pinhole direction through the same point of the plane in
+        // focus (the ray itself for a pinhole).
+        let d = if self.lens_radius > 0.0 {
+            let focus = lens + dir * (self.focus_distance / cos);
+            focus - self.eye
+        } else {
+            dir
+        };
+        let z = d.dot(self.forward);
+        if z <= 0.0 {
+            return None;
+        }
+        let th = self.tan_half_fov();
+        let sx = d.dot(self.right) / z / (th * self.aspect);
+        let sy = d.dot(self.up) / z / th;
+        let film = Vec2::new(0.5 * (sx + 1.0), 0.5 * (1.0 - sy));
+        ((0.0..1.0).contains(&film.x) && (0.0..1.0).contains(&film.y)).then_some((film, cos))
+    }
+
+    /// Importance of a ray leaving the lens at cosine `cos` to the
+    /// viewing direction: `1 / (A lens_area cos^4)`, with `A` the image
+    /// area at unit distance, so that it integrates to one over the film
+    /// and the lens.
+    fn importance(&self, cos: f32) -> f32 {
+        let c2 = cos * cos;
+        1.0 / (self.image_plane_area() * self.lens_area() * c2 * c2)
+    }
+
+    /// Solid-angle density with which [`Camera::generate_ray`] (uniform
+    /// film positions) sends a ray along unit `dir` (from any lens point):
+    /// `1 / (A cos^3)`, zero off the film.
+    pub(crate) fn pdf_dir(&self, lens: Vec3, dir: Vec3) -> f32 {
+        match self.film_of(lens, dir) {
+            Some((_, cos)) => 1.0 / (self.image_plane_area() * cos * cos * cos),
+            None => 0.0,
+        }
+    }
+
+    /// The lens seen from `p`: a point on the lens (`u`; the eye for a
+    /// pinhole), with the film position of the ray from it to `p` and the
+    /// importance arriving along it, or `None` if that ray misses the film.
+    pub(crate) fn sample_toward(&self, p: Vec3, u: Vec2) -> Option<LensSample> {
+        let lens = if self.lens_radius > 0.0 {
+            let l = concentric_disc(u) * self.lens_radius;
+            self.eye + self.right * l.x + self.up * l.y
+        } else {
+            self.eye
+        };
+        let to_p = p - lens;
+        let dist = to_p.length();
+        if dist <= 0.0 || !dist.is_finite() {
+            return None;
+        }
+        let dir = to_p / dist;
+        let (film, cos) = self.film_of(lens, dir)?;
+        Some(LensSample {
+            film,
+            lens,
+            wi: -dir,
+            dist,
+            importance: self.importance(cos),
+            pdf: dist * dist / (cos * self.lens_area()),
+        })
+    }
+
     /// Fraction of the shutter interval at `time`, in `[0, 1]` (0 for an
     /// instantaneous shutter).
     pub fn shutter_fraction(&self, time: f32) -> f32 {
@@ -105,6 +196,23 @@ impl Camera {
             0.0
         }
     }
+}
+
+/// The camera seen from a point (see [`Camera::sample_toward`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LensSample {
+    /// Normalised film position of the ray.
+    pub film: Vec2,
+    /// The point on the lens.
+    pub lens: Vec3,
+    /// Unit direction from the point to the lens.
+    pub wi: Vec3,
+    /// Distance from the point to the lens.
+    pub dist: f32,
+    /// Importance `W_e` of the ray.
+    pub importance: f32,
+    /// Solid-angle density of `wi` at the point.
+    pub pdf: f32,
 }
 
 #[cfg(test)]
@@ -118,6 +226,47 @@ mod tests {
         let (top, _) = c.generate_ray(Vec2::new(0.5, 0.1), Vec2::ZERO, 0.0);
         assert!(left.dir.x > 0.0);
         assert!(top.dir.y > 0.0);
+    }
+
+    /// The lens seen from a point gives back the film position of the
+    /// camera ray through that point, for a pinhole and a thin lens; and
+    /// importance over the film integrates to one.
+    #[test]
+    fn sample_toward_inverts_generate_ray() {
+        let pin = Camera::look_at(Vec3::new(1.0, 2.0, 3.0), Vec3::ZERO, Vec3::Y, 50.0, 1.5);
+        let lens = pin.with_thin_lens(0.2, 2.5);
+        for c in [pin, lens] {
+            for (film, u) in [
+                (Vec2::new(0.3, 0.7), Vec2::new(0.1, 0.9)),
+                (Vec2::new(0.95, 0.05), Vec2::new(0.5, 0.5)),
+            ] {
+                let (ray, _) = c.generate_ray(film, u, 0.0);
+                let p = ray.origin + ray.dir * 1.7;
+                let s = c.sample_toward(p, u).unwrap();
+                assert!(
+                    (s.film - film).abs().max_element() < 1e-4,
+                    "{:?} {film}",
+                    s.film
+                );
+                assert!((s.lens - ray.origin).length() < 1e-5);
+                assert!((s.wi + ray.dir).length() < 1e-4);
+            }
+        }
+        // Integral of W_e cos over directions through the film, by
+        // uniform film positions: 1 = E[W_e cos / pdf_dir] = E[W_e / (pdf... )].
+        let c = pin;
+        let n = 200;
+        let mut sum = 0.0f64;
+        for i in 0..n {
+            for j in 0..n {
+                let film = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let (ray, _) = c.generate_ray(film, Vec2::ZERO, 0.0);
+                let cos = ray.dir.dot(c.forward);
+                sum += (c.importance(cos) * cos / c.pdf_dir(ray.origin, ray.dir)) as f64;
+            }
+        }
+        let integral = sum / (n * n) as f64;
+        assert!((integral - 1.0).abs() < 1e-3, "{integral}");
     }
 
     #[test]
