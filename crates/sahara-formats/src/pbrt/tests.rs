@@ -707,3 +707,33 @@ fn the_fuzz_seed_with_every_material_warns_only_of_what_it_approximates() {
     // 13 shapes: the sphere of alpha 0 is not there.
     assert_eq!(s.scene.instances.len(), 12);
 }
+
+/// pbrt's bidirectional integrators map onto Sahara's: `bdpt` and
+/// `lightpath` with their `maxdepth`, `mlt` onto `bdpt` with a warning.
+#[test]
+fn bidirectional_integrators_map_onto_bdpt_and_light_tracing() {
+    use sahara_render::Integrator;
+    let integrator = |line: &str| {
+        let text =
+            format!("{line}\nLookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin");
+        let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/scenes")).unwrap();
+        (s.settings.as_ref().unwrap().integrator, s.warnings.clone())
+    };
+    let (i, w) = integrator("Integrator \"bdpt\" \"integer maxdepth\" 7");
+    assert_eq!(i, Integrator::Bdpt { max_depth: 7 });
+    assert!(w.is_empty(), "{w:?}");
+    let (i, _) = integrator("Integrator \"bdpt\"");
+    assert_eq!(i, Integrator::Bdpt { max_depth: 5 });
+    let (i, w) = integrator("Integrator \"lightpath\" \"integer maxdepth\" 3");
+    assert_eq!(i, Integrator::LightPath { max_depth: 3 });
+    assert!(w.is_empty(), "{w:?}");
+    let (i, w) = integrator("Integrator \"mlt\" \"integer mutationsperpixel\" 100");
+    assert_eq!(i, Integrator::Bdpt { max_depth: 5 });
+    assert!(
+        w.iter()
+            .any(|w| w.contains("'mlt' is rendered by bidirectional path tracing")),
+        "{w:?}"
+    );
+    let (_, w) = integrator("Integrator \"bdpt\" \"bool visualizestrategies\" true");
+    assert!(w.iter().any(|w| w.contains("visualizestrategies")), "{w:?}");
+}
