@@ -119,8 +119,28 @@ fn check_args(args: &RenderArgs) -> Result<()> {
 /// the frame, from every pixel's samples: a piece of the frame by pixels
 /// would miss the light of the others, and adaptive sampling would change
 /// how much light tracing each pixel's samples bring. Both are refused.
+///
+/// SPPM's iterations each shrink the search radius the next one uses: it
+/// splits by pixels exactly, not by sample ranges, and has no samples to
+/// stop adaptively.
 fn check_splatting(settings: &RenderSettings, piece: Option<&part::Piece>) -> Result<()> {
     let integrator = settings.integrator;
+    if let Integrator::Sppm { .. } = integrator {
+        if piece.is_some_and(|p| p.samples != (0..settings.spp)) {
+            bail!(
+                "the sppm integrator's iterations each shrink the radius the next one uses: \
+                 split it by pixels (--split tiles, --crop) rather than by samples \
+                 (--split samples, --samples)"
+            );
+        }
+        if settings.adaptive.is_some() {
+            bail!(
+                "adaptive sampling (a noise threshold) needs the path or distribution \
+                 integrator, not sppm"
+            );
+        }
+        return Ok(());
+    }
     if !integrator.splats() {
         return Ok(());
     }

@@ -454,3 +454,52 @@ fn bdpt_splits_by_samples_exactly_and_refuses_splits_by_pixels() {
     }
     fs::remove_dir_all(&dir).unwrap();
 }
+
+/// SPPM splits by tiles exactly (a pixel's estimate depends on its own
+/// visible points and the photons only); a split by samples, whose
+/// iterations depend on the ones before, is refused in one line.
+#[test]
+fn sppm_splits_by_tiles_exactly_and_refuses_sample_ranges() {
+    let dir = temp_dir("farm-sppm");
+    let sppm = ["--integrator", "sppm"];
+    let whole = dir.join("whole.exr");
+    render(&sppm, &whole);
+    let pieces: Vec<Vec<String>> = split(3, "tiles")
+        .into_iter()
+        .map(|mut p| {
+            p.extend(sppm.iter().map(|s| s.to_string()));
+            p
+        })
+        .collect();
+    let files = parts(&dir, "sppm", &pieces);
+    let out = dir.join("merged.exr");
+    let m = merge(&files, &out, &[]);
+    assert!(m.status.success(), "{}", stderr(&m));
+    assert!(
+        fs::read(&out).unwrap() == fs::read(&whole).unwrap(),
+        "the merged sppm frame differs from the whole one"
+    );
+    let o = dir.join("refused.exr");
+    for extra in [
+        &["--part", "0/2", "--split", "samples"][..],
+        &["--samples", "0..5"][..],
+        &["--noise-threshold", "0.05"][..],
+    ] {
+        let r = sahara(
+            &[
+                &["render"],
+                FRAME,
+                &sppm,
+                extra,
+                &["-o", o.to_str().unwrap()],
+            ]
+            .concat(),
+        );
+        let e = stderr(&r);
+        assert!(!r.status.success(), "{extra:?} was rendered");
+        assert_eq!(e.trim_end().lines().count(), 1, "{extra:?}: one line: {e}");
+        assert!(e.contains("sppm"), "{extra:?}: {e}");
+        assert!(!o.exists(), "{extra:?}: an output was written");
+    }
+    fs::remove_dir_all(&dir).unwrap();
+}

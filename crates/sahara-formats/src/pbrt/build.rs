@@ -680,7 +680,33 @@ fn settings(
                     i.params.mark_all_used();
                     Integrator::Bdpt { max_depth }
                 }
-                "sppm" | "simplepath" | "simplevolpath" | "randomwalk" => {
+                "sppm" => {
+                    // pbrt-v4's SPPM takes its iteration count from here,
+                    // not from the sampler.
+                    let iterations = i.params.int("iterations", spp)?;
+                    if iterations < 1 {
+                        return Err(i
+                            .loc
+                            .error("integrator 'sppm': iterations must be at least 1"));
+                    }
+                    spp = iterations;
+                    let radius = i.params.float("radius", 1.0)?;
+                    if !(radius.is_finite() && radius > 0.0) {
+                        return Err(i
+                            .loc
+                            .error("integrator 'sppm': radius must be a positive number"));
+                    }
+                    let photons = i.params.int("photonsperiteration", -1)?;
+                    for k in ["seed", "imagewritefrequency"] {
+                        i.params.get(k);
+                    }
+                    Integrator::Sppm {
+                        max_depth,
+                        radius: radius as f32,
+                        photons: photons.clamp(0, u32::MAX as i64) as u32,
+                    }
+                }
+                "simplepath" | "simplevolpath" | "randomwalk" => {
                     w.add(
                         format!(
                             "integrator '{}' is replaced by Sahara's path tracer",

@@ -708,8 +708,10 @@ fn the_fuzz_seed_with_every_material_warns_only_of_what_it_approximates() {
     assert_eq!(s.scene.instances.len(), 12);
 }
 
-/// pbrt's bidirectional integrators map onto Sahara's: `bdpt` and
-/// `lightpath` with their `maxdepth`, `mlt` onto `bdpt` with a warning.
+/// pbrt's bidirectional and photon integrators map onto Sahara's: `bdpt`
+/// and `lightpath` with their `maxdepth`, `mlt` onto `bdpt` with a
+/// warning, `sppm` with its radius and photons (pbrt's `-1`: one per
+/// pixel).
 #[test]
 fn bidirectional_integrators_map_onto_bdpt_and_light_tracing() {
     use sahara_render::Integrator;
@@ -733,6 +735,26 @@ fn bidirectional_integrators_map_onto_bdpt_and_light_tracing() {
         w.iter()
             .any(|w| w.contains("'mlt' is rendered by bidirectional path tracing")),
         "{w:?}"
+    );
+    let (i, _) = integrator(
+        "Integrator \"sppm\" \"integer maxdepth\" 4 \"float radius\" 0.25 \"integer photonsperiteration\" 5000",
+    );
+    assert_eq!(
+        i,
+        Integrator::Sppm {
+            max_depth: 4,
+            radius: 0.25,
+            photons: 5000
+        }
+    );
+    let (i, _) = integrator("Integrator \"sppm\"");
+    assert_eq!(
+        i,
+        Integrator::Sppm {
+            max_depth: 5,
+            radius: 1.0,
+            photons: 0
+        }
     );
     let (_, w) = integrator("Integrator \"bdpt\" \"bool visualizestrategies\" true");
     assert!(w.iter().any(|w| w.contains("visualizestrategies")), "{w:?}");

@@ -225,7 +225,7 @@ fn f_towards(v: &Vertex, w: Vec3, importance: bool) -> Vec3 {
 /// The adjoint factors of a light subpath's scattering at `hit` towards
 /// `w`: refraction's radiance scaling undone, and the shading normal's
 /// correction `|wo.ns| |w.ng| / (|wo.ng| |w.ns|)`.
-fn adjoint(hit: &SurfaceHit, sh: &Shading, w: Vec3) -> f32 {
+pub(super) fn adjoint(hit: &SurfaceHit, sh: &Shading, w: Vec3) -> f32 {
     let ns = sh.frame.n;
     let den = sh.wo_world.dot(hit.ng) * w.dot(ns);
     if den == 0.0 {

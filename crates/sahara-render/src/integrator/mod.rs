@@ -5,6 +5,7 @@ pub(crate) mod bdpt;
 pub mod debug;
 mod distribution;
 mod path;
+pub(crate) mod sppm;
 mod state;
 pub(crate) mod wavefront;
 
@@ -61,6 +62,21 @@ pub enum Integrator {
         /// Largest number of scattering events.
         max_depth: u32,
     },
+    /// Stochastic progressive photon mapping: per iteration (one per
+    /// sample per pixel), camera paths through mirrors and glass to their
+    /// first rough surface, photons from the lights gathered there within
+    /// a radius that shrinks as iterations add up. Finds caustics seen in
+    /// mirrors and through glass.
+    Sppm {
+        /// Largest number of scattering events of camera paths and of
+        /// photons.
+        max_depth: u32,
+        /// Initial search radius in scene units (0: twice a pixel's width
+        /// at the distance from the camera to the scene's centre).
+        radius: f32,
+        /// Photons per iteration (0: one per pixel).
+        photons: u32,
+    },
     /// The shading normal, mapped to `n / 2 + 1/2`.
     Normals,
     /// Distance to the first hit (0 where nothing is hit).
@@ -116,6 +132,8 @@ pub enum IntegratorKind {
     Bdpt,
     /// [`Integrator::LightPath`].
     LightPath,
+    /// [`Integrator::Sppm`].
+    Sppm,
     /// [`Integrator::Normals`].
     Normals,
     /// [`Integrator::Depth`].
@@ -131,6 +149,7 @@ name_table!(IntegratorKind, "integrator", {
     IntegratorKind::Distribution => "distribution",
     IntegratorKind::Bdpt => "bdpt",
     IntegratorKind::LightPath => "lightpath",
+    IntegratorKind::Sppm => "sppm",
     IntegratorKind::Normals => "normals",
     IntegratorKind::Depth => "depth",
     IntegratorKind::Ao => "ao",
@@ -165,6 +184,19 @@ impl IntegratorKind {
                 accepts: Accepts::WholeAtLeast(1),
             },
         ];
+        const SPPM: &[Parameter] = &[
+            MAX_DEPTH,
+            Parameter {
+                name: "radius",
+                default: 0.0,
+                accepts: Accepts::AtLeast(0.0),
+            },
+            Parameter {
+                name: "photons",
+                default: 0.0,
+                accepts: Accepts::WholeAtLeast(0),
+            },
+        ];
         const AO: &[Parameter] = &[
             Parameter {
                 name: "samples",
@@ -181,6 +213,7 @@ impl IntegratorKind {
             IntegratorKind::Path => PATH,
             IntegratorKind::Distribution => DISTRIBUTION,
             IntegratorKind::Bdpt | IntegratorKind::LightPath => &[MAX_DEPTH],
+            IntegratorKind::Sppm => SPPM,
             IntegratorKind::Ao => AO,
             IntegratorKind::Normals | IntegratorKind::Depth | IntegratorKind::Cost => &[],
         }
@@ -220,6 +253,11 @@ impl Integrator {
             (IntegratorKind::LightPath, &[max_depth]) => Integrator::LightPath {
                 max_depth: max_depth as u32,
             },
+            (IntegratorKind::Sppm, &[max_depth, radius, photons]) => Integrator::Sppm {
+                max_depth: max_depth as u32,
+                radius,
+                photons: photons as u32,
+            },
             (IntegratorKind::Ao, &[samples, distance]) => Integrator::Ao {
                 samples: samples as u32,
                 distance,
@@ -250,6 +288,11 @@ impl Integrator {
             Integrator::Bdpt { max_depth } | Integrator::LightPath { max_depth } => {
                 vec![max_depth as f32]
             }
+            Integrator::Sppm {
+                max_depth,
+                radius,
+                photons,
+            } => vec![max_depth as f32, radius, photons as f32],
             Integrator::Normals | Integrator::Depth | Integrator::Cost => Vec::new(),
         }
     }
@@ -263,6 +306,7 @@ impl Integrator {
             Integrator::Distribution { .. } => IntegratorKind::Distribution,
             Integrator::Bdpt { .. } => IntegratorKind::Bdpt,
             Integrator::LightPath { .. } => IntegratorKind::LightPath,
+            Integrator::Sppm { .. } => IntegratorKind::Sppm,
             Integrator::Normals => IntegratorKind::Normals,
             Integrator::Depth => IntegratorKind::Depth,
             Integrator::Ao { .. } => IntegratorKind::Ao,
@@ -318,7 +362,8 @@ impl Integrator {
     /// at a time (the render loop answers them in batches, with the same
     /// result bit for bit: see `wavefront`). The bidirectional integrators'
     /// light tracing contributions land elsewhere on the film: they are
-    /// left out here (see [`Integrator::li_splats`]).
+    /// left out here (see [`Integrator::li_splats`]); so is the photons'
+    /// part of SPPM's.
     pub fn li(&self, ctx: &mut Context, ray: &Ray, time: f32) -> Vec3 {
         self.li_splats(ctx, ray, time, Vec2::ONE, &mut Vec::new())
     }
@@ -361,6 +406,13 @@ impl Integrator {
                 film,
                 splats,
             ),
+            // The photons' part of the estimate needs a whole iteration
+            // (the render loop's): one ray alone gets the light its
+            // camera path finds directly.
+            Integrator::Sppm { max_depth, .. } => {
+                ctx.stats.camera_rays -= 1;
+                sppm::camera_path(ctx, *ray, time, max_depth).0
+            }
             Integrator::Path { .. } | Integrator::Distribution { .. } => {
                 let world = ctx.world;
                 let mut st = PathState::new(*ray, time, ctx.sampler);

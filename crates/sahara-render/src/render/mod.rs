@@ -12,6 +12,7 @@
 pub mod adaptive;
 pub mod aux;
 pub mod digest;
+mod sppm;
 
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::Arc;
@@ -374,6 +375,19 @@ pub fn render_watched(
         layout: world.accel.layout(),
         ..Default::default()
     };
+    if let Integrator::Sppm {
+        max_depth,
+        radius,
+        photons,
+    } = settings.integrator
+    {
+        let params = sppm::Params {
+            max_depth,
+            radius,
+            photons: photons as u64,
+        };
+        return sppm::render(&world, settings, params, progress, stats, start);
+    }
     let render_start = Instant::now();
     let cpu_start = process_cpu_time();
     let mut last_preview = Instant::now();
@@ -730,7 +744,7 @@ fn render_tile(
 /// it is zeroed so one cannot ruin a pixel, and counted in `nan` for the
 /// statistics; a negative component is clamped and counted in `negative`.
 #[inline(always)]
-fn guard(mut l: Vec3, nan: &mut u64, negative: &mut u64) -> Vec3 {
+pub(super) fn guard(mut l: Vec3, nan: &mut u64, negative: &mut u64) -> Vec3 {
     if !l.is_finite() {
         *nan += 1;
         l = Vec3::ZERO;

@@ -1,0 +1,208 @@
+//! The render loop of stochastic progressive photon mapping
+//! ([`crate::integrator::sppm`]): one iteration per sample per pixel, each
+//! a camera pass over the window's pixels and a photon pass over the
+//! whole scene, then every pixel's radius reduction.
+//!
+//! A pixel's estimate depends on its own visible points and on the
+//! photons, never on other pixels: a window of the frame rendered alone
+//! gives the same bits as the whole frame's render over it, so a frame
+//! splits by tiles exactly. It does not split by sample ranges: each
+//! iteration's radius depends on the ones before.
+
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::{finish, Progress, RenderResult, RenderSettings, RenderStats};
+use crate::cpu_time::process_cpu_time;
+use crate::film::sums::SumBuffer;
+use crate::film::window::PixelWindow;
+use crate::integrator::sppm::{self, Grid, PixelStats, VisiblePoint};
+use crate::integrator::{Context, TraceStats};
+use crate::math::hash::hash2;
+use crate::sampler::{dims, PixelSampler, SampleId};
+use crate::world::World;
+
+/// A pixel's camera path: the light it found directly, and its visible
+/// point.
+type CameraSample = (Vec3, Option<VisiblePoint>);
+
+/// SPPM's parameters.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Params {
+    pub max_depth: u32,
+    /// Initial search radius (0: twice a pixel's width at the distance
+    /// from the camera to the scene's centre).
+    pub radius: f32,
+    /// Photons per iteration (0: one per pixel of the image).
+    pub photons: u64,
+}
+
+/// Renders `world` with SPPM under `settings`; `start` is when the render
+/// began (the time limit counts from it).
+pub(crate) fn render(
+    world: &World,
+    settings: &RenderSettings,
+    params: Params,
+    progress: &(dyn Fn(Progress) + Sync),
+    mut stats: RenderStats,
+    start: Instant,
+) -> RenderResult {
+    let (w, h) = (settings.width.max(1), settings.height.max(1));
+    let window = settings
+        .window
+        .unwrap_or(PixelWindow::full(w, h))
+        .intersect(&PixelWindow::full(w, h));
+    let iterations = settings.spp.max(1);
+    let photons = if params.photons > 0 {
+        params.photons
+    } else {
+        u64::from(w) * u64::from(h)
+    };
+    let camera = &world.scene.camera;
+    let r0 = if params.radius > 0.0 {
+        params.radius
+    } else {
+        let pixel = 2.0 * camera.tan_half_fov() / h as f32;
+        (2.0 * pixel * camera.eye.distance(world.center)).max(1e-6 * world.radius)
+    };
+    let n = window.pixels() as usize;
+    let mut pixels = vec![PixelStats::new(r0); n];
+    let inv = Vec2::new(1.0 / w as f32, 1.0 / h as f32);
+    let render_start = Instant::now();
+    let cpu_start = process_cpu_time();
+    let cancelled = || {
+        settings
+            .cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    };
+    let out_of_time = || settings.time_limit.is_some_and(|t| start.elapsed() >= t);
+    let mut done = 0;
+    let mut rays = 0u64;
+    for it in 0..iterations {
+        if it > 0 && (cancelled() || out_of_time()) {
+            stats.stopped_early = true;
+            break;
+        }
+        // The camera pass: every pixel's visible point, row by row.
+        let rows: Vec<(Vec<CameraSample>, TraceStats)> = (window.y0..window.y1)
+            .into_par_iter()
+            .map(|y| {
+                let mut ts = TraceStats::default();
+                let row = (window.x0..window.x1)
+                    .map(|x| {
+                        let sampler = PixelSampler::new(
+                            settings.sampler,
+                            SampleId {
+                                stream: hash2(
+                                    settings.seed,
+                                    u64::from(y) * u64::from(w) + u64::from(x),
+                                ),
+                                pass: 0,
+                                index: it,
+                                count: iterations,
+                            },
+                        );
+                        let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
+                        let (ray, time) = camera.generate_ray(
+                            pos * inv,
+                            sampler.get_2d(dims::LENS),
+                            sampler.get_1d(dims::TIME),
+                        );
+                        let mut ctx = Context {
+                            world,
+                            sampler,
+                            stats: &mut ts,
+                        };
+                        sppm::camera_path(&mut ctx, ray, time, params.max_depth)
+                    })
+                    .collect();
+                (row, ts)
+            })
+            .collect();
+        let mut points: Vec<Option<VisiblePoint>> = Vec::with_capacity(n);
+        for (k, (row, ts)) in rows.into_iter().enumerate() {
+            stats.trace += ts;
+            for (j, (direct, vp)) in row.into_iter().enumerate() {
+                let p = &mut pixels[k * window.width() as usize + j];
+                p.direct += guard(direct, &mut stats);
+                points.push(vp);
+            }
+        }
+        // The photon pass, in chunks whose deposits apply in order.
+        let radii: Vec<f32> = pixels.iter().map(|p| p.radius).collect();
+        let listed: Vec<(u32, &VisiblePoint)> = points
+            .iter()
+            .enumerate()
+            .filter_map(|(k, vp)| vp.as_ref().map(|vp| (k as u32, vp)))
+            .collect();
+        let grid = Grid::new(&listed, &radii);
+        let shutter = (camera.shutter_open, camera.shutter_close);
+        let time = 0.5 * (shutter.0 + shutter.1);
+        let chunks: Vec<(Vec<sppm::Deposit>, TraceStats)> = sppm::chunks(photons)
+            .collect::<Vec<_>>()
+            .into_par_iter()
+            .with_max_len(1)
+            .map(|(first, count)| {
+                let mut ts = TraceStats::default();
+                let d = sppm::trace_photons(
+                    world,
+                    settings.seed,
+                    it,
+                    first,
+                    count,
+                    params.max_depth,
+                    time,
+                    &grid,
+                    &points,
+                    &radii,
+                    &mut ts,
+                );
+                (d, ts)
+            })
+            .collect();
+        let mut phi = vec![Vec3::ZERO; n];
+        let mut m = vec![0u32; n];
+        for (deposits, ts) in chunks {
+            stats.trace += ts;
+            for (k, f) in deposits {
+                phi[k as usize] += f;
+                m[k as usize] += 1;
+            }
+        }
+        for (k, p) in pixels.iter_mut().enumerate() {
+            let f = guard(phi[k], &mut stats);
+            p.update(f, m[k]);
+        }
+        done += 1;
+        let t = &stats.trace;
+        rays = t.camera_rays + t.bounce_rays + t.shadow_rays;
+        progress(Progress {
+            pass: it,
+            passes: iterations,
+            tiles_done: 1,
+            tiles: 1,
+            elapsed: start.elapsed(),
+            rays,
+        });
+    }
+    let _ = rays;
+    stats.passes = done;
+    stats.spp = done;
+    stats.render_time = render_start.elapsed();
+    stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
+    let mut sums = SumBuffer::new(window.x0, window.y0, window.width(), window.height());
+    for (s, p) in sums.sums.iter_mut().zip(&pixels) {
+        s.add_sample(p.radiance(done, photons), 1.0);
+    }
+    finish(sums, None, None, stats, settings, None)
+}
+
+/// A NaN or infinite value is zeroed and counted, a negative component
+/// clamped and counted (as the render loop does for samples).
+fn guard(v: Vec3, stats: &mut RenderStats) -> Vec3 {
+    super::guard(v, &mut stats.nan_samples, &mut stats.negative_samples)
+}
