@@ -187,7 +187,7 @@ mod tests {
             IntegratorKind::from_name("whitted")
                 .unwrap_err()
                 .to_string(),
-            "unknown integrator 'whitted'; expected path, distribution, bdpt, lightpath, normals, depth, ao or cost"
+            "unknown integrator 'whitted'; expected path, distribution, bdpt, lightpath, sppm, normals, depth, ao or cost"
         );
     }
 
