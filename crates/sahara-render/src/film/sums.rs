@@ -207,33 +207,38 @@ impl SumBuffer {
     /// the sums stay exact, so the image still does not depend on the
     /// order the contributions arrive in.
     pub fn add_splat(&mut self, filter: &Filter, pos: Vec2, l: Vec3) {
-        if self.width == 0 || self.height == 0 || !pos.is_finite() {
+        let (x0, y0, width, height) = (self.x0, self.y0, self.width, self.height);
+        splat_rows(&mut self.sums, x0, y0, width, height, filter, pos, l);
+    }
+
+    /// [`SumBuffer::add_splat`] for every splat of `groups`, each `scale`
+    /// times, spread over the thread pool by bands of rows (the sums are
+    /// exact, so the order they arrive in does not matter).
+    pub(crate) fn add_splats(&mut self, filter: &Filter, groups: &[&[Splat]], scale: f32) {
+        use rayon::prelude::*;
+        let w = self.width as usize;
+        if w == 0 || self.height == 0 || groups.iter().all(|g| g.is_empty()) {
             return;
         }
+        let band = (self.height as usize)
+            .div_ceil(4 * rayon::current_num_threads().max(1))
+            .max(1);
         let r = filter.radius();
-        let lo = |p: f32, o: u32| ((p - 0.5 - r).ceil().max(o as f32)) as u32;
-        let hi = |p: f32, o: u32, n: u32| (p - 0.5 + r).floor().min((o + n - 1) as f32);
-        let (x0, y0) = (lo(pos.x, self.x0), lo(pos.y, self.y0));
-        let (x1, y1) = (
-            hi(pos.x, self.x0, self.width),
-            hi(pos.y, self.y0, self.height),
-        );
-        if x1 < x0 as f32 || y1 < y0 as f32 {
-            return;
-        }
-        for py in y0..=y1 as u32 {
-            let wy = filter.eval_1d(pos.y - (py as f32 + 0.5));
-            if wy == 0.0 {
-                continue;
-            }
-            let row = (py - self.y0) as usize * self.width as usize;
-            for px in x0..=x1 as u32 {
-                let w = wy * filter.eval_1d(pos.x - (px as f32 + 0.5));
-                if w != 0.0 {
-                    self.sums[row + (px - self.x0) as usize].add_radiance(l, w);
+        let (x0, y0, width) = (self.x0, self.y0, self.width);
+        self.sums
+            .par_chunks_mut(band * w)
+            .enumerate()
+            .for_each(|(b, rows)| {
+                let top = y0 + (b * band) as u32;
+                let n = (rows.len() / w) as u32;
+                // Pixel centres y + 1/2 within the filter's radius of the band.
+                let (lo, hi) = (top as f32 + 0.5 - r, (top + n) as f32 - 0.5 + r);
+                for s in groups.iter().flat_map(|g| g.iter()) {
+                    if s.pos.y >= lo && s.pos.y <= hi {
+                        splat_rows(rows, x0, top, width, n, filter, s.pos, s.l * scale);
+                    }
                 }
-            }
-        }
+            });
     }
 
     /// Adds `other`'s sums over the pixels both cover.
@@ -249,6 +254,56 @@ impl SumBuffer {
                 };
                 let b = other.sums[b];
                 self.sums[a].add(&b);
+            }
+        }
+    }
+}
+
+/// Light arriving at a film position from the samples of other pixels
+/// (light tracing), added to the pixels around it without weight (see
+/// [`SumBuffer::add_splat`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Splat {
+    /// Film position, in pixels from the top-left corner.
+    pub pos: Vec2,
+    /// The contribution.
+    pub l: Vec3,
+}
+
+/// [`SumBuffer::add_splat`] into the pixel sums `sums` of the rectangle
+/// `[x0, x0 + width) x [y0, y0 + height)`, row-major.
+#[allow(clippy::too_many_arguments)]
+fn splat_rows(
+    sums: &mut [PixelSum],
+    x0: u32,
+    y0: u32,
+    width: u32,
+    height: u32,
+    filter: &Filter,
+    pos: Vec2,
+    l: Vec3,
+) {
+    if width == 0 || height == 0 || !pos.is_finite() {
+        return;
+    }
+    let r = filter.radius();
+    let lo = |p: f32, o: u32| ((p - 0.5 - r).ceil().max(o as f32)) as u32;
+    let hi = |p: f32, o: u32, n: u32| (p - 0.5 + r).floor().min((o + n - 1) as f32);
+    let (px0, py0) = (lo(pos.x, x0), lo(pos.y, y0));
+    let (px1, py1) = (hi(pos.x, x0, width), hi(pos.y, y0, height));
+    if px1 < px0 as f32 || py1 < py0 as f32 {
+        return;
+    }
+    for py in py0..=py1 as u32 {
+        let wy = filter.eval_1d(pos.y - (py as f32 + 0.5));
+        if wy == 0.0 {
+            continue;
+        }
+        let row = (py - y0) as usize * width as usize;
+        for px in px0..=px1 as u32 {
+            let w = wy * filter.eval_1d(pos.x - (px as f32 + 0.5));
+            if w != 0.0 {
+                sums[row + (px - x0) as usize].add_radiance(l, w);
             }
         }
     }

@@ -32,16 +32,7 @@ use crate::sampler::dims;
 use crate::scene::camera::Camera;
 use crate::world::{pass_through_draw, SurfaceHit, World, MAX_PASS_THROUGHS};
 
-/// A contribution of light tracing: radiance arriving at film position
-/// `pos` (pixel units) from a light subpath joined to the lens.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Splat {
-    /// Film position, in pixels from the top-left corner.
-    pub pos: Vec2,
-    /// The contribution: added to the pixels around `pos` with their
-    /// filter weights, without adding to their weight sums.
-    pub l: Vec3,
-}
+pub(crate) use crate::film::sums::Splat;
 
 /// Which of the strategies a render uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -401,77 +392,76 @@ struct Densities {
 /// the path the connection makes: `(index from the light's end, pl, pc)`.
 type Overrides = [(usize, Option<f32>, Option<f32>); 4];
 
-/// The power-heuristic weight of strategy `s` for the path of light
-/// vertices `light` (the first `s`) and camera vertices `camera` (the
-/// first `t`), with the connection's `overrides`. `delta_light`: the
-/// path's light is a point, spot or directional light, which no camera
-/// path can find.
-fn mis_weight(
-    light: &[&Vertex],
-    camera: &[&Vertex],
+/// The power-heuristic weight of strategy `s` for the path of `s` light
+/// vertices (`light(i)`, from the light) and `t` camera vertices
+/// (`camera(j)`, from the camera), with the connection's `overrides`.
+/// `delta_light`: the path's light is a point, spot or directional light,
+/// which no camera path can find.
+fn mis_weight<'a>(
+    s: usize,
+    t: usize,
+    light: &dyn Fn(usize) -> &'a Vertex,
+    camera: &dyn Fn(usize) -> &'a Vertex,
     overrides: &Overrides,
     delta_light: bool,
 ) -> f32 {
-    let (s, t) = (light.len(), camera.len());
     let n = s + t;
-    let mut d = [Densities {
-        pl: 0.0,
-        pc: 0.0,
-        delta: false,
-    }; 2 * MAX_VERTICES];
-    if n > d.len() {
-        return 0.0;
-    }
-    for (i, v) in light.iter().enumerate() {
-        d[i] = Densities {
-            pl: v.pdf_fwd,
-            pc: v.pdf_rev,
-            delta: v.delta,
-        };
-    }
-    for (j, v) in camera.iter().enumerate() {
-        d[n - 1 - j] = Densities {
-            pl: v.pdf_rev,
-            pc: v.pdf_fwd,
-            delta: v.delta,
-        };
-    }
-    for &(i, pl, pc) in overrides {
-        if i < n {
-            if let Some(pl) = pl {
-                d[i].pl = pl;
+    // Vertex `i` of the whole path, counted from the light.
+    let d = |i: usize| {
+        let mut d = if i < s {
+            let v = light(i);
+            Densities {
+                pl: v.pdf_fwd,
+                pc: v.pdf_rev,
+                delta: v.delta,
             }
-            if let Some(pc) = pc {
-                d[i].pc = pc;
+        } else {
+            let v = camera(n - 1 - i);
+            Densities {
+                pl: v.pdf_rev,
+                pc: v.pdf_fwd,
+                delta: v.delta,
+            }
+        };
+        for &(j, pl, pc) in overrides {
+            if j == i {
+                if let Some(pl) = pl {
+                    d.pl = pl;
+                }
+                if let Some(pc) = pc {
+                    d.pc = pc;
+                }
             }
         }
-    }
-    // The connection's own ends scatter through their non-delta lobes.
-    if s > 0 {
-        d[s - 1].delta = false;
-    }
-    d[s].delta = false;
+        // The connection's own ends scatter through their non-delta lobes.
+        if i == s || (s > 0 && i == s - 1) {
+            d.delta = false;
+        }
+        d
+    };
     let possible = |sp: usize| {
         let tp = n - sp;
         if tp == 0 || (sp == 1 && tp == 1) {
             return false;
         }
         if sp == 0 {
-            return !delta_light && !d[0].delta;
+            return !delta_light && !d(0).delta;
         }
-        !d[sp - 1].delta && !d[sp].delta
+        !d(sp - 1).delta && !d(sp).delta
     };
     let remap = |f: f32| if f != 0.0 { f } else { 1.0 };
     let mut sum = 1.0f32;
     let mut r = 1.0f32;
     for i in (0..s).rev() {
-        r *= remap(d[i].pc) / remap(d[i].pl);
+        let di = d(i);
+        r *= remap(di.pc) / remap(di.pl);
         if possible(i) {
             sum += r * r;
         }
     }
     r = 1.0;
-    for (i, di) in d.iter().enumerate().take(n - 1).skip(s) {
+    for i in s..n - 1 {
+        let di = d(i);
         r *= remap(di.pl) / remap(di.pc);
         if possible(i + 1) {
             sum += r * r;
@@ -598,8 +588,7 @@ fn emitter_found(world: &World, cv: &[Vertex], strategies: Strategies) -> Vec3 {
         (usize::MAX, None, None),
         (usize::MAX, None, None),
     ];
-    let camera: Vec<&Vertex> = cv.iter().collect();
-    c * mis_weight(&[], &camera, &overrides, false)
+    c * mis_weight(0, t, &|i| &cv[i], &|j| &cv[j], &overrides, false)
 }
 
 /// Strategy `s = 1`: a point on a light sampled from the camera
@@ -641,8 +630,7 @@ fn light_sampled(ctx: &mut Context, cv: &[Vertex], time: f32) -> Vec3 {
         (2, Some(pdf_next(world, pt, Some(&x0), prev)), None),
         (usize::MAX, None, None),
     ];
-    let camera: Vec<&Vertex> = cv.iter().collect();
-    let w = mis_weight(&[&x0], &camera, &overrides, light.is_delta());
+    let w = mis_weight(1, t, &|_| &x0, &|j| &cv[j], &overrides, light.is_delta());
     if w <= 0.0 {
         return Vec3::ZERO;
     }
@@ -692,9 +680,8 @@ fn to_lens(
                 (usize::MAX, None, None),
                 (usize::MAX, None, None),
             ];
-            let light: Vec<&Vertex> = lv.iter().collect();
             let delta_light = world.lights[lv[0].light].is_delta();
-            mis_weight(&light, &[&lens], &overrides, delta_light)
+            mis_weight(s, 1, &|i| &lv[i], &|_| &lens, &overrides, delta_light)
         }
     };
     if w <= 0.0 {
@@ -734,10 +721,8 @@ fn joined(ctx: &mut Context, lv: &[Vertex], cv: &[Vertex], time: f32) -> Vec3 {
         (s, Some(pdf_next(world, qs, Some(&lv[s - 2]), pt)), None),
         (s + 1, Some(pdf_next(world, pt, Some(qs), &cv[t - 2])), None),
     ];
-    let light: Vec<&Vertex> = lv.iter().collect();
-    let camera: Vec<&Vertex> = cv.iter().collect();
     let delta_light = world.lights[lv[0].light].is_delta();
-    let weight = mis_weight(&light, &camera, &overrides, delta_light);
+    let weight = mis_weight(s, t, &|i| &lv[i], &|j| &cv[j], &overrides, delta_light);
     if weight <= 0.0 {
         return Vec3::ZERO;
     }

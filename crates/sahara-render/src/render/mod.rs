@@ -502,11 +502,10 @@ pub fn render_watched(
             stats.first_pass_pixels = mask.iter().filter(|&&m| m).count() as u64;
             finished = Some(mask);
         }
+        let splats: Vec<&[Splat]> = outs.iter().flatten().map(|o| &o.splats[..]).collect();
+        sums.add_splats(&settings.filter, &splats, splat_scale);
         for out in outs.into_iter().flatten() {
             sums.add(&out.sums);
-            for splat in &out.splats {
-                sums.add_splat(&settings.filter, splat.pos, splat.l * splat_scale);
-            }
             stats.trace += out.stats;
             stats.time_split += out.split;
             if let (Some(a), Some(o)) = (&mut aux, &out.aux) {
