@@ -1,0 +1,521 @@
+//! Mitsuba bsdfs as Sahara materials: the one table that decides what
+//! each becomes.
+//!
+//! | Mitsuba | Sahara | lost (warned) |
+//! |---|---|---|
+//! | `diffuse` | diffuse | |
+//! | `conductor`, `roughconductor` (`material`, `eta`, `k`, `specular_reflectance`) | complex-IOR conductor, scattering once between microfacets as Mitsuba's does, tinted by `specular_reflectance` | Beckmann (GGX of the same alpha), anisotropy (the mean alpha), textured `eta` / `k` |
+//! | `dielectric`, `roughdielectric` (`int_ior`, `ext_ior`) | glass / rough glass of index `int_ior / ext_ior` | tinted `specular_reflectance` / `specular_transmittance`; Beckmann |
+//! | `thindielectric` | thin dielectric | |
+//! | `plastic`, `roughplastic` | coated diffuse: a dielectric coat of index `int_ior / ext_ior` over `diffuse_reflectance` | a `specular_reflectance` other than 1; Beckmann |
+//! | `principled` | glTF metallic-roughness (`base_color`, `metallic`, `roughness`, `eta`), with a clear coat (`clearcoat`, `clearcoat_gloss`) | `anisotropic`, `sheen`, `spec_trans`, `spec_tint`, `flatness` |
+//! | `twosided` | the nested bsdf, scattering on both faces | a different back bsdf (the front one is used) |
+//! | `mask` (`opacity`) | the nested bsdf, cut by stochastic transparency | |
+//! | `blendbsdf` (`weight`) | the blend where exact (two diffuse colours, or the same bsdf), else the bsdf of larger weight | the blend |
+//! | `normalmap` | the nested bsdf with the normal map | |
+//! | `bumpmap` | the nested bsdf | the bumps |
+//! | `null` | no surface (the shape is skipped) | |
+//! | `hair`, `measured`, `pplastic`, `polarizer`, `retarder`, `circular` | diffuse grey 0.5 | the model |
+//!
+//! Mitsuba's bsdfs are one-sided: a surface seen from its back is black,
+//! and so it is here, unless wrapped in `twosided` (glass has two sides
+//! by nature). Roughness: Mitsuba's `alpha` is GGX's alpha, Sahara's
+//! roughness its square root.
+
+use glam::Vec3;
+use sahara_render::{AlphaMode, Bsdf, Clearcoat, Material, NormalMap, TextureMap};
+
+use super::build::{key, Builder};
+use super::properties::Object;
+use super::spectra::{conductor_rgb, Color, Usage};
+use super::xml::Node;
+use crate::pbrt::materials::blend;
+use crate::pbrt::spectrum;
+use crate::pbrt::textures::{with_opacity, Tint};
+use crate::FormatError;
+
+/// Deepest chain of bsdfs nested in bsdfs.
+const MAX_NESTING: usize = 16;
+
+/// Mitsuba's named indices of refraction (its `dielectric` docs' table).
+const IORS: &[(&str, f64)] = &[
+    ("vacuum", 1.0),
+    ("helium", 1.00004),
+    ("hydrogen", 1.00013),
+    ("air", 1.00028),
+    ("carbon dioxide", 1.00045),
+    ("water", 1.3330),
+    ("acetone", 1.36),
+    ("ethanol", 1.361),
+    ("carbon tetrachloride", 1.461),
+    ("glycerol", 1.4729),
+    ("benzene", 1.501),
+    ("silicone oil", 1.52045),
+    ("bromine", 1.661),
+    ("water ice", 1.31),
+    ("fused quartz", 1.458),
+    ("pyrex", 1.470),
+    ("acrylic glass", 1.49),
+    ("polypropylene", 1.49),
+    ("bk7", 1.5046),
+    ("sodium chloride", 1.544),
+    ("amber", 1.55),
+    ("pet", 1.5750),
+    ("diamond", 2.419),
+];
+
+/// Types Sahara has no model for (replaced by diffuse grey, warned).
+const UNSUPPORTED: &[&str] = &[
+    "hair",
+    "measured",
+    "pplastic",
+    "polarizer",
+    "retarder",
+    "circular",
+];
+
+/// A Sahara roughness of Mitsuba's GGX `alpha`.
+fn roughness(alpha: f64) -> f32 {
+    alpha.clamp(0.0, 1.0).sqrt() as f32
+}
+
+/// A diffuse material of reflectance `tint`.
+fn diffuse(tint: &Tint) -> Material {
+    let mut m = Material::diffuse(tint.color.clamp(Vec3::ZERO, Vec3::ONE));
+    m.textures.base_color = tint.image_map();
+    m
+}
+
+/// A material of `bsdf` whose colour is multiplied by `tint` (white: none).
+fn tinted(bsdf: Bsdf, tint: &Tint) -> Material {
+    let mut m = Material::new(bsdf);
+    m.textures.base_color = tint.map();
+    m
+}
+
+impl<'a> Builder<'a> {
+    /// The grey one-sided diffuse of shapes without a bsdf (Mitsuba's
+    /// default).
+    pub(crate) fn default_material(&mut self) -> u32 {
+        if let Some(m) = self.default_material {
+            return m;
+        }
+        let m = self
+            .scene
+            .add_material(Material::diffuse(Vec3::splat(0.5)).with_two_sided(false));
+        self.default_material = Some(m);
+        m
+    }
+
+    /// The material of the bsdf element `node` (made once); `None`: no
+    /// surface (`null`).
+    pub(crate) fn material(&mut self, node: &'a Node) -> Result<Option<u32>, FormatError> {
+        if let Some(m) = self.materials.get(&key(node)) {
+            return Ok(*m);
+        }
+        let m = self.bsdf(node, 0)?;
+        let id = m.map(|m| self.scene.add_material(m));
+        self.materials.insert(key(node), id);
+        Ok(id)
+    }
+
+    /// An index of refraction: a number or one of Mitsuba's names.
+    fn ior(&mut self, o: &Object<'a>, name: &str, default: f64) -> Result<f64, FormatError> {
+        let Some(p) = o.get(name) else {
+            return Ok(default);
+        };
+        match &p.value {
+            super::properties::Value::Str(s) => IORS
+                .iter()
+                .find(|(n, _)| n.eq_ignore_ascii_case(s))
+                .map(|&(_, v)| v)
+                .ok_or_else(|| {
+                    p.error(format!(
+                        "unknown index of refraction '{s}' (a number, or one of: {})",
+                        IORS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+                    ))
+                }),
+            _ => o.float(name, default),
+        }
+    }
+
+    /// The roughness of a rough bsdf (`alpha`, or the mean of `alpha_u`
+    /// and `alpha_v`), with its `distribution` checked.
+    fn alpha(&mut self, o: &Object<'a>, default: f64) -> Result<f32, FormatError> {
+        match o.string("distribution")?.unwrap_or("beckmann") {
+            "ggx" => {}
+            "beckmann" => self.w.add(
+                format!(
+                    "{}: the Beckmann distribution is replaced by GGX of the same alpha",
+                    o.what()
+                ),
+                &o.node.loc,
+            ),
+            other => {
+                return Err(o.error(format!(
+                    "unknown microfacet distribution '{other}' (expected beckmann or ggx)"
+                )))
+            }
+        }
+        o.get("sample_visible");
+        let a = self.number(o, "alpha", default)?;
+        let u = self.number(o, "alpha_u", a)?;
+        let v = self.number(o, "alpha_v", a)?;
+        if (u - v).abs() > 1e-6 {
+            self.w.add(
+                format!(
+                    "{}: anisotropic roughness is replaced by the mean of alpha_u and alpha_v",
+                    o.what()
+                ),
+                &o.node.loc,
+            );
+        }
+        Ok(roughness(0.5 * (u + v)))
+    }
+
+    /// The single bsdf nested in `o` (a wrapper's).
+    fn inner(
+        &mut self,
+        o: &Object<'a>,
+        depth: usize,
+    ) -> Result<Vec<Option<Material>>, FormatError> {
+        let mut out = Vec::new();
+        for e in o.entries() {
+            if e.name.is_some() && e.child.node().tag != "ref" && e.child.node().tag != "bsdf" {
+                continue;
+            }
+            let node = self.resolve(e.child, &["bsdf", "texture"], "a <bsdf>")?;
+            if node.tag != "bsdf" {
+                continue;
+            }
+            e.take();
+            out.push(self.bsdf(node, depth + 1)?);
+        }
+        Ok(out)
+    }
+
+    /// The material of a bsdf element; `None` for no surface.
+    fn bsdf(&mut self, node: &'a Node, depth: usize) -> Result<Option<Material>, FormatError> {
+        if depth > MAX_NESTING {
+            return Err(node.error("bsdfs nest too deep (a cycle of references?)"));
+        }
+        let o = self.object(node)?;
+        let grey = Vec3::splat;
+        let approx = |b: &mut Self, what: &str| {
+            b.w.add(format!("{}: {what}", o.what()), &node.loc);
+        };
+        let one_sided = |m: Material| m.with_two_sided(false);
+        let m = match o.ty {
+            "diffuse" => one_sided(diffuse(&self.tint(
+                &o,
+                "reflectance",
+                grey(0.5),
+                Usage::Reflectance,
+            )?)),
+            "conductor" | "roughconductor" => {
+                let r = if o.ty == "roughconductor" {
+                    self.alpha(&o, 0.1)?
+                } else {
+                    0.0
+                };
+                let tint = self.tint(&o, "specular_reflectance", Vec3::ONE, Usage::Reflectance)?;
+                let (eta, k) = self.metal(&o)?;
+                one_sided(tinted(
+                    Bsdf::ComplexConductor {
+                        eta: eta.max(Vec3::ZERO),
+                        k: k.max(Vec3::ZERO),
+                        roughness: r,
+                        multiple_scattering: false,
+                    },
+                    &tint,
+                ))
+            }
+            "dielectric" | "roughdielectric" | "thindielectric" => {
+                let int = self.ior(&o, "int_ior", 1.5046)?;
+                let ext = self.ior(&o, "ext_ior", 1.000277)?;
+                if int <= 0.0 || ext <= 0.0 {
+                    return Err(o.error("int_ior and ext_ior must be > 0"));
+                }
+                for k in ["specular_reflectance", "specular_transmittance"] {
+                    let t = self.tint(&o, k, Vec3::ONE, Usage::Reflectance)?;
+                    if t.image.is_some() || t.color != Vec3::ONE {
+                        approx(self, &format!("a tinted '{k}' is not supported; clear"));
+                    }
+                }
+                let eta = (int / ext) as f32;
+                if (eta - 1.0).abs() < 1e-6 {
+                    o.mark_all_used();
+                    return Ok(None);
+                }
+                match o.ty {
+                    "thindielectric" => Material::new(Bsdf::ThinDielectric { ior: eta }),
+                    "dielectric" => Material::glass(eta),
+                    _ => {
+                        let r = self.alpha(&o, 0.1)?;
+                        Material::rough_glass(eta, r)
+                    }
+                }
+            }
+            "plastic" | "roughplastic" => {
+                let base = self.tint(&o, "diffuse_reflectance", grey(0.5), Usage::Reflectance)?;
+                let spec = self.tint(&o, "specular_reflectance", Vec3::ONE, Usage::Reflectance)?;
+                if spec.image.is_some() || spec.color != Vec3::ONE {
+                    approx(
+                        self,
+                        "a 'specular_reflectance' other than 1 is not supported; 1",
+                    );
+                }
+                let int = self.ior(&o, "int_ior", 1.49)?;
+                let ext = self.ior(&o, "ext_ior", 1.000277)?;
+                o.get("nonlinear");
+                let r = if o.ty == "roughplastic" {
+                    self.alpha(&o, 0.1)?
+                } else {
+                    0.0
+                };
+                one_sided(tinted(
+                    Bsdf::CoatedDiffuse {
+                        albedo: base.color.clamp(Vec3::ZERO, Vec3::ONE),
+                        ior: ((int / ext) as f32).max(1.0),
+                        roughness: r,
+                    },
+                    &Tint {
+                        color: Vec3::ONE,
+                        ..base
+                    },
+                ))
+            }
+            "principled" => self.principled(&o)?,
+            "twosided" => {
+                let inner = self.inner(&o, depth)?;
+                let front = match &inner[..] {
+                    [] => return Err(o.error("twosided needs a nested bsdf")),
+                    [a] => a.clone(),
+                    [a, b] => {
+                        if a != b {
+                            approx(self, "a different back bsdf is not supported; the front one is used on both sides");
+                        }
+                        a.clone()
+                    }
+                    _ => return Err(o.error("twosided takes one or two nested bsdfs")),
+                };
+                match front {
+                    Some(m) => m.with_two_sided(true),
+                    None => {
+                        o.warn_unused(&mut self.w);
+                        return Ok(None);
+                    }
+                }
+            }
+            "mask" => {
+                let opacity = self.tint(&o, "opacity", grey(0.5), Usage::Reflectance)?;
+                let inner = self.inner(&o, depth)?;
+                let [Some(mut m)] = <[Option<Material>; 1]>::try_from(inner)
+                    .map_err(|_| o.error("mask needs one nested bsdf"))?
+                else {
+                    o.warn_unused(&mut self.w);
+                    return Ok(None);
+                };
+                let factor = opacity.color.x.clamp(0.0, 1.0);
+                if let Some(img) = &opacity.image {
+                    let old = m.textures.base_color.take();
+                    let texture = with_opacity(old.as_ref().map(|t| &t.texture), img);
+                    m.textures.base_color = Some(match old {
+                        Some(o) => TextureMap { texture, ..o },
+                        None => opacity.sampling.map(texture),
+                    });
+                } else if factor <= 0.0 {
+                    o.warn_unused(&mut self.w);
+                    return Ok(None);
+                }
+                m.with_alpha(AlphaMode::Blend, factor)
+            }
+            "blendbsdf" => {
+                let t = self.number(&o, "weight", 0.5)? as f32;
+                let inner = self.inner(&o, depth)?;
+                let [a, b] = <[Option<Material>; 2]>::try_from(inner)
+                    .map_err(|_| o.error("blendbsdf needs two nested bsdfs"))?;
+                match (&a, &b) {
+                    (Some(x), Some(y)) if blend(x, y, t).is_some() => {
+                        blend(x, y, t).expect("checked")
+                    }
+                    _ => {
+                        if t > 0.0 && t < 1.0 && a != b {
+                            approx(self, "the blend is replaced by the bsdf of larger weight");
+                        }
+                        let pick = if t < 0.5 { a } else { b };
+                        o.warn_unused(&mut self.w);
+                        return Ok(pick);
+                    }
+                }
+            }
+            "normalmap" => {
+                let Some(e) = o.named("normalmap") else {
+                    return Err(o.error("normalmap needs a 'normalmap' texture"));
+                };
+                let tex = self.resolve(e.child, &["texture"], "a <texture>")?;
+                let t = self.texture(tex)?;
+                let inner = self.inner(&o, depth)?;
+                let [m] = <[Option<Material>; 1]>::try_from(inner)
+                    .map_err(|_| o.error("normalmap needs one nested bsdf"))?;
+                let Some(mut m) = m else {
+                    o.warn_unused(&mut self.w);
+                    return Ok(None);
+                };
+                if let Some(map) = t.image_map() {
+                    m.textures.normal = Some(NormalMap { map, scale: 1.0 });
+                }
+                m
+            }
+            "bumpmap" => {
+                for e in o.entries() {
+                    if e.child.node().tag == "texture" {
+                        e.take();
+                    }
+                }
+                o.get("scale");
+                approx(self, "bump mapping is not supported; the surface is smooth");
+                let inner = self.inner(&o, depth)?;
+                let [m] = <[Option<Material>; 1]>::try_from(inner)
+                    .map_err(|_| o.error("bumpmap needs one nested bsdf"))?;
+                o.warn_unused(&mut self.w);
+                return Ok(m);
+            }
+            "null" => {
+                o.warn_unused(&mut self.w);
+                return Ok(None);
+            }
+            t if UNSUPPORTED.contains(&t) => {
+                o.mark_all_used();
+                approx(self, "not supported; replaced by diffuse grey 0.5");
+                Material::diffuse(grey(0.5)).with_two_sided(false)
+            }
+            other => return Err(o.error(format!("unknown bsdf type '{other}'"))),
+        };
+        o.warn_unused(&mut self.w);
+        Ok(Some(m))
+    }
+
+    /// A conductor's `(eta, k)`: a `material` preset, else `eta` and `k`
+    /// (Mitsuba's default, `none`, is a perfect mirror).
+    fn metal(&mut self, o: &Object<'a>) -> Result<(Vec3, Vec3), FormatError> {
+        if o.has("eta") || o.has("k") {
+            if o.has("material") {
+                return Err(o.error("give 'material' or 'eta' and 'k', not both"));
+            }
+            let part = |b: &mut Self, name: &str| -> Result<Color, FormatError> {
+                if let Some(c) = o.color(name)? {
+                    return Ok(c);
+                }
+                let t = b.tint(o, name, Vec3::ZERO, Usage::Index)?;
+                if t.image.is_some() {
+                    b.w.add(
+                        format!(
+                            "{}: textured 'eta' / 'k' are replaced by their means",
+                            o.what()
+                        ),
+                        &o.node.loc,
+                    );
+                }
+                Ok(Color::Rgb(t.mean().as_dvec3()))
+            };
+            let eta = part(self, "eta")?;
+            let k = part(self, "k")?;
+            return Ok(conductor_rgb(&eta, &k));
+        }
+        let name = o.string("material")?.unwrap_or("none");
+        if name == "none" {
+            // Fresnel 1 at every angle: eta = 1, k large.
+            return Ok((Vec3::ONE, Vec3::splat(1e4)));
+        }
+        let table = |part: &str| match spectrum::named(&format!("metal-{name}-{part}")) {
+            Some(spectrum::Named::Rgb(c)) => Some(glam::DVec3::from_array(c).as_vec3()),
+            _ => None,
+        };
+        match (table("eta"), table("k")) {
+            (Some(e), Some(k)) => Ok((e, k)),
+            _ => {
+                let p = o.get("material").expect("present");
+                Err(p.error(format!(
+                    "conductor material '{name}' is not tabulated in Sahara (known: none, Ag, Al, Au, Cu, CuZn); give 'eta' and 'k'"
+                )))
+            }
+        }
+    }
+
+    /// `principled` as glTF's metallic-roughness model.
+    fn principled(&mut self, o: &Object<'a>) -> Result<Material, FormatError> {
+        let base = self.tint(o, "base_color", Vec3::splat(0.5), Usage::Reflectance)?;
+        let metallic = self.number(o, "metallic", 0.0)? as f32;
+        let r = self.number(o, "roughness", 0.5)? as f32;
+        let eta = match o.float_opt("eta")? {
+            Some(e) => e as f32,
+            None => {
+                // Mitsuba: specular = ((eta - 1) / (eta + 1))^2 / 0.08.
+                let s = self.number(o, "specular", 0.5)?.clamp(0.0, 1.0) as f32;
+                let r0 = (0.08 * s).sqrt();
+                (1.0 + r0) / (1.0 - r0).max(1e-3)
+            }
+        };
+        let mut lost = Vec::new();
+        for (k, d) in [
+            ("anisotropic", 0.0),
+            ("sheen", 0.0),
+            ("spec_trans", 0.0),
+            ("spec_tint", 0.0),
+            ("flatness", 0.0),
+            ("sheen_tint", 0.0),
+        ] {
+            if (self.number(o, k, d)? - d).abs() > 1e-6 && k != "sheen_tint" {
+                lost.push(k);
+            }
+        }
+        for k in [
+            "diff_trans",
+            "eta_thin",
+            "main_specular_sampling_rate",
+            "clearcoat_sampling_rate",
+            "diffuse_reflectance_sampling_rate",
+        ] {
+            o.get(k);
+        }
+        if !lost.is_empty() {
+            self.w.add(
+                format!(
+                    "bsdf 'principled': {} not supported; left out",
+                    lost.join(", ")
+                ),
+                &o.node.loc,
+            );
+        }
+        let mut m = tinted(
+            Bsdf::MetallicRoughness {
+                base_color: base.color.clamp(Vec3::ZERO, Vec3::ONE),
+                metallic: metallic.clamp(0.0, 1.0),
+                roughness: r.clamp(0.0, 1.0),
+                ior: eta.max(1.0),
+                specular: 1.0,
+                specular_color: Vec3::ONE,
+            },
+            &Tint {
+                color: Vec3::ONE,
+                ..base
+            },
+        );
+        let coat = self.number(o, "clearcoat", 0.0)? as f32;
+        let gloss = self.number(o, "clearcoat_gloss", 0.0)? as f32;
+        if coat > 0.0 {
+            // Disney's coat: alpha from 0.1 (gloss 0) to 0.001 (gloss 1).
+            let alpha = 0.1 + (0.001 - 0.1) * gloss.clamp(0.0, 1.0);
+            m.clearcoat = Some(Box::new(Clearcoat {
+                factor: coat.clamp(0.0, 1.0),
+                roughness: alpha.sqrt(),
+                ior: 1.5,
+                factor_map: None,
+                roughness_map: None,
+                normal_map: None,
+            }));
+        }
+        Ok(m.with_two_sided(false))
+    }
+}

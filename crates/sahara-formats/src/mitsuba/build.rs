@@ -1,0 +1,182 @@
+//! The expanded `<scene>` as a [`SceneDescription`]: the table of `id`s,
+//! the walk over the scene's elements, and the state the other modules
+//! share (materials and meshes made once each, warnings).
+//!
+//! - Each `<shape>` is an object ([`super::shapes`]); a `shapegroup` is
+//!   one mesh made once, and each `instance` of it an object showing it.
+//! - Each bsdf becomes a material on first use ([`super::bsdfs`]), a
+//!   shape's `area` emitter its material emitting.
+//! - The `<sensor>` is the camera and, with the `<integrator>`, the
+//!   render settings ([`super::sensor`], [`super::integrator`]); a scene
+//!   without one is seen by Sahara's automatic camera.
+//! - Other emitters are lights or the environment ([`super::emitters`]).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use super::properties::{Child, Object};
+use super::xml::Node;
+use crate::description::{CameraRequest, SceneDescription};
+use crate::pbrt::textures::Tint;
+use crate::pbrt::warnings::Warnings;
+use crate::FormatError;
+
+/// What the walk over a scene builds, and what it has made so far.
+pub(crate) struct Builder<'a> {
+    /// The folder of the file the render started from.
+    pub(crate) main: PathBuf,
+    /// Every object with an `id`, by id.
+    pub(crate) ids: HashMap<&'a str, &'a Node>,
+    /// The description being built.
+    pub(crate) scene: SceneDescription,
+    /// Warnings, one line per kind.
+    pub(crate) w: Warnings,
+    /// The material of each bsdf element (by address), once mapped;
+    /// `None`: no surface (`null`).
+    pub(crate) materials: HashMap<usize, Option<u32>>,
+    /// The grey default of shapes without a bsdf.
+    pub(crate) default_material: Option<u32>,
+    /// Meshes loaded from files, by file, index within it and options.
+    pub(crate) file_meshes: HashMap<(PathBuf, i64, bool, bool), Option<u32>>,
+    /// The mesh of each shapegroup (by address), once made.
+    pub(crate) groups: HashMap<usize, Option<u32>>,
+    /// Textures read so far (by element address).
+    pub(crate) textures: HashMap<usize, Tint>,
+}
+
+/// The address of an element: its identity for the caches.
+pub(crate) fn key(node: &Node) -> usize {
+    node as *const Node as usize
+}
+
+/// Collects the ids of `node`'s descendants into `ids`.
+fn collect_ids<'a>(
+    node: &'a Node,
+    ids: &mut HashMap<&'a str, &'a Node>,
+) -> Result<(), FormatError> {
+    for c in &node.children {
+        if c.tag != "ref" {
+            if let Some(id) = c.attr("id") {
+                if let Some(first) = ids.insert(id, c) {
+                    return Err(c.error(format!(
+                        "id \"{id}\" is given twice (first at line {})",
+                        first.loc.line
+                    )));
+                }
+            }
+        }
+        collect_ids(c, ids)?;
+    }
+    Ok(())
+}
+
+impl<'a> Builder<'a> {
+    /// The object `child` stands for (a `<ref>` looked up by its id),
+    /// which must be one of `tags` (`what` names them in messages).
+    pub(crate) fn resolve(
+        &self,
+        child: Child<'a>,
+        tags: &[&str],
+        what: &str,
+    ) -> Result<&'a Node, FormatError> {
+        let node = match child {
+            Child::Node(n) => n,
+            Child::Ref(r) => {
+                let id = r.need("id")?;
+                *self.ids.get(id).ok_or_else(|| {
+                    r.error(format!("<ref id=\"{id}\">: no object has the id \"{id}\""))
+                })?
+            }
+        };
+        if !tags.contains(&node.tag.as_str()) {
+            let at = child.node();
+            return Err(at.error(format!(
+                "expected {what} here, found a <{}>{}",
+                node.tag,
+                match child {
+                    Child::Ref(_) => format!(" (id \"{}\")", at.attr("id").unwrap_or("")),
+                    Child::Node(_) => String::new(),
+                }
+            )));
+        }
+        Ok(node)
+    }
+
+    /// The parsed object of `node`.
+    pub(crate) fn object(&self, node: &'a Node) -> Result<Object<'a>, FormatError> {
+        Object::parse(node, &self.main)
+    }
+}
+
+/// The description of the expanded `<scene>` `root`, read from the file
+/// `name` in `folder`.
+pub(crate) fn build(
+    root: &Node,
+    name: &str,
+    folder: &Path,
+    w: Warnings,
+) -> Result<SceneDescription, FormatError> {
+    let mut ids = HashMap::new();
+    collect_ids(root, &mut ids)?;
+    let mut b = Builder {
+        main: folder.to_path_buf(),
+        ids,
+        scene: SceneDescription::new(name),
+        w,
+        materials: HashMap::new(),
+        default_material: None,
+        file_meshes: HashMap::new(),
+        groups: HashMap::new(),
+        textures: HashMap::new(),
+    };
+    let mut sensor = None;
+    let mut integrator = None;
+    for node in &root.children {
+        match node.tag.as_str() {
+            "sensor" if sensor.is_some() => b.w.add(
+                "more than one <sensor>: the first one is used",
+                &node.loc,
+            ),
+            "sensor" => sensor = Some(node),
+            "integrator" if integrator.is_some() => b.w.add(
+                "more than one <integrator>: the first one is used",
+                &node.loc,
+            ),
+            "integrator" => integrator = Some(node),
+            "shape" => b.top_shape(node)?,
+            "emitter" => b.emitter(node)?,
+            // Made when used (a shape or an instance refers to them).
+            "bsdf" | "texture" => {
+                node.need("type")?;
+            }
+            "medium" | "phase" | "volume" => b.w.add(
+                "participating media are not supported; ignored",
+                &node.loc,
+            ),
+            "film" | "sampler" | "rfilter" => b.w.add(
+                format!("<{}> outside a <sensor> has no effect; ignored", node.tag),
+                &node.loc,
+            ),
+            "ref" => b.w.add("<ref> directly in <scene> has no effect; ignored", &node.loc),
+            other if super::properties::OBJECT_TAGS.contains(&other) => unreachable!(),
+            other => {
+                return Err(node.error(format!(
+                    "unknown element <{other}> in <scene> (expected shape, bsdf, texture, emitter, sensor, integrator, default or include)"
+                )))
+            }
+        }
+    }
+    let integrator = super::integrator::integrator(&mut b, integrator)?;
+    let (camera, settings) = super::sensor::sensor(&mut b, sensor, integrator)?;
+    b.scene.camera = match camera {
+        Some(camera) => CameraRequest::Given {
+            camera,
+            source: String::new(),
+        },
+        None => CameraRequest::Automatic,
+    };
+    b.scene.settings = Some(settings);
+    let mut scene = b.scene;
+    scene.warnings = b.w.into_lines();
+    Ok(scene)
+}

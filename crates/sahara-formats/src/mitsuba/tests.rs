@@ -1,0 +1,1 @@
+//! Tests of the Mitsuba reader as a whole.
