@@ -357,9 +357,11 @@ pub(crate) fn sensor<'a>(
         }
         c = c.with_thin_lens(r as f32, d as f32);
     }
-    let open = o.float("shutter_open", 0.0)?;
-    let time = o.float("shutter_close", open)?;
-    c = c.with_shutter(open as f32, time as f32);
+    if o.has("shutter_open") || o.has("shutter_close") {
+        let open = o.float("shutter_open", 0.0)?;
+        let close = o.float("shutter_close", open)?;
+        c = c.with_shutter(open as f32, close as f32);
+    }
     let clip = ["near_clip", "far_clip"]
         .into_iter()
         .filter(|k| o.get(k).is_some())

@@ -206,10 +206,7 @@ pub(crate) type MeshToWrite = (Vec<[f32; 3]>, Vec<[u32; 3]>, u32);
 /// A serialized file of `meshes`, version 4 with doubles when `double`,
 /// for tests.
 #[cfg(test)]
-pub(crate) fn write_serialized(
-    meshes: &[MeshToWrite],
-    double: bool,
-) -> Vec<u8> {
+pub(crate) fn write_serialized(meshes: &[MeshToWrite], double: bool) -> Vec<u8> {
     use std::io::Write;
     let mut out = Vec::new();
     let mut offsets = Vec::new();

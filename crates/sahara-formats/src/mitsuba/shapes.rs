@@ -199,7 +199,7 @@ impl<'a> Builder<'a> {
             }
             let node = self.resolve(
                 e.child,
-                &["bsdf", "emitter", "medium", "texture", "shape"],
+                &["bsdf", "emitter", "medium"],
                 "a <bsdf> or <emitter>",
             )?;
             match node.tag.as_str() {
@@ -221,7 +221,6 @@ impl<'a> Builder<'a> {
                     "participating media are not supported; ignored",
                     &e.child.node().loc,
                 ),
-                // Named textures and the like are the shape type's business.
                 _ => continue,
             }
             e.take();
