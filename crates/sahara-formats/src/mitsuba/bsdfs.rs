@@ -30,7 +30,6 @@ use super::properties::Object;
 use super::spectra::{conductor_rgb, Color, Usage};
 use super::xml::Node;
 use crate::pbrt::materials::blend;
-use crate::pbrt::spectrum;
 use crate::pbrt::textures::{with_opacity, Tint};
 use crate::FormatError;
 
@@ -428,16 +427,16 @@ impl<'a> Builder<'a> {
             // Fresnel 1 at every angle: eta = 1, k large.
             return Ok((Vec3::ONE, Vec3::splat(1e4)));
         }
-        let table = |part: &str| match spectrum::named(&format!("metal-{name}-{part}")) {
-            Some(spectrum::Named::Rgb(c)) => Some(glam::DVec3::from_array(c).as_vec3()),
-            _ => None,
-        };
-        match (table("eta"), table("k")) {
-            (Some(e), Some(k)) => Ok((e, k)),
-            _ => {
+        match super::metals::mitsuba_metal(name) {
+            Some((e, k)) => Ok((
+                glam::DVec3::from_array(e).as_vec3(),
+                glam::DVec3::from_array(k).as_vec3(),
+            )),
+            None => {
                 let p = o.get("material").expect("present");
                 Err(p.error(format!(
-                    "conductor material '{name}' is not tabulated in Sahara (known: none, Ag, Al, Au, Cu, CuZn); give 'eta' and 'k'"
+                    "unknown conductor material '{name}' (Mitsuba's: none, {})",
+                    super::metals::names().collect::<Vec<_>>().join(", ")
                 )))
             }
         }

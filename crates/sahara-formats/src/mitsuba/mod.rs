@@ -22,6 +22,7 @@ mod defaults;
 mod emitters;
 mod expand;
 mod integrator;
+mod metals;
 mod properties;
 mod sensor;
 mod serialized;
