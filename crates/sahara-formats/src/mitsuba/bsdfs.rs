@@ -4,10 +4,10 @@
 //! | Mitsuba | Sahara | lost (warned) |
 //! |---|---|---|
 //! | `diffuse` | diffuse | |
-//! | `conductor`, `roughconductor` (`material`, `eta`, `k`, `specular_reflectance`) | complex-IOR conductor, scattering once between microfacets as Mitsuba's does, tinted by `specular_reflectance` | Beckmann (GGX of the same alpha), anisotropy (the mean alpha), textured `eta` / `k` |
+//! | `conductor`, `roughconductor` (`material`: every preset Mitsuba ships, see [`super::metals`]; `eta`, `k`, `specular_reflectance`) | complex-IOR conductor, scattering once between microfacets as Mitsuba's does, tinted by `specular_reflectance` | Beckmann (GGX of the same alpha), anisotropy (the mean alpha), textured `eta` / `k` |
 //! | `dielectric`, `roughdielectric` (`int_ior`, `ext_ior`) | glass / rough glass of index `int_ior / ext_ior` | tinted `specular_reflectance` / `specular_transmittance`; Beckmann |
 //! | `thindielectric` | thin dielectric | |
-//! | `plastic`, `roughplastic` | coated diffuse: a dielectric coat of index `int_ior / ext_ior` over `diffuse_reflectance` | a `specular_reflectance` other than 1; Beckmann |
+//! | `plastic`, `roughplastic` | coated diffuse: a dielectric coat of index `int_ior / ext_ior` over a base whose albedo gives Mitsuba's diffuse light (`nonlinear` false: `diffuse_reflectance / (1 - F_i)`; true: as given) | a `specular_reflectance` other than 1; a textured base read as `nonlinear`; Beckmann |
 //! | `principled` | glTF metallic-roughness (`base_color`, `metallic`, `roughness`, `eta`), with a clear coat (`clearcoat`, `clearcoat_gloss`) | `anisotropic`, `sheen`, `spec_trans`, `spec_tint`, `flatness` |
 //! | `twosided` | the nested bsdf, scattering on both faces | a different back bsdf (the front one is used) |
 //! | `mask` (`opacity`) | the nested bsdf, cut by stochastic transparency | |
@@ -92,6 +92,28 @@ fn tinted(bsdf: Bsdf, tint: &Tint) -> Material {
     m
 }
 
+/// Mitsuba's diffuse Fresnel reflectance of an interface of relative
+/// index `eta` (Egan and Hilgeman's fit below 1, d'Eon and Irving's above).
+fn diffuse_fresnel(eta: f32) -> f32 {
+    if eta < 1.0 {
+        -1.4399 * eta * eta + 0.7099 * eta + 0.6681 + 0.0636 / eta
+    } else {
+        let i = 1.0 / eta;
+        0.919317 - 3.4793 * i + 6.75335 * i.powi(2) - 7.80989 * i.powi(3) + 4.98554 * i.powi(4)
+            - 1.36881 * i.powi(5)
+    }
+}
+
+/// The base albedo of Sahara's coated diffuse (whose base scatters the
+/// light the coat reflects back down again, Mitsuba's `nonlinear` plastic)
+/// that gives the diffuse light of Mitsuba's default, linear plastic of
+/// diffuse reflectance `rho`: `rho / (1 - F_i)` where Sahara has
+/// `a / (1 - a F_i)`, `F_i` the coat's internal diffuse reflectance.
+fn linear_plastic_albedo(rho: Vec3, eta: f32) -> Vec3 {
+    let fi = diffuse_fresnel(1.0 / eta);
+    (rho / (Vec3::splat(1.0 - fi) + rho * fi)).clamp(Vec3::ZERO, Vec3::ONE)
+}
+
 impl<'a> Builder<'a> {
     /// The grey one-sided diffuse of shapes without a bsdf (Mitsuba's
     /// default).
@@ -103,6 +125,18 @@ impl<'a> Builder<'a> {
             .scene
             .add_material(Material::diffuse(Vec3::splat(0.5)).with_two_sided(false));
         self.default_material = Some(m);
+        m
+    }
+
+    /// The black one-sided surface of emitters without a bsdf.
+    pub(crate) fn black_material(&mut self) -> u32 {
+        if let Some(m) = self.black_material {
+            return m;
+        }
+        let m = self
+            .scene
+            .add_material(Material::diffuse(Vec3::ZERO).with_two_sided(false));
+        self.black_material = Some(m);
         m
     }
 
@@ -266,16 +300,29 @@ impl<'a> Builder<'a> {
                 }
                 let int = self.ior(&o, "int_ior", 1.49)?;
                 let ext = self.ior(&o, "ext_ior", 1.000277)?;
-                o.get("nonlinear");
+                let eta = ((int / ext) as f32).max(1.0);
+                let nonlinear = o.bool("nonlinear", false)?;
                 let r = if o.ty == "roughplastic" {
                     self.alpha(&o, 0.1)?
                 } else {
                     0.0
                 };
+                let rho = base.color.clamp(Vec3::ZERO, Vec3::ONE);
+                let albedo = if nonlinear || base.image.is_some() {
+                    if !nonlinear {
+                        approx(
+                            self,
+                            "a textured 'diffuse_reflectance' is read as with 'nonlinear' (deeper colours)",
+                        );
+                    }
+                    rho
+                } else {
+                    linear_plastic_albedo(rho, eta)
+                };
                 one_sided(tinted(
                     Bsdf::CoatedDiffuse {
-                        albedo: base.color.clamp(Vec3::ZERO, Vec3::ONE),
-                        ior: ((int / ext) as f32).max(1.0),
+                        albedo,
+                        ior: eta,
                         roughness: r,
                     },
                     &Tint {
@@ -516,5 +563,29 @@ impl<'a> Builder<'a> {
             }));
         }
         Ok(m.with_two_sided(false))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_linear_plastic_gets_the_base_that_gives_mitsubas_diffuse_light() {
+        // Sahara's coat gives a / (1 - a F_i), Mitsuba's linear plastic
+        // rho / (1 - F_i).
+        let fi = diffuse_fresnel(1.0 / 1.5);
+        assert!((fi - 0.5968).abs() < 1e-3, "{fi}");
+        let rho = Vec3::new(0.1, 0.5, 0.9);
+        let a = linear_plastic_albedo(rho, 1.5);
+        let sahara = a / (Vec3::ONE - a * fi);
+        let mitsuba = rho / (1.0 - fi);
+        assert!(
+            (sahara - mitsuba).abs().max_element() < 1e-5,
+            "{sahara} {mitsuba}"
+        );
+        // The internal reflectance of a smooth interface is larger than
+        // the external one.
+        assert!(diffuse_fresnel(1.5) < fi);
     }
 }

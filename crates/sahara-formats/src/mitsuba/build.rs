@@ -36,6 +36,8 @@ pub(crate) struct Builder<'a> {
     pub(crate) materials: HashMap<usize, Option<u32>>,
     /// The grey default of shapes without a bsdf.
     pub(crate) default_material: Option<u32>,
+    /// The black surface of emitters without a bsdf.
+    pub(crate) black_material: Option<u32>,
     /// Meshes loaded from files, by file, index within it and options.
     pub(crate) file_meshes: HashMap<(PathBuf, i64, bool, bool), Option<u32>>,
     /// The mesh of each shapegroup (by address), once made.
@@ -125,6 +127,7 @@ pub(crate) fn build(
         w,
         materials: HashMap::new(),
         default_material: None,
+        black_material: None,
         file_meshes: HashMap::new(),
         groups: HashMap::new(),
         textures: HashMap::new(),

@@ -232,9 +232,11 @@ impl<'a> Builder<'a> {
             );
             emitter = None;
         }
-        let material = match bsdf {
-            Some(b) => self.material(b)?,
-            None => Some(self.default_material()),
+        let material = match (bsdf, emitter) {
+            (Some(b), _) => self.material(b)?,
+            // Mitsuba's emitters without a bsdf reflect nothing.
+            (None, Some(_)) => Some(self.black_material()),
+            (None, None) => Some(self.default_material()),
         };
         match (material, emitter) {
             (Some(m), e) => Ok((Some(m), e)),
@@ -244,10 +246,7 @@ impl<'a> Builder<'a> {
                     "a 'null' bsdf with an area emitter: the emitter's surface blocks light (black)",
                     &o.node.loc,
                 );
-                let black = self.scene.add_material(
-                    sahara_render::Material::diffuse(Vec3::ZERO).with_two_sided(false),
-                );
-                Ok((Some(black), Some(e)))
+                Ok((Some(self.black_material()), Some(e)))
             }
         }
     }
