@@ -147,6 +147,8 @@ pub(crate) fn build(
             ),
             "integrator" => integrator = Some(node),
             "shape" => b.top_shape(node)?,
+            // An area emitter with an id is defined for shapes to refer to.
+            "emitter" if node.attr("type") == Some("area") && node.attr("id").is_some() => {}
             "emitter" => b.emitter(node)?,
             // Made when used (a shape or an instance refers to them).
             "bsdf" | "texture" => {

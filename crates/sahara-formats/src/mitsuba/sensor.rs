@@ -356,6 +356,10 @@ pub(crate) fn sensor<'a>(
             return Err(o.error("thinlens: aperture_radius must be >= 0 and focus_distance > 0"));
         }
         c = c.with_thin_lens(r as f32, d as f32);
+    } else {
+        // A pinhole's focus distance changes nothing (Mitsuba's own
+        // scenes give one).
+        o.get("focus_distance");
     }
     if o.has("shutter_open") || o.has("shutter_close") {
         let open = o.float("shutter_open", 0.0)?;

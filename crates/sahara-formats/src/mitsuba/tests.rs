@@ -173,6 +173,21 @@ fn ids_and_refs_share_one_material() {
 }
 
 #[test]
+fn an_area_emitter_with_an_id_lights_the_shapes_that_refer_to_it() {
+    // As Mitsuba's own Cornell boxes write it: the emitter after the shape.
+    let d = describe(
+        "<shape type=\"rectangle\"><ref id=\"e\"/></shape>\n\
+         <emitter type=\"area\" id=\"e\"><rgb name=\"radiance\" value=\"2\"/></emitter>",
+    );
+    assert_eq!(material(&d, 0).emission, Vec3::splat(2.0));
+    assert!(d.lights.is_empty() && d.environment.is_none());
+    assert_eq!(
+        err("<emitter type=\"area\"/>"),
+        "t.xml: line 2: column 1: an 'area' emitter belongs inside a <shape>"
+    );
+}
+
+#[test]
 fn bad_files_say_what_and_where_in_one_line() {
     // Unclosed tag.
     let e = err("<shape type=\"sphere\">\n<bsdf type=\"diffuse\">\n</shape>");
