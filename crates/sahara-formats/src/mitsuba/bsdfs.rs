@@ -15,7 +15,7 @@
 //! | `normalmap` | the nested bsdf with the normal map | |
 //! | `bumpmap` | the nested bsdf | the bumps |
 //! | `null` | no surface (the shape is skipped) | |
-//! | `hair`, `measured`, `pplastic`, `polarizer`, `retarder`, `circular` | diffuse grey 0.5 | the model |
+//! | `hair`, `measured`, `measured_polarized`, `pplastic`, `polarizer`, `retarder`, `circular` | diffuse grey 0.5 | the model |
 //!
 //! Mitsuba's bsdfs are one-sided: a surface seen from its back is black,
 //! and so it is here, unless wrapped in `twosided` (glass has two sides
@@ -67,6 +67,7 @@ const IORS: &[(&str, f64)] = &[
 const UNSUPPORTED: &[&str] = &[
     "hair",
     "measured",
+    "measured_polarized",
     "pplastic",
     "polarizer",
     "retarder",

@@ -12,8 +12,9 @@
 //! - Other emitters are lights or the environment ([`super::emitters`]).
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
+use super::expand::Search;
 use super::properties::{Child, Object};
 use super::xml::Node;
 use crate::description::{CameraRequest, SceneDescription};
@@ -23,8 +24,8 @@ use crate::FormatError;
 
 /// What the walk over a scene builds, and what it has made so far.
 pub(crate) struct Builder<'a> {
-    /// The folder of the file the render started from.
-    pub(crate) main: PathBuf,
+    /// Where files named in the scene are looked for.
+    pub(crate) main: Search,
     /// Every object with an `id`, by id.
     pub(crate) ids: HashMap<&'a str, &'a Node>,
     /// The description being built.
@@ -104,6 +105,28 @@ impl<'a> Builder<'a> {
         Ok(node)
     }
 
+    /// The first nested object of `o` (written in place or referred to)
+    /// whose element is `<tag>`, marked used.
+    pub(crate) fn child_of(
+        &self,
+        o: &Object<'a>,
+        tag: &str,
+    ) -> Result<Option<&'a Node>, FormatError> {
+        for e in o.entries() {
+            let node = match e.child {
+                Child::Node(n) => n,
+                Child::Ref(_) => {
+                    self.resolve(e.child, super::properties::OBJECT_TAGS, "an object")?
+                }
+            };
+            if node.tag == tag {
+                e.take();
+                return Ok(Some(node));
+            }
+        }
+        Ok(None)
+    }
+
     /// The parsed object of `node`.
     pub(crate) fn object(&self, node: &'a Node) -> Result<Object<'a>, FormatError> {
         Object::parse(node, &self.main)
@@ -111,17 +134,17 @@ impl<'a> Builder<'a> {
 }
 
 /// The description of the expanded `<scene>` `root`, read from the file
-/// `name` in `folder`.
+/// `name`, files looked for as `search` says.
 pub(crate) fn build(
     root: &Node,
     name: &str,
-    folder: &Path,
+    search: Search,
     w: Warnings,
 ) -> Result<SceneDescription, FormatError> {
     let mut ids = HashMap::new();
     collect_ids(root, &mut ids)?;
     let mut b = Builder {
-        main: folder.to_path_buf(),
+        main: search,
         ids,
         scene: SceneDescription::new(name),
         w,
@@ -158,6 +181,8 @@ pub(crate) fn build(
                 "participating media are not supported; ignored",
                 &node.loc,
             ),
+            // Defined for a sensor to refer to.
+            "film" | "sampler" | "rfilter" if node.attr("id").is_some() => {}
             "film" | "sampler" | "rfilter" => b.w.add(
                 format!("<{}> outside a <sensor> has no effect; ignored", node.tag),
                 &node.loc,

@@ -44,7 +44,7 @@ const NAMED_TAGS: &[&str] = &[
 pub(crate) fn expand_scene(
     root: Node,
     defaults: &mut Defaults,
-    main: &Path,
+    search: &mut Search,
     w: &mut Warnings,
 ) -> Result<Node, FormatError> {
     let mut out = Vec::new();
@@ -56,7 +56,7 @@ pub(crate) fn expand_scene(
         loc,
         folder,
     } = root;
-    expand_children(children, legacy, defaults, main, 0, w, &mut out)?;
+    expand_children(children, legacy, defaults, search, 0, w, &mut out)?;
     Ok(Node {
         tag,
         attrs,
@@ -118,7 +118,7 @@ fn expand_children(
     children: Vec<Node>,
     legacy: bool,
     defaults: &mut Defaults,
-    main: &Path,
+    search: &mut Search,
     depth: usize,
     w: &mut Warnings,
     out: &mut Vec<Node>,
@@ -126,6 +126,11 @@ fn expand_children(
     for node in children {
         match node.tag.as_str() {
             "default" => defaults.declare(&node)?,
+            "path" => {
+                let dir = defaults.substitute(&node, node.need("value")?)?;
+                let dir = node.folder.join(dir);
+                search.extra.push(dir);
+            }
             "include" => {
                 let file = defaults.substitute(&node, node.need("filename")?)?;
                 if depth >= MAX_INCLUDE_DEPTH {
@@ -133,7 +138,7 @@ fn expand_children(
                         "<include> nests more than {MAX_INCLUDE_DEPTH} deep (a file including itself?)"
                     )));
                 }
-                let path = resolve(&node.folder, main, &file);
+                let path = search.resolve(&node.folder, &file);
                 let name = path.display().to_string();
                 let root = read_file(&path, &name, w)
                     .map_err(|e| node.error(format!("<include filename=\"{file}\">: {e}")))?;
@@ -142,13 +147,13 @@ fn expand_children(
                     root.children,
                     inner_legacy,
                     defaults,
-                    main,
+                    search,
                     depth + 1,
                     w,
                     out,
                 )?;
             }
-            _ => out.push(expand_node(node, legacy, defaults, main, depth, w)?),
+            _ => out.push(expand_node(node, legacy, defaults, search, depth, w)?),
         }
     }
     Ok(())
@@ -160,7 +165,7 @@ fn expand_node(
     mut node: Node,
     legacy: bool,
     defaults: &mut Defaults,
-    main: &Path,
+    search: &mut Search,
     depth: usize,
     w: &mut Warnings,
 ) -> Result<Node, FormatError> {
@@ -174,27 +179,44 @@ fn expand_node(
     }
     let children = std::mem::take(&mut node.children);
     let mut out = Vec::with_capacity(children.len());
-    expand_children(children, legacy, defaults, main, depth, w, &mut out)?;
+    expand_children(children, legacy, defaults, search, depth, w, &mut out)?;
     node.children = out;
     Ok(node)
 }
 
-/// A file named in the scene: absolute as given, else from the folder of
-/// the file naming it, else (if not there) from the main file's folder.
-pub(crate) fn resolve(folder: &Path, main: &Path, file: &str) -> PathBuf {
-    let p = Path::new(file);
-    if p.is_absolute() {
-        return p.to_path_buf();
+/// Where files named in the scene are looked for.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Search {
+    /// The folder of the file the render started from.
+    pub(crate) main: PathBuf,
+    /// Folders added by `<path value="..."/>`, in file order.
+    pub(crate) extra: Vec<PathBuf>,
+}
+
+impl Search {
+    /// Files looked up from `main` (and the naming file's folder).
+    pub(crate) fn new(main: &Path) -> Self {
+        Self {
+            main: main.to_path_buf(),
+            extra: Vec::new(),
+        }
     }
-    let near = folder.join(p);
-    if near.exists() {
-        return near;
-    }
-    let far = main.join(p);
-    if far.exists() {
-        far
-    } else {
-        near
+
+    /// A file named in the scene: absolute as given, else the first that
+    /// exists of: the folder of the file naming it, the `<path>` folders
+    /// (the last added first, as Mitsuba's resolver), the main file's
+    /// folder; if none has it, the first.
+    pub(crate) fn resolve(&self, folder: &Path, file: &str) -> PathBuf {
+        let p = Path::new(file);
+        if p.is_absolute() {
+            return p.to_path_buf();
+        }
+        let near = folder.join(p);
+        std::iter::once(near.clone())
+            .chain(self.extra.iter().rev().map(|d| d.join(p)))
+            .chain(std::iter::once(self.main.join(p)))
+            .find(|c| c.exists())
+            .unwrap_or(near)
     }
 }
 

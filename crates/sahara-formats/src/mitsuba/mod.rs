@@ -93,8 +93,9 @@ fn described(
     mut w: Warnings,
 ) -> Result<SceneDescription, FormatError> {
     let mut d = defaults::Defaults::given(params);
-    let scene = expand::expand_scene(root, &mut d, folder, &mut w)?;
-    build::build(&scene, name, folder, w)
+    let mut search = expand::Search::new(folder);
+    let scene = expand::expand_scene(root, &mut d, &mut search, &mut w)?;
+    build::build(&scene, name, search, w)
 }
 
 /// The assembled scene, checked.

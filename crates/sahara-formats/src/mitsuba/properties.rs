@@ -10,11 +10,11 @@
 //! error, as in Mitsuba.
 
 use std::cell::Cell;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use glam::{DMat4, DVec3};
 
-use super::expand::resolve;
+use super::expand::Search;
 use super::spectra::{numbers, parse_rgb, parse_spectrum, parse_temperature, Color};
 use super::transform::parse_transform;
 use super::xml::Node;
@@ -142,7 +142,7 @@ pub(crate) struct Object<'a> {
 }
 
 /// Reads a property element.
-fn property(node: &Node, main: &Path) -> Result<Value, FormatError> {
+fn property(node: &Node, search: &Search) -> Result<Value, FormatError> {
     let value = || node.need("value");
     let one = |what: &str| -> Result<f64, FormatError> {
         let text = value()?;
@@ -172,7 +172,7 @@ fn property(node: &Node, main: &Path) -> Result<Value, FormatError> {
         "spectrum" => {
             let path = node
                 .attr("filename")
-                .map(|f| resolve(&node.folder, main, f));
+                .map(|f| search.resolve(&node.folder, f));
             Value::Color(parse_spectrum(node, path.as_deref())?)
         }
         "blackbody" => Value::Color(parse_temperature(node, node.need("temperature")?)?),
@@ -210,9 +210,9 @@ fn property(node: &Node, main: &Path) -> Result<Value, FormatError> {
 }
 
 impl<'a> Object<'a> {
-    /// The object of a plugin element (`main`: the main file's folder,
-    /// for files named by properties).
-    pub(crate) fn parse(node: &'a Node, main: &Path) -> Result<Object<'a>, FormatError> {
+    /// The object of a plugin element (`search`: where files named by
+    /// properties are looked for).
+    pub(crate) fn parse(node: &'a Node, search: &Search) -> Result<Object<'a>, FormatError> {
         let ty = node.need("type")?;
         let mut props: Vec<Prop> = Vec::new();
         let mut entries = Vec::new();
@@ -239,7 +239,7 @@ impl<'a> Object<'a> {
                 }
                 props.push(Prop {
                     name: name.to_owned(),
-                    value: property(c, main)?,
+                    value: property(c, search)?,
                     loc: c.loc.clone(),
                     used: Cell::new(false),
                 });
@@ -327,10 +327,10 @@ impl<'a> Object<'a> {
     }
 
     /// A file named by string property `name`, resolved as Mitsuba does.
-    pub(crate) fn file(&self, name: &str, main: &Path) -> Result<Option<PathBuf>, FormatError> {
+    pub(crate) fn file(&self, name: &str, search: &Search) -> Result<Option<PathBuf>, FormatError> {
         Ok(self
             .string(name)?
-            .map(|f| resolve(&self.node.folder, main, f)))
+            .map(|f| search.resolve(&self.node.folder, f)))
     }
 
     /// A point or vector, if given.
@@ -425,6 +425,7 @@ impl<'a> Object<'a> {
 mod tests {
     use super::*;
     use crate::mitsuba::xml::parse_text;
+    use std::path::Path;
 
     fn node(text: &str) -> Node {
         parse_text(
@@ -446,7 +447,7 @@ mod tests {
              <transform name=\"t\"><translate x=\"1\"/></transform>\
              <texture name=\"tex\" type=\"bitmap\"/><ref id=\"other\"/>\n</bsdf>",
         );
-        let o = Object::parse(&n, Path::new("/f")).unwrap();
+        let o = Object::parse(&n, &Search::new(Path::new("/f"))).unwrap();
         assert_eq!(o.ty, "x");
         assert_eq!(o.int("i", 0).unwrap(), 3);
         assert_eq!(o.float("i", 0.0).unwrap(), 3.0);
@@ -485,7 +486,7 @@ mod tests {
     #[test]
     fn bad_values_and_repeats_are_errors_at_their_element() {
         let e = |t: &str| {
-            Object::parse(&node(t), Path::new("/f"))
+            Object::parse(&node(t), &Search::new(Path::new("/f")))
                 .unwrap_err()
                 .to_string()
         };

@@ -105,8 +105,7 @@ fn film<'a>(b: &mut Builder<'a>, node: Option<&'a Node>) -> Result<Film, FormatE
     ] {
         o.get(k);
     }
-    let filters = o.nested("rfilter");
-    let filter = match filters.first() {
+    let filter = match b.child_of(&o, "rfilter")? {
         None => gaussian,
         Some(f) => rfilter(b, f)?,
     };
@@ -340,10 +339,10 @@ pub(crate) fn sensor<'a>(
         }
         other => return Err(o.error(format!("unknown sensor type '{other}'"))),
     }
-    let films = o.nested("film");
-    let f = film(b, films.first().copied())?;
-    let samplers = o.nested("sampler");
-    let s = sampler(b, samplers.first().copied())?;
+    let films = b.child_of(&o, "film")?;
+    let f = film(b, films)?;
+    let samplers = b.child_of(&o, "sampler")?;
+    let s = sampler(b, samplers)?;
     let aspect = f64::from(f.width) / f64::from(f.height);
     let m = o.transform("to_world")?;
     let mut c = camera(&o, m, x_fov(&o, aspect)?, aspect)?;

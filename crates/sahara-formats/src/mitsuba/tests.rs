@@ -145,6 +145,31 @@ fn includes_splice_files_read_from_their_own_folder() {
 }
 
 #[test]
+fn a_path_element_adds_a_folder_to_look_in_and_sensors_refer_to_their_parts() {
+    let dir = folder("path");
+    std::fs::create_dir_all(dir.join("common/meshes")).unwrap();
+    write_meshes(&dir.join("common/meshes"));
+    std::fs::create_dir_all(dir.join("scenes")).unwrap();
+    let d = describe_in(
+        "<path value=\"common\"/>\n\
+         <shape type=\"ply\"><string name=\"filename\" value=\"meshes/q.ply\"/></shape>\n\
+         <sampler type=\"stratified\" id=\"s\"><integer name=\"sample_count\" value=\"9\"/></sampler>\n\
+         <film type=\"hdrfilm\" id=\"f\"><integer name=\"width\" value=\"32\"/></film>\n\
+         <sensor type=\"perspective\"><ref id=\"s\"/><ref id=\"f\"/></sensor>",
+        &dir,
+    )
+    .unwrap();
+    assert!(matches!(d.objects[0].geometry, Geometry::Mesh(_)));
+    let s = d.settings.as_ref().unwrap();
+    assert_eq!(
+        (s.sampler, s.spp, s.width),
+        (SamplerKind::Stratified, 9, 32)
+    );
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn ids_and_refs_share_one_material() {
     let d = describe(
         "<bsdf type=\"diffuse\" id=\"red\"><rgb name=\"reflectance\" value=\"0.8, 0.1, 0.1\"/></bsdf>\n\

@@ -7,6 +7,7 @@
 //!   image is sRGB unless `raw` is true.
 //! - `checkerboard` (`color0`, `color1`, `to_uv`): baked at 32 texels a
 //!   check, two checks a side per unit of uv.
+//! - `mesh_attribute`, `volume`: grey 0.5 (warned).
 //! - A texture where Sahara holds a number (roughness, opacity's constant
 //!   part, an emitter's radiance) is its mean, warned.
 //!
@@ -191,6 +192,14 @@ impl<'a> Builder<'a> {
                         transform: to_uv,
                     },
                 }
+            }
+            "mesh_attribute" | "volume" => {
+                self.w.add(
+                    format!("texture '{}' is not supported; grey 0.5", o.ty),
+                    &node.loc,
+                );
+                o.mark_all_used();
+                Tint::constant(Vec3::splat(0.5))
             }
             other => return Err(o.error(format!("unknown texture type '{other}'"))),
         };
