@@ -376,8 +376,8 @@ impl<'a> Object<'a> {
         Some(e)
     }
 
-    /// The nested objects and references (named or not) whose element is
-    /// `<tag>` or a `<ref>`, not marked used.
+    /// Every nested object and reference, named or not (iterating marks
+    /// none used).
     pub(crate) fn entries(&self) -> impl Iterator<Item = &Entry<'a>> {
         self.entries.iter()
     }

@@ -194,7 +194,8 @@ impl<'a> Builder<'a> {
         let mut bsdf = None;
         let mut emitter = None;
         for e in o.entries() {
-            if e.name.is_some() && e.child.node().tag != "ref" {
+            let tag = e.child.node().tag.as_str();
+            if !["ref", "bsdf", "emitter", "medium"].contains(&tag) {
                 continue;
             }
             let node = self.resolve(
