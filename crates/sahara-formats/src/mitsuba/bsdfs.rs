@@ -13,7 +13,7 @@
 //! | `mask` (`opacity`) | the nested bsdf, cut by stochastic transparency | |
 //! | `blendbsdf` (`weight`) | the blend where exact (two diffuse colours, or the same bsdf), else the bsdf of larger weight | the blend |
 //! | `normalmap` | the nested bsdf with the normal map | |
-//! | `bumpmap` | the nested bsdf | the bumps |
+//! | `bumpmap` (`scale`) | the nested bsdf with a normal map baked from the heights' slopes (strength: see `build::scale_bumps`) | the strength where the length a unit of uv spans varies |
 //! | `null` | no surface (the shape is skipped) | |
 //! | `hair`, `measured`, `measured_polarized`, `pplastic`, `polarizer`, `retarder`, `circular` | diffuse grey 0.5 | the model |
 //!
@@ -23,7 +23,9 @@
 //! roughness its square root.
 
 use glam::Vec3;
-use sahara_render::{AlphaMode, Bsdf, Clearcoat, Material, NormalMap, TextureMap};
+use std::sync::Arc;
+
+use sahara_render::{AlphaMode, Bsdf, Clearcoat, Material, NormalMap, Texture, TextureMap};
 
 use super::build::{key, Builder};
 use super::properties::Object;
@@ -91,6 +93,28 @@ fn tinted(bsdf: Bsdf, tint: &Tint) -> Material {
     let mut m = Material::new(bsdf);
     m.textures.base_color = tint.map();
     m
+}
+
+/// The tangent-space normal map of the height image `h` (texel rows
+/// along Mitsuba's `v`) times `scale`: the normal of the surface lifted by
+/// the height, `(-dh/du, -dh/dv, 1)`, with its slopes per unit of uv
+/// (central differences, wrapping), encoded as `(n + 1) / 2`.
+fn bump_normals(h: &Texture, scale: f32) -> Texture {
+    let (w, ht) = (i64::from(h.width), i64::from(h.height));
+    let at = |x: i64, y: i64| {
+        let t = h.texel(x.rem_euclid(w), y.rem_euclid(ht));
+        (t.x + t.y + t.z) / 3.0
+    };
+    let mut texels = Vec::with_capacity((w * ht) as usize);
+    for y in 0..ht {
+        for x in 0..w {
+            let du = (at(x + 1, y) - at(x - 1, y)) * 0.5 * w as f32 * scale;
+            let dv = (at(x, y + 1) - at(x, y - 1)) * 0.5 * ht as f32 * scale;
+            let n = Vec3::new(-du, -dv, 1.0).normalize();
+            texels.push((n + Vec3::ONE) * 0.5);
+        }
+    }
+    Texture::new(h.width, h.height, texels)
 }
 
 /// Mitsuba's diffuse Fresnel reflectance of an interface of relative
@@ -415,18 +439,41 @@ impl<'a> Builder<'a> {
                 m
             }
             "bumpmap" => {
+                let scale = self.number(&o, "scale", 1.0)? as f32;
+                let mut height = None;
                 for e in o.entries() {
-                    if e.child.node().tag == "texture" {
+                    let node =
+                        self.resolve(e.child, &["bsdf", "texture"], "a <bsdf> or <texture>")?;
+                    if node.tag == "texture" && height.is_none() {
                         e.take();
+                        height = Some(self.texture(node)?);
                     }
                 }
-                o.get("scale");
-                approx(self, "bump mapping is not supported; the surface is smooth");
+                let Some(height) = height else {
+                    return Err(o.error("bumpmap needs a nested height <texture>"));
+                };
                 let inner = self.inner(&o, depth)?;
                 let [m] = <[Option<Material>; 1]>::try_from(inner)
                     .map_err(|_| o.error("bumpmap needs one nested bsdf"))?;
-                o.warn_unused(&mut self.w);
-                return Ok(m);
+                let Some(mut m) = m else {
+                    o.warn_unused(&mut self.w);
+                    return Ok(None);
+                };
+                if let Some(img) = &height.image {
+                    approx(
+                        self,
+                        "bumps become a normal map of the heights' slopes, scaled by the mean length a unit of uv spans on the shapes wearing it (Mitsuba uses each point's own)",
+                    );
+                    // Slopes per unit of uv; the scale to slopes per unit
+                    // of length is set once the shapes wearing it are known.
+                    let normals = Arc::new(bump_normals(img, height.color.x * scale));
+                    self.bump_maps.push(normals.clone());
+                    m.textures.normal = Some(NormalMap {
+                        map: height.sampling.map(normals),
+                        scale: 1.0,
+                    });
+                }
+                m
             }
             "null" => {
                 o.warn_unused(&mut self.w);
@@ -588,5 +635,22 @@ mod tests {
         // The internal reflectance of a smooth interface is larger than
         // the external one.
         assert!(diffuse_fresnel(1.5) < fi);
+    }
+}
+
+#[cfg(test)]
+mod bump_tests {
+    use super::*;
+
+    #[test]
+    fn a_height_ramp_along_u_tilts_the_normal_against_u() {
+        // Heights rising by 1/8 a texel along u: slope 1 per unit of uv.
+        let t: Vec<Vec3> = (0..8 * 8)
+            .map(|i| Vec3::splat((i % 8) as f32 / 8.0))
+            .collect();
+        let n = bump_normals(&Texture::new(8, 8, t), 1.0);
+        let c = n.texel(3, 3) * 2.0 - Vec3::ONE;
+        let want = Vec3::new(-1.0, 0.0, 1.0).normalize();
+        assert!((c - want).abs().max_element() < 1e-5, "{c}");
     }
 }

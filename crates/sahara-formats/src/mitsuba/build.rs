@@ -43,6 +43,9 @@ pub(crate) struct Builder<'a> {
     pub(crate) file_meshes: HashMap<(PathBuf, i64, bool, bool), Option<u32>>,
     /// The mesh of each shapegroup (by address), once made.
     pub(crate) groups: HashMap<usize, Option<u32>>,
+    /// The normal maps made from bumpmaps' heights (their slopes are per
+    /// unit of uv until [`scale_bumps`] sets their strength).
+    pub(crate) bump_maps: Vec<std::sync::Arc<sahara_render::Texture>>,
     /// Textures read so far (by element address).
     pub(crate) textures: HashMap<usize, Tint>,
 }
@@ -154,6 +157,7 @@ pub(crate) fn build(
         file_meshes: HashMap::new(),
         groups: HashMap::new(),
         textures: HashMap::new(),
+        bump_maps: Vec::new(),
     };
     let mut sensor = None;
     let mut integrator = None;
@@ -196,6 +200,7 @@ pub(crate) fn build(
             }
         }
     }
+    scale_bumps(&mut b.scene, &b.bump_maps);
     let integrator = super::integrator::integrator(&mut b, integrator)?;
     let (camera, settings) = super::sensor::sensor(&mut b, sensor, integrator)?;
     b.scene.camera = match camera {
@@ -209,4 +214,75 @@ pub(crate) fn build(
     let mut scene = b.scene;
     scene.warnings = b.w.into_lines();
     Ok(scene)
+}
+
+/// Sets the strength of each normal map made from a `bumpmap`'s heights
+/// (slopes per unit of uv) to the inverse of the mean length a unit of uv
+/// spans on the meshes and quads wearing it, so that the slopes are per
+/// unit of length, as Mitsuba's bumps are.
+fn scale_bumps(scene: &mut SceneDescription, bumps: &[std::sync::Arc<sahara_render::Texture>]) {
+    use crate::description::{Geometry, ObjectPlacement};
+    use glam::{Affine3A, Vec3};
+    let mut sums: HashMap<u32, (f64, f64)> = HashMap::new();
+    for o in &scene.objects {
+        let Some(m) = o.material else { continue };
+        let bumped = scene.materials[m as usize]
+            .textures
+            .normal
+            .as_ref()
+            .is_some_and(|n| {
+                bumps
+                    .iter()
+                    .any(|b| std::sync::Arc::ptr_eq(b, &n.map.texture))
+            });
+        if !bumped {
+            continue;
+        }
+        let xf = match o.placement {
+            ObjectPlacement::Static(a) => a,
+            _ => Affine3A::IDENTITY,
+        };
+        let mut add = |p: [Vec3; 3], uv: [glam::Vec2; 3]| {
+            let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+            let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+            let det = d1.x * d2.y - d1.y * d2.x;
+            let area = 0.5 * e1.cross(e2).length();
+            if det.abs() < 1e-12 || area <= 0.0 {
+                return;
+            }
+            let du = (e1 * d2.y - e2 * d1.y) / det;
+            let dv = (e2 * d1.x - e1 * d2.x) / det;
+            let s = sums.entry(m).or_default();
+            s.0 += f64::from(area * (du.length() * dv.length()).sqrt());
+            s.1 += f64::from(area);
+        };
+        match &o.geometry {
+            Geometry::Mesh(i) => {
+                let mesh = &scene.meshes[*i as usize];
+                let Some(uvs) = &mesh.uvs else { continue };
+                for t in &mesh.mesh.indices {
+                    let p = t.map(|k| xf.transform_point3(mesh.mesh.positions[k as usize]));
+                    add(p, t.map(|k| uvs[k as usize]));
+                }
+            }
+            Geometry::Shape(sahara_render::Shape::Quad {
+                corner,
+                edge_u,
+                edge_v,
+            }) => {
+                let p =
+                    [*corner, *corner + *edge_u, *corner + *edge_v].map(|v| xf.transform_point3(v));
+                add(p, [glam::Vec2::ZERO, glam::Vec2::X, glam::Vec2::Y]);
+            }
+            _ => {}
+        }
+    }
+    for (m, (l, a)) in sums {
+        let len = l / a;
+        if let Some(n) = &mut scene.materials[m as usize].textures.normal {
+            if len > 0.0 && len.is_finite() {
+                n.scale = (1.0 / len) as f32;
+            }
+        }
+    }
 }

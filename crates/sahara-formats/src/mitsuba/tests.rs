@@ -578,6 +578,7 @@ fn bsdfs_map_onto_sahara_materials() {
     assert_eq!(base_color, Vec3::new(0.9, 0.5, 0.1));
     let m = material(&d, 8);
     assert_eq!((m.alpha_mode, m.alpha), (AlphaMode::Blend, 0.25));
+    assert!(material(&d, 10).textures.normal.is_some());
     assert_eq!(
         material(&d, 9).bsdf,
         Bsdf::Diffuse {
@@ -590,7 +591,7 @@ fn bsdfs_map_onto_sahara_materials() {
         "{w}"
     );
     assert!(
-        w.contains("bsdf 'bumpmap': bump mapping is not supported"),
+        w.contains("bsdf 'bumpmap': bumps become a normal map"),
         "{w}"
     );
     assert!(!w.contains("Beckmann"), "{w}");
