@@ -661,7 +661,7 @@ fn emitters_are_area_materials_lights_and_environments() {
          <emitter type=\"spot\"><transform name=\"to_world\"><lookat origin=\"0 1 0\" target=\"0 0 0\"/></transform>\
            <float name=\"cutoff_angle\" value=\"30\"/><float name=\"beam_width\" value=\"20\"/></emitter>\n\
          <emitter type=\"directional\"><vector name=\"direction\" x=\"0\" y=\"-1\" z=\"0\"/><spectrum name=\"irradiance\" value=\"2\"/></emitter>\n\
-         <emitter type=\"constant\"><rgb name=\"radiance\" value=\"0.5\"/></emitter>\n\
+         <emitter type=\"constant\"><blackbody name=\"radiance\" temperature=\"6500K\"/></emitter>\n\
          <emitter type=\"envmap\"><string name=\"filename\" value=\"env.pfm\"/><float name=\"scale\" value=\"3\"/></emitter>",
         &dir,
     )
@@ -701,6 +701,7 @@ fn emitters_are_area_materials_lights_and_environments() {
         "{w}"
     );
     assert!(w.contains("spot: Mitsuba's falloff"), "{w}");
+    assert!(w.contains("blackbody: normalised to luminance 1"), "{w}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

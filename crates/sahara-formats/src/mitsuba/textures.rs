@@ -56,6 +56,12 @@ impl<'a> Builder<'a> {
         usage: Usage,
     ) -> Result<Tint, FormatError> {
         if let Some(c) = o.color(name)? {
+            if matches!(c, super::spectra::Color::Blackbody(_)) {
+                self.w.add(
+                    "blackbody: normalised to luminance 1 (Mitsuba's is in absolute units)",
+                    &o.get(name).expect("given").loc,
+                );
+            }
             return Ok(Tint::constant(c.rgb(usage)));
         }
         let Some(e) = o.named(name) else {
