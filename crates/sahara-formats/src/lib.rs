@@ -3,6 +3,7 @@
 //! - scenes, each read into a [`description::SceneDescription`]:
 //!   [`scene_file`] (TOML, documented in `docs/scene-format.md`) with
 //!   [`scene_load`] (its description), [`pbrt`] (pbrt-v4 scenes),
+//!   [`mitsuba`] (Mitsuba 3 XML scenes),
 //!   [`mesh_scene`] (a bare mesh file as a scene);
 //! - to the renderer: [`assembly`] (a description as a
 //!   `sahara_render::Scene`: the sky rule, the automatic camera), using
@@ -31,6 +32,7 @@ pub mod image_out;
 pub mod material_map;
 pub mod mesh_library;
 pub mod mesh_scene;
+pub mod mitsuba;
 pub mod part_file;
 pub mod pbrt;
 pub mod scene_file;

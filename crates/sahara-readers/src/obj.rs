@@ -25,7 +25,7 @@ use glam::Vec3;
 use crate::error::FormatError;
 use crate::fan::fan_triangulate;
 
-pub use with_materials::{load_obj_with_materials, ObjScene};
+pub use with_materials::{load_obj_geometry, load_obj_with_materials, ObjScene};
 
 /// Loads an OBJ file; errors name the file and, when it can be found, the line.
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, FormatError> {

@@ -74,7 +74,7 @@ pub struct MergeArgs {
 /// brackets apply when neither gives one.
 #[derive(Debug, Args, Clone, PartialEq, Default)]
 pub struct RenderArgs {
-    /// What to render: a scene file (.toml, .pbrt, .pbrt.gz), or a mesh (.obj, .ply, .gltf,
+    /// What to render: a scene file (.toml, .pbrt, .pbrt.gz, Mitsuba .xml), or a mesh (.obj, .ply, .gltf,
     /// .glb) with its own materials and lights, seen by its camera sidecar,
     /// its own camera or an automatic one, and lit by a default sky and
     /// sun when its own lights are weak (see --sky); none for the built-in
@@ -144,6 +144,11 @@ pub struct RenderArgs {
     /// for a scene file].
     #[arg(long, value_name = "default|none|auto|FILE")]
     pub sky: Option<String>,
+    /// A parameter of a Mitsuba scene (.xml), as Mitsuba's own `-D`: its
+    /// `$NAME` references take VALUE, whatever the file's `<default>` says
+    /// (repeatable).
+    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+    pub define: Vec<(String, String)>,
     /// Kd-tree builder (as for `sahara bench`): a speed setting only, the
     /// image is the same with any [default: sah].
     #[arg(long, value_name = "NAME", value_parser = parse_builder)]
@@ -402,7 +407,7 @@ impl Default for BenchOptions {
 #[derive(Debug, Args)]
 pub struct StatsArgs {
     /// The mesh (.obj, .ply, .gltf or .glb; a glTF scene's meshes are merged
-    /// in scene order), or a scene file (.toml, .pbrt, .pbrt.gz): then the
+    /// in scene order), or a scene file (.toml, .pbrt, .pbrt.gz, .xml): then the
     /// trees and instances a render of it builds.
     pub mesh: PathBuf,
     /// The tree to build.
@@ -560,6 +565,19 @@ fn parse_set(s: &str) -> Result<SetKind, String> {
 }
 
 /// A run count, 1 to 1000.
+/// `NAME=VALUE` of `-D`: a parameter name of letters, digits and `_`.
+fn parse_define(s: &str) -> Result<(String, String), String> {
+    let Some((name, value)) = s.split_once('=') else {
+        return Err(format!("'{s}' is not NAME=VALUE"));
+    };
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(format!(
+            "'{name}' is not a parameter name (letters, digits and '_')"
+        ));
+    }
+    Ok((name.to_owned(), value.to_owned()))
+}
+
 fn parse_runs(s: &str) -> Result<usize, String> {
     match s.parse::<usize>() {
         Ok(n) if (1..=1000).contains(&n) => Ok(n),

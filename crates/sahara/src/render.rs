@@ -61,6 +61,7 @@ pub fn run(args: &RenderArgs) -> Result<Finish> {
         args.scene.as_deref(),
         args.camera.as_deref(),
         args.sky.as_deref(),
+        &args.define,
     )?;
     let Some(job) = plan(args, input)? else {
         return Ok(Finish::Done);

@@ -1,5 +1,5 @@
 //! What `sahara render` renders: the built-in Cornell box, a scene file
-//! (TOML or pbrt) or a mesh file, as a renderer scene with the settings its
+//! (TOML, pbrt or Mitsuba) or a mesh file, as a renderer scene with the settings its
 //! file asks for and the problems found while reading it.
 
 use std::path::Path;
@@ -28,15 +28,20 @@ pub(crate) struct Input {
 }
 
 /// The scene to render: the built-in Cornell box, a scene file or a mesh
-/// file, seen by `camera` (`--camera`) and lit as `sky` (`--sky`) says.
+/// file, seen by `camera` (`--camera`) and lit as `sky` (`--sky`) says;
+/// `defines` are a Mitsuba scene's parameters (`-D name=value`).
 pub(crate) fn load_input(
     path: Option<&Path>,
     camera: Option<&str>,
     sky: Option<&str>,
+    defines: &[(String, String)],
 ) -> Result<Input> {
     let flat = |e: sahara_formats::FormatError| anyhow!("{e}");
     let sky = sky.map(|s| Sky::parse(s, Path::new("")));
     let Some(path) = path else {
+        if !defines.is_empty() {
+            bail!("-D sets parameters of a Mitsuba scene (.xml); no scene file is given");
+        }
         let mut scene = builtin::cornell_box();
         if let Some(file) = camera {
             let c = read_sidecar(Path::new(file)).map_err(flat)?;
@@ -55,7 +60,7 @@ pub(crate) fn load_input(
         });
     };
     const EXPECTED: &str =
-        "expected a scene file (.toml, .pbrt, .pbrt.gz) or a mesh (.obj, .ply, .gltf, .glb)";
+        "expected a scene file (.toml, .pbrt, .pbrt.gz, .xml) or a mesh (.obj, .ply, .gltf, .glb)";
     if path.is_dir() {
         bail!("{}: is a folder; {EXPECTED}", path.display());
     }
@@ -74,6 +79,13 @@ pub(crate) fn load_input(
     }
     // A `FormatError`'s message already names the file and place.
     let pbrt = sahara_formats::pbrt::is_pbrt_path(path);
+    let mitsuba = sahara_formats::mitsuba::is_mitsuba_path(path);
+    if !defines.is_empty() && !mitsuba {
+        bail!(
+            "{}: -D sets parameters of Mitsuba scenes (.xml), not of this file",
+            path.display()
+        );
+    }
     let mesh = matches!(ext.as_str(), "obj" | "ply" | "gltf" | "glb");
     let mut desc = match ext.as_str() {
         _ if pbrt && camera.is_some() => bail!(
@@ -81,6 +93,13 @@ pub(crate) fn load_input(
             path.display()
         ),
         _ if pbrt => sahara_formats::pbrt::read_pbrt(path).map_err(flat)?,
+        _ if mitsuba && camera.is_some() => bail!(
+            "{}: --camera applies to meshes and the built-in scene; a Mitsuba file has its own <sensor>",
+            path.display()
+        ),
+        _ if mitsuba => {
+            sahara_formats::mitsuba::read_mitsuba_with(path, defines).map_err(flat)?
+        }
         "toml" if camera.is_some() => bail!(
             "{}: --camera applies to meshes and the built-in scene; a scene file has its own [camera]",
             path.display()

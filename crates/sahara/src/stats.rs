@@ -55,9 +55,10 @@ pub fn run(args: &StatsArgs) -> Result<()> {
     Ok(())
 }
 
-/// A scene file (TOML or pbrt) rather than a mesh.
+/// A scene file (TOML, pbrt or Mitsuba) rather than a mesh.
 fn is_scene_file(path: &Path) -> bool {
     sahara_formats::pbrt::is_pbrt_path(path)
+        || sahara_formats::mitsuba::is_mitsuba_path(path)
         || path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
@@ -99,7 +100,7 @@ fn run_scene(args: &StatsArgs) -> Result<()> {
     if args.tree.subset.is_some() {
         bail!("--subset applies to meshes, not to scene files");
     }
-    let input = crate::scene_input::load_input(Some(&args.mesh), None, None)?;
+    let input = crate::scene_input::load_input(Some(&args.mesh), None, None, &[])?;
     crate::warnings::print(&input.warnings);
     let threads = args
         .threads

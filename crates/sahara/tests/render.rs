@@ -625,7 +625,7 @@ fn a_path_without_a_usable_extension_says_what_it_is() {
         );
         assert!(!err.contains("cannot render . files"), "{err}");
         assert!(
-            err.contains("expected a scene file (.toml, .pbrt, .pbrt.gz) or a mesh"),
+            err.contains("expected a scene file (.toml, .pbrt, .pbrt.gz, .xml) or a mesh"),
             "{err}"
         );
     }

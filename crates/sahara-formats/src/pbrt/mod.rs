@@ -21,17 +21,17 @@
 
 mod build;
 mod declarations;
-mod envmap;
-mod lexer;
+pub(crate) mod envmap;
+pub(crate) mod lexer;
 mod lights;
-mod materials;
+pub(crate) mod materials;
 mod params;
 mod parser;
 mod shapes;
-mod spectrum;
-mod subdivision;
-mod textures;
-mod warnings;
+pub(crate) mod spectrum;
+pub(crate) mod subdivision;
+pub(crate) mod textures;
+pub(crate) mod warnings;
 
 #[cfg(test)]
 mod tests;

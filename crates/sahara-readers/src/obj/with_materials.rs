@@ -100,6 +100,29 @@ pub fn load_obj_with_materials(path: &Path) -> Result<ObjScene, FormatError> {
     })
 }
 
+/// Loads an OBJ file's geometry, normals and uvs without its materials:
+/// `mtllib` and `usemtl` are not read (a missing or malformed library is
+/// no problem), `materials` is empty and every `material_ids` entry 0.
+/// For scene formats whose own materials replace the file's (Mitsuba).
+pub fn load_obj_geometry(path: &Path) -> Result<ObjScene, FormatError> {
+    let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
+    let name = path.display().to_string();
+    let source = tobj_source(&bytes);
+    let (models, _) = tobj::load_obj_buf(&mut &source[..], &obj_load_options(), |_| {
+        Ok((Vec::new(), Default::default()))
+    })
+    .map_err(|e| locate::describe(&bytes, &name, e))?;
+    let scene = build(&models, &name)?;
+    Ok(ObjScene {
+        material_ids: vec![0; scene.mesh.indices.len()],
+        mesh: scene.mesh,
+        normals: scene.normals,
+        uvs: scene.uvs,
+        materials: Vec::new(),
+        warnings: Vec::new(),
+    })
+}
+
 /// Key under which the loader records, in each tobj material, the MTL file it came from.
 const MTL_PATH_KEY: &str = "\u{0}sahara-mtl-path";
 

@@ -1,0 +1,129 @@
+//! Mitsuba's `<integrator>` as Sahara's.
+//!
+//! Depth: Mitsuba's `max_depth` counts path segments from the camera (1:
+//! emitters seen directly, 2: direct light, -1: no limit); Sahara's counts
+//! scattering events (1: direct light). So Sahara's is Mitsuba's minus
+//! one. Both start Russian roulette once `rr_depth` bounces are done
+//! (`rr_depth` carries over as it is).
+//!
+//! | Mitsuba | Sahara |
+//! |---|---|
+//! | `path` (`max_depth`, `rr_depth`) | path tracer |
+//! | `direct` | path tracer of depth 1: direct light with MIS |
+//! | `volpath`, `volpathmis`, `prb`, `prb_basic`, `prbvolpath`, `ptracer` | path tracer (warned; no media) |
+//! | `depth` | depth |
+//! | `aov` | its nested integrator (warned: the image only) |
+//! | `hide_emitters` | not supported (warned) |
+
+use sahara_render::Integrator;
+
+use super::build::Builder;
+use super::xml::Node;
+use crate::FormatError;
+
+/// Sahara's deepest path.
+const MAX_DEPTH: u32 = 1 << 16;
+
+/// The integrator `node` asks for (Mitsuba's default without one: path
+/// tracing, unlimited depth, roulette from depth 5).
+pub(crate) fn integrator<'a>(
+    b: &mut Builder<'a>,
+    node: Option<&'a Node>,
+) -> Result<Integrator, FormatError> {
+    let Some(node) = node else {
+        return Ok(Integrator::Path {
+            max_depth: MAX_DEPTH,
+            rr_depth: 5,
+        });
+    };
+    let o = b.object(node)?;
+    let path = |b: &mut Builder<'a>,
+                o: &super::properties::Object<'a>|
+     -> Result<Integrator, FormatError> {
+        let depth = o.int("max_depth", -1)?;
+        let rr = o.int("rr_depth", 5)?;
+        if o.bool("hide_emitters", false)? {
+            b.w.add(
+                format!(
+                    "{}: 'hide_emitters' is not supported; emitters are seen",
+                    o.what()
+                ),
+                &o.node.loc,
+            );
+        }
+        let max_depth =
+            match depth {
+                d if d < 0 => MAX_DEPTH,
+                0 | 1 => {
+                    b.w.add(
+                        format!(
+                        "{}: max_depth {depth} ({}) is rendered with max_depth 2 (direct light)",
+                        o.what(),
+                        if depth == 0 { "nothing" } else { "emitters only" }
+                    ),
+                        &o.node.loc,
+                    );
+                    1
+                }
+                d => (d - 1).min(i64::from(MAX_DEPTH)) as u32,
+            };
+        if rr < 0 {
+            return Err(o.error("rr_depth must be >= 0"));
+        }
+        Ok(Integrator::Path {
+            max_depth,
+            rr_depth: rr.min(i64::from(MAX_DEPTH)) as u32,
+        })
+    };
+    let out = match o.ty {
+        "path" => path(b, &o)?,
+        "volpath" | "volpathmis" | "prb" | "prb_basic" | "prbvolpath" | "ptracer" => {
+            b.w.add(
+                format!(
+                    "integrator '{}' is rendered by Sahara's path tracer (no media)",
+                    o.ty
+                ),
+                &node.loc,
+            );
+            for k in ["samples_per_pass", "timeout"] {
+                o.get(k);
+            }
+            path(b, &o)?
+        }
+        "direct" => {
+            for k in ["emitter_samples", "bsdf_samples", "shading_samples"] {
+                o.int(k, 1)?;
+            }
+            if o.bool("hide_emitters", false)? {
+                b.w.add(
+                    "integrator 'direct': 'hide_emitters' is not supported; emitters are seen",
+                    &node.loc,
+                );
+            }
+            Integrator::Path {
+                max_depth: 1,
+                rr_depth: MAX_DEPTH,
+            }
+        }
+        "depth" => Integrator::Depth,
+        "aov" => {
+            o.get("aovs");
+            b.w.add("integrator 'aov': only the image is rendered", &node.loc);
+            let inner = o.nested("integrator");
+            let out = integrator(b, inner.first().copied())?;
+            o.warn_unused(&mut b.w);
+            return Ok(out);
+        }
+        "bdpt" | "mlt" | "pssmlt" | "photonmapper" | "sppm" | "stokes" | "moment" => {
+            b.w.add(
+                format!("integrator '{}' is replaced by Sahara's path tracer", o.ty),
+                &node.loc,
+            );
+            o.mark_all_used();
+            path(b, &o)?
+        }
+        other => return Err(o.error(format!("unknown integrator type '{other}'"))),
+    };
+    o.warn_unused(&mut b.w);
+    Ok(out)
+}
