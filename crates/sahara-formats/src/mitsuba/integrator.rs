@@ -77,7 +77,52 @@ pub(crate) fn integrator<'a>(
     };
     let out = match o.ty {
         "path" => path(b, &o)?,
-        "volpath" | "volpathmis" | "prb" | "prb_basic" | "prbvolpath" | "ptracer" => {
+        // Mitsuba's particle tracer is light tracing.
+        "ptracer" => {
+            for k in ["samples_per_pass", "timeout", "hide_emitters"] {
+                o.get(k);
+            }
+            match path(b, &o)? {
+                Integrator::Path { max_depth, .. } => Integrator::LightPath { max_depth },
+                other => other,
+            }
+        }
+        // Mitsuba 0.6's bidirectional and photon-mapping plugins.
+        "bdpt" => {
+            for k in ["light_image", "sample_direct"] {
+                o.get(k);
+            }
+            match path(b, &o)? {
+                Integrator::Path { max_depth, .. } => Integrator::Bdpt { max_depth },
+                other => other,
+            }
+        }
+        "sppm" | "photonmapper" => {
+            let radius = o.float("initial_radius", 0.0)?;
+            let photons = o.int("photon_count", 0)?;
+            for k in ["alpha", "granularity", "max_passes"] {
+                o.get(k);
+            }
+            if o.ty == "photonmapper" {
+                b.w.add(
+                    "integrator 'photonmapper' is rendered by stochastic progressive photon mapping (sppm)",
+                    &node.loc,
+                );
+            }
+            match path(b, &o)? {
+                Integrator::Path { max_depth, .. } => Integrator::Sppm {
+                    max_depth,
+                    radius: if radius.is_finite() && radius > 0.0 {
+                        radius as f32
+                    } else {
+                        0.0
+                    },
+                    photons: photons.clamp(0, i64::from(u32::MAX)) as u32,
+                },
+                other => other,
+            }
+        }
+        "volpath" | "volpathmis" | "prb" | "prb_basic" | "prbvolpath" => {
             b.w.add(
                 format!(
                     "integrator '{}' is rendered by Sahara's path tracer (no media)",
@@ -114,7 +159,21 @@ pub(crate) fn integrator<'a>(
             o.warn_unused(&mut b.w);
             return Ok(out);
         }
-        "bdpt" | "mlt" | "pssmlt" | "photonmapper" | "sppm" | "stokes" | "moment" => {
+        "mlt" | "pssmlt" => {
+            b.w.add(
+                format!(
+                    "integrator '{}' is rendered by bidirectional path tracing (bdpt), which converges to the same image",
+                    o.ty
+                ),
+                &node.loc,
+            );
+            o.mark_all_used();
+            match path(b, &o)? {
+                Integrator::Path { max_depth, .. } => Integrator::Bdpt { max_depth },
+                other => other,
+            }
+        }
+        "stokes" | "moment" => {
             b.w.add(
                 format!("integrator '{}' is replaced by Sahara's path tracer", o.ty),
                 &node.loc,

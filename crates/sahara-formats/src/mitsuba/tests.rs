@@ -780,6 +780,47 @@ fn the_sensor_sees_as_mitsubas_and_sets_film_sampler_filter_and_depth() {
     ));
 }
 
+/// Mitsuba's particle tracer is light tracing; Mitsuba 0.6's `bdpt`,
+/// `sppm` and `photonmapper` map onto bidirectional path tracing and SPPM
+/// (depth counted in bounces, as for `path`), its Metropolis plugins onto
+/// `bdpt` with a warning.
+#[test]
+fn light_tracing_bidirectional_and_photon_integrators_map_onto_saharas() {
+    let integrator = |xml: &str| {
+        let d = describe(xml);
+        (d.settings.unwrap().integrator, d.warnings)
+    };
+    let (i, w) = integrator(
+        "<integrator type=\"ptracer\"><integer name=\"max_depth\" value=\"6\"/></integrator>",
+    );
+    assert_eq!(i, Integrator::LightPath { max_depth: 5 });
+    assert!(w.is_empty(), "{w:?}");
+    let (i, _) = integrator(
+        "<integrator type=\"bdpt\"><integer name=\"max_depth\" value=\"9\"/></integrator>",
+    );
+    assert_eq!(i, Integrator::Bdpt { max_depth: 8 });
+    let (i, _) = integrator(
+        "<integrator type=\"sppm\"><integer name=\"max_depth\" value=\"4\"/>\
+         <float name=\"initial_radius\" value=\"0.5\"/><integer name=\"photon_count\" value=\"1000\"/></integrator>",
+    );
+    assert_eq!(
+        i,
+        Integrator::Sppm {
+            max_depth: 3,
+            radius: 0.5,
+            photons: 1000
+        }
+    );
+    let (i, w) = integrator(
+        "<integrator type=\"pssmlt\"><integer name=\"max_depth\" value=\"3\"/></integrator>",
+    );
+    assert_eq!(i, Integrator::Bdpt { max_depth: 2 });
+    assert!(
+        w.iter().any(|w| w.contains("bidirectional path tracing")),
+        "{w:?}"
+    );
+}
+
 #[test]
 fn approximations_are_warned_once_per_kind_with_a_count() {
     let d = describe(
