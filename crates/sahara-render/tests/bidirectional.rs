@@ -149,47 +149,13 @@ fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
     assert_agree("bdpt", &reference, &b, 0.01, 0.06);
 }
 
-/// A spot light shining straight down through a thick glass slab onto a
-/// white floor: the path tracer cannot find this light (a point light
-/// seen through glass), light tracing can. On the axis, the slab of
-/// thickness `d` and index `n` makes the light seem `d (1 - 1/n)` closer
-/// and passes `(1 - R)^2` of it at normal incidence (`R = ((n - 1) / (n +
-/// 1))^2`; with three scattering events at most, no light bounces inside
-/// the slab), so the floor's radiance there is `rho / pi * I (1 - R)^2 /
-/// (h - d (1 - 1/n))^2`.
+/// A spot light shining down through a thick glass slab onto a white
+/// floor ([`common::glass_slab`]): the path tracer cannot find this light
+/// (a point light seen through glass), light tracing can, with the
+/// energy the analytic estimate gives.
 #[test]
 fn light_through_a_glass_slab_casts_the_caustic_an_analytic_estimate_gives() {
-    let (h, d, n, rho, intensity) = (3.0f32, 1.5f32, 1.5f32, 0.8f32, 1.0f32);
-    let camera = Camera::look_at(Vec3::new(0.0, 1.0, -4.0), Vec3::ZERO, Vec3::Y, 4.0, 1.0);
-    let mut scene = Scene::new(camera);
-    let white = scene.add_material(Material::diffuse(Vec3::splat(rho)));
-    let glass = scene.add_material(Material::glass(n));
-    scene.add_shape(
-        Shape::Quad {
-            corner: Vec3::new(-10.0, 0.0, -10.0),
-            edge_u: Vec3::new(0.0, 0.0, 20.0),
-            edge_v: Vec3::new(20.0, 0.0, 0.0),
-        },
-        white,
-    );
-    scene.add_shape(
-        Shape::Box {
-            min: Vec3::new(-1.0, 0.5, -1.0),
-            max: Vec3::new(1.0, 0.5 + d, 1.0),
-        },
-        glass,
-    );
-    scene.add_light(Light::spot(
-        Vec3::new(0.0, h, 0.0),
-        Vec3::ZERO,
-        Vec3::splat(intensity),
-        10.0,
-        10.0,
-    ));
-    let r = (n - 1.0) / (n + 1.0);
-    let r = r * r;
-    let expected = rho / std::f32::consts::PI * intensity * (1.0 - r) * (1.0 - r)
-        / (h - d * (1.0 - 1.0 / n)).powi(2);
+    let (scene, expected) = common::glass_slab(false);
     let mut s = settings(64, 64, 256, bdpt(3));
     s.tile_size = 64;
     let img = run(&scene, &s);

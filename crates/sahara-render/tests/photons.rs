@@ -7,9 +7,7 @@ mod common;
 
 use common::{run, settings};
 use glam::Vec3;
-use sahara_render::{
-    builtin, render, Camera, Integrator, Light, Material, PixelWindow, RenderSettings, Scene, Shape,
-};
+use sahara_render::{builtin, render, Integrator, PixelWindow, RenderSettings, Scene};
 
 fn sppm(max_depth: u32, photons: u32) -> Integrator {
     Integrator::Sppm {
@@ -40,61 +38,14 @@ fn sppm_agrees_with_the_path_tracer_on_a_diffuse_box() {
     }
 }
 
-/// A spot light shining down through a glass slab onto a white floor,
-/// and a camera looking at the lit floor either from the side or from
-/// straight above, through the slab; the floor's radiance on the axis,
-/// and the slab's transmittance back to the camera.
-fn slab(from_above: bool) -> (Scene, f32) {
-    let (h, d, n, rho, intensity) = (3.0f32, 1.5f32, 1.5f32, 0.8f32, 1.0f32);
-    let camera = if from_above {
-        Camera::look_at(Vec3::new(0.0, 4.0, 0.0), Vec3::ZERO, Vec3::Z, 4.0, 1.0)
-    } else {
-        Camera::look_at(Vec3::new(0.0, 1.0, -4.0), Vec3::ZERO, Vec3::Y, 4.0, 1.0)
-    };
-    let mut scene = Scene::new(camera);
-    let white = scene.add_material(Material::diffuse(Vec3::splat(rho)));
-    let glass = scene.add_material(Material::glass(n));
-    scene.add_shape(
-        Shape::Quad {
-            corner: Vec3::new(-10.0, 0.0, -10.0),
-            edge_u: Vec3::new(0.0, 0.0, 20.0),
-            edge_v: Vec3::new(20.0, 0.0, 0.0),
-        },
-        white,
-    );
-    scene.add_shape(
-        Shape::Box {
-            min: Vec3::new(-1.0, 0.5, -1.0),
-            max: Vec3::new(1.0, 0.5 + d, 1.0),
-        },
-        glass,
-    );
-    scene.add_light(Light::spot(
-        Vec3::new(0.0, h, 0.0),
-        Vec3::ZERO,
-        Vec3::splat(intensity),
-        10.0,
-        10.0,
-    ));
-    let r = ((n - 1.0) / (n + 1.0)).powi(2);
-    let floor = rho / std::f32::consts::PI * intensity * (1.0 - r) * (1.0 - r)
-        / (h - d * (1.0 - 1.0 / n)).powi(2);
-    let seen = if from_above {
-        floor * (1.0 - r) * (1.0 - r)
-    } else {
-        floor
-    };
-    (scene, seen)
-}
-
 /// The slab's caustic, seen directly and through the slab itself
 /// (specular, diffuse, specular: a point light's caustic that neither the
 /// path tracer nor bidirectional path tracing can see), matches the
-/// analytic estimate (see `tests/bidirectional.rs` for its derivation).
+/// analytic estimate (see `common::glass_slab`).
 #[test]
 fn sppm_sees_the_slab_caustic_directly_and_through_the_glass() {
     for from_above in [false, true] {
-        let (scene, expected) = slab(from_above);
+        let (scene, expected) = common::glass_slab(from_above);
         // Enough depth for the photons' two refractions and the camera's
         // two, and none for light bouncing inside the slab.
         let mut s = settings(32, 32, 32, sppm(3, 100_000));
@@ -135,7 +86,7 @@ fn bits(threads: usize, scene: &Scene, s: &RenderSettings) -> Vec<u32> {
 /// a frame splits by tiles exactly).
 #[test]
 fn sppm_is_deterministic_across_threads_and_windows() {
-    let (scene, _) = slab(false);
+    let (scene, _) = common::glass_slab(false);
     let s = settings(24, 20, 6, sppm(5, 3000));
     let one = bits(1, &scene, &s);
     assert!(one == bits(2, &scene, &s), "1 and 2 threads differ");

@@ -30,7 +30,7 @@ use crate::light::emission::pdf_disc;
 use crate::light::LightSource;
 use crate::sampler::dims;
 use crate::scene::camera::Camera;
-use crate::world::{pass_through_draw, SurfaceHit, World, MAX_PASS_THROUGHS};
+use crate::world::{SurfaceHit, World};
 
 pub(crate) use crate::film::sums::Splat;
 
@@ -258,13 +258,7 @@ fn walk(
             }
             return;
         };
-        let m = world.material(hit.material);
-        if m.has_holes()
-            && holes < MAX_PASS_THROUGHS
-            && m.passes(&hit.uvs(), pass_through_draw(&ray, &hit, holes))
-        {
-            holes += 1;
-            ray = Ray::new(hit.spawn_origin(ray.dir), ray.dir);
+        if super::through_hole(world, &mut ray, &hit, &mut holes) {
             continue;
         }
         let sh = Shading::new(world, &hit, ray.dir);
@@ -330,19 +324,10 @@ fn walk(
 /// The light subpath of one sample, up to `max_len` vertices.
 fn light_subpath(ctx: &mut Context, time: f32, max_len: usize, path: &mut Vec<Vertex>) {
     let world = ctx.world;
-    let u_pick = ctx.sampler.get_1d(light_dim(0, 0));
-    let Some((i, pmf)) = world.pick_light(u_pick) else {
+    let Some((i, pmf, e, beta, ray)) = super::leave_light(ctx, |k| light_dim(0, k)) else {
         return;
     };
     let light: &LightSource = &world.lights[i];
-    let Some(e) = light.sample_emission(
-        ctx.sampler.get_2d(light_dim(0, 1)),
-        ctx.sampler.get_2d(light_dim(0, 2)),
-        world.center,
-        world.radius,
-    ) else {
-        return;
-    };
     let infinite = light.is_infinite();
     let mut v = if infinite {
         Vertex::endpoint(Kind::Infinite, Vec3::ZERO, -e.dir, e.le)
@@ -353,30 +338,8 @@ fn light_subpath(ctx: &mut Context, time: f32, max_len: usize, path: &mut Vec<Ve
     v.two_sided = e.two_sided;
     v.pdf_fwd = pmf * light.pdf_origin(-e.dir);
     path.push(v);
-    let cos = if e.n == Vec3::ZERO {
-        1.0
-    } else {
-        e.n.dot(e.dir).abs()
-    };
-    let beta = e.le * (cos / (pmf * e.pdf_pos * e.pdf_dir));
-    // Off the emitting surface by a little more than rounding (analytic
-    // spheres are tessellated inside the exact surface sampled here).
-    let origin = if e.n == Vec3::ZERO {
-        e.p
-    } else {
-        e.p + e.n * (1e-5 * e.p.abs().max_element().max(1.0))
-    };
     let pdf = if infinite { e.pdf_pos } else { e.pdf_dir };
-    walk(
-        ctx,
-        Ray::new(origin, e.dir),
-        time,
-        beta,
-        pdf,
-        path,
-        max_len,
-        true,
-    );
+    walk(ctx, ray, time, beta, pdf, path, max_len, true);
 }
 
 /// The densities of one vertex of a complete path, as sampled from the

@@ -605,6 +605,60 @@ pub(crate) fn pass_through(ctx: &Context, st: &mut PathState, hit: &SurfaceHit) 
     true
 }
 
+/// If the surface of `hit` has a hole where `ray` meets it (the `holes`-th
+/// the ray has passed), moves `ray` past it and counts it: the
+/// bidirectional and photon integrators' [`pass_through`], whose draws are
+/// a hash of the ray and the hit rather than sample dimensions.
+pub(crate) fn through_hole(
+    world: &World,
+    ray: &mut Ray,
+    hit: &SurfaceHit,
+    holes: &mut u32,
+) -> bool {
+    let m = world.material(hit.material);
+    if !m.has_holes()
+        || *holes >= crate::world::MAX_PASS_THROUGHS
+        || !m.passes(
+            &hit.uvs(),
+            crate::world::pass_through_draw(ray, hit, *holes),
+        )
+    {
+        return false;
+    }
+    *holes += 1;
+    *ray = Ray::new(hit.spawn_origin(ray.dir), ray.dir);
+    true
+}
+
+/// Light leaving a light chosen by power: the light's index, the
+/// emission, the throughput its ray carries (`Le cos / (pmf pdf_pos
+/// pdf_dir)`), and the ray, off the emitting surface by a little more than
+/// rounding (analytic spheres are tessellated inside the exact surface
+/// sampled here). `dim(k)` is the sample dimension of decision `k`.
+pub(crate) fn leave_light(
+    ctx: &Context,
+    dim: impl Fn(u32) -> u32,
+) -> Option<(usize, f32, crate::light::emission::Emission, Vec3, Ray)> {
+    let world = ctx.world;
+    let (i, pmf) = world.pick_light(ctx.sampler.get_1d(dim(0)))?;
+    let e = world.lights[i].sample_emission(
+        ctx.sampler.get_2d(dim(1)),
+        ctx.sampler.get_2d(dim(2)),
+        world.center,
+        world.radius,
+    )?;
+    let (cos, origin) = if e.n == Vec3::ZERO {
+        (1.0, e.p)
+    } else {
+        (
+            e.n.dot(e.dir).abs(),
+            e.p + e.n * (1e-5 * e.p.abs().max_element().max(1.0)),
+        )
+    };
+    let beta = e.le * (cos / (pmf * e.pdf_pos * e.pdf_dir));
+    Some((i, pmf, e, beta, Ray::new(origin, e.dir)))
+}
+
 /// Light from a light sample if nothing blocks it: `f |cos| Li` (not
 /// divided by the pdf), the BSDF's density for the direction, and the
 /// shadow ray that decides whether it arrives (counted); `None` if zero.

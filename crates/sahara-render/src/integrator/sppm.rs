@@ -27,7 +27,7 @@ use super::{bdpt, Context, Shading};
 use crate::math::hash::hash2;
 use crate::math::warp::luminance;
 use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
-use crate::world::{pass_through_draw, SurfaceHit, World, MAX_PASS_THROUGHS};
+use crate::world::{SurfaceHit, World};
 
 /// The fraction of new photons each iteration keeps in the radius
 /// reduction (Hachisuka and Jensen's alpha; pbrt uses 2/3).
@@ -121,13 +121,7 @@ pub(crate) fn camera_path(
             l += beta * world.env_radiance(ray.dir);
             return (l, None);
         };
-        let m = world.material(hit.material);
-        if m.has_holes()
-            && holes < MAX_PASS_THROUGHS
-            && m.passes(&hit.uvs(), pass_through_draw(&ray, &hit, holes))
-        {
-            holes += 1;
-            ray = Ray::new(hit.spawn_origin(ray.dir), ray.dir);
+        if super::through_hole(world, &mut ray, &hit, &mut holes) {
             continue;
         }
         let sh = Shading::new(world, &hit, ray.dir);
@@ -259,29 +253,9 @@ fn trace_photon(
 ) {
     let world = ctx.world;
     let dim = |depth: u32, k: u32| dims::extra(depth.min(63), 0xffc, k);
-    let Some((i, pmf)) = world.pick_light(ctx.sampler.get_1d(dim(0, 0))) else {
+    let Some((_, _, _, mut beta, mut ray)) = super::leave_light(ctx, |k| dim(0, k)) else {
         return;
     };
-    let Some(e) = world.lights[i].sample_emission(
-        ctx.sampler.get_2d(dim(0, 1)),
-        ctx.sampler.get_2d(dim(0, 2)),
-        world.center,
-        world.radius,
-    ) else {
-        return;
-    };
-    let cos = if e.n == Vec3::ZERO {
-        1.0
-    } else {
-        e.n.dot(e.dir).abs()
-    };
-    let mut beta = e.le * (cos / (pmf * e.pdf_pos * e.pdf_dir));
-    let origin = if e.n == Vec3::ZERO {
-        e.p
-    } else {
-        e.p + e.n * (1e-5 * e.p.abs().max_element().max(1.0))
-    };
-    let mut ray = Ray::new(origin, e.dir);
     let mut holes = 0;
     let mut depth = 0u32;
     while depth < max_depth {
@@ -289,13 +263,7 @@ fn trace_photon(
         let Some(hit) = world.intersect(&ray, time) else {
             return;
         };
-        let m = world.material(hit.material);
-        if m.has_holes()
-            && holes < MAX_PASS_THROUGHS
-            && m.passes(&hit.uvs(), pass_through_draw(&ray, &hit, holes))
-        {
-            holes += 1;
-            ray = Ray::new(hit.spawn_origin(ray.dir), ray.dir);
+        if super::through_hole(world, &mut ray, &hit, &mut holes) {
             continue;
         }
         // Light arriving straight from a light is found by the visible

@@ -3,7 +3,8 @@
 
 use glam::Vec3;
 use sahara_render::{
-    render, Filter, FilterKind, Integrator, RenderResult, RenderSettings, SamplerKind, Scene,
+    render, Camera, Filter, FilterKind, Integrator, Light, Material, RenderResult, RenderSettings,
+    SamplerKind, Scene, Shape,
 };
 
 /// Settings for a small test render with a one-pixel box filter, its
@@ -78,4 +79,56 @@ pub fn pixel_inside_sphere(
     let oc = c - ray.origin;
     let t = oc.dot(ray.dir);
     (oc - ray.dir * t).length() < frac * radius
+}
+
+/// A spot light shining straight down through a glass slab onto a white
+/// floor, and a camera looking at the lit floor either from the side or
+/// from straight above, through the slab; with the radiance the camera
+/// sees on the axis. There the slab of thickness `d` and index `n` makes
+/// the light seem `d (1 - 1/n)` closer and passes `(1 - R)^2` of it at
+/// normal incidence (`R = ((n - 1) / (n + 1))^2`; with three scattering
+/// events at most, no light bounces inside the slab), so the floor's
+/// radiance is `rho / pi * I (1 - R)^2 / (h - d (1 - 1/n))^2`; seen
+/// through the slab, `(1 - R)^2` of that.
+pub fn glass_slab(from_above: bool) -> (Scene, f32) {
+    let (h, d, n, rho, intensity) = (3.0f32, 1.5f32, 1.5f32, 0.8f32, 1.0f32);
+    let camera = if from_above {
+        Camera::look_at(Vec3::new(0.0, 4.0, 0.0), Vec3::ZERO, Vec3::Z, 4.0, 1.0)
+    } else {
+        Camera::look_at(Vec3::new(0.0, 1.0, -4.0), Vec3::ZERO, Vec3::Y, 4.0, 1.0)
+    };
+    let mut scene = Scene::new(camera);
+    let white = scene.add_material(Material::diffuse(Vec3::splat(rho)));
+    let glass = scene.add_material(Material::glass(n));
+    scene.add_shape(
+        Shape::Quad {
+            corner: Vec3::new(-10.0, 0.0, -10.0),
+            edge_u: Vec3::new(0.0, 0.0, 20.0),
+            edge_v: Vec3::new(20.0, 0.0, 0.0),
+        },
+        white,
+    );
+    scene.add_shape(
+        Shape::Box {
+            min: Vec3::new(-1.0, 0.5, -1.0),
+            max: Vec3::new(1.0, 0.5 + d, 1.0),
+        },
+        glass,
+    );
+    scene.add_light(Light::spot(
+        Vec3::new(0.0, h, 0.0),
+        Vec3::ZERO,
+        Vec3::splat(intensity),
+        10.0,
+        10.0,
+    ));
+    let r = ((n - 1.0) / (n + 1.0)).powi(2);
+    let floor = rho / std::f32::consts::PI * intensity * (1.0 - r) * (1.0 - r)
+        / (h - d * (1.0 - 1.0 / n)).powi(2);
+    let seen = if from_above {
+        floor * (1.0 - r) * (1.0 - r)
+    } else {
+        floor
+    };
+    (scene, seen)
 }
