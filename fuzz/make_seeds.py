@@ -340,7 +340,7 @@ def hand_made():
 
 
 def main():
-    for target in ["obj", "ply", "scene_file", "gltf", "image", "kdtree", "pbrt"]:
+    for target in ["obj", "ply", "scene_file", "gltf", "image", "kdtree", "pbrt", "mitsuba"]:
         (CORPUS / target).mkdir(parents=True, exist_ok=True)
     obj_seeds()
     ply_seeds()

@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:?usage: fuzz/run.sh SECONDS [TARGET...]}
 shift
 if [ $# -eq 0 ]; then
-    set -- obj ply scene_file gltf image kdtree pbrt
+    set -- obj ply scene_file gltf image kdtree pbrt mitsuba
 fi
 export RUSTC_BOOTSTRAP=1
 python3 fuzz/make_seeds.py
