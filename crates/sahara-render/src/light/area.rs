@@ -95,6 +95,25 @@ pub(crate) fn texture_factor(
     EmissionTextures::at(maps, t, b1, b2)
 }
 
+/// A point of a mesh light's triangles, uniform by area (`u`): the
+/// triangle, the point's barycentrics `(b1, b2)`, the point and the
+/// triangle's front normal.
+pub(crate) fn mesh_point(
+    tris: &[[Vec3; 3]],
+    dist: &Distribution1D,
+    u: Vec2,
+) -> (usize, f32, f32, Vec3, Vec3) {
+    let (x, _, i) = dist.sample_continuous(u.x);
+    // Reuse the position within the chosen cell as a fresh uniform
+    // number: it is uniform and independent of i.
+    let ux = (x * dist.len() as f32 - i as f32).clamp(0.0, 1.0);
+    let (b1, b2) = uniform_triangle(Vec2::new(ux, u.y));
+    let t = &tris[i];
+    let q = t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2;
+    let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+    (i, b1, b2, q, n)
+}
+
 /// An emitting surface with its radiance.
 #[derive(Clone, Debug)]
 pub struct AreaLight {
@@ -259,14 +278,7 @@ impl AreaLight {
                 dist,
                 ..
             } => {
-                let (x, _, i) = dist.sample_continuous(u.x);
-                // Reuse the position within the chosen cell as a fresh
-                // uniform number: it is uniform and independent of i.
-                let ux = (x * dist.len() as f32 - i as f32).clamp(0.0, 1.0);
-                let (b1, b2) = uniform_triangle(Vec2::new(ux, u.y));
-                let t = &tris[i];
-                let q = t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2;
-                let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+                let (i, b1, b2, q, n) = mesh_point(tris, dist, u);
                 let le = emitted(radiance[i], two_sided[i], n, p - q);
                 let le = if le == Vec3::ZERO {
                     le

@@ -107,12 +107,7 @@ impl AreaLight {
                 dist,
                 ..
             } => {
-                let (x, _, i) = dist.sample_continuous(u.x);
-                let ux = (x * dist.len() as f32 - i as f32).clamp(0.0, 1.0);
-                let (b1, b2) = crate::math::warp::uniform_triangle(Vec2::new(ux, u.y));
-                let t = &tris[i];
-                let q = t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2;
-                let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+                let (i, b1, b2, q, n) = super::area::mesh_point(tris, dist, u);
                 let le = radiance[i] * super::area::texture_factor(maps, &textures[i], b1, b2);
                 (q, n, le, two_sided[i])
             }
