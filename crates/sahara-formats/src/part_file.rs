@@ -6,8 +6,12 @@
 //! the four 128-bit fixed-point sums of a pixel
 //! ([`sahara_render::PixelSum`]: R, G, B and the weight) as four 32-bit
 //! words, `sum.R.w0` (least significant) to `sum.R.w3`, then `sum.G.*`,
-//! `sum.B.*` and `weight.w*`. What the merge needs to know of it is in
-//! string attributes ([`PartInfo`]). It is written atomically.
+//! `sum.B.*` and `weight.w*`. The render passes' sums follow in the same
+//! form, each under its pass's name (`albedo.sum.R.w0` ... `albedo.weight.w3`;
+//! the variance's two buffers as `variance.sum.*` and `variance.square.*`),
+//! and with adaptive sampling each pixel's sample count as `samples.n`.
+//! What the merge needs to know of it is in string attributes
+//! ([`PartInfo`]). It is written atomically.
 
 use std::io::{BufWriter, Read, Write};
 use std::ops::Range;
@@ -18,7 +22,9 @@ use exr::prelude::{
     AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
     WritableImage,
 };
-use sahara_render::{IntegratorKind, PixelSum, PixelWindow, SumBuffer, ToneMap};
+use sahara_render::{
+    Aov, AuxSums, IntegratorKind, Named, PixelSum, PixelWindow, SumBuffer, ToneMap,
+};
 
 use crate::atomic::write_atomically;
 use crate::FormatError;
@@ -61,8 +67,115 @@ pub struct PartInfo {
     pub exposure: f32,
     /// Tone map for a PNG of the merged frame.
     pub tonemap: ToneMap,
+    /// The render passes whose sums the part holds (sorted).
+    pub passes: Vec<Aov>,
+    /// The render passes the merged frame writes as layers (sorted; the
+    /// denoiser's albedo and normal are held without being written).
+    pub aovs: Vec<Aov>,
+    /// True if the merged frame is denoised (parts never are).
+    pub denoise: bool,
+    /// True if the denoiser is to clean the albedo and normal first
+    /// (depth of field or motion blur make them noisy).
+    pub noisy_guides: bool,
+    /// True if the part holds each pixel's sample count (adaptive
+    /// sampling).
+    pub sample_counts: bool,
     /// Render statistics as (name, value) pairs, kept for people.
     pub stats: Vec<(String, String)>,
+}
+
+/// The pixels of a part: the beauty's sums, the passes' sums and, with
+/// adaptive sampling, each pixel's sample count, all over its window.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartSums {
+    /// The beauty's sums.
+    pub beauty: SumBuffer,
+    /// The sums of the passes named by [`PartInfo::passes`] (the others
+    /// `None`).
+    pub passes: AuxSums,
+    /// Samples per pixel, rows top to bottom, if
+    /// [`PartInfo::sample_counts`].
+    pub samples: Option<Vec<u32>>,
+}
+
+impl PartSums {
+    /// Sums of the beauty alone.
+    pub fn beauty(beauty: SumBuffer) -> Self {
+        Self {
+            beauty,
+            passes: AuxSums::default(),
+            samples: None,
+        }
+    }
+
+    /// Each sum buffer with the prefix of its channels, beauty first.
+    fn buffers(&self) -> Vec<(String, &SumBuffer)> {
+        let mut out = vec![(String::new(), &self.beauty)];
+        out.extend(
+            pass_buffers(&self.passes)
+                .into_iter()
+                .map(|(name, b)| (format!("{name}."), b)),
+        );
+        out
+    }
+}
+
+/// The buffers of the passes present in `p`, with their names, in the
+/// order of [`Aov`].
+fn pass_buffers(p: &AuxSums) -> Vec<(&'static str, &SumBuffer)> {
+    let mut out: Vec<(&'static str, &SumBuffer)> = [
+        ("albedo", &p.albedo),
+        ("normal", &p.normal),
+        ("depth", &p.depth),
+        ("position", &p.position),
+        ("uv", &p.uv),
+    ]
+    .into_iter()
+    .filter_map(|(name, b)| Some((name, b.as_ref()?)))
+    .collect();
+    if let Some([sum, square]) = &p.moments {
+        out.push(("variance.sum", sum));
+        out.push(("variance.square", square));
+    }
+    out
+}
+
+/// Empty sums over `window` for `passes`.
+fn empty_passes(passes: &[Aov], window: &PixelWindow) -> AuxSums {
+    let b = || SumBuffer::new(window.x0, window.y0, window.width(), window.height());
+    let asked = |a: Aov| passes.contains(&a).then(b);
+    AuxSums {
+        albedo: asked(Aov::Albedo),
+        normal: asked(Aov::Normal),
+        depth: asked(Aov::Depth),
+        position: asked(Aov::Position),
+        uv: asked(Aov::Uv),
+        moments: passes.contains(&Aov::Variance).then(|| [b(), b()]),
+    }
+}
+
+/// The passes present in `p`.
+fn passes_of(p: &AuxSums) -> Vec<Aov> {
+    [
+        (Aov::Albedo, p.albedo.is_some()),
+        (Aov::Normal, p.normal.is_some()),
+        (Aov::Depth, p.depth.is_some()),
+        (Aov::Position, p.position.is_some()),
+        (Aov::Uv, p.uv.is_some()),
+        (Aov::Variance, p.moments.is_some()),
+    ]
+    .into_iter()
+    .filter_map(|(a, present)| present.then_some(a))
+    .collect()
+}
+
+/// A list of passes as the header writes it: names joined by commas.
+fn pass_list(passes: &[Aov]) -> String {
+    passes
+        .iter()
+        .map(|a| a.name())
+        .collect::<Vec<_>>()
+        .join(",")
 }
 
 impl PartInfo {
@@ -87,6 +200,11 @@ impl PartInfo {
             ("sahara:seed", self.seed.to_string()),
             ("sahara:exposure", self.exposure.to_string()),
             ("sahara:tonemap", self.tonemap.to_string()),
+            ("sahara:passes", pass_list(&self.passes)),
+            ("sahara:aovs", pass_list(&self.aovs)),
+            ("sahara:denoise", self.denoise.to_string()),
+            ("sahara:noisy_guides", self.noisy_guides.to_string()),
+            ("sahara:sample_counts", self.sample_counts.to_string()),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
@@ -152,11 +270,41 @@ impl PartInfo {
         if samples_done.start != samples.start || samples_done.end > samples.end {
             return Err(bad("sahara:samples_done", &range(&samples_done)));
         }
+        // Parts of a render without passes may leave these out.
+        let flag = |key: &str| match get(key).as_deref() {
+            None => Ok(false),
+            Some("true") => Ok(true),
+            Some("false") => Ok(false),
+            Some(v) => Err(bad(key, v)),
+        };
         let complete = match need("sahara:complete")?.as_str() {
             "true" => true,
             "false" => false,
             v => return Err(bad("sahara:complete", v)),
         };
+        let passes = |key: &str| -> Result<Vec<Aov>, FormatError> {
+            let v = get(key).unwrap_or_default();
+            let mut list = v
+                .split(',')
+                .filter(|p| !p.is_empty())
+                .map(Aov::from_name)
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|_| bad(key, &v))?;
+            list.sort();
+            list.dedup();
+            Ok(list)
+        };
+        let held = passes("sahara:passes")?;
+        let aovs = passes("sahara:aovs")?;
+        let denoise = flag("sahara:denoise")?;
+        let noisy_guides = flag("sahara:noisy_guides")?;
+        let sample_counts = flag("sahara:sample_counts")?;
+        if let Some(a) = aovs.iter().find(|a| !held.contains(a)) {
+            return Err(bad("sahara:aovs", a.name()));
+        }
+        if denoise && !(held.contains(&Aov::Albedo) && held.contains(&Aov::Normal)) {
+            return Err(bad("sahara:passes", &pass_list(&held)));
+        }
         if complete && samples_done != samples {
             return Err(bad("sahara:samples_done", &range(&samples_done)));
         }
@@ -186,6 +334,11 @@ impl PartInfo {
             tonemap: tonemap
                 .parse()
                 .map_err(|_| bad("sahara:tonemap", &tonemap))?,
+            passes: held,
+            aovs,
+            denoise,
+            noisy_guides,
+            sample_counts,
             stats: Vec::new(),
         })
     }
@@ -195,27 +348,66 @@ fn range(r: &Range<u32>) -> String {
     format!("{}..{}", r.start, r.end)
 }
 
-/// Channel names, in the order of the words of [`PixelSum`]'s sums.
-fn channel_names() -> Vec<String> {
+/// The channel of each pixel's sample count.
+const SAMPLES_CHANNEL: &str = "samples.n";
+
+/// Channel names of a sum buffer whose channels begin with `prefix`, in
+/// the order of the words of [`PixelSum`]'s sums.
+fn sum_channels(prefix: &str) -> Vec<String> {
     let mut names = Vec::with_capacity(16);
     for sum in ["sum.R", "sum.G", "sum.B", "weight"] {
         for word in 0..4 {
-            names.push(format!("{sum}.w{word}"));
+            names.push(format!("{prefix}{sum}.w{word}"));
         }
     }
     names
 }
 
-/// Writes a part: `sums` must cover exactly `info.window`.
-pub fn write_part(path: &Path, info: &PartInfo, sums: &SumBuffer) -> Result<(), FormatError> {
+/// Every channel a part described by `info` holds, sorted.
+fn channel_names(info: &PartInfo) -> Vec<String> {
+    let window = PixelWindow {
+        x0: 0,
+        x1: 0,
+        y0: 0,
+        y1: 0,
+    };
+    let mut names = sum_channels("");
+    for (name, _) in pass_buffers(&empty_passes(&info.passes, &window)) {
+        names.extend(sum_channels(&format!("{name}.")));
+    }
+    if info.sample_counts {
+        names.push(SAMPLES_CHANNEL.to_string());
+    }
+    names.sort();
+    names
+}
+
+/// Writes a part: `sums` must cover exactly `info.window` and hold the
+/// passes and sample counts it names.
+pub fn write_part(path: &Path, info: &PartInfo, sums: &PartSums) -> Result<(), FormatError> {
     let name = path.display().to_string();
     let w = &info.window;
-    if (sums.x0, sums.y0, sums.width, sums.height) != (w.x0, w.y0, w.width(), w.height())
-        && !(w.is_empty() && sums.sums.is_empty())
-    {
+    let fits = |b: &SumBuffer| {
+        (b.x0, b.y0, b.width, b.height) == (w.x0, w.y0, w.width(), w.height())
+            || (w.is_empty() && b.sums.is_empty())
+    };
+    let buffers = sums.buffers();
+    if !buffers.iter().all(|(_, b)| fits(b)) {
         return Err(FormatError::in_file(
             &name,
             "the sums do not cover the part's window",
+        ));
+    }
+    if passes_of(&sums.passes) != info.passes
+        || sums.samples.is_some() != info.sample_counts
+        || sums
+            .samples
+            .as_ref()
+            .is_some_and(|n| n.len() != w.pixels() as usize)
+    {
+        return Err(FormatError::in_file(
+            &name,
+            "the sums are not those the part's header names",
         ));
     }
     let (fw, fh) = if w.is_empty() {
@@ -224,16 +416,22 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &SumBuffer) -> Result<(), 
         (w.width() as usize, w.height() as usize)
     };
     let zero = [PixelSum::default()];
-    let pixels: &[PixelSum] = if w.is_empty() { &zero } else { &sums.sums };
     let value = |p: &PixelSum, k: usize| if k < 3 { p.rgb[k] } else { p.weight };
     let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
-    for (c, channel) in channel_names().into_iter().enumerate() {
-        let (sum, word) = (c / 4, c % 4);
-        let data: Vec<u32> = pixels
-            .iter()
-            .map(|p| (value(p, sum) as u128 >> (32 * word)) as u32)
-            .collect();
-        channels.push(AnyChannel::new(channel.as_str(), FlatSamples::U32(data)));
+    for (prefix, buffer) in buffers {
+        let pixels: &[PixelSum] = if w.is_empty() { &zero } else { &buffer.sums };
+        for (c, channel) in sum_channels(&prefix).into_iter().enumerate() {
+            let (sum, word) = (c / 4, c % 4);
+            let data: Vec<u32> = pixels
+                .iter()
+                .map(|p| (value(p, sum) as u128 >> (32 * word)) as u32)
+                .collect();
+            channels.push(AnyChannel::new(channel.as_str(), FlatSamples::U32(data)));
+        }
+    }
+    if let Some(n) = &sums.samples {
+        let data = if w.is_empty() { vec![0] } else { n.clone() };
+        channels.push(AnyChannel::new(SAMPLES_CHANNEL, FlatSamples::U32(data)));
     }
     let mut attributes = LayerAttributes::default();
     for (key, value) in info.attributes() {
@@ -328,9 +526,7 @@ pub fn read_part_info(path: &Path) -> Result<PartInfo, FormatError> {
         .iter()
         .map(|c| c.name.to_string())
         .collect();
-    let mut wanted = channel_names();
-    wanted.sort();
-    if names != wanted {
+    if names != channel_names(&info) {
         return Err(FormatError::in_file(
             &name,
             format!("not a Sahara render part: its channels are {names:?}"),
@@ -340,24 +536,28 @@ pub fn read_part_info(path: &Path) -> Result<PartInfo, FormatError> {
 }
 
 /// Reads a part: its header and its sums (over its window).
-pub fn read_part(path: &Path) -> Result<(PartInfo, SumBuffer), FormatError> {
+pub fn read_part(path: &Path) -> Result<(PartInfo, PartSums), FormatError> {
     let name = path.display().to_string();
     let info = read_part_info(path)?;
     let image = exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| {
         FormatError::in_file(&name, format!("truncated or damaged OpenEXR file: {e}"))
     })?;
     let w = info.window;
-    let mut sums = SumBuffer::new(w.x0, w.y0, w.width(), w.height());
+    let mut sums = PartSums {
+        beauty: SumBuffer::new(w.x0, w.y0, w.width(), w.height()),
+        passes: empty_passes(&info.passes, &w),
+        samples: info.sample_counts.then(|| vec![0; w.pixels() as usize]),
+    };
     if w.is_empty() {
         return Ok((info, sums));
     }
     let channels = &image.layer_data.channel_data.list;
-    for (c, channel) in channel_names().iter().enumerate() {
-        let data = channels
+    let data = |channel: &str, len: usize| {
+        channels
             .iter()
-            .find(|ch| ch.name.to_string() == *channel)
+            .find(|ch| ch.name.to_string() == channel)
             .and_then(|ch| match &ch.sample_data {
-                FlatSamples::U32(d) if d.len() == sums.sums.len() => Some(d),
+                FlatSamples::U32(d) if d.len() == len => Some(d),
                 _ => None,
             })
             .ok_or_else(|| {
@@ -365,16 +565,43 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, SumBuffer), FormatError> {
                     &name,
                     format!("channel {channel} is missing, not UINT or of the wrong size"),
                 )
-            })?;
-        let (sum, word) = (c / 4, c % 4);
-        for (p, &v) in sums.sums.iter_mut().zip(data) {
-            let slot = if sum < 3 {
-                &mut p.rgb[sum]
-            } else {
-                &mut p.weight
-            };
-            *slot = (*slot as u128 | (v as u128) << (32 * word)) as i128;
+            })
+    };
+    let mut buffers: Vec<(String, &mut SumBuffer)> = vec![(String::new(), &mut sums.beauty)];
+    let p = &mut sums.passes;
+    for (prefix, b) in [
+        ("albedo.", &mut p.albedo),
+        ("normal.", &mut p.normal),
+        ("depth.", &mut p.depth),
+        ("position.", &mut p.position),
+        ("uv.", &mut p.uv),
+    ] {
+        if let Some(b) = b {
+            buffers.push((prefix.to_string(), b));
         }
+    }
+    if let Some([sum, square]) = &mut p.moments {
+        buffers.push(("variance.sum.".to_string(), sum));
+        buffers.push(("variance.square.".to_string(), square));
+    }
+    for (prefix, buffer) in buffers {
+        let len = buffer.sums.len();
+        for (c, channel) in sum_channels(&prefix).iter().enumerate() {
+            let data = data(channel, len)?;
+            let (sum, word) = (c / 4, c % 4);
+            for (p, &v) in buffer.sums.iter_mut().zip(data) {
+                let slot = if sum < 3 {
+                    &mut p.rgb[sum]
+                } else {
+                    &mut p.weight
+                };
+                *slot = (*slot as u128 | (v as u128) << (32 * word)) as i128;
+            }
+        }
+    }
+    if let Some(n) = &mut sums.samples {
+        let len = n.len();
+        n.copy_from_slice(data(SAMPLES_CHANNEL, len)?);
     }
     Ok((info, sums))
 }
@@ -400,6 +627,11 @@ mod tests {
             seed: 3,
             exposure: -0.5,
             tonemap: ToneMap::Filmic,
+            passes: Vec::new(),
+            aovs: Vec::new(),
+            denoise: false,
+            noisy_guides: false,
+            sample_counts: false,
             stats: vec![("rays".into(), "123".into())],
         }
     }
@@ -422,10 +654,42 @@ mod tests {
             sums.splat(&f, 2, x, y, pos, Vec3::new(1e6 * k as f32, 0.25, 1e-9));
         }
         let path = dir.join("p.exr");
-        write_part(&path, &info(window), &sums).unwrap();
+        write_part(&path, &info(window), &PartSums::beauty(sums.clone())).unwrap();
         let (back, back_sums) = read_part(&path).unwrap();
         assert_eq!(back, info(window));
-        assert_eq!(back_sums, sums);
+        assert_eq!(back_sums, PartSums::beauty(sums.clone()));
+        // With render passes and sample counts: each buffer its own sums.
+        let with = PartInfo {
+            passes: vec![Aov::Albedo, Aov::Normal, Aov::Uv, Aov::Variance],
+            aovs: vec![Aov::Uv, Aov::Variance],
+            denoise: true,
+            noisy_guides: true,
+            sample_counts: true,
+            ..info(window)
+        };
+        let mut passes = empty_passes(&with.passes, &window);
+        let scaled = |k: f32| {
+            let mut b = SumBuffer::new(2, 1, 4, 3);
+            for (i, p) in b.sums.iter_mut().enumerate() {
+                p.add_sample(Vec3::new(k, -k * i as f32, 1e5 * k), 1.0 + i as f32);
+            }
+            b
+        };
+        passes.albedo = Some(scaled(1.0));
+        passes.normal = Some(scaled(-2.0));
+        passes.uv = Some(scaled(3.0));
+        passes.moments = Some([scaled(4.0), scaled(5.0)]);
+        let full = PartSums {
+            beauty: sums.clone(),
+            passes,
+            samples: Some((0..12).map(|k| 7 * k).collect()),
+        };
+        write_part(&path, &with, &full).unwrap();
+        let (back, back_sums) = read_part(&path).unwrap();
+        assert_eq!(back, with);
+        assert_eq!(back_sums, full);
+        // A header that names other passes than the sums hold is refused.
+        assert!(write_part(&path, &info(window), &full).is_err());
         // A part without pixels.
         let empty = PixelWindow {
             x0: 3,
@@ -433,10 +697,11 @@ mod tests {
             y0: 0,
             y1: 7,
         };
-        write_part(&path, &info(empty), &SumBuffer::new(3, 0, 0, 7)).unwrap();
+        let nothing = PartSums::beauty(SumBuffer::new(3, 0, 0, 7));
+        write_part(&path, &info(empty), &nothing).unwrap();
         let (back, back_sums) = read_part(&path).unwrap();
         assert_eq!(back.window, empty);
-        assert!(back_sums.sums.is_empty());
+        assert!(back_sums.beauty.sums.is_empty());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

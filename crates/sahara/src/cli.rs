@@ -63,6 +63,11 @@ pub struct MergeArgs {
     /// Also merge parts that were interrupted (partial), saying what was merged.
     #[arg(long)]
     pub allow_partial: bool,
+    /// Denoise the merged frame with Intel Open Image Denoise (the parts must
+    /// hold the albedo and normal: render them with --denoise, which also
+    /// makes merge denoise, or with --aov albedo,normal).
+    #[arg(long)]
+    pub denoise: bool,
 }
 
 /// Options of `sahara render`.

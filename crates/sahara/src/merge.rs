@@ -6,7 +6,10 @@
 //! overlap (the sample ranges of one tile) form a group, which is summed
 //! into one buffer over the group's pixels, turned into the image's
 //! pixels, and dropped. At most one group's sums, one part and the image
-//! are in memory at once.
+//! (with its render passes) are in memory at once. The passes' sums are
+//! merged like the beauty's, so the merged frame's passes are those of the
+//! whole frame rendered at once; a frame whose parts ask for denoising is
+//! denoised here, once merged (a part alone never is).
 
 use std::ops::Range;
 use std::path::PathBuf;
@@ -14,7 +17,8 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Result};
 use sahara_formats::part_file::{read_part, read_part_info, PartInfo};
 use sahara_render::{
-    cost_maps, Film, Integrator, RenderResult, RenderSettings, RenderStats, SumBuffer,
+    cost_maps, Aov, Aux, AuxImages, AuxSums, Film, Integrator, Named, RenderResult, RenderSettings,
+    RenderStats, SumBuffer,
 };
 use sahara_render::{tile, PixelWindow};
 
@@ -47,7 +51,38 @@ pub fn run(args: &MergeArgs) -> Result<()> {
                 short(&first.digest)
             );
         }
+        let same_passes = (&info.passes, &info.aovs, info.denoise, info.sample_counts)
+            == (
+                &first.passes,
+                &first.aovs,
+                first.denoise,
+                first.sample_counts,
+            );
+        if !same_passes {
+            bail!(
+                "{}: rendered with other render passes than {} ({} vs {}): render every part \
+                 with the same --aov and --denoise",
+                path.display(),
+                first_path.display(),
+                passes_said(info),
+                passes_said(first)
+            );
+        }
     }
+    let denoise = args.denoise || first.denoise;
+    let guides = [Aov::Albedo, Aov::Normal];
+    if denoise && !guides.iter().all(|a| first.passes.contains(a)) {
+        bail!(
+            "--denoise: the parts hold no albedo and normal for the denoiser: render them with \
+             --denoise (or --aov albedo,normal)"
+        );
+    }
+    // The library is found before any pixel is read.
+    let denoiser = if denoise {
+        Some(crate::denoise::load()?)
+    } else {
+        None
+    };
     let partial: Vec<&(PathBuf, PartInfo)> = parts.iter().filter(|(_, i)| !i.complete).collect();
     if let Some((path, info)) = partial.first().filter(|_| !args.allow_partial) {
         bail!(
@@ -71,6 +106,8 @@ pub fn run(args: &MergeArgs) -> Result<()> {
 
     let (w, h) = (first.width, first.height);
     let mut film = Film::new(w, h);
+    let mut passes = FramePasses::new(&first.passes, w, h);
+    let mut samples = first.sample_counts.then(|| vec![0u32; (w * h) as usize]);
     for group in groups(&parts) {
         let bounds = group
             .iter()
@@ -83,6 +120,13 @@ pub fn run(args: &MergeArgs) -> Result<()> {
             })
             .expect("a group has a part");
         let mut sums = SumBuffer::new(bounds.x0, bounds.y0, bounds.width(), bounds.height());
+        let mut aux = Aux::new(
+            &first.passes,
+            bounds.x0,
+            bounds.y0,
+            bounds.width(),
+            bounds.height(),
+        );
         for &k in &group {
             let (path, info) = &parts[k];
             if info.samples_done.is_empty() {
@@ -92,15 +136,26 @@ pub fn run(args: &MergeArgs) -> Result<()> {
             if again != *info {
                 bail!("{}: the file changed while being merged", path.display());
             }
-            sums.add(&part);
+            sums.add(&part.beauty);
+            aux.add(&Aux {
+                images: AuxImages::default(),
+                sums: part.passes,
+            });
+            if let (Some(frame), Some(n)) = (&mut samples, &part.samples) {
+                let win = info.window;
+                for (k, (x, y)) in rows(&win).enumerate() {
+                    frame[(y * w + x) as usize] += n[k];
+                }
+            }
         }
+        let aux = Aux::from_sums(aux.sums);
         for &k in &group {
             let win = parts[k].1.window;
-            for y in win.y0..win.y1 {
-                for x in win.x0..win.x1 {
-                    let value = sums.get(x, y).expect("inside the group").value();
-                    film.pixels[(y * w + x) as usize] = value;
-                }
+            for (x, y) in rows(&win) {
+                let value = sums.get(x, y).expect("inside the group").value();
+                film.pixels[(y * w + x) as usize] = value;
+                let at = (y - bounds.y0) * bounds.width() + (x - bounds.x0);
+                passes.set((y * w + x) as usize, &aux.images, at as usize);
             }
         }
     }
@@ -115,7 +170,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         integrator,
         ..Default::default()
     };
-    let result = RenderResult {
+    let mut result = RenderResult {
         film,
         sums: SumBuffer::new(0, 0, 0, 0),
         stats: RenderStats {
@@ -124,16 +179,23 @@ pub fn run(args: &MergeArgs) -> Result<()> {
             ..Default::default()
         },
         cost,
-        aux: None,
-        samples: None,
+        aux: (!first.passes.is_empty()).then(|| Aux {
+            images: passes.images,
+            sums: AuxSums::default(),
+        }),
+        samples,
+    };
+    let noisy = match &denoiser {
+        Some(d) => crate::denoise::apply(d, &mut result, first.noisy_guides)?,
+        None => None,
     };
     let out = Output {
         path: args.output.clone(),
         settings: &settings,
         exposure: first.exposure,
         tonemap,
-        aovs: &[],
-        noisy: None,
+        aovs: &first.aovs,
+        noisy: noisy.as_deref(),
     };
     out.write(&result, !partial.is_empty(), true)?;
     eprintln!(
@@ -146,6 +208,66 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         spp
     );
     Ok(())
+}
+
+/// The frame's render passes, filled group by group.
+struct FramePasses {
+    images: AuxImages,
+}
+
+impl FramePasses {
+    /// Black images of the frame for `passes`.
+    fn new(passes: &[Aov], w: u32, h: u32) -> Self {
+        let n = (w * h) as usize;
+        let sized = |a: Aov| if passes.contains(&a) { n } else { 0 };
+        Self {
+            images: AuxImages {
+                albedo: vec![Default::default(); sized(Aov::Albedo)],
+                normal: vec![Default::default(); sized(Aov::Normal)],
+                depth: vec![0.0; sized(Aov::Depth)],
+                position: vec![Default::default(); sized(Aov::Position)],
+                uv: vec![Default::default(); sized(Aov::Uv)],
+                variance: vec![Default::default(); sized(Aov::Variance)],
+            },
+        }
+    }
+
+    /// Pixel `to` of the frame's passes from pixel `from` of `group`'s.
+    fn set(&mut self, to: usize, group: &AuxImages, from: usize) {
+        fn copy<T: Copy>(to: usize, frame: &mut [T], group: &[T], from: usize) {
+            if let Some(v) = group.get(from) {
+                frame[to] = *v;
+            }
+        }
+        let f = &mut self.images;
+        copy(to, &mut f.albedo, &group.albedo, from);
+        copy(to, &mut f.normal, &group.normal, from);
+        copy(to, &mut f.depth, &group.depth, from);
+        copy(to, &mut f.position, &group.position, from);
+        copy(to, &mut f.uv, &group.uv, from);
+        copy(to, &mut f.variance, &group.variance, from);
+    }
+}
+
+/// The pixels of `win`, rows top to bottom.
+fn rows(win: &PixelWindow) -> impl Iterator<Item = (u32, u32)> + '_ {
+    (win.y0..win.y1).flat_map(move |y| (win.x0..win.x1).map(move |x| (x, y)))
+}
+
+/// A part's render passes, for a message.
+fn passes_said(info: &PartInfo) -> String {
+    let list = |p: &[Aov]| {
+        if p.is_empty() {
+            "none".to_string()
+        } else {
+            p.iter().map(|a| a.name()).collect::<Vec<_>>().join(",")
+        }
+    };
+    format!(
+        "passes {}{}",
+        list(&info.aovs),
+        if info.denoise { ", denoised" } else { "" }
+    )
 }
 
 fn short(digest: &str) -> &str {

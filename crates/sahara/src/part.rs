@@ -5,9 +5,9 @@ use std::ops::Range;
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
-use sahara_formats::part_file::{read_part_info, write_part, PartInfo};
+use sahara_formats::part_file::{read_part_info, write_part, PartInfo, PartSums};
 use sahara_render::{crop, sample_range, tile, PixelWindow};
-use sahara_render::{RenderResult, RenderSettings, SumBuffer, ToneMap};
+use sahara_render::{Aov, Aux, RenderResult, RenderSettings, SumBuffer, ToneMap};
 
 use crate::cli::{RenderArgs, Split};
 
@@ -118,6 +118,12 @@ pub struct PartRecord<'a> {
     pub exposure: f32,
     /// Tone map for a PNG of the merged frame.
     pub tonemap: ToneMap,
+    /// The render passes the merged frame writes as layers.
+    pub aovs: &'a [Aov],
+    /// True if the merged frame is to be denoised.
+    pub denoise: bool,
+    /// True if the denoiser is to clean the albedo and normal first.
+    pub noisy_guides: bool,
     /// True if the render was interrupted.
     pub interrupted: bool,
 }
@@ -133,18 +139,37 @@ pub fn write(
     let s = &result.stats;
     // An interrupted first pass leaves some pixels with fewer samples than
     // others: a part holds whole passes only.
+    let w = piece.window;
     let (done, sums) = if s.passes == 0 && !piece.samples.is_empty() {
-        let w = piece.window;
+        let nothing = Aux::new(&settings.aovs, w.x0, w.y0, w.width(), w.height());
         (
             piece.samples.start..piece.samples.start,
-            SumBuffer::new(w.x0, w.y0, w.width(), w.height()),
+            PartSums {
+                beauty: SumBuffer::new(w.x0, w.y0, w.width(), w.height()),
+                passes: nothing.sums,
+                samples: result
+                    .samples
+                    .as_ref()
+                    .map(|_| vec![0; w.pixels() as usize]),
+            },
         )
     } else {
+        let passes = match &result.aux {
+            Some(aux) => aux.sums.clone(),
+            None => Default::default(),
+        };
         (
             piece.samples.start..piece.samples.start + s.spp,
-            result.sums.clone(),
+            PartSums {
+                beauty: result.sums.clone(),
+                passes,
+                samples: result.samples.clone(),
+            },
         )
     };
+    let mut aovs = record.aovs.to_vec();
+    aovs.sort();
+    aovs.dedup();
     let info = PartInfo {
         digest: record.digest.to_string(),
         width: settings.width,
@@ -159,6 +184,11 @@ pub fn write(
         seed: settings.seed,
         exposure: record.exposure,
         tonemap: record.tonemap,
+        passes: settings.aovs.clone(),
+        aovs,
+        denoise: record.denoise,
+        noisy_guides: record.noisy_guides,
+        sample_counts: sums.samples.is_some(),
         stats: vec![
             ("passes".into(), s.passes.to_string()),
             ("rays".into(), s.rays().to_string()),

@@ -105,14 +105,6 @@ fn check_args(args: &RenderArgs) -> Result<()> {
         check_output(output, part::is_part(args))?;
         check_aov_output(args, output)?;
     }
-    for (given, name) in [(!args.aov.is_empty(), "--aov"), (args.denoise, "--denoise")] {
-        if given && part::is_part(args) {
-            bail!(
-                "{name} cannot be used with --part, --crop or --samples: part files carry the \
-                 beauty's sums only"
-            );
-        }
-    }
     Ok(())
 }
 
@@ -205,7 +197,9 @@ struct Job {
     piece: Option<(Piece, String)>,
     /// Render passes written beside the beauty.
     aovs: Vec<sahara_render::Aov>,
-    /// The denoiser, with `--denoise`.
+    /// True with `--denoise` (or the scene file's `denoise`).
+    denoise: bool,
+    /// The denoiser, with `--denoise` (None for a part: `merge` denoises).
     denoiser: Option<sahara_denoise::Denoiser>,
 }
 
@@ -263,12 +257,6 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         refuse_sample_ranges(args, "the scene file's noise_threshold")?;
     }
     let file_denoise = !args.denoise && file.as_ref().is_some_and(|f| f.denoise);
-    if file_denoise && piece.is_some() {
-        bail!(
-            "the scene file's `denoise` cannot be used with --part, --crop or --samples: part \
-             files carry the beauty's sums only (render the parts without it)"
-        );
-    }
     let denoise = args.denoise || file_denoise;
     settings.aovs = args.aov.clone();
     if denoise {
@@ -312,8 +300,10 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
             Some(_) => {}
         }
     }
-    // The library is found before the render, not after it.
-    let denoiser = if denoise {
+    // The library is found before the render, not after it. A part is
+    // never denoised alone: it carries the albedo and normal, and `merge`
+    // denoises the whole frame (so a farm's nodes need no denoiser).
+    let denoiser = if denoise && piece.is_none() {
         Some(crate::denoise::load()?)
     } else {
         None
@@ -367,6 +357,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         output,
         piece,
         aovs: args.aov.clone(),
+        denoise,
         denoiser,
     }))
 }
@@ -533,6 +524,9 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
             digest,
             exposure: job.exposure,
             tonemap: job.tonemap,
+            aovs: &job.aovs,
+            denoise: job.denoise,
+            noisy_guides: crate::denoise::guides_are_noisy(&job.scene),
             interrupted: partial,
         };
         let path = if partial {

@@ -503,3 +503,145 @@ fn sppm_splits_by_tiles_exactly_and_refuses_sample_ranges() {
     }
     fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Each option list of `pieces` with `extra` added.
+fn with(pieces: Vec<Vec<String>>, extra: &[&str]) -> Vec<Vec<String>> {
+    pieces
+        .into_iter()
+        .map(|mut p| {
+            p.extend(extra.iter().map(|s| s.to_string()));
+            p
+        })
+        .collect()
+}
+
+/// The names of an EXR file's channels.
+fn channel_names(path: &Path) -> Vec<String> {
+    let image = exr::prelude::read_all_flat_layers_from_file(path).unwrap();
+    image
+        .layer_data
+        .iter()
+        .flat_map(|l| l.channel_data.list.iter().map(|c| c.name.to_string()))
+        .collect()
+}
+
+/// Render passes are merged like the beauty: the merged frame's layers
+/// (and, with adaptive sampling, its sample counts) are the whole frame's
+/// byte for byte; parts rendered with other passes are refused.
+#[test]
+fn render_passes_merge_to_the_whole_frames_byte_for_byte() {
+    let dir = temp_dir("farm-passes");
+    let aov = ["--aov", "albedo,normal,depth,position,uv,variance"];
+    let adaptive = ["--noise-threshold", "0.05", "--aov", "depth"];
+    for (tag, extra, pieces) in [
+        ("tiles", &aov[..], split(3, "tiles")),
+        ("samples", &aov[..], split(3, "samples")),
+        ("adaptive", &adaptive[..], split(2, "tiles")),
+    ] {
+        let whole = dir.join(format!("whole-{tag}.exr"));
+        render(extra, &whole);
+        let names = channel_names(&whole);
+        for layer in ["depth.Z", "R"] {
+            assert!(names.iter().any(|n| n == layer), "{tag}: {names:?}");
+        }
+        if tag == "adaptive" {
+            assert!(names.iter().any(|n| n == "samples.Y"), "{names:?}");
+        }
+        let files = parts(&dir, tag, &with(pieces, extra));
+        let out = dir.join(format!("merged-{tag}.exr"));
+        let m = merge(&files, &out, &[]);
+        assert!(m.status.success(), "{tag}: {}", stderr(&m));
+        assert!(
+            fs::read(&out).unwrap() == fs::read(&whole).unwrap(),
+            "{tag}: the merged passes differ from the whole frame's"
+        );
+    }
+    // One tile rendered without the passes: refused in one line.
+    let mut files = parts(&dir, "mixed", &with(split(3, "tiles"), &aov));
+    files[0] = parts(&dir, "plain", &split(3, "tiles")[..1])[0].clone();
+    let out = dir.join("mixed.exr");
+    let m = merge(&files, &out, &[]);
+    let e = stderr(&m);
+    assert!(!m.status.success());
+    assert_eq!(e.trim_end().lines().count(), 1, "one line: {e}");
+    assert!(e.contains("other render passes"), "{e}");
+    assert!(!out.exists());
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Parts of a denoised frame carry the albedo and normal and are not
+/// denoised alone; `merge` denoises the merged frame, which is then the
+/// whole frame's denoised image. Skipped (said so) where Open Image Denoise
+/// is not installed, unless `SAHARA_REQUIRE_OIDN` is set, as CI sets it.
+#[test]
+fn a_denoised_frame_is_denoised_once_merged() {
+    let dir = temp_dir("farm-denoise");
+    let whole = dir.join("whole.exr");
+    let o = whole.to_str().unwrap();
+    let r = sahara(&[&["render"], FRAME, &["--denoise", "-o", o]].concat());
+    if !r.status.success() && stderr(&r).contains("Open Image Denoise not found") {
+        assert!(
+            std::env::var_os("SAHARA_REQUIRE_OIDN").is_none(),
+            "SAHARA_REQUIRE_OIDN is set: {}",
+            stderr(&r)
+        );
+        eprintln!("skipped: Open Image Denoise is not installed here (pip install pyoidn)");
+        return;
+    }
+    assert!(r.status.success(), "{}", stderr(&r));
+    let files = parts(&dir, "tile", &with(split(2, "tiles"), &["--denoise"]));
+    for f in &files {
+        let (info, sums) = read_part(f).unwrap();
+        assert!(info.denoise && info.aovs.is_empty(), "{info:?}");
+        assert!(sums.passes.albedo.is_some() && sums.passes.normal.is_some());
+    }
+    let out = dir.join("merged.exr");
+    let m = merge(&files, &out, &[]);
+    assert!(m.status.success(), "{}", stderr(&m));
+    assert!(
+        stderr(&m).contains("denoised with Open Image Denoise"),
+        "{}",
+        stderr(&m)
+    );
+    let read = |p: &Path| {
+        let image = exr::prelude::read_all_flat_layers_from_file(p).unwrap();
+        let mut out = std::collections::BTreeMap::new();
+        for l in &image.layer_data {
+            for c in &l.channel_data.list {
+                let v: Vec<f32> = c.sample_data.values_as_f32().collect();
+                out.insert(c.name.to_string(), v);
+            }
+        }
+        out
+    };
+    let (a, b) = (read(&out), read(&whole));
+    assert_eq!(
+        a.keys().collect::<Vec<_>>(),
+        b.keys().collect::<Vec<_>>(),
+        "the same layers"
+    );
+    for (name, va) in &a {
+        let vb = &b[name];
+        if name.starts_with("noisy.") {
+            assert_eq!(va, vb, "{name}: the noisy image is the whole frame's");
+        } else {
+            // The same network on the same input; allow for a library
+            // that is not bit-reproducible across runs.
+            let worst = va
+                .iter()
+                .zip(vb)
+                .map(|(x, y)| (x - y).abs() / y.abs().max(1e-3))
+                .fold(0.0f32, f32::max);
+            assert!(worst < 1e-3, "{name}: off by {worst}");
+        }
+    }
+    // Parts without albedo and normal cannot be denoised.
+    let plain = parts(&dir, "plain", &split(2, "tiles"));
+    let m = merge(&plain, &dir.join("plain.exr"), &["--denoise"]);
+    let e = stderr(&m);
+    assert!(
+        !m.status.success() && e.contains("no albedo and normal"),
+        "{e}"
+    );
+    fs::remove_dir_all(&dir).unwrap();
+}

@@ -1267,12 +1267,6 @@ fn a_scene_file_asks_for_adaptive_sampling_and_denoising() {
         !ok && err.contains("`min_spp` needs `noise_threshold`"),
         "{err}"
     );
-    write("", "denoise = true");
-    let (ok, err) = run(&["--part", "1/2"]);
-    assert!(
-        !ok && err.contains("the scene file's `denoise` cannot be used with --part"),
-        "{err}"
-    );
     let _ = fs::remove_dir_all(&dir);
 }
 
@@ -1390,20 +1384,6 @@ fn denoising_lowers_the_error_of_a_noisy_render() {
     ]);
     assert!(
         stderr(&out).contains("--denoise needs the path or distribution integrator"),
-        "{}",
-        stderr(&out)
-    );
-    let part = dir.join("p.exr");
-    let out = sahara(&[
-        "render",
-        "--denoise",
-        "--part",
-        "0/2",
-        "-o",
-        part.to_str().unwrap(),
-    ]);
-    assert!(
-        stderr(&out).contains("--denoise cannot be used with --part"),
         "{}",
         stderr(&out)
     );

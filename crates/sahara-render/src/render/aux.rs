@@ -49,7 +49,7 @@ pub struct Aux {
 }
 
 /// The exact sums of the passes asked for (None: not asked for).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct AuxSums {
     /// Albedo.
     pub albedo: Option<SumBuffer>,
@@ -96,7 +96,7 @@ pub struct AuxImages {
 impl Aux {
     /// Empty sums over `[x0, x0 + width) x [y0, y0 + height)` for the
     /// passes `aovs`.
-    pub(crate) fn new(aovs: &[Aov], x0: u32, y0: u32, width: u32, height: u32) -> Self {
+    pub fn new(aovs: &[Aov], x0: u32, y0: u32, width: u32, height: u32) -> Self {
         let b = || SumBuffer::new(x0, y0, width, height);
         let asked = |a: Aov| aovs.contains(&a).then(b);
         Self {
@@ -110,6 +110,16 @@ impl Aux {
                 moments: aovs.contains(&Aov::Variance).then(|| [b(), b()]),
             },
         }
+    }
+
+    /// The images of `sums` (the passes they hold; the others empty).
+    pub fn from_sums(sums: AuxSums) -> Self {
+        let mut aux = Self {
+            images: AuxImages::default(),
+            sums,
+        };
+        aux.develop(None);
+        aux
     }
 
     /// Adds one sample of pixel `(x, y)`: its auxiliary values `a` and its
@@ -142,7 +152,7 @@ impl Aux {
     }
 
     /// Adds `other`'s sums.
-    pub(crate) fn add(&mut self, other: &Aux) {
+    pub fn add(&mut self, other: &Aux) {
         let (a, b) = (&mut self.sums, &other.sums);
         for (x, y) in [
             (&mut a.albedo, &b.albedo),

@@ -87,7 +87,8 @@ pub struct RenderSettings {
     pub aovs: Vec<Aov>,
     /// Adaptive sampling: pixels stop once their noise is low enough, and
     /// `spp` is a cap (None: every pixel takes `spp`). Not with `samples`
-    /// (a pixel's decisions need all its samples), which it is ignored with.
+    /// other than `0..spp` (a pixel's decisions need all its samples),
+    /// which it is ignored with.
     pub adaptive: Option<Adaptive>,
 }
 
@@ -366,8 +367,14 @@ pub fn render_watched(
             window.height(),
         )
     });
-    let mut convergence = match (settings.adaptive, &settings.samples) {
-        (Some(a), None) => Some(Convergence::new(region, a)),
+    // Adaptive sampling judges each pixel by all of its samples: a piece of
+    // the frame by pixels (all samples) can use it, a range of samples not.
+    let all_samples = settings
+        .samples
+        .as_ref()
+        .is_none_or(|r| *r == (0..settings.spp));
+    let mut convergence = match settings.adaptive {
+        Some(a) if all_samples => Some(Convergence::new(region, a)),
         _ => None,
     };
     let mut stats = RenderStats {
