@@ -61,9 +61,34 @@ pub struct AssembledScene {
     /// lights' power as a share of the default sky and sun's
     /// ([`sky::own_share`]; weak below [`sky::WEAK_FRACTION`]).
     pub sky_share: Option<f32>,
+    /// What the scene's objects and materials are called.
+    pub names: SceneNames,
     /// Problems that did not stop loading, one line each, naming the
     /// file: the reader's, then the assembly's.
     pub warnings: Vec<String>,
+}
+
+/// What the scene's objects and materials are called, for the lists of
+/// names beside the `object` and `material` render passes: the file's
+/// names where it gives them, else made up from what the thing is.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneNames {
+    /// The name of each of the scene's instances, by index.
+    pub objects: Vec<String>,
+    /// The name of each of the scene's materials, by index.
+    pub materials: Vec<String>,
+}
+
+impl SceneNames {
+    /// Names by number (`object 1`, `material 1`, ...: the ids of the
+    /// render passes) for a scene that gives none.
+    pub fn numbered(scene: &Scene) -> Self {
+        let list = |what: &str, n: usize| (1..=n).map(|i| format!("{what} {i}")).collect();
+        Self {
+            objects: list("object", scene.instances.len()),
+            materials: list("material", scene.materials.len()),
+        }
+    }
 }
 
 impl AssembledScene {
@@ -83,6 +108,7 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
         _ => placeholder,
     });
     scene.materials = desc.materials;
+    let mut object_names: Vec<String> = Vec::new();
     let mut meshes: Vec<Option<u32>> = vec![None; desc.meshes.len()];
     let mut inline = desc.meshes.into_iter().map(Some).collect::<Vec<_>>();
     let mut library = MeshLibrary::new();
@@ -164,6 +190,27 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
         if o.placement.is_moving() && emits {
             moving_emitters += 1;
         }
+        // Name the instances the object added.
+        let label = o.name.clone().unwrap_or_else(|| match &o.geometry {
+            Geometry::File(path) => path.file_name().map_or_else(
+                || path.display().to_string(),
+                |f| f.to_string_lossy().into_owned(),
+            ),
+            Geometry::Shape(s) => format!("{} {}", s.kind(), k + 1),
+            Geometry::Mesh(_) => format!("mesh {}", k + 1),
+        });
+        let added = scene.instances.len() - object_names.len();
+        let parts = match &o.geometry {
+            Geometry::File(path) => library.part_names(path),
+            _ => Vec::new(),
+        };
+        for j in 0..added {
+            object_names.push(match (added, parts.get(j).cloned().flatten()) {
+                (_, Some(part)) => format!("{label}/{part}"),
+                (1, None) => label.clone(),
+                (_, None) => format!("{label}/{j}"),
+            });
+        }
     }
     warnings.append(&mut library.warnings);
     if moving_emitters > 0 {
@@ -227,12 +274,28 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
     scene.camera = camera;
     let (sky, sky_share) = sky::apply(&mut scene, &desc.sky)
         .map_err(|e| FormatError::in_file(&name, format!("sky: {e}")))?;
+    // What the sky added (its ground) is named after it.
+    object_names.resize(scene.instances.len(), "sky ground".into());
+    let materials = (0..scene.materials.len() as u32)
+        .map(|id| {
+            desc.material_names
+                .get(&id)
+                .or(library.material_names.get(&id))
+                .cloned()
+                .unwrap_or_else(|| format!("material {}", id + 1))
+        })
+        .collect();
+    let names = SceneNames {
+        objects: object_names,
+        materials,
+    };
     Ok(AssembledScene {
         scene,
         settings: desc.settings,
         camera_source,
         sky,
         sky_share,
+        names,
         warnings,
     })
 }

@@ -25,6 +25,7 @@
 
 mod settings;
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use glam::Affine3A;
@@ -42,6 +43,10 @@ pub struct SceneDescription {
     /// The materials objects refer to by index, in the order the
     /// renderer's scene numbers them.
     pub materials: Vec<Material>,
+    /// The names the file gives materials, by index into
+    /// [`SceneDescription::materials`] (for the `material` render pass's
+    /// list of names; unnamed ones are named by the assembly).
+    pub material_names: BTreeMap<u32, String>,
     /// Meshes given in the file itself (pbrt's triangle meshes and
     /// object definitions), referred to by index by [`Geometry::Mesh`];
     /// their per-triangle material ids are indices into
@@ -73,6 +78,7 @@ impl SceneDescription {
             name: name.into(),
             camera: CameraRequest::Automatic,
             materials: Vec::new(),
+            material_names: BTreeMap::new(),
             meshes: Vec::new(),
             objects: Vec::new(),
             lights: Vec::new(),
@@ -87,6 +93,13 @@ impl SceneDescription {
     pub fn add_material(&mut self, m: Material) -> u32 {
         self.materials.push(m);
         self.materials.len() as u32 - 1
+    }
+
+    /// Adds a material named `name` in the file; returns its index.
+    pub fn add_named_material(&mut self, name: impl Into<String>, m: Material) -> u32 {
+        let id = self.add_material(m);
+        self.material_names.insert(id, name.into());
+        id
     }
 
     /// Adds a mesh; returns its index.
@@ -127,6 +140,9 @@ pub struct Object {
     /// geometry's own materials (a mesh file's MTL or glTF materials, a
     /// mesh's per-triangle ids), or the grey default where it has none.
     pub material: Option<u32>,
+    /// The name the file gives it, if any (for the `object` render
+    /// pass's list of names).
+    pub name: Option<String>,
 }
 
 /// An object's geometry.

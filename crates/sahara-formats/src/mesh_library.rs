@@ -7,7 +7,7 @@
 //! material ids pointing at them. Objects then only add instances, so many
 //! copies of a mesh cost one mesh's memory (and one kd-tree).
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec2};
@@ -31,6 +31,9 @@ pub struct MeshPart {
 pub struct LoadedFile {
     /// The meshes and their placements in the file.
     pub parts: Vec<MeshPart>,
+    /// The names the file gives its parts (glTF mesh names), parallel to
+    /// `parts`.
+    pub part_names: Vec<Option<String>>,
     /// Material for instances that do not override it: `None` when the
     /// meshes carry per-triangle ids of the file's own materials, else the
     /// scene's default material (a PLY, or materials not asked for).
@@ -50,6 +53,9 @@ pub struct MeshLibrary {
     files: HashMap<PathBuf, LoadedFile>,
     textures: TextureCache,
     default_material: Option<u32>,
+    /// The names of the materials the files brought (and of the default
+    /// one), by the scene's material index.
+    pub material_names: BTreeMap<u32, String>,
     /// Problems that did not stop loading, one line each, naming the file.
     pub warnings: Vec<String>,
 }
@@ -65,6 +71,13 @@ impl MeshLibrary {
         Self::default()
     }
 
+    /// The names of the parts of the loaded file `path` (none if not loaded).
+    pub fn part_names(&self, path: &Path) -> Vec<Option<String>> {
+        self.files
+            .get(&file_key(path))
+            .map_or_else(Vec::new, |f| f.part_names.clone())
+    }
+
     /// Number of distinct files loaded.
     pub fn file_count(&self) -> usize {
         self.files.len()
@@ -72,9 +85,11 @@ impl MeshLibrary {
 
     /// The scene's grey default material, added on first use.
     pub fn default_material(&mut self, scene: &mut Scene) -> u32 {
-        *self
-            .default_material
-            .get_or_insert_with(|| scene.add_material(Scene::default_material()))
+        *self.default_material.get_or_insert_with(|| {
+            let id = scene.add_material(Scene::default_material());
+            self.material_names.insert(id, "default".into());
+            id
+        })
     }
 
     /// Loads `path` into `scene` unless it already is; with
@@ -105,6 +120,7 @@ impl MeshLibrary {
                         mesh,
                         transform: Mat4::IDENTITY,
                     }],
+                    part_names: vec![None],
                     material: Some(self.default_material(scene)),
                     emissive: false,
                     cameras: Vec::new(),
@@ -143,10 +159,11 @@ impl MeshLibrary {
         let mut emissive = false;
         let material = if own_materials {
             let first = scene.materials.len() as u32;
-            for m in &obj.materials {
-                let m = mtl_material(m, &mut self.textures, &mut self.warnings);
+            for mtl in &obj.materials {
+                let m = mtl_material(mtl, &mut self.textures, &mut self.warnings);
                 emissive |= m.is_emissive();
-                scene.add_material(m);
+                let id = scene.add_material(m);
+                self.material_names.insert(id, mtl.name.clone());
             }
             mesh.material_ids = Some(obj.material_ids.iter().map(|&i| first + i).collect());
             None
@@ -159,6 +176,7 @@ impl MeshLibrary {
                 mesh,
                 transform: Mat4::IDENTITY,
             }],
+            part_names: vec![None],
             material,
             emissive,
             cameras: Vec::new(),
@@ -179,10 +197,13 @@ impl MeshLibrary {
         let mut emissive = false;
         let first = scene.materials.len() as u32;
         let material = if own_materials {
-            for m in &g.materials {
-                let m = gltf_material(m, &name, &mut self.textures, &mut self.warnings);
+            for gm in &g.materials {
+                let m = gltf_material(gm, &name, &mut self.textures, &mut self.warnings);
                 emissive |= m.is_emissive();
-                scene.add_material(m);
+                let id = scene.add_material(m);
+                if let Some(n) = &gm.name {
+                    self.material_names.insert(id, n.clone());
+                }
             }
             None
         } else {
@@ -194,6 +215,7 @@ impl MeshLibrary {
         let flip = |uvs: Option<Vec<Vec2>>| {
             uvs.map(|uvs| uvs.iter().map(|uv| Vec2::new(uv.x, 1.0 - uv.y)).collect())
         };
+        let mesh_names: Vec<Option<String>> = g.meshes.iter().map(|m| m.name.clone()).collect();
         let ids: Vec<u32> = g
             .meshes
             .into_iter()
@@ -224,6 +246,11 @@ impl MeshLibrary {
             .collect();
         Ok(LoadedFile {
             parts,
+            part_names: g
+                .instances
+                .iter()
+                .map(|i| mesh_names[i.mesh].clone())
+                .collect(),
             material,
             emissive,
             cameras: g.cameras,

@@ -91,6 +91,7 @@ pub fn read_mesh_scene(
         geometry: Geometry::File(path.to_path_buf()),
         placement: ObjectPlacement::World,
         material: None,
+        name: None,
     });
     Ok(desc)
 }

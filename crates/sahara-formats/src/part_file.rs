@@ -9,7 +9,8 @@
 //! `sum.B.*` and `weight.w*`. The render passes' sums follow in the same
 //! form, each under its pass's name (`albedo.sum.R.w0` ... `albedo.weight.w3`;
 //! the variance's two buffers as `variance.sum.*` and `variance.square.*`),
-//! and with adaptive sampling each pixel's sample count as `samples.n`.
+//! with adaptive sampling each pixel's sample count as `samples.n`, and the
+//! object and material ids as `object.id` and `material.id`.
 //! What the merge needs to know of it is in string attributes
 //! ([`PartInfo`]). It is written atomically.
 
@@ -80,6 +81,9 @@ pub struct PartInfo {
     /// True if the part holds each pixel's sample count (adaptive
     /// sampling).
     pub sample_counts: bool,
+    /// The list of names of the object and material passes (JSON, ASCII;
+    /// empty without those passes).
+    pub names: String,
     /// Render statistics as (name, value) pairs, kept for people.
     pub stats: Vec<(String, String)>,
 }
@@ -96,6 +100,12 @@ pub struct PartSums {
     /// Samples per pixel, rows top to bottom, if
     /// [`PartInfo::sample_counts`].
     pub samples: Option<Vec<u32>>,
+    /// The object ids of the pixels, if [`PartInfo::passes`] names
+    /// [`Aov::Object`] (rows top to bottom).
+    pub object: Option<Vec<u32>>,
+    /// The material ids of the pixels, if [`PartInfo::passes`] names
+    /// [`Aov::Material`].
+    pub material: Option<Vec<u32>>,
 }
 
 impl PartSums {
@@ -105,7 +115,30 @@ impl PartSums {
             beauty,
             passes: AuxSums::default(),
             samples: None,
+            object: None,
+            material: None,
         }
+    }
+
+    /// The passes it holds: those with sums, then the ids.
+    fn passes(&self) -> Vec<Aov> {
+        let mut p = passes_of(&self.passes);
+        p.extend(self.object.as_ref().map(|_| Aov::Object));
+        p.extend(self.material.as_ref().map(|_| Aov::Material));
+        p.sort();
+        p
+    }
+
+    /// The channels of whole numbers per pixel: sample counts and ids.
+    fn counts(&self) -> Vec<(&'static str, &Vec<u32>)> {
+        [
+            (SAMPLES_CHANNEL, &self.samples),
+            (OBJECT_CHANNEL, &self.object),
+            (MATERIAL_CHANNEL, &self.material),
+        ]
+        .into_iter()
+        .filter_map(|(name, v)| Some((name, v.as_ref()?)))
+        .collect()
     }
 
     /// Each sum buffer with the prefix of its channels, beauty first.
@@ -205,6 +238,7 @@ impl PartInfo {
             ("sahara:denoise", self.denoise.to_string()),
             ("sahara:noisy_guides", self.noisy_guides.to_string()),
             ("sahara:sample_counts", self.sample_counts.to_string()),
+            ("sahara:names", self.names.clone()),
         ]
         .into_iter()
         .map(|(k, v)| (k.to_string(), v))
@@ -339,6 +373,7 @@ impl PartInfo {
             denoise,
             noisy_guides,
             sample_counts,
+            names: get("sahara:names").unwrap_or_default(),
             stats: Vec::new(),
         })
     }
@@ -350,6 +385,10 @@ fn range(r: &Range<u32>) -> String {
 
 /// The channel of each pixel's sample count.
 const SAMPLES_CHANNEL: &str = "samples.n";
+/// The channel of each pixel's object id.
+const OBJECT_CHANNEL: &str = "object.id";
+/// The channel of each pixel's material id.
+const MATERIAL_CHANNEL: &str = "material.id";
 
 /// Channel names of a sum buffer whose channels begin with `prefix`, in
 /// the order of the words of [`PixelSum`]'s sums.
@@ -375,8 +414,14 @@ fn channel_names(info: &PartInfo) -> Vec<String> {
     for (name, _) in pass_buffers(&empty_passes(&info.passes, &window)) {
         names.extend(sum_channels(&format!("{name}.")));
     }
-    if info.sample_counts {
-        names.push(SAMPLES_CHANNEL.to_string());
+    for (held, channel) in [
+        (info.sample_counts, SAMPLES_CHANNEL),
+        (info.passes.contains(&Aov::Object), OBJECT_CHANNEL),
+        (info.passes.contains(&Aov::Material), MATERIAL_CHANNEL),
+    ] {
+        if held {
+            names.push(channel.to_string());
+        }
     }
     names.sort();
     names
@@ -398,12 +443,12 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &PartSums) -> Result<(), F
             "the sums do not cover the part's window",
         ));
     }
-    if passes_of(&sums.passes) != info.passes
+    if sums.passes() != info.passes
         || sums.samples.is_some() != info.sample_counts
         || sums
-            .samples
-            .as_ref()
-            .is_some_and(|n| n.len() != w.pixels() as usize)
+            .counts()
+            .iter()
+            .any(|(_, n)| n.len() != w.pixels() as usize)
     {
         return Err(FormatError::in_file(
             &name,
@@ -429,9 +474,9 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &PartSums) -> Result<(), F
             channels.push(AnyChannel::new(channel.as_str(), FlatSamples::U32(data)));
         }
     }
-    if let Some(n) = &sums.samples {
+    for (channel, n) in sums.counts() {
         let data = if w.is_empty() { vec![0] } else { n.clone() };
-        channels.push(AnyChannel::new(SAMPLES_CHANNEL, FlatSamples::U32(data)));
+        channels.push(AnyChannel::new(channel, FlatSamples::U32(data)));
     }
     let mut attributes = LayerAttributes::default();
     for (key, value) in info.attributes() {
@@ -547,6 +592,14 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, PartSums), FormatError> {
         beauty: SumBuffer::new(w.x0, w.y0, w.width(), w.height()),
         passes: empty_passes(&info.passes, &w),
         samples: info.sample_counts.then(|| vec![0; w.pixels() as usize]),
+        object: info
+            .passes
+            .contains(&Aov::Object)
+            .then(|| vec![0; w.pixels() as usize]),
+        material: info
+            .passes
+            .contains(&Aov::Material)
+            .then(|| vec![0; w.pixels() as usize]),
     };
     if w.is_empty() {
         return Ok((info, sums));
@@ -599,9 +652,15 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, PartSums), FormatError> {
             }
         }
     }
-    if let Some(n) = &mut sums.samples {
-        let len = n.len();
-        n.copy_from_slice(data(SAMPLES_CHANNEL, len)?);
+    for (channel, n) in [
+        (SAMPLES_CHANNEL, &mut sums.samples),
+        (OBJECT_CHANNEL, &mut sums.object),
+        (MATERIAL_CHANNEL, &mut sums.material),
+    ] {
+        if let Some(n) = n {
+            let len = n.len();
+            n.copy_from_slice(data(channel, len)?);
+        }
     }
     Ok((info, sums))
 }
@@ -632,6 +691,7 @@ mod tests {
             denoise: false,
             noisy_guides: false,
             sample_counts: false,
+            names: String::new(),
             stats: vec![("rays".into(), "123".into())],
         }
     }
@@ -660,11 +720,18 @@ mod tests {
         assert_eq!(back_sums, PartSums::beauty(sums.clone()));
         // With render passes and sample counts: each buffer its own sums.
         let with = PartInfo {
-            passes: vec![Aov::Albedo, Aov::Normal, Aov::Uv, Aov::Variance],
+            passes: vec![
+                Aov::Albedo,
+                Aov::Normal,
+                Aov::Uv,
+                Aov::Variance,
+                Aov::Object,
+            ],
             aovs: vec![Aov::Uv, Aov::Variance],
             denoise: true,
             noisy_guides: true,
             sample_counts: true,
+            names: "{\"object\": {\"1\": \"t\\u00eate\"}}".into(),
             ..info(window)
         };
         let mut passes = empty_passes(&with.passes, &window);
@@ -683,6 +750,8 @@ mod tests {
             beauty: sums.clone(),
             passes,
             samples: Some((0..12).map(|k| 7 * k).collect()),
+            object: Some((0..12).map(|k| 100 + k).collect()),
+            material: None,
         };
         write_part(&path, &with, &full).unwrap();
         let (back, back_sums) = read_part(&path).unwrap();

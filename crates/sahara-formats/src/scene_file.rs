@@ -235,6 +235,8 @@ pub struct ObjectSpec {
     pub material: Option<String>,
     /// Object-to-world placement.
     pub placement: Placement,
+    /// Its name, for the `object` render pass's list of names.
+    pub name: Option<String>,
 }
 
 /// Geometry: a mesh file or a built-in shape.

@@ -99,7 +99,7 @@ pub fn describe(file: &SceneFile, name: &str) -> Result<SceneDescription, Format
     let mut textures = TextureCache::new();
     for m in &file.materials {
         let material = material_of(m, &mut textures, &mut desc.warnings, name);
-        let id = desc.add_material(material);
+        let id = desc.add_named_material(&m.name, material);
         named.insert(m.name.as_str(), id);
     }
     for o in &file.objects {
@@ -113,6 +113,7 @@ pub fn describe(file: &SceneFile, name: &str) -> Result<SceneDescription, Format
             geometry,
             placement: placement(&o.placement),
             material,
+            name: o.name.clone(),
         });
     }
     for l in &file.lights {
@@ -269,6 +270,7 @@ fn add_light(
                 geometry: Geometry::Shape(shape),
                 placement: ObjectPlacement::World,
                 material: Some(m),
+                name: None,
             });
         }
         LightSpec::Environment(EnvironmentSpec::Constant(c)) => {

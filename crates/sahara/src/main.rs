@@ -11,6 +11,7 @@ mod cli;
 mod demo_scene;
 mod denoise;
 mod human;
+mod id_names;
 mod input;
 mod memory;
 mod merge;

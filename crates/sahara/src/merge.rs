@@ -141,10 +141,22 @@ pub fn run(args: &MergeArgs) -> Result<()> {
                 images: AuxImages::default(),
                 sums: part.passes,
             });
+            let win = info.window;
             if let (Some(frame), Some(n)) = (&mut samples, &part.samples) {
-                let win = info.window;
                 for (k, (x, y)) in rows(&win).enumerate() {
                     frame[(y * w + x) as usize] += n[k];
+                }
+            }
+            // Ids depend on the pixel alone: every part of a pixel has them.
+            let f = &mut passes.images;
+            for (frame, ids) in [
+                (&mut f.object, &part.object),
+                (&mut f.material, &part.material),
+            ] {
+                if let Some(ids) = ids {
+                    for (k, (x, y)) in rows(&win).enumerate() {
+                        frame[(y * w + x) as usize] = ids[k];
+                    }
                 }
             }
         }
@@ -198,6 +210,9 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         noisy: noisy.as_deref(),
     };
     out.write(&result, !partial.is_empty(), true)?;
+    if !first.names.is_empty() {
+        crate::id_names::write_beside(&args.output, &first.names)?;
+    }
     eprintln!(
         "wrote {}{}: {} parts, {}x{}, {} spp",
         if partial.is_empty() { "" } else { "PARTIAL " },
@@ -228,6 +243,8 @@ impl FramePasses {
                 position: vec![Default::default(); sized(Aov::Position)],
                 uv: vec![Default::default(); sized(Aov::Uv)],
                 variance: vec![Default::default(); sized(Aov::Variance)],
+                object: vec![0; sized(Aov::Object)],
+                material: vec![0; sized(Aov::Material)],
             },
         }
     }

@@ -163,6 +163,11 @@ pub(crate) fn flat(v: &[glam::Vec3]) -> Vec<f32> {
     v.iter().flat_map(|p| p.to_array()).collect()
 }
 
+/// Ids as floats.
+fn ids(v: &[u32]) -> Vec<f32> {
+    v.iter().map(|&id| id as f32).collect()
+}
+
 /// Each pass's channel names and values, interleaved per pixel.
 fn aov_layers(aovs: &[Aov], images: &AuxImages) -> Vec<(Aov, &'static [&'static str], Vec<f32>)> {
     let mut aovs = aovs.to_vec();
@@ -180,6 +185,9 @@ fn aov_layers(aovs: &[Aov], images: &AuxImages) -> Vec<(Aov, &'static [&'static 
                 images.uv.iter().flat_map(|v| v.to_array()).collect(),
             ),
             Aov::Variance => (aov, &["R", "G", "B"][..], flat(&images.variance)),
+            // Whole numbers, exact in a float up to 2^24.
+            Aov::Object => (aov, &["id"][..], ids(&images.object)),
+            Aov::Material => (aov, &["id"][..], ids(&images.material)),
         })
         .collect()
 }

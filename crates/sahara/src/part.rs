@@ -7,7 +7,7 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Result};
 use sahara_formats::part_file::{read_part_info, write_part, PartInfo, PartSums};
 use sahara_render::{crop, sample_range, tile, PixelWindow};
-use sahara_render::{Aov, Aux, RenderResult, RenderSettings, SumBuffer, ToneMap};
+use sahara_render::{Aov, Aux, AuxImages, RenderResult, RenderSettings, SumBuffer, ToneMap};
 
 use crate::cli::{RenderArgs, Split};
 
@@ -124,6 +124,8 @@ pub struct PartRecord<'a> {
     pub denoise: bool,
     /// True if the denoiser is to clean the albedo and normal first.
     pub noisy_guides: bool,
+    /// The list of names of the object and material passes (JSON).
+    pub names: Option<&'a str>,
     /// True if the render was interrupted.
     pub interrupted: bool,
 }
@@ -140,6 +142,19 @@ pub fn write(
     // An interrupted first pass leaves some pixels with fewer samples than
     // others: a part holds whole passes only.
     let w = piece.window;
+    // The ids depend on the pixel alone: kept even if no pass finished.
+    let ids = |pick: fn(&AuxImages) -> &Vec<u32>, aov: Aov| {
+        settings.aovs.contains(&aov).then(|| {
+            result
+                .aux
+                .as_ref()
+                .map_or_else(|| vec![0; w.pixels() as usize], |a| pick(&a.images).clone())
+        })
+    };
+    let (object, material) = (
+        ids(|i| &i.object, Aov::Object),
+        ids(|i| &i.material, Aov::Material),
+    );
     let (done, sums) = if s.passes == 0 && !piece.samples.is_empty() {
         let nothing = Aux::new(&settings.aovs, w.x0, w.y0, w.width(), w.height());
         (
@@ -151,6 +166,8 @@ pub fn write(
                     .samples
                     .as_ref()
                     .map(|_| vec![0; w.pixels() as usize]),
+                object,
+                material,
             },
         )
     } else {
@@ -164,6 +181,8 @@ pub fn write(
                 beauty: result.sums.clone(),
                 passes,
                 samples: result.samples.clone(),
+                object,
+                material,
             },
         )
     };
@@ -189,6 +208,7 @@ pub fn write(
         denoise: record.denoise,
         noisy_guides: record.noisy_guides,
         sample_counts: sums.samples.is_some(),
+        names: record.names.unwrap_or_default().to_string(),
         stats: vec![
             ("passes".into(), s.passes.to_string()),
             ("rays".into(), s.rays().to_string()),

@@ -199,6 +199,9 @@ struct Job {
     aovs: Vec<sahara_render::Aov>,
     /// True with `--denoise` (or the scene file's `denoise`).
     denoise: bool,
+    /// The list of names of the object and material passes (JSON), if
+    /// asked for.
+    names: Option<String>,
     /// The denoiser, with `--denoise` (None for a part: `merge` denoises).
     denoiser: Option<sahara_denoise::Denoiser>,
 }
@@ -214,6 +217,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         name,
         description,
         mut warnings,
+        names,
     } = input;
     // The finished scene's problems, named after the file they come from.
     let from_file = args.scene.as_ref().map(|p| p.display().to_string());
@@ -356,6 +360,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         output_existed: output.exists(),
         output,
         piece,
+        names: crate::id_names::json(&names, &args.aov),
         aovs: args.aov.clone(),
         denoise,
         denoiser,
@@ -527,6 +532,7 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
             aovs: &job.aovs,
             denoise: job.denoise,
             noisy_guides: crate::denoise::guides_are_noisy(&job.scene),
+            names: job.names.as_deref(),
             interrupted: partial,
         };
         let path = if partial {
@@ -560,6 +566,9 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
     let mut output = job.output_at(partial);
     output.noisy = noisy;
     output.write(result, partial, true)?;
+    if let Some(names) = &job.names {
+        crate::id_names::write_beside(&output.path, names)?;
+    }
     if !partial {
         // A preview written beside the earlier image is stale now.
         let beside = partial_path(&job.output, job.output_existed);

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
-use sahara_formats::assembly::assemble;
+use sahara_formats::assembly::{assemble, SceneNames};
 use sahara_formats::description::FileSettings;
 use sahara_formats::description::Sky;
 use sahara_formats::mesh_scene::{read_mesh_scene, CameraChoice};
@@ -23,6 +23,8 @@ pub(crate) struct Input {
     pub(crate) name: String,
     /// What the log calls it.
     pub(crate) description: String,
+    /// What the scene's objects and materials are called.
+    pub(crate) names: SceneNames,
     /// Problems that did not stop loading, one line each.
     pub(crate) warnings: Vec<String>,
 }
@@ -52,6 +54,7 @@ pub(crate) fn load_input(
             sahara_formats::assembly::sky::apply(&mut scene, sky).map_err(flat)?;
         }
         return Ok(Input {
+            names: SceneNames::numbered(&scene),
             scene,
             file: None,
             name: "cornell_box".into(),
@@ -138,6 +141,7 @@ pub(crate) fn load_input(
     }
     let (scene, file, warnings) = (a.scene, a.settings, a.warnings);
     Ok(Input {
+        names: a.names,
         scene,
         file,
         name: stem(path),

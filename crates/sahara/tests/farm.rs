@@ -531,7 +531,10 @@ fn channel_names(path: &Path) -> Vec<String> {
 #[test]
 fn render_passes_merge_to_the_whole_frames_byte_for_byte() {
     let dir = temp_dir("farm-passes");
-    let aov = ["--aov", "albedo,normal,depth,position,uv,variance"];
+    let aov = [
+        "--aov",
+        "albedo,normal,depth,position,uv,variance,object,material",
+    ];
     let adaptive = ["--noise-threshold", "0.05", "--aov", "depth"];
     for (tag, extra, pieces) in [
         ("tiles", &aov[..], split(3, "tiles")),
@@ -555,6 +558,10 @@ fn render_passes_merge_to_the_whole_frames_byte_for_byte() {
             fs::read(&out).unwrap() == fs::read(&whole).unwrap(),
             "{tag}: the merged passes differ from the whole frame's"
         );
+        // The list of names of the id passes comes along.
+        let names = |image: &Path| fs::read_to_string(image.with_extension("names.json")).ok();
+        assert_eq!(names(&out), names(&whole), "{tag}");
+        assert_eq!(names(&out).is_some(), tag != "adaptive", "{tag}");
     }
     // One tile rendered without the passes: refused in one line.
     let mut files = parts(&dir, "mixed", &with(split(3, "tiles"), &aov));

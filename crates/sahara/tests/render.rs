@@ -1122,6 +1122,106 @@ fn render_passes_are_layers_of_the_exr() {
     assert!((normal[2] + 1.0).abs() < 1e-3, "{normal:?}");
 }
 
+/// The `object` and `material` passes hold, per pixel, the ids of what its
+/// centre shows, and the list beside the image names them as the scene
+/// file does: a named sphere in front of a wall that does not fill the
+/// frame.
+#[test]
+fn id_passes_say_what_each_pixel_shows() {
+    let dir = temp_dir("aov-ids");
+    let scene = dir.join("ids.toml");
+    fs::write(
+        &scene,
+        r#"
+sky = "none"
+[film]
+width = 32
+height = 32
+[camera]
+eye = [0, 0, 5]
+target = [0, 0, 0]
+vfov = 40
+[[material]]
+name = "blue"
+type = "diffuse"
+albedo = [0.2, 0.3, 0.6]
+[[material]]
+name = "grey"
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+[[light]]
+type = "point"
+position = [0, 3, 4]
+intensity = [10, 10, 10]
+[[object]]
+type = "quad"
+name = "wall"
+corner = [-3, -1, -2]
+edge_u = [6, 0, 0]
+edge_v = [0, 2, 0]
+material = "grey"
+[[object]]
+type = "sphere"
+name = "ball"
+center = [0, 0, 0]
+radius = 1
+material = "blue"
+"#,
+    )
+    .unwrap();
+    let exr = dir.join("ids.exr");
+    let out = sahara(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--spp",
+        "2",
+        "--aov",
+        "object,material",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let a = exr_channels(&exr);
+    let names: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(dir.join("ids.names.json")).unwrap()).unwrap();
+    let at = |pass: &str, x: usize, y: usize| {
+        let id = a[&format!("{pass}.id")][y * 32 + x];
+        assert_eq!(id.fract(), 0.0, "an id is a whole number");
+        if id == 0.0 {
+            return "nothing".to_string();
+        }
+        names[pass][format!("{id}")].as_str().unwrap().to_string()
+    };
+    // The centre shows the ball, the left edge the wall, the top row
+    // (above the wall) nothing.
+    assert_eq!(
+        (at("object", 16, 16), at("material", 16, 16)),
+        ("ball".into(), "blue".into())
+    );
+    assert_eq!(
+        (at("object", 2, 16), at("material", 2, 16)),
+        ("wall".into(), "grey".into())
+    );
+    assert_eq!(
+        (at("object", 16, 0), at("material", 16, 0)),
+        ("nothing".into(), "nothing".into())
+    );
+    // The ball is a disc of angular radius asin(1/5) in a 40 degree view:
+    // about 0.56 of the half-height, 9 pixels of 16.
+    let ball = (0..32 * 32)
+        .filter(|&k| at("object", k % 32, k / 32) == "ball")
+        .count() as f64;
+    let expected = std::f64::consts::PI * (0.559 * 16.0f64).powi(2);
+    assert!(
+        (ball / expected - 1.0).abs() < 0.1,
+        "{ball} ball pixels, expected {expected:.0}"
+    );
+}
+
 #[test]
 fn render_passes_need_an_exr_and_a_path_tracer() {
     let dir = temp_dir("aov-errors");
@@ -1151,10 +1251,10 @@ fn render_passes_need_an_exr_and_a_path_tracer() {
         "{}",
         stderr(&out)
     );
-    let out = sahara(&["render", "--aov", "object", "-o", exr.to_str().unwrap()]);
+    let out = sahara(&["render", "--aov", "objects", "-o", exr.to_str().unwrap()]);
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("albedo, normal, depth, position, uv or variance"),
+        stderr(&out).contains("albedo, normal, depth, position, uv, variance, object or material"),
         "{}",
         stderr(&out)
     );

@@ -172,7 +172,10 @@ impl<'a> Builder<'a> {
             return Ok(*m);
         }
         let m = self.bsdf(node, 0)?;
-        let id = m.map(|m| self.scene.add_material(m));
+        let id = m.map(|m| match node.attr("id") {
+            Some(name) => self.scene.add_named_material(name, m),
+            None => self.scene.add_material(m),
+        });
         self.materials.insert(key(node), id);
         Ok(id)
     }

@@ -180,6 +180,7 @@ impl<'a> Builder<'a> {
             geometry,
             placement,
             material: Some(material),
+            name: o.node.attr("id").map(str::to_owned),
         });
         Ok(())
     }
@@ -460,6 +461,7 @@ impl<'a> Builder<'a> {
             geometry: Geometry::Mesh(mesh),
             placement: placement(&m),
             material: None,
+            name: o.node.attr("id").or(group.attr("id")).map(str::to_owned),
         });
         Ok(())
     }

@@ -158,6 +158,12 @@ impl Materials<'_> {
             }
         };
         let m = self.map(scene, &e, w, depth)?;
+        if let Some(id) = m {
+            scene
+                .material_names
+                .entry(id)
+                .or_insert_with(|| name.to_owned());
+        }
         self.named.insert(name.to_owned(), m);
         Ok(m)
     }
@@ -865,6 +871,7 @@ pub(crate) fn build(
             geometry,
             placement,
             material: Some(material),
+            name: None,
         });
     }
     let mut objects: HashMap<&str, Option<u32>> = HashMap::new();
@@ -888,6 +895,7 @@ pub(crate) fn build(
             geometry: Geometry::Mesh(mesh),
             placement: placement(&inst.xform, times, shutter),
             material: None,
+            name: Some(inst.name.clone()),
         });
     }
     for (name, (_, loc)) in &desc.objects {

@@ -155,6 +155,7 @@ impl fmt::Display for ShapeType {
 pub(super) struct RawObject {
     #[serde(rename = "type")]
     pub kind: Spanned<ShapeType>,
+    pub name: Opt<String>,
     pub file: Opt<String>,
     pub corner: Opt<V3>,
     pub edge_u: Opt<V3>,

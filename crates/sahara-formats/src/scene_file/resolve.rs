@@ -678,6 +678,7 @@ impl Ctx<'_> {
             shape,
             material: o.material.as_ref().map(|m| m.get_ref().clone()),
             placement,
+            name: o.name.as_ref().map(|n| n.get_ref().clone()),
         })
     }
 

@@ -271,7 +271,8 @@ fn a_complete_scene_parses_into_the_expected_values() {
                 edge_v: Vec3::new(0., 0., 2.)
             }),
             material: None,
-            placement: Placement::Static(TransformSpec::IDENTITY)
+            placement: Placement::Static(TransformSpec::IDENTITY),
+            name: None,
         }
     );
     assert_eq!(

@@ -1,6 +1,7 @@
 //! The images a denoiser and a compositor use besides the beauty (render
 //! passes, AOVs): albedo, normal, depth, position, texture coordinates and
-//! the variance of the pixel's estimate, as exact sums.
+//! the variance of the pixel's estimate, as exact sums; and the object and
+//! material ids of what each pixel's centre shows (`ids`).
 
 use glam::{Vec2, Vec3};
 
@@ -24,6 +25,10 @@ pub enum Aov {
     Uv,
     /// [`AuxImages::variance`].
     Variance,
+    /// [`AuxImages::object`].
+    Object,
+    /// [`AuxImages::material`].
+    Material,
 }
 
 name_table!(Aov, "render pass", {
@@ -33,6 +38,8 @@ name_table!(Aov, "render pass", {
     Aov::Position => "position",
     Aov::Uv => "uv",
     Aov::Variance => "variance",
+    Aov::Object => "object",
+    Aov::Material => "material",
 });
 
 /// The auxiliary images of a render and the exact sums they come from.
@@ -91,6 +98,13 @@ pub struct AuxImages {
     /// Variance of the pixel's estimate per channel: the sample variance
     /// of its own samples divided by their number (0 with fewer than two).
     pub variance: Vec<Vec3>,
+    /// The object the pixel's centre shows (not an average: the first
+    /// surface the ray through the centre meets): the scene's instance
+    /// index plus 1, 0 for none.
+    pub object: Vec<u32>,
+    /// The material the pixel's centre shows: the scene's material index
+    /// plus 1, 0 for none.
+    pub material: Vec<u32>,
 }
 
 impl Aux {
@@ -214,6 +228,8 @@ impl Aux {
             position: mean(&s.position),
             uv: mean(&s.uv).iter().map(|v| v.truncate()).collect(),
             variance,
+            object: std::mem::take(&mut self.images.object),
+            material: std::mem::take(&mut self.images.material),
         };
     }
 }

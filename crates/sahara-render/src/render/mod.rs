@@ -12,6 +12,7 @@
 pub mod adaptive;
 pub mod aux;
 pub mod digest;
+mod ids;
 mod sppm;
 
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -559,7 +560,22 @@ pub fn render_watched(
     stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
     stats.adaptive = convergence.as_ref().map(|c| c.stats(&window, stats.spp));
     let samples = convergence.as_ref().map(|c| c.samples(&window));
-    finish(sums, aux, finished.as_deref(), stats, settings, samples)
+    let mut result = finish(sums, aux, finished.as_deref(), stats, settings, samples);
+    let wants = |a: Aov| settings.aovs.contains(&a);
+    if let Some(aux) = result
+        .aux
+        .as_mut()
+        .filter(|_| wants(Aov::Object) || wants(Aov::Material))
+    {
+        let ids = ids::pixel_centres(&world, &window, w, h);
+        if wants(Aov::Object) {
+            aux.images.object = ids.objects;
+        }
+        if wants(Aov::Material) {
+            aux.images.material = ids.materials;
+        }
+    }
+    result
 }
 
 /// The image of the sums so far (black where `finished` says a pixel was not).
