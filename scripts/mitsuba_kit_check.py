@@ -28,7 +28,11 @@ Sahara is run on that file too, against the same reference.
 usage (Mitsuba 3.9.1 from PyPI: `python3 -m venv V && V/bin/pip install mitsuba==3.9.1 numpy OpenEXR`;
 `cargo build --release` first):
     V/bin/python scripts/mitsuba_kit_check.py [--kit DIR] [--scale 4] [--ref-spp 16384] [--spp 1024]
-                                              [--variant scalar_rgb] [--work DIR] [--test-data]
+                                              [--variant scalar_rgb] [--work DIR] [--only NAME,...]
+                                              [--test-data] [--refs-only] [--test-noise N] [--test-spp 256]
+--refs-only renders (or reuses, from --work) the references and skips Sahara's 1024-spp comparison;
+--test-noise N renders the test's XML with Sahara at --test-spp for seeds 1..N and prints the spread of
+the test's measures against the stored reference, which is what the test's tolerances are set from.
 The meshes are read from $SAHARA_SCENES, else ../shared/scenes beside the repository; Sahara is
 $SAHARA, else target/release/sahara.
 """
