@@ -9,6 +9,7 @@
 //! | `constant` (`radiance`) | constant environment |
 //! | `envmap` (`filename`, `scale`, `to_world`) | the lat-long map moved onto Sahara's layout (nearest texel; a quarter turn about `+y` is exact) |
 //! | `sunsky`, `sky`, `sun`, `projector` | skipped (warned) |
+//! | `sampling_weight` (any emitter) | checked, not used: Sahara picks lights by power |
 
 use std::sync::Arc;
 
@@ -54,6 +55,19 @@ fn to_sahara(img: &Texture, to_world: DMat3) -> (Texture, bool) {
     (Texture::new(w, h, texels), exact)
 }
 
+/// Reads an emitter's `sampling_weight`, which every Mitsuba emitter takes:
+/// how often Mitsuba picks it for light sampling. Sahara picks its lights
+/// by their power; the choice changes the noise, not the image, so the
+/// weight is checked and not used.
+fn sampling_weight(o: &Object) -> Result<(), FormatError> {
+    match o.float_opt("sampling_weight")? {
+        Some(w) if !(w.is_finite() && w >= 0.0) => {
+            Err(o.error("'sampling_weight' must be a finite number >= 0"))
+        }
+        _ => Ok(()),
+    }
+}
+
 impl<'a> Builder<'a> {
     /// `material` emitting as the area emitter `node` says.
     pub(crate) fn area_light(&mut self, material: u32, node: &'a Node) -> Result<u32, FormatError> {
@@ -65,7 +79,7 @@ impl<'a> Builder<'a> {
             )));
         }
         let radiance = self.tint(&o, "radiance", Vec3::ONE, Usage::Emission)?;
-        o.get("sampling_weight");
+        sampling_weight(&o)?;
         o.warn_unused(&mut self.w);
         let mut m = self.scene.materials[material as usize]
             .clone()
@@ -79,6 +93,7 @@ impl<'a> Builder<'a> {
     pub(crate) fn emitter(&mut self, node: &'a Node) -> Result<(), FormatError> {
         let o = self.object(node)?;
         let m = o.transform("to_world")?;
+        sampling_weight(&o)?;
         let color = |b: &mut Self, o: &Object<'a>, name: &str| -> Result<Vec3, FormatError> {
             let t = b.tint(o, name, Vec3::ONE, Usage::Emission)?;
             if t.image.is_some() {

@@ -705,6 +705,39 @@ fn emitters_are_area_materials_lights_and_environments() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Every Mitsuba emitter takes a `sampling_weight` (how often Mitsuba picks
+/// it); Sahara picks lights by power, which changes the noise and not the
+/// image, so the weight is read without a warning, and a bad one is an
+/// error.
+#[test]
+fn every_emitter_takes_a_sampling_weight() {
+    let weight = "<float name=\"sampling_weight\" value=\"2.5\"/>";
+    let d = describe(&format!(
+        "<shape type=\"rectangle\"><emitter type=\"area\">{weight}</emitter></shape>\n\
+         <emitter type=\"point\">{weight}</emitter>\n\
+         <emitter type=\"spot\">{weight}<float name=\"beam_width\" value=\"15\"/></emitter>\n\
+         <emitter type=\"directional\"><vector name=\"direction\" value=\"0 -1 0\"/>{weight}</emitter>\n\
+         <emitter type=\"constant\">{weight}</emitter>"
+    ));
+    assert_eq!(d.lights.len(), 3);
+    assert!(d.environment.is_some());
+    let unknown: Vec<_> = d
+        .warnings
+        .iter()
+        .filter(|w| w.contains("unknown"))
+        .collect();
+    assert!(unknown.is_empty(), "{unknown:?}");
+    let e =
+        err("<emitter type=\"constant\"><float name=\"sampling_weight\" value=\"-1\"/></emitter>");
+    assert!(
+        e.contains("'sampling_weight' must be a finite number >= 0"),
+        "{e}"
+    );
+    let e =
+        err("<emitter type=\"point\"><string name=\"sampling_weight\" value=\"a lot\"/></emitter>");
+    assert!(e.contains("sampling_weight"), "{e}");
+}
+
 #[test]
 fn the_sensor_sees_as_mitsubas_and_sets_film_sampler_filter_and_depth() {
     let d = describe(

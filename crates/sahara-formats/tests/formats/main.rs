@@ -9,6 +9,7 @@ mod gltf_data;
 mod gltf_extensions;
 mod image_in;
 mod image_out;
+mod mitsuba_kit;
 mod scene_file;
 mod scene_load;
 mod scenes;
