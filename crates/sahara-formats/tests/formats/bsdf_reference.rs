@@ -32,10 +32,10 @@ use sahara_formats::pbrt::load_pbrt;
 use sahara_formats::scene_load::load_scene;
 use sahara_render::{render, RenderSettings, Scene};
 
+use crate::blocks::block_errors;
+
 /// Samples per pixel of Sahara's renders.
 const SPP: u32 = 256;
-/// Block edge in pixels.
-const BLOCK: usize = 8;
 
 fn folder() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bsdf_reference")
@@ -92,23 +92,7 @@ fn errors(image: &[Vec3], reference: &[Vec3], size: usize) -> (Vec3, Vec<f32>) {
     let mean = |img: &[Vec3]| img.iter().copied().sum::<Vec3>() / img.len() as f32;
     let (m, r) = (mean(image), mean(reference));
     let mean_err = (m - r).abs() / (r + Vec3::splat(0.1));
-    let n = size / BLOCK;
-    let mut blocks = Vec::new();
-    for by in 0..n {
-        for bx in 0..n {
-            let (mut a, mut b) = (Vec3::ZERO, Vec3::ZERO);
-            for y in by * BLOCK..(by + 1) * BLOCK {
-                for x in bx * BLOCK..(bx + 1) * BLOCK {
-                    a += image[y * size + x];
-                    b += reference[y * size + x];
-                }
-            }
-            let k = (BLOCK * BLOCK) as f32;
-            let e = (a / k - b / k).abs() / (b / k + Vec3::splat(0.02));
-            blocks.extend(e.to_array());
-        }
-    }
-    blocks.sort_by(f32::total_cmp);
+    let blocks = block_errors(image, reference, size, size);
     (mean_err, blocks)
 }
 

@@ -1,6 +1,7 @@
 //! Tests for `sahara-formats`: glTF extensions, scene files and their conversion to renderer scenes, images in and out, and the shared scenes.
 
 // Shared with `sahara-readers`' tests (one copy of the helpers).
+mod blocks;
 mod bsdf_reference;
 #[path = "../../../sahara-readers/tests/readers/common.rs"]
 mod common;

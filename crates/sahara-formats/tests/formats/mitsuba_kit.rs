@@ -29,10 +29,8 @@ use sahara_formats::image_in::load_rgb_f32;
 use sahara_formats::mitsuba::read_mitsuba_with;
 use sahara_render::{render, RenderSettings};
 
+use crate::blocks::block_errors;
 use crate::common::{scenes_dir, TempDir};
-
-/// Block edge in pixels.
-const BLOCK: usize = 8;
 
 /// One kit scene and how close Sahara must come to Mitsuba on it.
 struct Case {
@@ -114,22 +112,7 @@ fn errors(image: &[Vec3], reference: &[Vec3], w: usize, h: usize) -> (Vec3, Vec<
     let mean = |img: &[Vec3]| img.iter().copied().sum::<Vec3>() / img.len() as f32;
     let (m, r) = (mean(image), mean(reference));
     let mean_err = (m - r).abs() / r;
-    let mut blocks = Vec::new();
-    for by in 0..h / BLOCK {
-        for bx in 0..w / BLOCK {
-            let (mut a, mut b) = (Vec3::ZERO, Vec3::ZERO);
-            for y in by * BLOCK..(by + 1) * BLOCK {
-                for x in bx * BLOCK..(bx + 1) * BLOCK {
-                    a += image[y * w + x];
-                    b += reference[y * w + x];
-                }
-            }
-            let k = (BLOCK * BLOCK) as f32;
-            let e = (a / k - b / k).abs() / (b / k + Vec3::splat(0.02));
-            blocks.extend(e.to_array());
-        }
-    }
-    blocks.sort_by(f32::total_cmp);
+    let blocks = block_errors(image, reference, w, h);
     (mean_err, blocks)
 }
 

@@ -24,3 +24,19 @@ pub fn sahara(args: &[&str]) -> Output {
         .output()
         .expect("run sahara")
 }
+
+/// True if `out` failed for want of Open Image Denoise, which a test then
+/// skips (said so), unless `SAHARA_REQUIRE_OIDN` is set, as CI sets it:
+/// then it fails.
+pub fn denoiser_missing(out: &Output) -> bool {
+    let err = String::from_utf8_lossy(&out.stderr);
+    if out.status.success() || !err.contains("Open Image Denoise not found") {
+        return false;
+    }
+    assert!(
+        std::env::var_os("SAHARA_REQUIRE_OIDN").is_none(),
+        "SAHARA_REQUIRE_OIDN is set: {err}"
+    );
+    eprintln!("skipped: Open Image Denoise is not installed here (pip install pyoidn)");
+    true
+}
