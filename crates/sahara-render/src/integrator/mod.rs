@@ -5,6 +5,7 @@ pub(crate) mod bdpt;
 pub mod debug;
 mod distribution;
 mod path;
+mod queries;
 pub(crate) mod sppm;
 mod state;
 pub(crate) mod wavefront;
