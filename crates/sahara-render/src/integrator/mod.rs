@@ -439,6 +439,19 @@ impl Integrator {
         }
     }
 
+    /// The bidirectional integrators' depth and strategies (the render
+    /// loop traces their samples in batches, [`bdpt::batch`]); `None` for
+    /// the others.
+    pub(crate) fn bidirectional(&self) -> Option<(u32, bdpt::Strategies)> {
+        match *self {
+            Integrator::Bdpt { max_depth } => Some((max_depth, bdpt::Strategies::All)),
+            Integrator::LightPath { max_depth } => {
+                Some((max_depth, bdpt::Strategies::LightTracing))
+            }
+            _ => None,
+        }
+    }
+
     /// True for the integrators written as steps over path states (path
     /// and distribution), which the render loop traces in batches.
     pub(crate) fn is_stepped(&self) -> bool {

@@ -149,7 +149,7 @@ impl Wavefront {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::light::environment::Environment;
     use crate::light::Light;
@@ -165,7 +165,7 @@ mod tests {
     /// A scene with every kind of light and lobe, a moving instance, a
     /// thin lens and a shutter, and `extra` more small spheres (past the
     /// packet path's instance count, the packets go ray by ray).
-    fn scene(extra: usize) -> Scene {
+    pub(crate) fn scene(extra: usize) -> Scene {
         let cam = Camera::look_at(Vec3::new(0.0, 2.0, -6.0), Vec3::ZERO, Vec3::Y, 50.0, 1.0)
             .with_thin_lens(0.05, 6.0)
             .with_shutter(0.0, 1.0);
