@@ -12,6 +12,7 @@ use std::time::{Duration, Instant};
 
 use sahara_kd::{Ray, PACKET16};
 
+use super::laps::{Lap, Laps};
 use super::queries::RayQueries;
 use super::state::{Deferred, PathState};
 use super::{Context, Integrator, TraceStats};
@@ -36,34 +37,14 @@ pub(crate) struct Wavefront {
     queries: RayQueries,
     /// Time spent finding hits and answering shadow rays, and in the
     /// paths' steps, since the last [`Wavefront::take_times`].
-    tracing: Duration,
-    shading: Duration,
-}
-
-/// What a stretch of a round's time went to.
-enum Lap {
-    Tracing,
-    Shading,
+    laps: Laps,
 }
 
 impl Wavefront {
     /// The time spent tracing and shading since the last call, and resets
-    /// both (a clock read per batch, not per ray: too rare to cost).
+    /// both.
     pub fn take_times(&mut self) -> (Duration, Duration) {
-        (
-            std::mem::take(&mut self.tracing),
-            std::mem::take(&mut self.shading),
-        )
-    }
-
-    /// Adds the time since `clock` to `what`; the clock for the next lap.
-    fn lap(&mut self, clock: Instant, what: Lap) -> Instant {
-        let now = Instant::now();
-        match what {
-            Lap::Tracing => self.tracing += now - clock,
-            Lap::Shading => self.shading += now - clock,
-        }
-        now
+        self.laps.take()
     }
 
     /// Traces every path of `paths` to its end with `integrator` (one of
@@ -95,7 +76,7 @@ impl Wavefront {
             }
             self.hits.clear();
             self.hits.resize(self.live.len(), None);
-            clock = self.lap(clock, Lap::Shading);
+            clock = self.laps.lap(clock, Lap::Shading);
             if first {
                 for ((r, t), h) in self
                     .rays
@@ -110,7 +91,7 @@ impl Wavefront {
                 self.queries
                     .closest(world, &self.rays, &self.times, &mut self.hits);
             }
-            clock = self.lap(clock, Lap::Tracing);
+            clock = self.laps.lap(clock, Lap::Tracing);
             // Every live path's step.
             self.deferred.clear();
             self.owner.clear();
@@ -128,7 +109,7 @@ impl Wavefront {
                     self.next.push(i);
                 }
             }
-            clock = self.lap(clock, Lap::Shading);
+            clock = self.laps.lap(clock, Lap::Shading);
             // The shadow rays in one batch, then their contributions in
             // the order made.
             let deferred = &self.deferred;
@@ -138,13 +119,13 @@ impl Wavefront {
                 |j| deferred[j].shadow.as_ref(),
                 &mut self.visible,
             );
-            clock = self.lap(clock, Lap::Tracing);
+            clock = self.laps.lap(clock, Lap::Tracing);
             for ((d, &i), &v) in self.deferred.iter().zip(&self.owner).zip(&self.visible) {
                 paths[i as usize].apply(&d.op, v);
             }
             std::mem::swap(&mut self.live, &mut self.next);
         }
-        self.lap(clock, Lap::Shading);
+        self.laps.lap(clock, Lap::Shading);
     }
 }
 

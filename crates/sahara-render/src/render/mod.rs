@@ -190,7 +190,8 @@ pub struct RenderStats {
 /// layer), the paths' steps between them (surface interaction, textures,
 /// BSDF and light sampling, MIS), and the rest of each tile (camera rays,
 /// the sampler's set-up, splatting into the film). Measured for the
-/// integrators that trace paths in batches (`path`); zero for the others.
+/// integrators that trace their samples in batches (`path`,
+/// `distribution`, `bdpt`, `lightpath`); zero for the others.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TimeSplit {
     /// Time in the batch traversals.
@@ -735,7 +736,10 @@ fn render_tile(
             }
             out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
         }
-        (out.split.tracing, out.split.shading) = strip.wavefront.take_times();
+        // One of the two traced the strip's samples.
+        let (wt, ws) = strip.wavefront.take_times();
+        let (bt, bs) = strip.bdpt.take_times();
+        (out.split.tracing, out.split.shading) = (wt + bt, ws + bs);
     });
     out.split.total = tile_start.elapsed();
     out

@@ -9,6 +9,8 @@
 //! the order [`super::sample`] sums them: the image is the same bit for
 //! bit, the tree sees rays in batches.
 
+use std::time::{Duration, Instant};
+
 use glam::{Vec2, Vec3};
 use sahara_kd::Ray;
 
@@ -16,6 +18,7 @@ use super::{
     camera_start, connect, light_start, subpath_lengths, Connection, Splat, Strategies, Vertex,
     Walk,
 };
+use crate::integrator::laps::{Lap, Laps};
 use crate::integrator::queries::RayQueries;
 use crate::integrator::{Context, TraceStats};
 use crate::sampler::PixelSampler;
@@ -72,9 +75,18 @@ pub(crate) struct BdptBatch {
     /// Whether each contribution's shadow ray is unblocked.
     visible: Vec<bool>,
     queries: RayQueries,
+    /// Time spent in the batched queries and between them, since the
+    /// last [`BdptBatch::take_times`].
+    laps: Laps,
 }
 
 impl BdptBatch {
+    /// The time spent tracing and shading since the last call, and resets
+    /// both.
+    pub fn take_times(&mut self) -> (Duration, Duration) {
+        self.laps.take()
+    }
+
     /// Traces the pixel samples `cameras`, paths of at most `max_depth`
     /// scattering events with `strategies`, in batches of at most
     /// [`BATCH`]: each sample's radiance for its pixel goes to the same
@@ -113,6 +125,7 @@ impl BdptBatch {
         stats: &mut TraceStats,
         splats: &mut Vec<Splat>,
     ) {
+        let mut clock = Instant::now();
         let (camera_len, light_len) = subpath_lengths(max_depth, strategies);
         if self.samples.len() < cameras.len() {
             self.samples.resize_with(cameras.len(), Sample::default);
@@ -148,8 +161,10 @@ impl BdptBatch {
             }
             self.hits.clear();
             self.hits.resize(self.live.len(), None);
+            clock = self.laps.lap(clock, Lap::Shading);
             self.queries
                 .closest(world, &self.rays, &self.times, &mut self.hits);
+            clock = self.laps.lap(clock, Lap::Tracing);
             self.next.clear();
             for (&(i, end), hit) in self.live.iter().zip(&self.hits) {
                 let s = &mut samples[i as usize];
@@ -187,12 +202,14 @@ impl BdptBatch {
             self.ends.push(self.connections.len() as u32);
         }
         let connections = &self.connections;
+        clock = self.laps.lap(clock, Lap::Shading);
         self.queries.visible(
             world,
             connections.len(),
             |j| connections[j].shadow.as_ref(),
             &mut self.visible,
         );
+        clock = self.laps.lap(clock, Lap::Tracing);
         let mut start = 0;
         for (l, &end) in radiance.iter_mut().zip(&self.ends) {
             let end = end as usize;
@@ -205,6 +222,7 @@ impl BdptBatch {
             }
             start = end;
         }
+        self.laps.lap(clock, Lap::Shading);
     }
 }
 
