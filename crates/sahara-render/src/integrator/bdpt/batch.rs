@@ -30,10 +30,11 @@ const CAMERA: usize = 0;
 const LIGHT: usize = 1;
 
 /// Most samples traced together. A sample's subpaths take up to 19
-/// vertices of about 300 bytes at the default depth: 128 samples keep
-/// them within a core's L2 cache between rounds. On the built-in Cornell
-/// box and `scenes/bunny_dof.toml`, batches of 1024 (a strip of four
-/// rows at 8 samples per pixel) ran 3-6 % slower than batches of 128.
+/// vertices of 304 bytes at the default depth: 128 samples keep them
+/// within a core's L2 cache between rounds. On the built-in Cornell box
+/// and `scenes/bunny_dof.toml`, batches of 1024 (a strip of four rows at
+/// 8 samples per pixel) took 3-5 % more time than batches of 128
+/// (docs/performance.md).
 pub(crate) const BATCH: usize = 128;
 
 /// The start of a pixel sample: its camera ray, time and random numbers.
