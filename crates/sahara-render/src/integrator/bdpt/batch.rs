@@ -35,7 +35,7 @@ const LIGHT: usize = 1;
 /// and `scenes/bunny_dof.toml`, batches of 1024 (a strip of four rows at
 /// 8 samples per pixel) took 3-5 % more time than batches of 128
 /// (docs/performance.md).
-pub(crate) const BATCH: usize = 128;
+const BATCH: usize = 128;
 
 /// The start of a pixel sample: its camera ray, time and random numbers.
 #[derive(Clone, Copy, Debug)]
@@ -237,8 +237,8 @@ mod tests {
     /// Samples traced in batches give each sample the radiance and the
     /// splats [`super::super::sample`] gives it alone, bit for bit and in
     /// the same order, with the same counts, for both strategies, in
-    /// batches of packets through the instances and ray by ray through
-    /// the top level, over more samples than one batch holds.
+    /// scenes traced through the instances' trees in batches and ray by
+    /// ray through the top level, over more samples than one batch holds.
     #[test]
     fn batches_give_the_radiance_and_splats_of_single_samples() {
         for extra in [0, 12] {
