@@ -4,7 +4,9 @@
 pub(crate) mod bdpt;
 pub mod debug;
 mod distribution;
+mod laps;
 mod path;
+mod queries;
 pub(crate) mod sppm;
 mod state;
 pub(crate) mod wavefront;
@@ -435,6 +437,19 @@ impl Integrator {
                 debug::ao(ctx, ray, time, samples.max(1), distance)
             }
             Integrator::Cost => debug::cost(ctx, ray, time),
+        }
+    }
+
+    /// The bidirectional integrators' depth and strategies (the render
+    /// loop traces their samples in batches, [`bdpt::batch`]); `None` for
+    /// the others.
+    pub(crate) fn bidirectional(&self) -> Option<(u32, bdpt::Strategies)> {
+        match *self {
+            Integrator::Bdpt { max_depth } => Some((max_depth, bdpt::Strategies::All)),
+            Integrator::LightPath { max_depth } => {
+                Some((max_depth, bdpt::Strategies::LightTracing))
+            }
+            _ => None,
         }
     }
 

@@ -12,9 +12,11 @@ use std::time::{Duration, Instant};
 
 use sahara_kd::{Ray, PACKET16};
 
+use super::laps::{Lap, Laps};
+use super::queries::RayQueries;
 use super::state::{Deferred, PathState};
 use super::{Context, Integrator, TraceStats};
-use crate::world::{ShadowQuery, SurfaceHit, World, WorldBuffers};
+use crate::world::{SurfaceHit, World};
 
 /// The buffers of a batch, kept from one batch to the next.
 #[derive(Default)]
@@ -31,78 +33,18 @@ pub(crate) struct Wavefront {
     owner: Vec<u32>,
     /// Whether each deferred contribution's shadow ray is unblocked.
     visible: Vec<bool>,
-    /// The order in which to trace a batch's rays.
-    order: Vec<u32>,
-    /// A batch's rays, times and hits in that order.
-    ordered_rays: Vec<Ray>,
-    ordered_times: Vec<f32>,
-    ordered_hits: Vec<Option<SurfaceHit>>,
-    /// The round's shadow queries in that order, and their answers.
-    queries: Vec<ShadowQuery>,
-    answers: Vec<bool>,
-    world: WorldBuffers,
+    /// The batched closest-hit and shadow queries.
+    queries: RayQueries,
     /// Time spent finding hits and answering shadow rays, and in the
     /// paths' steps, since the last [`Wavefront::take_times`].
-    tracing: Duration,
-    shading: Duration,
-}
-
-/// What a stretch of a round's time went to.
-enum Lap {
-    Tracing,
-    Shading,
-}
-
-/// A stand-in ray for the ordering of contributions without a shadow ray.
-const NO_RAY: Ray = Ray {
-    origin: glam::Vec3::ZERO,
-    dir: glam::Vec3::ONE,
-    tmin: 0.0,
-    tmax: 0.0,
-};
-
-/// Indices of `rays` grouped by direction octant (the three sign bits),
-/// in their given order within each group: a counting sort.
-fn octant_order(rays: &[Ray], order: &mut Vec<u32>) {
-    let octant = |r: &Ray| {
-        (r.dir.x.is_sign_negative() as usize)
-            | (r.dir.y.is_sign_negative() as usize) << 1
-            | (r.dir.z.is_sign_negative() as usize) << 2
-    };
-    let mut start = [0u32; 9];
-    for r in rays {
-        start[octant(r) + 1] += 1;
-    }
-    for o in 0..8 {
-        start[o + 1] += start[o];
-    }
-    order.clear();
-    order.resize(rays.len(), 0);
-    for (j, r) in rays.iter().enumerate() {
-        let o = octant(r);
-        order[start[o] as usize] = j as u32;
-        start[o] += 1;
-    }
+    laps: Laps,
 }
 
 impl Wavefront {
     /// The time spent tracing and shading since the last call, and resets
-    /// both (a clock read per batch, not per ray: too rare to cost).
+    /// both.
     pub fn take_times(&mut self) -> (Duration, Duration) {
-        (
-            std::mem::take(&mut self.tracing),
-            std::mem::take(&mut self.shading),
-        )
-    }
-
-    /// Adds the time since `clock` to `what`; the clock for the next lap.
-    fn lap(&mut self, clock: Instant, what: Lap) -> Instant {
-        let now = Instant::now();
-        match what {
-            Lap::Tracing => self.tracing += now - clock,
-            Lap::Shading => self.shading += now - clock,
-        }
-        now
+        self.laps.take()
     }
 
     /// Traces every path of `paths` to its end with `integrator` (one of
@@ -134,7 +76,7 @@ impl Wavefront {
             }
             self.hits.clear();
             self.hits.resize(self.live.len(), None);
-            clock = self.lap(clock, Lap::Shading);
+            clock = self.laps.lap(clock, Lap::Shading);
             if first {
                 for ((r, t), h) in self
                     .rays
@@ -146,29 +88,10 @@ impl Wavefront {
                 }
                 first = false;
             } else {
-                // One batch, grouped by direction octant: the rays that
-                // share their signs walk the cells in the same order
-                // (figures in docs/performance.md).
-                octant_order(&self.rays, &mut self.order);
-                self.ordered_rays.clear();
-                self.ordered_times.clear();
-                for &j in &self.order {
-                    self.ordered_rays.push(self.rays[j as usize]);
-                    self.ordered_times.push(self.times[j as usize]);
-                }
-                self.ordered_hits.clear();
-                self.ordered_hits.resize(self.order.len(), None);
-                world.intersect_batch(
-                    &self.ordered_rays,
-                    &self.ordered_times,
-                    &mut self.ordered_hits,
-                    &mut self.world,
-                );
-                for (&j, h) in self.order.iter().zip(&self.ordered_hits) {
-                    self.hits[j as usize] = *h;
-                }
+                self.queries
+                    .closest(world, &self.rays, &self.times, &mut self.hits);
             }
-            clock = self.lap(clock, Lap::Tracing);
+            clock = self.laps.lap(clock, Lap::Tracing);
             // Every live path's step.
             self.deferred.clear();
             self.owner.clear();
@@ -186,44 +109,28 @@ impl Wavefront {
                     self.next.push(i);
                 }
             }
-            clock = self.lap(clock, Lap::Shading);
-            // The shadow rays, grouped by octant, then their contributions
-            // in the order made.
-            self.rays.clear();
-            self.visible.clear();
-            self.visible.resize(self.deferred.len(), true);
-            for d in &self.deferred {
-                // Contributions without a shadow ray take a placeholder
-                // that the loop below skips.
-                self.rays.push(d.shadow.map_or(NO_RAY, |q| q.ray));
-            }
-            octant_order(&self.rays, &mut self.order);
-            self.queries.clear();
-            self.order
-                .retain(|&j| self.deferred[j as usize].shadow.is_some());
-            for &j in &self.order {
-                if let Some(q) = &self.deferred[j as usize].shadow {
-                    self.queries.push(*q);
-                }
-            }
-            self.answers.clear();
-            self.answers.resize(self.queries.len(), true);
-            world.visible_batch(&self.queries, &mut self.answers, &mut self.world);
-            clock = self.lap(clock, Lap::Tracing);
-            for (&j, &v) in self.order.iter().zip(&self.answers) {
-                self.visible[j as usize] = v;
-            }
+            clock = self.laps.lap(clock, Lap::Shading);
+            // The shadow rays in one batch, then their contributions in
+            // the order made.
+            let deferred = &self.deferred;
+            self.queries.visible(
+                world,
+                deferred.len(),
+                |j| deferred[j].shadow.as_ref(),
+                &mut self.visible,
+            );
+            clock = self.laps.lap(clock, Lap::Tracing);
             for ((d, &i), &v) in self.deferred.iter().zip(&self.owner).zip(&self.visible) {
                 paths[i as usize].apply(&d.op, v);
             }
             std::mem::swap(&mut self.live, &mut self.next);
         }
-        self.lap(clock, Lap::Shading);
+        self.laps.lap(clock, Lap::Shading);
     }
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::light::environment::Environment;
     use crate::light::Light;
@@ -239,7 +146,7 @@ mod tests {
     /// A scene with every kind of light and lobe, a moving instance, a
     /// thin lens and a shutter, and `extra` more small spheres (past the
     /// packet path's instance count, the packets go ray by ray).
-    fn scene(extra: usize) -> Scene {
+    pub(crate) fn scene(extra: usize) -> Scene {
         let cam = Camera::look_at(Vec3::new(0.0, 2.0, -6.0), Vec3::ZERO, Vec3::Y, 50.0, 1.0)
             .with_thin_lens(0.05, 6.0)
             .with_shutter(0.0, 1.0);

@@ -29,6 +29,7 @@ use crate::film::filter::Filter;
 use crate::film::sums::{filter_margin, SumBuffer};
 use crate::film::window::PixelWindow;
 use crate::film::{heat_color, Film};
+use crate::integrator::bdpt::batch::{BdptBatch, CameraSample};
 use crate::integrator::bdpt::Splat;
 use crate::integrator::wavefront::Wavefront;
 use crate::integrator::{defaults, AuxSample, Context, Integrator, PathState, TraceStats};
@@ -191,7 +192,8 @@ pub struct RenderStats {
 /// layer), the paths' steps between them (surface interaction, textures,
 /// BSDF and light sampling, MIS), and the rest of each tile (camera rays,
 /// the sampler's set-up, splatting into the film). Measured for the
-/// integrators that trace paths in batches (`path`); zero for the others.
+/// integrators that trace their samples in batches (`path`,
+/// `distribution`, `bdpt`, `lightpath`); zero for the others.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TimeSplit {
     /// Time in the batch traversals.
@@ -626,7 +628,8 @@ pub fn cost_maps(film: &mut Film, scale: Option<f32>) -> CostMaps {
 }
 
 /// Rows of a tile whose samples are traced as one batch by the stepped
-/// integrators: 4x4 pixel blocks make the camera packets.
+/// and the bidirectional integrators: 4x4 pixel blocks make the camera
+/// packets.
 const STRIP_ROWS: u32 = 4;
 
 /// Renders sample indices `indices` of pass `pass` of one tile, splatting
@@ -675,9 +678,9 @@ fn render_tile(
         splats: Vec::new(),
     };
     let active = |x: u32, y: u32| convergence.is_none_or(|c| c.is_active(x, y));
-    let stepped = s.integrator.is_stepped();
+    let batched = s.integrator.is_stepped() || s.integrator.bidirectional().is_some();
     let depth_view = matches!(s.integrator, Integrator::Depth);
-    let rows = if stepped { STRIP_ROWS } else { 1 };
+    let rows = if batched { STRIP_ROWS } else { 1 };
     // The strip's buffers, kept by the thread from tile to tile.
     STRIP.with_borrow_mut(|strip| {
         for y0 in (t.y0..t.y1).step_by(rows as usize) {
@@ -756,7 +759,10 @@ fn render_tile(
             }
             out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
         }
-        (out.split.tracing, out.split.shading) = strip.wavefront.take_times();
+        // One of the two traced the strip's samples.
+        let (wt, ws) = strip.wavefront.take_times();
+        let (bt, bs) = strip.bdpt.take_times();
+        (out.split.tracing, out.split.shading) = (wt + bt, ws + bs);
     });
     out.split.total = tile_start.elapsed();
     out
@@ -798,6 +804,11 @@ struct Strip {
     /// Light the samples add elsewhere on the film.
     splats: Vec<Splat>,
     wavefront: Wavefront,
+    /// The bidirectional integrators' samples, in pixel order, and their
+    /// radiance.
+    cameras: Vec<CameraSample>,
+    samples: Vec<Vec3>,
+    bdpt: BdptBatch,
 }
 
 impl Strip {
@@ -858,8 +869,43 @@ impl Strip {
         let slot_of = |x: u32, y: u32, index: u32| {
             (((y - y0) * (x1 - x0) + (x - x0)) * per_pixel + index - indices.start) as usize
         };
+        let film = Vec2::new(w as f32, h as f32);
+        if let Some((max_depth, strategies)) = s.integrator.bidirectional() {
+            // The samples pixel by pixel, rows top to bottom.
+            self.cameras.clear();
+            self.slot.clear();
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    if !active(x, y) {
+                        continue;
+                    }
+                    for index in indices.clone() {
+                        let (sampler, pos, ray, time) = camera_sample(x, y, index);
+                        let k = slot_of(x, y, index);
+                        self.pos[k] = pos;
+                        self.slot.push(k as u32);
+                        self.cameras.push(CameraSample { ray, time, sampler });
+                    }
+                }
+            }
+            self.samples.clear();
+            self.samples.resize(self.cameras.len(), Vec3::ZERO);
+            self.bdpt.trace(
+                world,
+                max_depth,
+                strategies,
+                film,
+                &self.cameras,
+                &mut self.samples,
+                stats,
+                &mut self.splats,
+            );
+            for (&l, &k) in self.samples.iter().zip(&self.slot) {
+                self.radiance[k as usize] = l;
+            }
+            return;
+        }
         if !s.integrator.is_stepped() {
-            let film = Vec2::new(w as f32, h as f32);
             for y in y0..y1 {
                 for x in x0..x1 {
                     if !active(x, y) {

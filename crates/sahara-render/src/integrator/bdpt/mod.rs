@@ -21,6 +21,14 @@
 //! pinhole has no area for). Painted occlusion maps, which are not
 //! physical, do not darken bidirectional paths. Light subpaths do not use
 //! Russian roulette: every path is cut at `max_depth` scattering events.
+//!
+//! The work is written as steps that leave the ray queries to their
+//! caller: a subpath grows by one vertex per closest hit ([`Walk`]), and
+//! the strategies of a sample are evaluated with their shadow rays left
+//! open ([`Connection`]), then summed in a fixed order. [`sample`] answers
+//! the queries one at a time; the render loop traces many samples
+//! together and answers them in batches ([`batch`]), with the same result
+//! bit for bit.
 
 use glam::{Vec2, Vec3};
 use sahara_kd::Ray;
@@ -30,9 +38,11 @@ use crate::light::emission::pdf_disc;
 use crate::light::LightSource;
 use crate::sampler::dims;
 use crate::scene::camera::Camera;
-use crate::world::{SurfaceHit, World};
+use crate::world::{ShadowQuery, SurfaceHit, World};
 
 pub(crate) use crate::film::sums::Splat;
+
+pub(crate) mod batch;
 
 /// Which of the strategies a render uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -231,48 +241,66 @@ fn light_dim(depth: usize, k: u32) -> u32 {
     dims::extra((depth as u32).min(63), LIGHT_DIMS, k)
 }
 
-/// Extends `path` from its last vertex along `ray` until it has
-/// `max_len` vertices or ends; `beta` is the throughput carried by the
-/// ray and `pdf` the density of its direction (for a ray from a light at
-/// infinity: the density of its origin on the disc).
-#[allow(clippy::too_many_arguments)]
-fn walk(
-    ctx: &mut Context,
-    mut ray: Ray,
-    time: f32,
-    mut beta: Vec3,
-    mut pdf: f32,
-    path: &mut Vec<Vertex>,
+/// A subpath being extended: the ray that finds its next vertex and what
+/// that ray carries.
+#[derive(Clone, Copy, Debug)]
+struct Walk {
+    /// The ray whose closest hit is the subpath's next vertex.
+    ray: Ray,
+    /// The throughput the ray carries.
+    beta: Vec3,
+    /// The density of the ray's direction (for a ray from a light at
+    /// infinity: the density of its origin on the disc).
+    pdf: f32,
+    /// Surfaces with holes the subpath has passed through.
+    holes: u32,
+    /// Most vertices of the subpath.
     max_len: usize,
+    /// A light subpath (it carries importance the other way).
     importance: bool,
-) {
-    let world = ctx.world;
-    let mut holes = 0;
-    while path.len() < max_len {
-        let Some(hit) = world.intersect(&ray, time) else {
+}
+
+impl Walk {
+    /// Whether `path` has room for the vertex this walk's ray finds.
+    fn open(&self, path: &[Vertex]) -> bool {
+        path.len() < self.max_len
+    }
+
+    /// Extends `path` by the closest hit `hit` of the walk's ray; returns
+    /// whether the subpath goes on (along the walk's new ray).
+    fn extend(
+        &mut self,
+        ctx: &mut Context,
+        path: &mut Vec<Vertex>,
+        hit: Option<SurfaceHit>,
+    ) -> bool {
+        let world = ctx.world;
+        let importance = self.importance;
+        let Some(hit) = hit else {
             if let (false, Some(env)) = (importance, world.env_light()) {
-                let mut v = Vertex::endpoint(Kind::Infinite, Vec3::ZERO, ray.dir, beta);
+                let mut v = Vertex::endpoint(Kind::Infinite, Vec3::ZERO, self.ray.dir, self.beta);
                 v.light = env as usize;
-                v.pdf_fwd = pdf;
+                v.pdf_fwd = self.pdf;
                 path.push(v);
             }
-            return;
+            return false;
         };
-        if super::through_hole(world, &mut ray, &hit, &mut holes) {
-            continue;
+        if super::through_hole(world, &mut self.ray, &hit, &mut self.holes) {
+            return true;
         }
+        let ray = self.ray;
         let sh = Shading::new(world, &hit, ray.dir);
-        let mut v = Vertex::endpoint(Kind::Surface, hit.p, hit.ng, beta);
+        let mut v = Vertex::endpoint(Kind::Surface, hit.p, hit.ng, self.beta);
         let prev = path.last().expect("a walk starts from an endpoint");
         v.pdf_fwd = if prev.infinite() {
-            pdf * hit.ng.dot(ray.dir).abs()
+            self.pdf * hit.ng.dot(ray.dir).abs()
         } else {
-            to_area(pdf, prev, &v)
+            to_area(self.pdf, prev, &v)
         };
         v.surface = Some((hit, sh));
         path.push(v);
-        if path.len() >= max_len {
-            return;
+        if path.len() >= self.max_len {
+            return false;
         }
         let depth = path.len() - 2;
         let (u_lobe, u) = if importance {
@@ -291,13 +319,13 @@ fn walk(
         let n = path.len();
         let (hit, sh) = path[n - 1].surface.as_ref().expect("just pushed");
         if sh.blind {
-            return;
+            return false;
         }
         let Some(s) = sh.bsdf.sample(sh.wo, u_lobe, u) else {
-            return;
+            return false;
         };
         let Some(wi) = sh.scattered(hit, s.wi, s.delta) else {
-            return;
+            return false;
         };
         ctx.stats.bounce_rays += 1;
         let mut weight = s.weight;
@@ -310,23 +338,44 @@ fn walk(
             (s.pdf, sh.bsdf.eval(sh.frame.to_local(wi), sh.wo).pdf)
         };
         let next = Ray::new(hit.spawn_origin(wi), wi);
-        beta *= weight;
+        self.beta *= weight;
         path[n - 1].delta = s.delta;
         path[n - 2].pdf_rev = to_area(pdf_rev, &path[n - 1], &path[n - 2]);
-        pdf = pdf_fwd;
-        ray = next;
-        if beta == Vec3::ZERO || !beta.is_finite() {
-            return;
-        }
+        self.pdf = pdf_fwd;
+        self.ray = next;
+        self.beta != Vec3::ZERO && self.beta.is_finite()
     }
 }
 
-/// The light subpath of one sample, up to `max_len` vertices.
-fn light_subpath(ctx: &mut Context, time: f32, max_len: usize, path: &mut Vec<Vertex>) {
+/// The start of a camera subpath of at most `max_len` vertices along
+/// camera ray `ray`: its first vertex, pushed to `path`, and the walk that
+/// finds the next.
+fn camera_start(world: &World, ray: &Ray, max_len: usize, path: &mut Vec<Vertex>) -> Walk {
+    path.push(Vertex::endpoint(
+        Kind::Camera,
+        ray.origin,
+        Vec3::ZERO,
+        Vec3::ONE,
+    ));
+    Walk {
+        ray: *ray,
+        beta: Vec3::ONE,
+        pdf: world.scene.camera.pdf_dir(ray.origin, ray.dir),
+        holes: 0,
+        max_len,
+        importance: false,
+    }
+}
+
+/// The start of a sample's light subpath of at most `max_len` vertices:
+/// the point on a light, pushed to `path`, and the walk that finds the
+/// next vertex; `None` if no light emits.
+fn light_start(ctx: &mut Context, max_len: usize, path: &mut Vec<Vertex>) -> Option<Walk> {
     let world = ctx.world;
-    let Some((i, pmf, e, beta, ray)) = super::leave_light(ctx, |k| light_dim(0, k)) else {
-        return;
-    };
+    if !world.has_lights() {
+        return None;
+    }
+    let (i, pmf, e, beta, ray) = super::leave_light(ctx, |k| light_dim(0, k))?;
     let light: &LightSource = &world.lights[i];
     let infinite = light.is_infinite();
     let mut v = if infinite {
@@ -338,8 +387,14 @@ fn light_subpath(ctx: &mut Context, time: f32, max_len: usize, path: &mut Vec<Ve
     v.two_sided = e.two_sided;
     v.pdf_fwd = pmf * light.pdf_origin(-e.dir);
     path.push(v);
-    let pdf = if infinite { e.pdf_pos } else { e.pdf_dir };
-    walk(ctx, ray, time, beta, pdf, path, max_len, true);
+    Some(Walk {
+        ray,
+        beta,
+        pdf: if infinite { e.pdf_pos } else { e.pdf_dir },
+        holes: 0,
+        max_len,
+        importance: true,
+    })
 }
 
 /// The densities of one vertex of a complete path, as sampled from the
@@ -440,11 +495,102 @@ fn mis_weight<'a>(
 /// Most vertices of a subpath (the camera or light and 62 scatterings).
 const MAX_VERTICES: usize = 64;
 
+/// A strategy's contribution to one sample, waiting on its shadow ray.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Connection {
+    /// The segment that must be unblocked for the light to arrive (none:
+    /// it arrives).
+    shadow: Option<ShadowQuery>,
+    /// The weighted contribution.
+    l: Vec3,
+    /// Light tracing's contributions: where on the film (in pixels) the
+    /// light lands; none: in the sample's pixel.
+    film: Option<Vec2>,
+}
+
+impl Connection {
+    /// A contribution to the sample's pixel.
+    fn pixel(l: Vec3, shadow: Option<ShadowQuery>) -> Self {
+        Self {
+            shadow,
+            l,
+            film: None,
+        }
+    }
+
+    /// Adds the contribution, if `visible` says its shadow ray (if any) is
+    /// unblocked, to the sample's radiance `l` or as a splat to `splats`.
+    fn apply(&self, visible: bool, l: &mut Vec3, splats: &mut Vec<Splat>) {
+        if !visible {
+            return;
+        }
+        match self.film {
+            Some(pos) => splats.push(Splat { pos, l: self.l }),
+            None => *l += self.l,
+        }
+    }
+}
+
+/// The lengths of a sample's subpaths: the camera's, and the light's.
+fn subpath_lengths(max_depth: u32, strategies: Strategies) -> (usize, usize) {
+    let depth = (max_depth as usize).min(MAX_VERTICES - 2);
+    let camera = match strategies {
+        Strategies::All => depth + 2,
+        Strategies::LightTracing => 2,
+    };
+    (camera, depth + 1)
+}
+
+/// Every strategy's contribution for the sample whose subpaths are `cv`
+/// (from the camera) and `lv` (from a light), at `time`, paths of at most
+/// `max_depth` scattering events; pushed to `out` in the order the sample
+/// sums them (`t` camera vertices outer, `s` light vertices inner), each
+/// with the shadow ray that decides whether it arrives. `film` is the
+/// image's size in pixels.
+#[allow(clippy::too_many_arguments)]
+fn connect(
+    ctx: &mut Context,
+    cv: &[Vertex],
+    lv: &[Vertex],
+    time: f32,
+    max_depth: u32,
+    strategies: Strategies,
+    film: Vec2,
+    out: &mut Vec<Connection>,
+) {
+    let world = ctx.world;
+    let camera = &world.scene.camera;
+    let depth = (max_depth as usize).min(MAX_VERTICES - 2);
+    for t in 1..=cv.len() {
+        for s in 0..=lv.len() {
+            if s + t < 2 || (s == 1 && t == 1) || s + t - 2 > depth {
+                continue;
+            }
+            if strategies == Strategies::LightTracing && !(t == 1 || (s == 0 && t == 2)) {
+                continue;
+            }
+            let c = match (t, s) {
+                (1, _) => to_lens(ctx, camera, &lv[..s], time, strategies, film),
+                (_, 0) => {
+                    let l = emitter_found(world, &cv[..t], strategies);
+                    // Adding zero to the radiance changes nothing.
+                    (l != Vec3::ZERO).then(|| Connection::pixel(l, None))
+                }
+                (_, 1) => light_sampled(ctx, &cv[..t], time),
+                _ => joined(ctx, &lv[..s], &cv[..t], time),
+            };
+            out.extend(c);
+        }
+    }
+}
+
 /// One pixel sample of bidirectional path tracing (or of light tracing
 /// alone) along camera ray `ray` at `time`, paths of at most `max_depth`
-/// scattering events; returns the radiance for the sample's pixel and
-/// pushes the light tracing contributions to `splats`. `film` is the
-/// image's size in pixels.
+/// scattering events, its ray queries answered one at a time; returns the
+/// radiance for the sample's pixel and pushes the light tracing
+/// contributions to `splats`. `film` is the image's size in pixels. The
+/// render loop traces many samples together ([`batch::BdptBatch`]) with
+/// the same result bit for bit.
 pub(crate) fn sample(
     ctx: &mut Context,
     ray: &Ray,
@@ -455,55 +601,35 @@ pub(crate) fn sample(
     splats: &mut Vec<Splat>,
 ) -> Vec3 {
     let world = ctx.world;
-    let camera = &world.scene.camera;
-    let depth = (max_depth as usize).min(MAX_VERTICES - 2);
-    let mut cv: Vec<Vertex> = Vec::with_capacity(depth + 2);
-    cv.push(Vertex::endpoint(
-        Kind::Camera,
-        ray.origin,
-        Vec3::ZERO,
-        Vec3::ONE,
-    ));
-    let camera_len = match strategies {
-        Strategies::All => depth + 2,
-        Strategies::LightTracing => 2,
-    };
-    walk(
-        ctx,
-        *ray,
-        time,
-        Vec3::ONE,
-        camera.pdf_dir(ray.origin, ray.dir),
-        &mut cv,
-        camera_len,
-        false,
-    );
-    let mut lv: Vec<Vertex> = Vec::with_capacity(depth + 1);
-    if world.has_lights() {
-        light_subpath(ctx, time, depth + 1, &mut lv);
-    }
-    let mut l = Vec3::ZERO;
-    for t in 1..=cv.len() {
-        for s in 0..=lv.len() {
-            if s + t < 2 || (s == 1 && t == 1) || s + t - 2 > depth {
-                continue;
-            }
-            if strategies == Strategies::LightTracing && !(t == 1 || (s == 0 && t == 2)) {
-                continue;
-            }
-            if t == 1 {
-                if let Some(splat) = to_lens(ctx, camera, &lv[..s], time, strategies, film) {
-                    splats.push(splat);
-                }
-            } else {
-                let c = match s {
-                    0 => emitter_found(world, &cv[..t], strategies),
-                    1 => light_sampled(ctx, &cv[..t], time),
-                    _ => joined(ctx, &lv[..s], &cv[..t], time),
-                };
-                l += c;
-            }
+    let (camera_len, light_len) = subpath_lengths(max_depth, strategies);
+    let walk_to_end = |ctx: &mut Context, mut w: Walk, path: &mut Vec<Vertex>| {
+        if !w.open(path) {
+            return;
         }
+        while w.extend(ctx, path, world.intersect(&w.ray, time)) {}
+    };
+    let mut cv = Vec::with_capacity(camera_len);
+    let w = camera_start(world, ray, camera_len, &mut cv);
+    walk_to_end(ctx, w, &mut cv);
+    let mut lv = Vec::with_capacity(light_len);
+    if let Some(w) = light_start(ctx, light_len, &mut lv) {
+        walk_to_end(ctx, w, &mut lv);
+    }
+    let mut connections = Vec::new();
+    connect(
+        ctx,
+        &cv,
+        &lv,
+        time,
+        max_depth,
+        strategies,
+        film,
+        &mut connections,
+    );
+    let mut l = Vec3::ZERO;
+    for c in &connections {
+        let visible = c.shadow.is_none_or(|q| world.visible(&q));
+        c.apply(visible, &mut l, splats);
     }
     l
 }
@@ -556,27 +682,21 @@ fn emitter_found(world: &World, cv: &[Vertex], strategies: Strategies) -> Vec3 {
 
 /// Strategy `s = 1`: a point on a light sampled from the camera
 /// subpath's last vertex.
-fn light_sampled(ctx: &mut Context, cv: &[Vertex], time: f32) -> Vec3 {
+fn light_sampled(ctx: &mut Context, cv: &[Vertex], time: f32) -> Option<Connection> {
     let world = ctx.world;
     let t = cv.len();
     let pt = &cv[t - 1];
-    let Some((hit, sh)) = pt.connectible() else {
-        return Vec3::ZERO;
-    };
+    let (hit, sh) = pt.connectible()?;
     let depth = (t - 2) as u32;
     let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
     let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
-    let Some((i, pmf)) = world.pick_light(u_pick) else {
-        return Vec3::ZERO;
-    };
+    let (i, pmf) = world.pick_light(u_pick)?;
     let light = &world.lights[i];
-    let Some(ls) = light.sample(hit.p, u) else {
-        return Vec3::ZERO;
-    };
+    let ls = light.sample(hit.p, u)?;
     let f = f_towards(pt, ls.wi, false);
     let c = pt.beta * f * sh.frame.n.dot(ls.wi).abs() * ls.li / (pmf * ls.pdf);
     if c.max_element() <= 0.0 {
-        return Vec3::ZERO;
+        return None;
     }
     let mut x0 = if light.is_infinite() {
         Vertex::endpoint(Kind::Infinite, Vec3::ZERO, ls.wi, ls.li)
@@ -595,15 +715,11 @@ fn light_sampled(ctx: &mut Context, cv: &[Vertex], time: f32) -> Vec3 {
     ];
     let w = mis_weight(1, t, &|_| &x0, &|j| &cv[j], &overrides, light.is_delta());
     if w <= 0.0 {
-        return Vec3::ZERO;
+        return None;
     }
     ctx.stats.shadow_rays += 1;
     let q = world.shadow_query(hit.spawn_origin(ls.wi), ls.wi, ls.dist, time, ls.ignore);
-    if world.visible(&q) {
-        c * w
-    } else {
-        Vec3::ZERO
-    }
+    Some(Connection::pixel(c * w, Some(q)))
 }
 
 /// Strategy `t = 1`: the light subpath's last vertex joined to a point on
@@ -615,7 +731,7 @@ fn to_lens(
     time: f32,
     strategies: Strategies,
     film: Vec2,
-) -> Option<Splat> {
+) -> Option<Connection> {
     let world = ctx.world;
     let s = lv.len();
     let qs = &lv[s - 1];
@@ -652,31 +768,32 @@ fn to_lens(
     }
     ctx.stats.shadow_rays += 1;
     let q = world.shadow_query(hit.spawn_origin(cs.wi), cs.wi, cs.dist, time, None);
-    world.visible(&q).then(|| Splat {
-        pos: cs.film * film,
+    Some(Connection {
+        shadow: Some(q),
         l: c * w,
+        film: Some(cs.film * film),
     })
 }
 
 /// Strategies `s, t >= 2`: the two subpaths' last vertices joined.
-fn joined(ctx: &mut Context, lv: &[Vertex], cv: &[Vertex], time: f32) -> Vec3 {
+fn joined(ctx: &mut Context, lv: &[Vertex], cv: &[Vertex], time: f32) -> Option<Connection> {
     let world = ctx.world;
     let (s, t) = (lv.len(), cv.len());
     let (qs, pt) = (&lv[s - 1], &cv[t - 1]);
     let (Some((qhit, qsh)), Some((phit, psh))) = (qs.connectible(), pt.connectible()) else {
-        return Vec3::ZERO;
+        return None;
     };
     let d = qhit.p - phit.p;
     let d2 = d.length_squared();
     if d2 == 0.0 {
-        return Vec3::ZERO;
+        return None;
     }
     let dist = d2.sqrt();
     let w = d / dist;
     let g = qsh.frame.n.dot(w).abs() * psh.frame.n.dot(w).abs() / d2;
     let c = qs.beta * f_towards(qs, -w, true) * f_towards(pt, w, false) * pt.beta * g;
     if c.max_element() <= 0.0 {
-        return Vec3::ZERO;
+        return None;
     }
     let overrides: Overrides = [
         (s - 1, None, Some(pdf_next(world, pt, Some(&cv[t - 2]), qs))),
@@ -687,13 +804,9 @@ fn joined(ctx: &mut Context, lv: &[Vertex], cv: &[Vertex], time: f32) -> Vec3 {
     let delta_light = world.lights[lv[0].light].is_delta();
     let weight = mis_weight(s, t, &|i| &lv[i], &|j| &cv[j], &overrides, delta_light);
     if weight <= 0.0 {
-        return Vec3::ZERO;
+        return None;
     }
     ctx.stats.shadow_rays += 1;
     let q = world.shadow_query(phit.spawn_origin(w), w, dist, time, None);
-    if world.visible(&q) {
-        c * weight
-    } else {
-        Vec3::ZERO
-    }
+    Some(Connection::pixel(c * weight, Some(q)))
 }
