@@ -24,7 +24,7 @@ use exr::prelude::{
     WritableImage,
 };
 use sahara_render::{
-    Aov, AuxSums, IntegratorKind, Named, PixelSum, PixelWindow, SumBuffer, ToneMap,
+    Aov, Aux, AuxSums, IntegratorKind, Named, PixelSum, PixelWindow, SumBuffer, ToneMap,
 };
 
 use crate::atomic::write_atomically;
@@ -175,16 +175,8 @@ fn pass_buffers(p: &AuxSums) -> Vec<(&'static str, &SumBuffer)> {
 
 /// Empty sums over `window` for `passes`.
 fn empty_passes(passes: &[Aov], window: &PixelWindow) -> AuxSums {
-    let b = || SumBuffer::new(window.x0, window.y0, window.width(), window.height());
-    let asked = |a: Aov| passes.contains(&a).then(b);
-    AuxSums {
-        albedo: asked(Aov::Albedo),
-        normal: asked(Aov::Normal),
-        depth: asked(Aov::Depth),
-        position: asked(Aov::Position),
-        uv: asked(Aov::Uv),
-        moments: passes.contains(&Aov::Variance).then(|| [b(), b()]),
-    }
+    let w = window;
+    Aux::new(passes, w.x0, w.y0, w.width(), w.height()).sums
 }
 
 /// The passes present in `p`.

@@ -95,24 +95,9 @@ impl Defaults {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::PathBuf;
-    use std::sync::Arc;
 
     fn node(attrs: &[(&str, &str)]) -> Node {
-        Node {
-            tag: "default".into(),
-            attrs: attrs
-                .iter()
-                .map(|(k, v)| (k.to_string(), v.to_string()))
-                .collect(),
-            children: Vec::new(),
-            loc: crate::pbrt::lexer::Loc {
-                file: "t.xml".into(),
-                line: 3,
-                col: 5,
-            },
-            folder: Arc::new(PathBuf::new()),
-        }
+        Node::at("default", attrs, 3, 5)
     }
 
     #[test]

@@ -197,24 +197,9 @@ pub(crate) fn conductor_rgb(eta: &Color, k: &Color) -> (Vec3, Vec3) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::PathBuf;
-    use std::sync::Arc;
 
     fn node(tag: &str, attrs: &[(&str, &str)]) -> Node {
-        Node {
-            tag: tag.into(),
-            attrs: attrs
-                .iter()
-                .map(|(k, v)| (k.to_string(), v.to_string()))
-                .collect(),
-            children: Vec::new(),
-            loc: crate::pbrt::lexer::Loc {
-                file: "t.xml".into(),
-                line: 1,
-                col: 1,
-            },
-            folder: Arc::new(PathBuf::new()),
-        }
+        Node::at(tag, attrs, 1, 1)
     }
 
     #[test]

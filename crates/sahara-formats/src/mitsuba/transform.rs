@@ -150,24 +150,10 @@ pub(crate) fn parse_transform(node: &Node) -> Result<DMat4, FormatError> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::PathBuf;
-    use std::sync::Arc;
 
     fn t(ops: &[(&str, &[(&str, &str)])]) -> Result<DMat4, FormatError> {
-        let n = |tag: &str, attrs: &[(&str, &str)]| Node {
-            tag: tag.into(),
-            attrs: attrs
-                .iter()
-                .map(|(k, v)| (k.to_string(), v.to_string()))
-                .collect(),
-            children: Vec::new(),
-            loc: crate::pbrt::lexer::Loc {
-                file: "t.xml".into(),
-                line: 2,
-                col: 3,
-            },
-            folder: Arc::new(PathBuf::new()),
-        };
+        let n = |tag: &str, attrs: &[(&str, &str)]| Node::at(tag, attrs, 2, 3);
+
         let mut root = n("transform", &[("name", "to_world")]);
         root.children = ops.iter().map(|(tag, a)| n(tag, a)).collect();
         parse_transform(&root)

@@ -162,6 +162,28 @@ fn xml_error(e: &roxmltree::Error, text: &str, at: &impl Fn(u32, u32) -> Loc) ->
 }
 
 #[cfg(test)]
+impl Node {
+    /// An element `<tag attrs.../>` of a file `t.xml` at `line`, `col`, for
+    /// the tests of the modules that read elements.
+    pub(crate) fn at(tag: &str, attrs: &[(&str, &str)], line: u32, col: u32) -> Node {
+        Node {
+            tag: tag.into(),
+            attrs: attrs
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect(),
+            children: Vec::new(),
+            loc: Loc {
+                file: "t.xml".into(),
+                line,
+                col,
+            },
+            folder: Arc::new(PathBuf::new()),
+        }
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
