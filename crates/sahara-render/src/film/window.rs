@@ -79,6 +79,21 @@ impl PixelWindow {
             y1: self.y1.saturating_add(m).min(height),
         }
     }
+
+    /// Grown outwards to the grid of `b x b` pixel blocks aligned with the
+    /// image's corner, within a `width x height` image.
+    pub fn align(&self, b: u32, width: u32, height: u32) -> PixelWindow {
+        let b = b.max(1);
+        if self.is_empty() {
+            return *self;
+        }
+        PixelWindow {
+            x0: self.x0 / b * b,
+            x1: self.x1.div_ceil(b).saturating_mul(b).min(width),
+            y0: self.y0 / b * b,
+            y1: self.y1.div_ceil(b).saturating_mul(b).min(height),
+        }
+    }
 }
 
 impl std::fmt::Display for PixelWindow {
@@ -177,6 +192,20 @@ mod tests {
         let thin = PixelWindow::full(1, 2);
         let total: u64 = (0..4).map(|i| tile(&thin, i, 4).pixels()).sum();
         assert_eq!(total, 2);
+    }
+
+    #[test]
+    fn aligned_windows_cover_whole_blocks_within_the_image() {
+        let w = PixelWindow {
+            x0: 3,
+            x1: 6,
+            y0: 4,
+            y1: 9,
+        };
+        let a = w.align(2, 100, 9);
+        assert_eq!((a.x0, a.x1, a.y0, a.y1), (2, 6, 4, 9));
+        assert_eq!(a.align(2, 100, 9), a);
+        assert_eq!(w.align(1, 100, 100), w);
     }
 
     #[test]

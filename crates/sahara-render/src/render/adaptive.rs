@@ -20,13 +20,21 @@
 //! samples, whose means converge faster than `σ / sqrt(n)`, the estimate
 //! errs on the safe side.
 //!
-//! The test runs after each pass once a pixel has `min_spp` samples; a
-//! converged pixel takes no more. Each pixel is judged by its own samples
-//! only, never by its neighbours': so a window of the frame rendered alone
-//! (a farm tile) makes the same decisions as the whole frame, and the
-//! frame split into tiles and merged is the frame rendered whole, bit for
-//! bit. The sums are in `f64`, added in sample order per pixel, and so do
-//! not depend on the number of threads either.
+//! The test runs after each pass once a pixel has `min_spp` samples, and
+//! pixels stop in 2x2 blocks: a block stops when all four of its pixels
+//! are below the threshold. The estimate of a pixel whose samples are
+//! mostly dark with rare bright ones (a glint, a small light seen through
+//! a rough reflection) is low until a bright sample comes; judged alone,
+//! such pixels stop early on a lucky run, darker than they should be
+//! (docs/clean-image.md has what that costs). A neighbour in the block
+//! that has seen its bright samples keeps the block going (Cycles widens
+//! the active pixels by one for the same reason). The blocks lie on a grid
+//! fixed to the image's corner and a piece of the frame renders whole
+//! blocks, so a window of the frame rendered alone (a farm tile) makes the
+//! same decisions as the whole frame, and the frame split into tiles and
+//! merged is the frame rendered whole, bit for bit. The sums are in `f64`,
+//! added in sample order per pixel, and so do not depend on the number of
+//! threads either.
 
 use glam::Vec3;
 
@@ -35,6 +43,10 @@ use crate::film::window::PixelWindow;
 /// The expected difference of two half-buffers' means, in standard errors
 /// of the whole mean: `sqrt(2/π)`, which keeps Cycles' threshold scale.
 const HALVES: f64 = 0.797_884_560_802_865_4;
+
+/// The side of the pixel blocks that stop together, on a grid aligned with
+/// the image's corner.
+pub(crate) const BLOCK: u32 = 2;
 
 /// Adaptive sampling: stop a pixel once its estimated noise is below
 /// `threshold` (the render's `spp` is then a cap).
@@ -178,23 +190,40 @@ impl Convergence {
         }
     }
 
-    /// After a pass: the pixels with at least `min_spp` samples whose
-    /// noise is below the threshold stop. Returns how many remain active.
+    /// After a pass: the blocks whose pixels all have at least `min_spp`
+    /// samples and noise below the threshold stop. Returns how many pixels
+    /// remain active.
     pub(crate) fn update(&mut self) -> usize {
         let min = self.settings.min_spp.max(2);
         let threshold = f64::from(self.settings.threshold);
+        let b = BLOCK;
+        let r = self.region;
         let mut left = 0;
-        for ((s, a), c) in self
-            .sums
-            .iter()
-            .zip(&mut self.active)
-            .zip(&mut self.converged)
-        {
-            if *a && s.count >= min && s.error() < threshold {
-                *a = false;
-                *c = true;
+        for by in (r.y0 / b * b..r.y1).step_by(b as usize) {
+            for bx in (r.x0 / b * b..r.x1).step_by(b as usize) {
+                let (ys, xs) = (
+                    by.max(r.y0)..(by + b).min(r.y1),
+                    bx.max(r.x0)..(bx + b).min(r.x1),
+                );
+                let pixels = || ys.clone().flat_map(|y| xs.clone().map(move |x| (x, y)));
+                // A block's pixels start, and so stay, in one state.
+                if !self.is_active(xs.start, ys.start) {
+                    continue;
+                }
+                let done = pixels().all(|(x, y)| {
+                    let s = &self.sums[self.index(x, y)];
+                    s.count >= min && s.error() < threshold
+                });
+                for (x, y) in pixels() {
+                    let i = self.index(x, y);
+                    if done {
+                        self.active[i] = false;
+                        self.converged[i] = true;
+                    } else {
+                        left += 1;
+                    }
+                }
             }
-            left += *a as usize;
         }
         left
     }
@@ -284,11 +313,15 @@ mod tests {
         assert!((HALVES - (2.0 / std::f64::consts::PI).sqrt()).abs() < 1e-15);
     }
 
+    /// Pixels stop in the 2x2 blocks of the image's grid, a block once all
+    /// of its pixels have the minimum samples and are below the threshold.
     #[test]
-    fn only_pixels_with_enough_samples_stop() {
+    fn pixels_stop_in_blocks_with_enough_samples() {
+        // Columns 1..5 of row 0: the blocks are columns 0..2 (only 1 in the
+        // region), 2..4 and 4..6 (only 4).
         let region = PixelWindow {
-            x0: 0,
-            x1: 2,
+            x0: 1,
+            x1: 5,
             y0: 0,
             y1: 1,
         };
@@ -299,20 +332,43 @@ mod tests {
                 min_spp: 4,
             },
         );
-        let mut tile = TileSums::new(0, 2, 0, 1);
+        let mut tile = TileSums::new(1, 5, 0, 1);
         for k in 0..2 {
-            tile.at(0, 0).add(Vec3::ONE);
-            tile.at(1, 0).add(Vec3::splat(k as f32));
+            for x in 1..4 {
+                tile.at(x, 0).add(Vec3::ONE);
+            }
+            tile.at(4, 0).add(Vec3::splat(k as f32));
         }
         c.add(&tile);
-        assert_eq!(c.update(), 2, "two samples are under the minimum");
+        assert_eq!(c.update(), 4, "two samples are under the minimum");
         c.add(&tile);
-        assert_eq!(c.update(), 1);
-        assert!(!c.is_active(0, 0) && c.is_active(1, 0));
+        assert_eq!(c.update(), 1, "the flat pixels stop, the noisy one not");
+        assert!((1..4).all(|x| !c.is_active(x, 0)) && c.is_active(4, 0));
         let st = c.stats(&region, 8);
         assert_eq!(
             (st.samples, st.budget, st.converged, st.pixels),
-            (8, 16, 1, 2)
+            (16, 32, 3, 4)
         );
+        // A flat pixel beside a noisy one in its block keeps going.
+        let mut c = Convergence::new(
+            PixelWindow {
+                x0: 2,
+                x1: 4,
+                y0: 0,
+                y1: 1,
+            },
+            Adaptive {
+                threshold: 0.01,
+                min_spp: 4,
+            },
+        );
+        let mut tile = TileSums::new(2, 4, 0, 1);
+        for k in 0..4 {
+            tile.at(2, 0).add(Vec3::ONE);
+            tile.at(3, 0).add(Vec3::splat((k % 2) as f32));
+        }
+        c.add(&tile);
+        assert_eq!(c.update(), 2);
+        assert!(c.is_active(2, 0));
     }
 }

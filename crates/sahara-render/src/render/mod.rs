@@ -343,8 +343,21 @@ pub fn render_watched(
         .window
         .unwrap_or(PixelWindow::full(w, h))
         .intersect(&PixelWindow::full(w, h));
-    // The pixels whose samples reach the window.
+    // The pixels whose samples reach the window; with adaptive sampling,
+    // whole blocks of them, so that a piece of the frame judges its pixels
+    // as the whole frame does.
+    // Adaptive sampling judges each pixel by all of its samples: a piece of
+    // the frame by pixels (all samples) can use it, a range of samples not.
+    let all_samples = settings
+        .samples
+        .as_ref()
+        .is_none_or(|r| *r == (0..settings.spp));
+    let adaptive = settings.adaptive.filter(|_| all_samples);
     let region = window.grow(filter_margin(&settings.filter), w, h);
+    let region = match adaptive {
+        Some(_) => region.align(adaptive::BLOCK, w, h),
+        None => region,
+    };
     let ts = settings.tile_size.max(1);
     let tiles: Vec<Tile> = (0..region.height().div_ceil(ts))
         .flat_map(|ty| {
@@ -370,16 +383,7 @@ pub fn render_watched(
             window.height(),
         )
     });
-    // Adaptive sampling judges each pixel by all of its samples: a piece of
-    // the frame by pixels (all samples) can use it, a range of samples not.
-    let all_samples = settings
-        .samples
-        .as_ref()
-        .is_none_or(|r| *r == (0..settings.spp));
-    let mut convergence = match settings.adaptive {
-        Some(a) if all_samples => Some(Convergence::new(region, a)),
-        _ => None,
-    };
+    let mut convergence = adaptive.map(|a| Convergence::new(region, a));
     let mut stats = RenderStats {
         build_time,
         layout: world.accel.layout(),
