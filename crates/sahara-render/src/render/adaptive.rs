@@ -125,28 +125,47 @@ impl PixelSums {
     }
 }
 
-/// Which pixels of the rendered region still take samples, and their
-/// sums so far.
+/// Which pixels of the rendered region still take samples, how many each
+/// takes in the next round, and their sums so far.
 #[derive(Clone, Debug)]
 pub(crate) struct Convergence {
     /// The pixels rendered: the window and the filter's margin around it.
     region: PixelWindow,
     settings: Adaptive,
+    /// Samples per pass, and the most a pixel takes.
+    pass: u32,
+    cap: u32,
+    /// False: every round is one pass.
+    grow: bool,
     sums: Vec<PixelSums>,
-    active: Vec<bool>,
+    /// Samples each pixel takes in the next round (0: none, it stopped).
+    take: Vec<u32>,
     /// Pixels that stopped below the threshold.
     converged: Vec<bool>,
 }
 
 impl Convergence {
-    /// Every pixel of `region` active.
-    pub(crate) fn new(region: PixelWindow, settings: Adaptive) -> Self {
+    /// Every pixel of `region` active, taking one pass of `pass` samples
+    /// in the first round, at most `cap` in all; with `grow` false, every
+    /// round is one pass (a render under a time limit, which drops the
+    /// round under way when time runs out, then loses little).
+    pub(crate) fn new(
+        region: PixelWindow,
+        settings: Adaptive,
+        pass: u32,
+        cap: u32,
+        grow: bool,
+    ) -> Self {
         let n = region.pixels() as usize;
+        let pass = pass.max(1);
         Self {
             region,
             settings,
+            pass,
+            cap,
+            grow,
             sums: vec![PixelSums::default(); n],
-            active: vec![true; n],
+            take: vec![pass.min(cap); n],
             converged: vec![false; n],
         }
     }
@@ -161,15 +180,26 @@ impl Convergence {
         if i < self.region.width() && j < self.region.height() {
             (j * self.region.width() + i) as usize
         } else {
-            self.active.len()
+            self.take.len()
         }
     }
 
-    /// True if pixel `(x, y)` of the region takes samples in this pass
+    /// True if pixel `(x, y)` of the region takes samples in this round
     /// (false outside it).
     #[inline]
     pub(crate) fn is_active(&self, x: u32, y: u32) -> bool {
-        self.active.get(self.index(x, y)).copied().unwrap_or(false)
+        self.take.get(self.index(x, y)).is_some_and(|&t| t > 0)
+    }
+
+    /// The samples pixel `(x, y)` takes in this round, numbered over all
+    /// passes (empty outside the region).
+    #[inline]
+    pub(crate) fn round(&self, x: u32, y: u32) -> std::ops::Range<u32> {
+        let i = self.index(x, y);
+        match (self.sums.get(i), self.take.get(i)) {
+            (Some(s), Some(&t)) => s.count..s.count + t,
+            _ => 0..0,
+        }
     }
 
     /// True if any pixel of `[x0, x1) x [y0, y1)` takes samples.
@@ -190,9 +220,18 @@ impl Convergence {
         }
     }
 
-    /// After a pass: the blocks whose pixels all have at least `min_spp`
-    /// samples and noise below the threshold stop. Returns how many pixels
-    /// remain active.
+    /// After a round: the blocks whose pixels all have at least `min_spp`
+    /// samples and noise below the threshold stop; the others are given
+    /// the samples of their next round. Returns how many pixels remain
+    /// active.
+    ///
+    /// A block takes whole passes, as many as its noise says it needs to
+    /// reach the threshold (`n ((error / threshold)^2 - 1)` more samples,
+    /// the error falling as `1 / sqrt(n)`), but at most as many as it has:
+    /// the pixels still noisy late in a render take many samples at a time,
+    /// which keeps the batches traced together full when few pixels are
+    /// left, while a block near the threshold takes one pass and is tested
+    /// again.
     pub(crate) fn update(&mut self) -> usize {
         let min = self.settings.min_spp.max(2);
         let threshold = f64::from(self.settings.threshold);
@@ -206,26 +245,46 @@ impl Convergence {
                     bx.max(r.x0)..(bx + b).min(r.x1),
                 );
                 let pixels = || ys.clone().flat_map(|y| xs.clone().map(move |x| (x, y)));
-                // A block's pixels start, and so stay, in one state.
+                // A block's pixels start, and so stay, in one state, with
+                // the same number of samples.
                 if !self.is_active(xs.start, ys.start) {
                     continue;
                 }
-                let done = pixels().all(|(x, y)| {
-                    let s = &self.sums[self.index(x, y)];
-                    s.count >= min && s.error() < threshold
-                });
+                let n = self.sums[self.index(xs.start, ys.start)].count;
+                let worst = pixels()
+                    .map(|(x, y)| self.sums[self.index(x, y)].error())
+                    .fold(0.0, f64::max);
+                let done = n >= min && worst < threshold;
+                let want = if n < min {
+                    min - n
+                } else if !self.grow {
+                    1
+                } else {
+                    // (NaN, for a flat block and a zero threshold, is one pass.)
+                    let more = f64::from(n) * ((worst / threshold).powi(2) - 1.0);
+                    more.ceil().max(1.0).min(f64::from(n)) as u32
+                };
+                let take = if done {
+                    0
+                } else {
+                    (want.div_ceil(self.pass) * self.pass).min(self.cap.saturating_sub(n))
+                };
                 for (x, y) in pixels() {
                     let i = self.index(x, y);
-                    if done {
-                        self.active[i] = false;
-                        self.converged[i] = true;
-                    } else {
-                        left += 1;
-                    }
+                    self.take[i] = take;
+                    self.converged[i] = done;
+                }
+                if take > 0 {
+                    left += pixels().count();
                 }
             }
         }
         left
+    }
+
+    /// The most samples a pixel of `window` took.
+    pub(crate) fn most_samples(&self, window: &PixelWindow) -> u32 {
+        self.samples(window).into_iter().max().unwrap_or(0)
     }
 
     /// The samples each pixel of `window` took, rows top to bottom.
@@ -331,7 +390,11 @@ mod tests {
                 threshold: 0.01,
                 min_spp: 4,
             },
+            2,
+            8,
+            true,
         );
+        assert_eq!(c.round(1, 0), 0..2, "the first round is one pass");
         let mut tile = TileSums::new(1, 5, 0, 1);
         for k in 0..2 {
             for x in 1..4 {
@@ -344,6 +407,8 @@ mod tests {
         c.add(&tile);
         assert_eq!(c.update(), 1, "the flat pixels stop, the noisy one not");
         assert!((1..4).all(|x| !c.is_active(x, 0)) && c.is_active(4, 0));
+        // Far above the threshold: as many samples as it has, to the cap.
+        assert_eq!(c.round(4, 0), 4..8);
         let st = c.stats(&region, 8);
         assert_eq!(
             (st.samples, st.budget, st.converged, st.pixels),
@@ -361,6 +426,9 @@ mod tests {
                 threshold: 0.01,
                 min_spp: 4,
             },
+            4,
+            8,
+            true,
         );
         let mut tile = TileSums::new(2, 4, 0, 1);
         for k in 0..4 {
@@ -370,5 +438,53 @@ mod tests {
         c.add(&tile);
         assert_eq!(c.update(), 2);
         assert!(c.is_active(2, 0));
+        assert_eq!(c.round(2, 0), 4..8);
+        // At the cap the block stops without having converged.
+        c.add(&tile);
+        assert_eq!(c.update(), 0);
+        let st = c.stats(&c.region, 8);
+        assert_eq!((st.samples, st.converged), (16, 0));
+    }
+
+    /// A block just above the threshold takes one pass; one at twice the
+    /// threshold three times its samples, but at most as many as it has.
+    #[test]
+    fn a_block_takes_the_passes_its_noise_asks_for() {
+        let region = PixelWindow {
+            x0: 0,
+            x1: 1,
+            y0: 0,
+            y1: 1,
+        };
+        let mut sums = PixelSums::default();
+        for k in 0..16 {
+            sums.add(Vec3::splat(1.0 + (k % 2) as f32));
+        }
+        let e = sums.error();
+        let mut tile = TileSums::new(0, 1, 0, 1);
+        *tile.at(0, 0) = sums;
+        for (threshold, take) in [(e * 0.99, 8), (e / 2.0 * 1.0001, 16), (e / 1.5, 16)] {
+            let mut c = Convergence::new(
+                region,
+                Adaptive {
+                    threshold: threshold as f32,
+                    min_spp: 4,
+                },
+                8,
+                1024,
+                true,
+            );
+            c.add(&tile);
+            c.update();
+            assert_eq!(c.round(0, 0).len() as u32, take, "threshold {threshold}");
+        }
+        let settings = Adaptive {
+            threshold: (e / 2.0) as f32,
+            min_spp: 4,
+        };
+        let mut c = Convergence::new(region, settings, 8, 1024, false);
+        c.add(&tile);
+        c.update();
+        assert_eq!(c.round(0, 0), 16..24, "one pass a round");
     }
 }

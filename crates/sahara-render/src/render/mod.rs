@@ -383,7 +383,10 @@ pub fn render_watched(
             window.height(),
         )
     });
-    let mut convergence = adaptive.map(|a| Convergence::new(region, a));
+    let mut convergence = adaptive.map(|a| {
+        let grow = settings.time_limit.is_none();
+        Convergence::new(region, a, settings.pass_size(), settings.spp.max(1), grow)
+    });
     let mut stats = RenderStats {
         build_time,
         layout: world.accel.layout(),
@@ -440,6 +443,13 @@ pub fn render_watched(
             break;
         }
         let indices = indices_of(pass);
+        let samples = match &convergence {
+            Some(c) => RoundSamples::Adaptive(c),
+            None => RoundSamples::Every {
+                start: pass * spp + indices.start,
+                end: pass * spp + indices.end,
+            },
+        };
         let done = AtomicU32::new(0);
         let abandon = AtomicBool::new(false);
         // The first pass stops pixel by pixel on cancel, so that a long
@@ -455,16 +465,7 @@ pub fn render_watched(
                     abandon.store(true, Ordering::Relaxed);
                     return None;
                 }
-                let out = render_tile(
-                    &world,
-                    settings,
-                    *tile,
-                    &window,
-                    pass,
-                    indices.clone(),
-                    convergence.as_ref(),
-                    &stop_pixel,
-                );
+                let out = render_tile(&world, settings, *tile, &window, samples, &stop_pixel);
                 if out.pixels_done < tile.pixels() {
                     abandon.store(true, Ordering::Relaxed);
                 }
@@ -561,6 +562,8 @@ pub fn render_watched(
     }
     if finished.is_some() {
         stats.spp = indices_of(first_pass).len() as u32;
+    } else if let Some(c) = &convergence {
+        stats.spp = c.most_samples(&window);
     }
     stats.render_time = render_start.elapsed();
     stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
@@ -636,20 +639,47 @@ pub fn cost_maps(film: &mut Film, scale: Option<f32>) -> CostMaps {
 /// packets.
 const STRIP_ROWS: u32 = 4;
 
-/// Renders sample indices `indices` of pass `pass` of one tile, splatting
-/// them into the window's pixels they reach; `stop` is asked before each
-/// strip of rows, and once it says so, the rest of the tile is left out.
-#[allow(clippy::too_many_arguments)]
+/// The samples one round gives each pixel, numbered over all passes:
+/// sample `g` is index `g % pass_size` of pass `g / pass_size`.
+#[derive(Clone, Copy)]
+enum RoundSamples<'a> {
+    /// Every pixel samples `start..end`.
+    Every { start: u32, end: u32 },
+    /// Each pixel those adaptive sampling gives it.
+    Adaptive(&'a Convergence),
+}
+
+impl RoundSamples<'_> {
+    /// The samples of pixel `(x, y)`.
+    #[inline]
+    fn of(&self, x: u32, y: u32) -> std::ops::Range<u32> {
+        match self {
+            Self::Every { start, end } => *start..*end,
+            Self::Adaptive(c) => c.round(x, y),
+        }
+    }
+
+    /// The convergence state, with adaptive sampling.
+    fn convergence(&self) -> Option<&Convergence> {
+        match self {
+            Self::Every { .. } => None,
+            Self::Adaptive(c) => Some(c),
+        }
+    }
+}
+
+/// Renders the round's `samples` of one tile, splatting them into the
+/// window's pixels they reach; `stop` is asked before each strip of rows,
+/// and once it says so, the rest of the tile is left out.
 fn render_tile(
     world: &World,
     s: &RenderSettings,
     t: Tile,
     window: &PixelWindow,
-    pass: u32,
-    indices: std::ops::Range<u32>,
-    convergence: Option<&Convergence>,
+    samples: RoundSamples,
     stop: &dyn Fn() -> bool,
 ) -> TileOut {
+    let convergence = samples.convergence();
     let (w, h) = (s.width.max(1), s.height.max(1));
     let m = filter_margin(&s.filter);
     let reach = PixelWindow {
@@ -681,7 +711,6 @@ fn render_tile(
         pixels_done: 0,
         splats: Vec::new(),
     };
-    let active = |x: u32, y: u32| convergence.is_none_or(|c| c.is_active(x, y));
     let batched = s.integrator.is_stepped() || s.integrator.bidirectional().is_some();
     let depth_view = matches!(s.integrator, Integrator::Depth);
     let rows = if batched { STRIP_ROWS } else { 1 };
@@ -696,18 +725,7 @@ fn render_tile(
                 out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
                 continue;
             }
-            strip.render(
-                world,
-                s,
-                t.x0,
-                t.x1,
-                y0,
-                y1,
-                pass,
-                indices.clone(),
-                convergence,
-                &mut out.stats,
-            );
+            strip.render(world, s, t.x0, t.x1, y0, y1, samples, &mut out.stats);
             for mut splat in strip.splats.drain(..) {
                 splat.l = guard(splat.l, &mut out.nan, &mut out.negative);
                 out.splats.push(splat);
@@ -717,7 +735,7 @@ fn render_tile(
                 let mut k = 0;
                 for y in y0..y1 {
                     for x in t.x0..t.x1 {
-                        for _ in indices.clone() {
+                        for _ in samples.of(x, y) {
                             let pos = strip.pos[k];
                             let l = strip.radiance[k];
                             k += 1;
@@ -735,11 +753,7 @@ fn render_tile(
             let mut k = 0;
             for y in y0..y1 {
                 for x in t.x0..t.x1 {
-                    if !active(x, y) {
-                        k += indices.len();
-                        continue;
-                    }
-                    for _ in indices.clone() {
+                    for _ in samples.of(x, y) {
                         let pos = strip.pos[k];
                         let raw = strip.radiance[k];
                         let l = guard(raw, &mut out.nan, &mut out.negative);
@@ -803,6 +817,8 @@ struct Strip {
     paths: Vec<PathState>,
     /// Where each path's radiance goes in `radiance`.
     slot: Vec<u32>,
+    /// Where each pixel's samples start in `pos` and `radiance`.
+    first: Vec<u32>,
     /// Each sample's auxiliary values (when the settings ask for them).
     aux: Vec<AuxSample>,
     /// Light the samples add elsewhere on the film.
@@ -816,8 +832,7 @@ struct Strip {
 }
 
 impl Strip {
-    /// Renders sample indices `indices` of pass `pass` of pixels
-    /// `[x0, x1) x [y0, y1)`.
+    /// Renders the round's `samples` of pixels `[x0, x1) x [y0, y1)`.
     #[allow(clippy::too_many_arguments)]
     fn render(
         &mut self,
@@ -827,19 +842,22 @@ impl Strip {
         x1: u32,
         y0: u32,
         y1: u32,
-        pass: u32,
-        indices: std::ops::Range<u32>,
-        convergence: Option<&Convergence>,
+        samples: RoundSamples,
         stats: &mut TraceStats,
     ) {
         let (w, h) = (s.width.max(1), s.height.max(1));
-        // With adaptive sampling, the pixels still taking samples.
-        let active = |x: u32, y: u32| convergence.is_none_or(|c| c.is_active(x, y));
         let camera = &world.scene.camera;
         let inv = Vec2::new(1.0 / w as f32, 1.0 / h as f32);
         let spp = s.pass_size();
-        let per_pixel = indices.len() as u32;
-        let n = ((x1 - x0) * (y1 - y0) * per_pixel) as usize;
+        // Where each pixel's samples start in the strip's buffers.
+        self.first.clear();
+        let mut n = 0usize;
+        for y in y0..y1 {
+            for x in x0..x1 {
+                self.first.push(n as u32);
+                n += samples.of(x, y).len();
+            }
+        }
         self.pos.clear();
         self.pos.resize(n, Vec2::ZERO);
         self.radiance.clear();
@@ -849,16 +867,16 @@ impl Strip {
         if aux {
             self.aux.resize(n, AuxSample::default());
         }
-        // Sample `index` of pixel (x, y): its sampler, film position and
+        // Sample `g` of pixel (x, y): its sampler, film position and
         // camera ray.
-        let camera_sample = |x: u32, y: u32, index: u32| {
+        let camera_sample = |x: u32, y: u32, g: u32| {
             let stream = hash2(s.seed, (y as u64) * w as u64 + x as u64);
             let sampler = PixelSampler::new(
                 s.sampler,
                 SampleId {
                     stream,
-                    pass,
-                    index,
+                    pass: g / spp,
+                    index: g % spp,
                     count: spp,
                 },
             );
@@ -870,8 +888,10 @@ impl Strip {
             );
             (sampler, pos, ray, time)
         };
-        let slot_of = |x: u32, y: u32, index: u32| {
-            (((y - y0) * (x1 - x0) + (x - x0)) * per_pixel + index - indices.start) as usize
+        let first = &self.first;
+        let slot_of = |x: u32, y: u32, g: u32| {
+            let start = samples.of(x, y).start;
+            (first[((y - y0) * (x1 - x0) + (x - x0)) as usize] + g - start) as usize
         };
         let film = Vec2::new(w as f32, h as f32);
         if let Some((max_depth, strategies)) = s.integrator.bidirectional() {
@@ -880,12 +900,9 @@ impl Strip {
             self.slot.clear();
             for y in y0..y1 {
                 for x in x0..x1 {
-                    if !active(x, y) {
-                        continue;
-                    }
-                    for index in indices.clone() {
-                        let (sampler, pos, ray, time) = camera_sample(x, y, index);
-                        let k = slot_of(x, y, index);
+                    for g in samples.of(x, y) {
+                        let (sampler, pos, ray, time) = camera_sample(x, y, g);
+                        let k = slot_of(x, y, g);
                         self.pos[k] = pos;
                         self.slot.push(k as u32);
                         self.cameras.push(CameraSample { ray, time, sampler });
@@ -912,17 +929,14 @@ impl Strip {
         if !s.integrator.is_stepped() {
             for y in y0..y1 {
                 for x in x0..x1 {
-                    if !active(x, y) {
-                        continue;
-                    }
-                    for index in indices.clone() {
-                        let (sampler, pos, ray, time) = camera_sample(x, y, index);
+                    for g in samples.of(x, y) {
+                        let (sampler, pos, ray, time) = camera_sample(x, y, g);
                         let mut ctx = Context {
                             world,
                             sampler,
                             stats,
                         };
-                        let k = slot_of(x, y, index);
+                        let k = slot_of(x, y, g);
                         self.pos[k] = pos;
                         self.radiance[k] =
                             s.integrator
@@ -933,21 +947,30 @@ impl Strip {
             return;
         }
         // The paths in camera-packet order: 4x4 pixel blocks, each block's
-        // samples index by index.
+        // samples index by index (the `i`-th sample of each of its pixels
+        // that takes that many).
         self.paths.clear();
         self.slot.clear();
         for (bx, by) in (y0..y1)
             .step_by(4)
             .flat_map(|by| (x0..x1).step_by(4).map(move |bx| (bx, by)))
         {
-            for index in indices.clone() {
-                for y in by..(by + 4).min(y1) {
-                    for x in bx..(bx + 4).min(x1) {
-                        if !active(x, y) {
+            let (ys, xs) = (by..(by + 4).min(y1), bx..(bx + 4).min(x1));
+            let most = ys
+                .clone()
+                .flat_map(|y| xs.clone().map(move |x| samples.of(x, y).len()))
+                .max()
+                .unwrap_or(0) as u32;
+            for i in 0..most {
+                for y in ys.clone() {
+                    for x in xs.clone() {
+                        let r = samples.of(x, y);
+                        let g = r.start + i;
+                        if g >= r.end {
                             continue;
                         }
-                        let (sampler, pos, ray, time) = camera_sample(x, y, index);
-                        let k = slot_of(x, y, index);
+                        let (sampler, pos, ray, time) = camera_sample(x, y, g);
+                        let k = slot_of(x, y, g);
                         self.pos[k] = pos;
                         self.slot.push(k as u32);
                         self.paths
