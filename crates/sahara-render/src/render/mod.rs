@@ -343,9 +343,6 @@ pub fn render_watched(
         .window
         .unwrap_or(PixelWindow::full(w, h))
         .intersect(&PixelWindow::full(w, h));
-    // The pixels whose samples reach the window; with adaptive sampling,
-    // whole blocks of them, so that a piece of the frame judges its pixels
-    // as the whole frame does.
     // Adaptive sampling judges each pixel by all of its samples: a piece of
     // the frame by pixels (all samples) can use it, a range of samples not.
     let all_samples = settings
@@ -353,6 +350,9 @@ pub fn render_watched(
         .as_ref()
         .is_none_or(|r| *r == (0..settings.spp));
     let adaptive = settings.adaptive.filter(|_| all_samples);
+    // The pixels whose samples reach the window; with adaptive sampling,
+    // whole blocks of them, so that a piece of the frame judges its pixels
+    // as the whole frame does.
     let region = window.grow(filter_margin(&settings.filter), w, h);
     let region = match adaptive {
         Some(_) => region.align(adaptive::BLOCK, w, h),
