@@ -122,7 +122,7 @@ impl PartSums {
 
     /// The passes it holds: those with sums, then the ids.
     fn passes(&self) -> Vec<Aov> {
-        let mut p = passes_of(&self.passes);
+        let mut p = self.passes.passes();
         p.extend(self.object.as_ref().map(|_| Aov::Object));
         p.extend(self.material.as_ref().map(|_| Aov::Material));
         p.sort();
@@ -145,53 +145,19 @@ impl PartSums {
     fn buffers(&self) -> Vec<(String, &SumBuffer)> {
         let mut out = vec![(String::new(), &self.beauty)];
         out.extend(
-            pass_buffers(&self.passes)
+            self.passes
+                .buffers()
                 .into_iter()
-                .map(|(name, b)| (format!("{name}."), b)),
+                .map(|(_, name, b)| (format!("{name}."), b)),
         );
         out
     }
-}
-
-/// The buffers of the passes present in `p`, with their names, in the
-/// order of [`Aov`].
-fn pass_buffers(p: &AuxSums) -> Vec<(&'static str, &SumBuffer)> {
-    let mut out: Vec<(&'static str, &SumBuffer)> = [
-        ("albedo", &p.albedo),
-        ("normal", &p.normal),
-        ("depth", &p.depth),
-        ("position", &p.position),
-        ("uv", &p.uv),
-    ]
-    .into_iter()
-    .filter_map(|(name, b)| Some((name, b.as_ref()?)))
-    .collect();
-    if let Some([sum, square]) = &p.moments {
-        out.push(("variance.sum", sum));
-        out.push(("variance.square", square));
-    }
-    out
 }
 
 /// Empty sums over `window` for `passes`.
 fn empty_passes(passes: &[Aov], window: &PixelWindow) -> AuxSums {
     let w = window;
     Aux::new(passes, w.x0, w.y0, w.width(), w.height()).sums
-}
-
-/// The passes present in `p`.
-fn passes_of(p: &AuxSums) -> Vec<Aov> {
-    [
-        (Aov::Albedo, p.albedo.is_some()),
-        (Aov::Normal, p.normal.is_some()),
-        (Aov::Depth, p.depth.is_some()),
-        (Aov::Position, p.position.is_some()),
-        (Aov::Uv, p.uv.is_some()),
-        (Aov::Variance, p.moments.is_some()),
-    ]
-    .into_iter()
-    .filter_map(|(a, present)| present.then_some(a))
-    .collect()
 }
 
 /// A list of passes as the header writes it: names joined by commas.
@@ -403,7 +369,7 @@ fn channel_names(info: &PartInfo) -> Vec<String> {
         y1: 0,
     };
     let mut names = sum_channels("");
-    for (name, _) in pass_buffers(&empty_passes(&info.passes, &window)) {
+    for (_, name, _) in empty_passes(&info.passes, &window).buffers() {
         names.extend(sum_channels(&format!("{name}.")));
     }
     for (held, channel) in [
@@ -613,21 +579,8 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, PartSums), FormatError> {
             })
     };
     let mut buffers: Vec<(String, &mut SumBuffer)> = vec![(String::new(), &mut sums.beauty)];
-    let p = &mut sums.passes;
-    for (prefix, b) in [
-        ("albedo.", &mut p.albedo),
-        ("normal.", &mut p.normal),
-        ("depth.", &mut p.depth),
-        ("position.", &mut p.position),
-        ("uv.", &mut p.uv),
-    ] {
-        if let Some(b) = b {
-            buffers.push((prefix.to_string(), b));
-        }
-    }
-    if let Some([sum, square]) = &mut p.moments {
-        buffers.push(("variance.sum.".to_string(), sum));
-        buffers.push(("variance.square.".to_string(), square));
+    for (_, name, b) in sums.passes.buffers_mut() {
+        buffers.push((format!("{name}."), b));
     }
     for (prefix, buffer) in buffers {
         let len = buffer.sums.len();

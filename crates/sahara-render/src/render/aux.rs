@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 
 use crate::film::sums::{SumBuffer, FRACTION_BITS};
 use crate::integrator::AuxSample;
-use crate::names::name_table;
+use crate::names::{name_table, Named};
 
 /// An auxiliary image a render can write beside the beauty (a render
 /// pass, an AOV).
@@ -71,6 +71,57 @@ pub struct AuxSums {
     pub uv: Option<SumBuffer>,
     /// The samples' radiance and its square, per channel (the variance).
     pub moments: Option<[SumBuffer; 2]>,
+}
+
+impl AuxSums {
+    /// The passes present, in the order of [`Aov`].
+    pub fn passes(&self) -> Vec<Aov> {
+        let mut out: Vec<Aov> = self.buffers().into_iter().map(|(a, _, _)| a).collect();
+        out.dedup();
+        out
+    }
+
+    /// The buffers present, in the order of [`Aov`], each with its pass and
+    /// a name: the pass's name, and for the variance `variance.sum` and
+    /// `variance.square`.
+    pub fn buffers(&self) -> Vec<(Aov, String, &SumBuffer)> {
+        let mut out: Vec<(Aov, String, &SumBuffer)> = [
+            (Aov::Albedo, &self.albedo),
+            (Aov::Normal, &self.normal),
+            (Aov::Depth, &self.depth),
+            (Aov::Position, &self.position),
+            (Aov::Uv, &self.uv),
+        ]
+        .into_iter()
+        .filter_map(|(a, b)| Some((a, a.name().to_string(), b.as_ref()?)))
+        .collect();
+        if let Some([sum, square]) = &self.moments {
+            let v = Aov::Variance.name();
+            out.push((Aov::Variance, format!("{v}.sum"), sum));
+            out.push((Aov::Variance, format!("{v}.square"), square));
+        }
+        out
+    }
+
+    /// [`AuxSums::buffers`], to fill.
+    pub fn buffers_mut(&mut self) -> Vec<(Aov, String, &mut SumBuffer)> {
+        let mut out: Vec<(Aov, String, &mut SumBuffer)> = [
+            (Aov::Albedo, &mut self.albedo),
+            (Aov::Normal, &mut self.normal),
+            (Aov::Depth, &mut self.depth),
+            (Aov::Position, &mut self.position),
+            (Aov::Uv, &mut self.uv),
+        ]
+        .into_iter()
+        .filter_map(|(a, b)| Some((a, a.name().to_string(), b.as_mut()?)))
+        .collect();
+        if let Some([sum, square]) = &mut self.moments {
+            let v = Aov::Variance.name();
+            out.push((Aov::Variance, format!("{v}.sum"), sum));
+            out.push((Aov::Variance, format!("{v}.square"), square));
+        }
+        out
+    }
 }
 
 /// What a denoiser (and a compositor) is told about each pixel, averaged
