@@ -76,7 +76,7 @@ pub use math::warp::luminance;
 pub use render::digest::frame_digest;
 pub use render::{
     cost_maps, render, render_watched, Aov, Aux, AuxImages, AuxSums, CostMaps, Preview, Progress,
-    RenderResult, RenderStats, TimeSplit,
+    RenderResult, RenderStats, TimeShares, TimeSplit,
 };
 
 /// Internals for the repository's tests and benchmarks: the scene prepared
