@@ -440,7 +440,12 @@ fn weights<K: Kernel>(w: &mut [f32; LANES], k: K, p: f32, c0: u32, n: usize) -> 
         let c = Vec4::splat(c0 as f32);
         let (i_lo, i_hi) = (Vec4::new(0.0, 1.0, 2.0, 3.0), Vec4::new(4.0, 5.0, 6.0, 7.0));
         let lo = k.eval4(Vec4::splat(p) - (c + i_lo + 0.5));
-        let hi = k.eval4(Vec4::splat(p) - (c + i_hi + 0.5));
+        // Four columns are enough for a radius up to 1.5 (tent, Gaussian).
+        let hi = if n > 4 {
+            k.eval4(Vec4::splat(p) - (c + i_hi + 0.5))
+        } else {
+            Vec4::ZERO
+        };
         // Lanes from `n` on are beyond the footprint (outside the buffer,
         // or the filter's margin): weight 0, chosen lane by lane.
         let n = Vec4::splat(n as f32);
@@ -480,16 +485,12 @@ fn scaled(l: Vec3) -> [f64; 4] {
     [l.x as f64 * ONE, l.y as f64 * ONE, l.z as f64 * ONE, ONE]
 }
 
-/// The largest magnitude of `ls`'s contributions at weight 1 (NaN if one
-/// is NaN, which then fails every bound).
+/// A bound on the magnitudes of `ls`'s contributions at weight 1: their
+/// sum, which is at least the largest, and NaN if one is NaN (which then
+/// fails every bound).
 #[inline(always)]
 fn largest(ls: &[f64; 4]) -> f64 {
-    let m = ls[0].abs().max(ls[1].abs()).max(ls[2].abs()).max(ls[3]);
-    if ls.iter().any(|v| v.is_nan()) {
-        f64::NAN
-    } else {
-        m
-    }
+    ls[0].abs() + ls[1].abs() + ls[2].abs() + ls[3]
 }
 
 /// How a splat adds a row of taps (a sample's radiance, each with one
