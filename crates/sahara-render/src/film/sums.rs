@@ -338,6 +338,27 @@ mod tests {
     }
 
     #[test]
+    fn the_one_step_conversion_gives_the_general_bits() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut values = vec![
+            0.0, -0.0, 2047.999, -2047.999, 2048.0, -2048.0, 1e-300, -5e-324,
+        ];
+        for _ in 0..20_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            // Magnitudes from 2^-60 to 2^14, both signs, fractions of all kinds.
+            let m = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let e = (state % 75) as i32 - 60;
+            let v = m * (2.0f64).powi(e);
+            values.push(if state & 1 == 0 { v } else { -v });
+        }
+        for v in values {
+            assert_eq!(fixed(v), fixed_general(v), "{v:e}");
+        }
+    }
+
+    #[test]
     fn negative_estimates_become_zero_and_empty_pixels_black() {
         let mut p = PixelSum::default();
         assert_eq!(p.value(), Vec3::ZERO);
