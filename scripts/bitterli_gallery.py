@@ -263,21 +263,23 @@ def srgb8(x):
 def sheet(bitterli, scenes, work):
     from PIL import Image, ImageDraw
     os.makedirs(IMAGES, exist_ok=True)
-    print("| Sahara | Tungsten | scene | ratio R, G, B | block error median, 90 % |")
-    print("|---|---|---|---|---|")
+    print("| Sahara, Tungsten | scene | ratio R, G, B | block error median, 90 % |")
+    print("|---|---|---|---|")
     for scene in scenes:
         ref, w, h = held_size(bitterli, scene)
         img, _, _ = render(scene_file(bitterli, scene), w, h, GALLERY[scene]["spp"], TEST_SEED,
                            os.path.join(work, f"{scene}-sheet.exr"))
         ratio, p50, p90, _ = measures(img, ref)
-        gap, caption = 4, 14
+        gap, caption = 4, 28
         pic = Image.new("RGB", (2 * w + gap, h + caption), (255, 255, 255))
         pic.paste(Image.fromarray(srgb8(img)), (0, 0))
         pic.paste(Image.fromarray(srgb8(ref)), (w + gap, 0))
-        text = f"Sahara | Tungsten   ratio {ratio[0]:.3f} {ratio[1]:.3f} {ratio[2]:.3f}"
-        ImageDraw.Draw(pic).text((2, h + 2), text, fill=(0, 0, 0))
+        draw = ImageDraw.Draw(pic)
+        draw.text((2, h + 2), "Sahara", fill=(0, 0, 0))
+        draw.text((w + gap + 2, h + 2), "Tungsten", fill=(0, 0, 0))
+        draw.text((2, h + 15), f"mean ratio {ratio[0]:.3f}, {ratio[1]:.3f}, {ratio[2]:.3f}", fill=(0, 0, 0))
         pic.save(os.path.join(IMAGES, f"{scene}.png"), optimize=True)
-        print(f"| ![{scene}](images/bitterli/{scene}.png) | | `{scene}` | "
+        print(f"| ![{scene}](images/bitterli/{scene}.png) | `{scene}` | "
               f"{ratio[0]:.3f}, {ratio[1]:.3f}, {ratio[2]:.3f} | {p50:.3f}, {p90:.3f} |")
 
 
