@@ -19,6 +19,13 @@ tolerances:
 --survey  renders every scene of the checkout that Sahara reads (but the four of SKIPPED) at an eighth
           of Tungsten's size and --survey-spp samples, and prints, per scene: complete or the files
           missing, the licence, the warnings, the time, the mean ratio and the block errors.
+--causes  renders the variants of CAUSES (a scene's file with its missing textures replaced by the
+          copies in the checkout's Tungsten files, or by black or white, or with one of its lights
+          removed; written beside links to the scene's files in a temporary folder) at the survey's
+          settings, with the same measures: how much of a difference each explains.
+--mitsuba renders with Mitsuba 3 (`scalar_rgb`; pip install mitsuba==3.9.1) Bitterli's own Mitsuba
+          file of the Cornell box at 4 and at 64 bounces, and volumetric-caustic's pbrt file written
+          for Mitsuba with and without its medium, against Tungsten's render and Sahara's.
 
 The measures, as the test computes them: the image mean of each channel over Tungsten's (its ratio), and
 the block error of blocks.rs, |mean of Sahara - mean of Tungsten| / (mean of Tungsten + 0.02) for every
@@ -27,8 +34,9 @@ whole 8 x 8 block and channel, of which the median and the 90th percentile are h
 usage (numpy, OpenEXR and pillow; `cargo build --release` first; Sahara is $SAHARA, else
 target/release/sahara):
     python3 scripts/bitterli_gallery.py --bitterli DIR [--write] [--seeds 8] [--sheet]
-                                        [--survey] [--survey-spp 256] [--only SCENE,...]
-With none of --write, --seeds, --sheet, --survey it does the first three.
+                                        [--survey] [--survey-spp 256] [--causes] [--mitsuba]
+                                        [--only SCENE,...]
+With none of --write, --seeds, --sheet, --survey, --causes, --mitsuba it does the first three.
 """
 import argparse
 import os
@@ -76,6 +84,30 @@ NOT_HELD = {
     "hair-curl": "the file keeps one `curve` of the hair (the other `Import`s are commented out) and "
                  "Sahara skips curves: its image is black where Tungsten's shows a head of hair",
 }
+
+# Variants of scenes not held, each (scene, name, what to change): `tungsten:` replaces a texture by
+# the file of that name in the scene's `tungsten/textures/`, `black` / `white` by a plain image,
+# `no-sun` / `no-sky` removes the `distant` / the `infinite` light.
+CAUSES = [
+    ("bathroom", "Tungsten's textures", {"wood": "tungsten:wood.jpg", "wood2": "tungsten:wood2.jpg",
+                                         "marble": "tungsten:marble.jpg",
+                                         "wallpaper-2": "tungsten:wallpaper-2.jpg"}),
+    ("classroom", "Tungsten's blackboard", {"blackboard": "tungsten:blackboard.jpg"}),
+    ("classroom", "sun alone", "no-sky"),
+    ("classroom", "sky alone", "no-sun"),
+    ("dining-room", "picture black", {"picture3": "black"}),
+    ("dining-room", "picture white", {"picture3": "white"}),
+    ("dining-room", "sun alone", "no-sky"),
+    ("dining-room", "sky alone", "no-sun"),
+    ("kitchen", "wood black", {"wood": "black"}),
+    ("kitchen", "wood white", {"wood": "white"}),
+    ("staircase", "textures black", {n: "black" for n in ["Painting2", "Painting3", "Fabric", "WoodChair"]}),
+    ("staircase", "textures white", {n: "white" for n in ["Painting2", "Painting3", "Fabric", "WoodChair"]}),
+    ("staircase2", "wood black", {"wood5": "black"}),
+    ("staircase2", "wood white", {"wood5": "white"}),
+]
+SUN_RE = re.compile(r'LightSource "distant"\n(\s+"[^\n]*\n){3}')
+SKY_RE = re.compile(r'LightSource "infinite"\n\s+"string filename" "[^"]*"\n')
 
 FILE_RE = re.compile(r'"([^"\n]+\.(?:ply|obj|png|jpg|jpeg|exr|tga|pfm|hdr|pbrt|spd|bmp|gz))"', re.I)
 INCLUDE_RE = re.compile(r'^\s*(?:Include|Import)\s+"([^"]+)"', re.M)
@@ -304,6 +336,129 @@ def survey(bitterli, spp, only, work):
                   f"block error median {p50:.3f}, 90 % {p90:.3f}")
 
 
+def variant_file(bitterli, scene, change, work):
+    """The scene's file changed as `change` says, beside links to its files in `work`."""
+    src = os.path.dirname(scene_file(bitterli, scene))
+    folder = os.path.join(work, scene)
+    if not os.path.isdir(folder):
+        os.makedirs(folder)
+        for entry in os.listdir(src):
+            os.symlink(os.path.join(src, entry), os.path.join(folder, entry))
+    text = open(scene_file(bitterli, scene)).read()
+    if change == "no-sun":
+        changed = SUN_RE.sub("", text)
+    elif change == "no-sky":
+        changed = SKY_RE.sub("", text)
+    else:
+        from PIL import Image
+        changed = text
+        for name, by in change.items():
+            if by.startswith("tungsten:"):
+                path = os.path.join(bitterli, scene, "tungsten", "textures", by.split(":", 1)[1])
+            else:
+                path = os.path.join(work, f"{by}.png")
+                level = 0 if by == "black" else 255
+                Image.new("RGB", (4, 4), (level, level, level)).save(path)
+            changed = changed.replace(f'"textures/{name}.tga"', f'"{path}"')
+    assert changed != text, (scene, change)
+    path = os.path.join(folder, f"variant-{len(os.listdir(folder))}.pbrt")
+    open(path, "w").write(changed)
+    return path
+
+
+def causes(bitterli, spp, only, work):
+    for scene, name, change in CAUSES:
+        if only and scene not in only:
+            continue
+        ref = box_down(read_exr(os.path.join(bitterli, scene, "pbrt", "TungstenRender.exr")), 8)
+        h, w, _ = ref.shape
+        pbrt = variant_file(bitterli, scene, change, work)
+        img, dt, warnings = render(pbrt, w, h, spp, 1, os.path.join(work, "variant.exr"))
+        if img is None:
+            sys.exit(f"{scene}, {name}: Sahara failed: {warnings}")
+        ratio, p50, p90, _ = measures(img, ref)
+        print(f"{scene}, {name}: ratio {ratio[0]:.3f} {ratio[1]:.3f} {ratio[2]:.3f}, "
+              f"block error median {p50:.3f}, 90 % {p90:.3f} ({w} x {h}, {spp} spp, {dt:.0f} s)")
+
+
+def mitsuba_volumetric_caustic(mi, medium, spp, size):
+    """volumetric-caustic's pbrt file as a Mitsuba 3 scene: the Cornell box of 2 x 2 x 2 around a
+    glass sphere, lit by a 5 x 4 mm quad under the ceiling, seen through its open front, and filled
+    with a medium of sigma_s 1 and sigma_a 0 (a null-bsdf cube just inside the walls) if `medium`.
+    pbrt's `maxdepth 7` is Mitsuba's `max_depth` 8."""
+    T = mi.ScalarTransform4f
+
+    def diffuse(rgb):
+        return {"type": "twosided",
+                "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": rgb}}}
+    white = [0.725, 0.71, 0.68]
+    d = {
+        "type": "scene",
+        "integrator": {"type": "volpath" if medium else "path", "max_depth": 8},
+        "sensor": {"type": "perspective", "fov": 19.5, "fov_axis": "smaller",
+                   "to_world": T().look_at(origin=[0, 1, 7], target=[0, 1, 0], up=[0, 1, 0]),
+                   "sampler": {"type": "independent", "sample_count": spp},
+                   "film": {"type": "hdrfilm", "width": size, "height": size,
+                            "rfilter": {"type": "tent"}, "pixel_format": "rgb"}},
+        "floor": {"type": "rectangle", "to_world": T().rotate([1, 0, 0], -90), "bsdf": diffuse(white)},
+        "ceiling": {"type": "rectangle", "to_world": T().translate([0, 2, 0]).rotate([1, 0, 0], 90),
+                    "bsdf": diffuse(white)},
+        "back": {"type": "rectangle", "to_world": T().translate([0, 1, -1]), "bsdf": diffuse(white)},
+        "left": {"type": "rectangle", "to_world": T().translate([-1, 1, 0]).rotate([0, 1, 0], 90),
+                 "bsdf": diffuse([0.63, 0.065, 0.05])},
+        "right": {"type": "rectangle", "to_world": T().translate([1, 1, 0]).rotate([0, 1, 0], -90),
+                  "bsdf": diffuse([0.14, 0.45, 0.091])},
+        "light": {"type": "rectangle",
+                  "to_world": T().translate([-0.005, 1.98, -0.03]).rotate([1, 0, 0], 90)
+                  .scale([0.0025, 0.002, 1]),
+                  "emitter": {"type": "area",
+                              "radiance": {"type": "rgb", "value": [541126.75, 381971.8, 127323.94]}},
+                  "bsdf": diffuse([0, 0, 0])},
+    }
+    sphere = {"type": "sphere", "center": [-0.22827, 1.2, 0.152505], "radius": 0.3,
+              "bsdf": {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}}
+    if medium:
+        gas = {"type": "homogeneous", "albedo": {"type": "rgb", "value": [1, 1, 1]}, "sigma_t": 1.0}
+        e = 1e-4
+        d["gas"] = {"type": "cube", "to_world": T().translate([0, 1, 0]).scale([1 - e, 1 - e, 1 - e]),
+                    "bsdf": {"type": "null"}, "interior": gas}
+        sphere["exterior"] = gas
+        d["light"]["exterior"] = gas
+    d["sphere"] = sphere
+    return mi.load_dict(d)
+
+
+def mitsuba_checks(bitterli, work, spp=256):
+    import mitsuba as mi
+    mi.set_variant("scalar_rgb")
+
+    def line(label, img, ref):
+        ratio, p50, p90, _ = measures(img, ref)
+        print(f"  {label}: ratio {ratio[0]:.4f} {ratio[1]:.4f} {ratio[2]:.4f}, "
+              f"block error median {p50:.3f}, 90 % {p90:.3f}")
+
+    for scene in ["cornell-box", "volumetric-caustic"]:
+        ref = box_down(read_exr(os.path.join(bitterli, scene, "pbrt", "TungstenRender.exr")), 8)
+        h, w, _ = ref.shape
+        sahara, _, _ = render(scene_file(bitterli, scene), w, h, spp, 0, os.path.join(work, "s.exr"))
+        print(f"{scene}, {w} x {h}, {spp} spp:")
+        line("Sahara / Tungsten", sahara, ref)
+        if scene == "cornell-box":
+            xml = os.path.join(bitterli, scene, "mitsuba", "scene_v3.xml")
+            for depth in ["5", "65"]:
+                s = mi.load_file(xml, max_depth=depth, spp=str(spp), resx=str(w), resy=str(h))
+                img = np.asarray(mi.render(s, spp=spp), dtype=np.float64)[..., :3]
+                line(f"Mitsuba max_depth {depth} / Tungsten", img, ref)
+                line(f"Sahara / Mitsuba max_depth {depth}", sahara, img)
+        else:
+            for medium, mspp in [(False, spp), (True, 2 * spp)]:
+                img = mi.render(mitsuba_volumetric_caustic(mi, medium, mspp, w), spp=mspp)
+                img = np.asarray(img, dtype=np.float64)[..., :3]
+                name = "with its medium" if medium else "without a medium"
+                line(f"Mitsuba {name}, {mspp} spp / Tungsten", img, ref)
+                line(f"Sahara / Mitsuba {name}", sahara, img)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--bitterli", required=True, help="a checkout of the pbrt-v4 Bitterli scenes")
@@ -312,13 +467,15 @@ def main():
     ap.add_argument("--sheet", action="store_true", help="write the contact sheet")
     ap.add_argument("--survey", action="store_true", help="render every scene Sahara reads")
     ap.add_argument("--survey-spp", type=int, default=256)
+    ap.add_argument("--causes", action="store_true", help="render the variants of CAUSES")
+    ap.add_argument("--mitsuba", action="store_true", help="the checks with Mitsuba 3")
     ap.add_argument("--keep-mb", type=float, default=10.0,
                     help="largest scene (its files, MB) kept in the repository (default 10)")
     ap.add_argument("--only", default="", help="comma-separated scene names")
     args = ap.parse_args()
     only = [s for s in args.only.split(",") if s]
     scenes = [s for s in GALLERY if not only or s in only]
-    if not (args.write or args.seeds or args.sheet or args.survey):
+    if not (args.write or args.seeds or args.sheet or args.survey or args.causes or args.mitsuba):
         args.write, args.seeds, args.sheet = True, 8, True
     with tempfile.TemporaryDirectory() as work:
         if args.write:
@@ -329,6 +486,10 @@ def main():
             sheet(args.bitterli, scenes, work)
         if args.survey:
             survey(args.bitterli, args.survey_spp, only, work)
+        if args.causes:
+            causes(args.bitterli, args.survey_spp, only, work)
+        if args.mitsuba:
+            mitsuba_checks(args.bitterli, work)
 
 
 if __name__ == "__main__":
