@@ -324,7 +324,7 @@ def survey(bitterli, spp, only, work):
         ref = read_exr(os.path.join(bitterli, scene, "pbrt", "TungstenRender.exr"))
         ref = box_down(ref, 8)
         h, w, _ = ref.shape
-        img, dt, warnings = render(pbrt, w, h, spp, 1, os.path.join(work, f"{scene}-survey.exr"))
+        img, dt, warnings = render(pbrt, w, h, spp, TEST_SEED, os.path.join(work, f"{scene}-survey.exr"))
         lic = licence(os.path.dirname(pbrt)) or "none"
         state = "complete" if not missing else f"missing {len(missing)}: {', '.join(missing)}"
         print(f"== {scene}: {state}; licence {lic}; {w} x {h}, {spp} spp, {dt:.1f} s")
