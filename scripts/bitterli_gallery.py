@@ -1,0 +1,496 @@
+#!/usr/bin/env python3
+"""Benedikt Bitterli's scenes, as written for pbrt-v4, rendered by Sahara and held to Tungsten's renders.
+
+A checkout of the pbrt-v4 versions of Bitterli's rendering resources (--bitterli DIR) holds, for each
+scene, `<scene>/pbrt/scene-v4.pbrt`, its meshes and textures, its `LICENSE.txt`, and Tungsten's
+converged render `TungstenRender.exr`. The scenes of GALLERY are held by the Rust test
+`crates/sahara-formats/tests/formats/bitterli_gallery.rs`; this script makes its data and its
+tolerances:
+
+--write   copies each held scene's files (the .pbrt file(s), every mesh and image they name, and
+          LICENSE.txt) into crates/sahara-formats/tests/bitterli/<scene>/ when they total at most
+          --keep-mb (else the test reads the scene from $BITTERLI and skips without it), and writes
+          there `reference.exr`: Tungsten's render box-filtered down by the scene's factor (half floats).
+--seeds N renders each held scene with Sahara at the test's size and samples for seeds 1..N and prints
+          each measure's mean and standard deviation, and the test's table of cases with the bounds
+          mean +- 4 sigma (the test renders with seed 0, outside the measured ones).
+--sheet   renders each held scene with seed 0 and writes docs/images/bitterli/<scene>.png (Sahara's
+          image beside Tungsten's, with the measured ratio) and the table for docs/pbrt.md.
+--survey  renders every scene of the checkout that Sahara reads (but the four of SKIPPED) at an eighth
+          of Tungsten's size and --survey-spp samples, and prints, per scene: complete or the files
+          missing, the licence, the warnings, the time, the mean ratio and the block errors.
+--causes  renders the variants of CAUSES (a scene's file with its missing textures replaced by the
+          copies in the checkout's Tungsten files, or by black or white, or with one of its lights
+          removed; written beside links to the scene's files in a temporary folder) at the survey's
+          settings, with the same measures: how much of a difference each explains.
+--mitsuba renders with Mitsuba 3 (`scalar_rgb`; pip install mitsuba==3.9.1) Bitterli's own Mitsuba
+          file of the Cornell box at 4 and at 64 bounces, and volumetric-caustic's pbrt file written
+          for Mitsuba with and without its medium, against Tungsten's render and Sahara's.
+
+The measures, as the test computes them: the image mean of each channel over Tungsten's (its ratio), and
+the block error of blocks.rs, |mean of Sahara - mean of Tungsten| / (mean of Tungsten + 0.02) for every
+whole 8 x 8 block and channel, of which the median and the 90th percentile are held.
+
+usage (numpy, OpenEXR and pillow; `cargo build --release` first; Sahara is $SAHARA, else
+target/release/sahara):
+    python3 scripts/bitterli_gallery.py --bitterli DIR [--write] [--seeds 8] [--sheet]
+                                        [--survey] [--survey-spp 256] [--causes] [--mitsuba]
+                                        [--only SCENE,...]
+With none of --write, --seeds, --sheet, --survey, --causes, --mitsuba it does the first three.
+"""
+import argparse
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SAHARA = os.environ.get("SAHARA") or os.path.join(ROOT, "target", "release", "sahara")
+TEST_DATA = os.path.join(ROOT, "crates", "sahara-formats", "tests", "bitterli")
+IMAGES = os.path.join(ROOT, "docs", "images", "bitterli")
+BLOCK = 8
+TEST_SEED = 0
+
+# The held scenes: Tungsten's image is divided by `factor` on each side (an integer, so that the box
+# filter is exact and the aspect ratio kept), Sahara renders `spp` samples per pixel with the
+# integrator and depth the file asks for. `why` is the reason the ratio is what it is.
+GALLERY = {
+    "cornell-box": dict(
+        factor=8, spp=64,
+        why="the file asks for `maxdepth 4` where Tungsten traced 64 bounces: 3-4 % of the light, "
+            "most in red, is missing. Mitsuba 3 renders Bitterli's own Mitsuba file of the scene at "
+            "max_depth 5 (4 bounces) to the same ratio, and at 65 to Tungsten's within 0.01 %"),
+    "coffee": dict(
+        factor=8, spp=64,
+        why="nothing is approximated: the ratio is 1 within the noise"),
+    "volumetric-caustic": dict(
+        factor=8, spp=64,
+        why="the box is full of a scattering medium, which Sahara does not render: the image is the "
+            "box without it (as Mitsuba 3 renders that, block for block), and its mean is carried "
+            "by rare paths from the tiny light through the glass sphere, hence the wide bounds"),
+}
+
+# Scenes left to a separate comparison: their files and Tungsten's renders differ in ways measured
+# there.
+SKIPPED = {"veach-mis", "veach-ajar", "water-caustic", "veach-bidir"}
+
+# Scenes whose files are complete and read, but not held, and why.
+NOT_HELD = {
+    "hair-curl": "the file keeps one `curve` of the hair (the other `Import`s are commented out) and "
+                 "Sahara skips curves: its image is black where Tungsten's shows a head of hair",
+}
+
+# Variants of scenes not held, each (scene, name, what to change): `tungsten:` replaces a texture by
+# the file of that name in the scene's `tungsten/textures/`, `black` / `white` by a plain image,
+# `no-sun` / `no-sky` removes the `distant` / the `infinite` light.
+CAUSES = [
+    ("bathroom", "Tungsten's textures", {"wood": "tungsten:wood.jpg", "wood2": "tungsten:wood2.jpg",
+                                         "marble": "tungsten:marble.jpg",
+                                         "wallpaper-2": "tungsten:wallpaper-2.jpg"}),
+    ("classroom", "Tungsten's blackboard", {"blackboard": "tungsten:blackboard.jpg"}),
+    ("classroom", "sun alone", "no-sky"),
+    ("classroom", "sky alone", "no-sun"),
+    ("dining-room", "picture black", {"picture3": "black"}),
+    ("dining-room", "picture white", {"picture3": "white"}),
+    ("dining-room", "sun alone", "no-sky"),
+    ("dining-room", "sky alone", "no-sun"),
+    ("kitchen", "wood black", {"wood": "black"}),
+    ("kitchen", "wood white", {"wood": "white"}),
+    ("staircase", "textures black", {n: "black" for n in ["Painting2", "Painting3", "Fabric", "WoodChair"]}),
+    ("staircase", "textures white", {n: "white" for n in ["Painting2", "Painting3", "Fabric", "WoodChair"]}),
+    ("staircase2", "wood black", {"wood5": "black"}),
+    ("staircase2", "wood white", {"wood5": "white"}),
+]
+SUN_RE = re.compile(r'LightSource "distant"\n(\s+"[^\n]*\n){3}')
+SKY_RE = re.compile(r'LightSource "infinite"\n\s+"string filename" "[^"]*"\n')
+
+FILE_RE = re.compile(r'"([^"\n]+\.(?:ply|obj|png|jpg|jpeg|exr|tga|pfm|hdr|pbrt|spd|bmp|gz))"', re.I)
+INCLUDE_RE = re.compile(r'^\s*(?:Include|Import)\s+"([^"]+)"', re.M)
+FILM_RE = re.compile(r'Film\s+"[^"]*"\s*(?:#[^\n]*)?\s*"string filename"\s*\[?\s*"([^"]+)"')
+
+
+def strip_comments(text):
+    return "\n".join(line.split("#", 1)[0] for line in text.split("\n"))
+
+
+def references(pbrt):
+    """Every file `pbrt` names (and the files it includes name), relative to its folder: (present,
+    missing). The film's output name is not one."""
+    folder = os.path.dirname(pbrt)
+    present, missing, seen, todo = [], [], set(), [os.path.basename(pbrt)]
+    while todo:
+        rel = todo.pop()
+        text = open(os.path.join(folder, rel), errors="replace").read()
+        outputs = set(FILM_RE.findall(text))
+        text = strip_comments(text)
+        names = FILE_RE.findall(text) + INCLUDE_RE.findall(text)
+        for name in names:
+            if name in seen or name in outputs:
+                continue
+            seen.add(name)
+            if os.path.isfile(os.path.join(folder, name)):
+                present.append(name)
+                if name.endswith(".pbrt"):
+                    todo.append(name)
+            else:
+                missing.append(name)
+    return present, missing
+
+
+def licence(folder):
+    path = os.path.join(folder, "LICENSE.txt")
+    if not os.path.exists(path):
+        return None
+    text = open(path, errors="replace").read()
+    if "CC0" in text:
+        return "CC0"
+    if "CC-BY" in text:
+        return "CC-BY"
+    return None
+
+
+def read_exr(path):
+    import OpenEXR
+    with OpenEXR.File(path) as f:
+        ch = f.parts[0].channels
+        if "RGB" in ch:
+            return np.asarray(ch["RGB"].pixels, dtype=np.float64)[..., :3]
+        if "RGBA" in ch:
+            return np.asarray(ch["RGBA"].pixels, dtype=np.float64)[..., :3]
+        return np.stack([np.asarray(ch[c].pixels, dtype=np.float64) for c in "RGB"], -1)
+
+
+def write_exr(path, rgb):
+    import OpenEXR
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    OpenEXR.File(header, {"RGB": np.ascontiguousarray(rgb, dtype=np.float16)}).write(path)
+
+
+def box_down(img, k):
+    h, w, _ = img.shape
+    assert h % k == 0 and w % k == 0, f"{w} x {h} is not a multiple of {k}"
+    return img.reshape(h // k, k, w // k, k, 3).mean(axis=(1, 3))
+
+
+def measures(img, ref):
+    """(ratio per channel, block error median, block error 90th percentile), as the test has them."""
+    ratio = img.reshape(-1, 3).mean(0) / ref.reshape(-1, 3).mean(0)
+    h, w, _ = img.shape
+    hb, wb = h // BLOCK, w // BLOCK
+    a = img[:hb * BLOCK, :wb * BLOCK].reshape(hb, BLOCK, wb, BLOCK, 3).mean(axis=(1, 3))
+    b = ref[:hb * BLOCK, :wb * BLOCK].reshape(hb, BLOCK, wb, BLOCK, 3).mean(axis=(1, 3))
+    e = np.sort((np.abs(a - b) / (b + 0.02)).ravel())
+    return ratio, e[len(e) // 2], e[len(e) * 9 // 10], e
+
+
+def render(pbrt, w, h, spp, seed, out):
+    cmd = [SAHARA, "render", pbrt, "--width", str(w), "--height", str(h), "--spp", str(spp),
+           "--seed", str(seed), "-o", out]
+    t = time.time()
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    dt = time.time() - t
+    warnings = [line for line in r.stderr.splitlines() if line.startswith(("warning", "error"))]
+    if r.returncode != 0:
+        return None, dt, warnings
+    return read_exr(out), dt, warnings
+
+
+def scene_file(bitterli, scene):
+    return os.path.join(bitterli, scene, "pbrt", "scene-v4.pbrt")
+
+
+def held_size(bitterli, scene):
+    """(reference image, test width, height) of a held scene."""
+    k = GALLERY[scene]["factor"]
+    ref = box_down(read_exr(os.path.join(bitterli, scene, "pbrt", "TungstenRender.exr")), k)
+    # As stored (half floats), so that the measures here are the test's.
+    ref = ref.astype(np.float16).astype(np.float64)
+    return ref, ref.shape[1], ref.shape[0]
+
+
+def check_held(bitterli, scene):
+    pbrt = scene_file(bitterli, scene)
+    present, missing = references(pbrt)
+    if missing:
+        sys.exit(f"{scene}: held, but its files are incomplete: {missing}")
+    if licence(os.path.dirname(pbrt)) is None:
+        sys.exit(f"{scene}: held, but its licence does not allow redistribution")
+    return present
+
+
+def write(bitterli, scenes, keep_mb):
+    for scene in scenes:
+        present = check_held(bitterli, scene)
+        src = os.path.dirname(scene_file(bitterli, scene))
+        dst = os.path.join(TEST_DATA, scene)
+        if os.path.isdir(dst):
+            shutil.rmtree(dst)
+        os.makedirs(dst)
+        files = ["scene-v4.pbrt", "LICENSE.txt"] + present
+        size = sum(os.path.getsize(os.path.join(src, f)) for f in files)
+        kept = size <= keep_mb * 1e6
+        if kept:
+            for f in files:
+                os.makedirs(os.path.dirname(os.path.join(dst, f)), exist_ok=True)
+                shutil.copyfile(os.path.join(src, f), os.path.join(dst, f))
+        else:
+            shutil.copyfile(os.path.join(src, "LICENSE.txt"), os.path.join(dst, "LICENSE.txt"))
+        ref, w, h = held_size(bitterli, scene)
+        write_exr(os.path.join(dst, "reference.exr"), ref)
+        print(f"{scene}: {len(files)} files, {size / 1e6:.2f} MB, "
+              f"{'kept' if kept else 'not kept (read from $BITTERLI)'}; reference {w} x {h}")
+
+
+def spread(bitterli, scenes, seeds, work):
+    rows = []
+    for scene in scenes:
+        ref, w, h = held_size(bitterli, scene)
+        spp = GALLERY[scene]["spp"]
+        runs, times = [], []
+        for seed in list(range(1, seeds + 1)) + [TEST_SEED]:
+            img, dt, warnings = render(scene_file(bitterli, scene), w, h, spp, seed,
+                                       os.path.join(work, f"{scene}-{seed}.exr"))
+            if img is None:
+                sys.exit(f"{scene}: Sahara failed: {warnings}")
+            ratio, p50, p90, _ = measures(img, ref)
+            runs.append(np.array([*ratio, p50, p90]))
+            times.append(dt)
+        m = np.array(runs[:-1])
+        mean, sd = m.mean(0), m.std(0, ddof=1)
+        test = runs[-1]
+        inside = np.all(np.abs(test - mean) <= 4 * sd)
+        print(f"{scene}: {w} x {h}, {spp} spp, {seeds} seeds, {np.mean(times):.1f} s a render")
+        for i, name in enumerate(["ratio R", "ratio G", "ratio B", "block median", "block p90"]):
+            print(f"  {name:12s} mean {mean[i]:.4f}  sd {sd[i]:.4f}  bounds {mean[i] - 4 * sd[i]:.4f} .. "
+                  f"{mean[i] + 4 * sd[i]:.4f}  seed {TEST_SEED}: {test[i]:.4f}")
+        print(f"  seed {TEST_SEED} {'within' if inside else 'OUTSIDE'} the bounds")
+        kept = os.path.exists(os.path.join(TEST_DATA, scene, "scene-v4.pbrt"))
+        rows.append((scene, kept, w, h, spp, mean, 4 * sd))
+    print("\n// The test's table (bitterli_gallery.rs, CASES):")
+    for scene, kept, w, h, spp, mean, tol in rows:
+        why = GALLERY[scene]["why"]
+        print(f"    // {scene}: {why}.")
+        print("    Case {")
+        print(f'        scene: "{scene}",')
+        print(f"        kept: {'true' if kept else 'false'},")
+        print(f"        width: {w},\n        height: {h},\n        spp: {spp},")
+        print(f"        ratio: [{mean[0]:.4f}, {mean[1]:.4f}, {mean[2]:.4f}],")
+        print(f"        ratio_tol: [{tol[0]:.4f}, {tol[1]:.4f}, {tol[2]:.4f}],")
+        print(f"        block_p50: ({mean[3]:.4f}, {tol[3]:.4f}),")
+        print(f"        block_p90: ({mean[4]:.4f}, {tol[4]:.4f}),")
+        print("    },")
+
+
+def srgb8(x):
+    x = np.clip(x, 0.0, 1.0)
+    x = np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
+    return (x * 255 + 0.5).astype(np.uint8)
+
+
+def sheet(bitterli, scenes, work):
+    from PIL import Image, ImageDraw
+    os.makedirs(IMAGES, exist_ok=True)
+    print("| Sahara, Tungsten | scene | ratio R, G, B | block error median, 90 % |")
+    print("|---|---|---|---|")
+    for scene in scenes:
+        ref, w, h = held_size(bitterli, scene)
+        img, _, _ = render(scene_file(bitterli, scene), w, h, GALLERY[scene]["spp"], TEST_SEED,
+                           os.path.join(work, f"{scene}-sheet.exr"))
+        ratio, p50, p90, _ = measures(img, ref)
+        gap, caption = 4, 28
+        pic = Image.new("RGB", (2 * w + gap, h + caption), (255, 255, 255))
+        pic.paste(Image.fromarray(srgb8(img)), (0, 0))
+        pic.paste(Image.fromarray(srgb8(ref)), (w + gap, 0))
+        draw = ImageDraw.Draw(pic)
+        draw.text((2, h + 2), "Sahara", fill=(0, 0, 0))
+        draw.text((w + gap + 2, h + 2), "Tungsten", fill=(0, 0, 0))
+        draw.text((2, h + 15), f"mean ratio {ratio[0]:.3f}, {ratio[1]:.3f}, {ratio[2]:.3f}", fill=(0, 0, 0))
+        pic.save(os.path.join(IMAGES, f"{scene}.png"), optimize=True)
+        print(f"| ![{scene}](images/bitterli/{scene}.png) | `{scene}` | "
+              f"{ratio[0]:.3f}, {ratio[1]:.3f}, {ratio[2]:.3f} | {p50:.3f}, {p90:.3f} |")
+
+
+def survey(bitterli, spp, only, work):
+    for scene in sorted(os.listdir(bitterli)):
+        pbrt = scene_file(bitterli, scene)
+        if scene in SKIPPED or not os.path.exists(pbrt) or (only and scene not in only):
+            continue
+        present, missing = references(pbrt)
+        ref = read_exr(os.path.join(bitterli, scene, "pbrt", "TungstenRender.exr"))
+        ref = box_down(ref, 8)
+        h, w, _ = ref.shape
+        img, dt, warnings = render(pbrt, w, h, spp, TEST_SEED, os.path.join(work, f"{scene}-survey.exr"))
+        lic = licence(os.path.dirname(pbrt)) or "none"
+        state = "complete" if not missing else f"missing {len(missing)}: {', '.join(missing)}"
+        print(f"== {scene}: {state}; licence {lic}; {w} x {h}, {spp} spp, {dt:.1f} s")
+        for line in warnings:
+            print(f"   {line}")
+        if img is not None:
+            ratio, p50, p90, _ = measures(img, ref)
+            print(f"   ratio {ratio[0]:.3f} {ratio[1]:.3f} {ratio[2]:.3f}, "
+                  f"block error median {p50:.3f}, 90 % {p90:.3f}")
+
+
+def variant_file(bitterli, scene, change, work):
+    """The scene's file changed as `change` says, beside links to its files in `work`."""
+    src = os.path.dirname(scene_file(bitterli, scene))
+    folder = os.path.join(work, scene)
+    if not os.path.isdir(folder):
+        os.makedirs(folder)
+        for entry in os.listdir(src):
+            os.symlink(os.path.join(src, entry), os.path.join(folder, entry))
+    text = open(scene_file(bitterli, scene)).read()
+    if change == "no-sun":
+        changed = SUN_RE.sub("", text)
+    elif change == "no-sky":
+        changed = SKY_RE.sub("", text)
+    else:
+        from PIL import Image
+        changed = text
+        for name, by in change.items():
+            if by.startswith("tungsten:"):
+                path = os.path.join(bitterli, scene, "tungsten", "textures", by.split(":", 1)[1])
+            else:
+                path = os.path.join(work, f"{by}.png")
+                level = 0 if by == "black" else 255
+                Image.new("RGB", (4, 4), (level, level, level)).save(path)
+            changed = changed.replace(f'"textures/{name}.tga"', f'"{path}"')
+    assert changed != text, (scene, change)
+    path = os.path.join(folder, f"variant-{len(os.listdir(folder))}.pbrt")
+    open(path, "w").write(changed)
+    return path
+
+
+def causes(bitterli, spp, only, work):
+    for scene, name, change in CAUSES:
+        if only and scene not in only:
+            continue
+        ref = box_down(read_exr(os.path.join(bitterli, scene, "pbrt", "TungstenRender.exr")), 8)
+        h, w, _ = ref.shape
+        pbrt = variant_file(bitterli, scene, change, work)
+        img, dt, warnings = render(pbrt, w, h, spp, 1, os.path.join(work, "variant.exr"))
+        if img is None:
+            sys.exit(f"{scene}, {name}: Sahara failed: {warnings}")
+        ratio, p50, p90, _ = measures(img, ref)
+        print(f"{scene}, {name}: ratio {ratio[0]:.3f} {ratio[1]:.3f} {ratio[2]:.3f}, "
+              f"block error median {p50:.3f}, 90 % {p90:.3f} ({w} x {h}, {spp} spp, {dt:.0f} s)")
+
+
+def mitsuba_volumetric_caustic(mi, medium, spp, size):
+    """volumetric-caustic's pbrt file as a Mitsuba 3 scene: the Cornell box of 2 x 2 x 2 around a
+    glass sphere, lit by a 5 x 4 mm quad under the ceiling, seen through its open front, and filled
+    with a medium of sigma_s 1 and sigma_a 0 (a null-bsdf cube just inside the walls) if `medium`.
+    pbrt's `maxdepth 7` is Mitsuba's `max_depth` 8."""
+    T = mi.ScalarTransform4f
+
+    def diffuse(rgb):
+        return {"type": "twosided",
+                "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": rgb}}}
+    white = [0.725, 0.71, 0.68]
+    d = {
+        "type": "scene",
+        "integrator": {"type": "volpath" if medium else "path", "max_depth": 8},
+        "sensor": {"type": "perspective", "fov": 19.5, "fov_axis": "smaller",
+                   "to_world": T().look_at(origin=[0, 1, 7], target=[0, 1, 0], up=[0, 1, 0]),
+                   "sampler": {"type": "independent", "sample_count": spp},
+                   "film": {"type": "hdrfilm", "width": size, "height": size,
+                            "rfilter": {"type": "tent"}, "pixel_format": "rgb"}},
+        "floor": {"type": "rectangle", "to_world": T().rotate([1, 0, 0], -90), "bsdf": diffuse(white)},
+        "ceiling": {"type": "rectangle", "to_world": T().translate([0, 2, 0]).rotate([1, 0, 0], 90),
+                    "bsdf": diffuse(white)},
+        "back": {"type": "rectangle", "to_world": T().translate([0, 1, -1]), "bsdf": diffuse(white)},
+        "left": {"type": "rectangle", "to_world": T().translate([-1, 1, 0]).rotate([0, 1, 0], 90),
+                 "bsdf": diffuse([0.63, 0.065, 0.05])},
+        "right": {"type": "rectangle", "to_world": T().translate([1, 1, 0]).rotate([0, 1, 0], -90),
+                  "bsdf": diffuse([0.14, 0.45, 0.091])},
+        "light": {"type": "rectangle",
+                  "to_world": T().translate([-0.005, 1.98, -0.03]).rotate([1, 0, 0], 90)
+                  .scale([0.0025, 0.002, 1]),
+                  "emitter": {"type": "area",
+                              "radiance": {"type": "rgb", "value": [541126.75, 381971.8, 127323.94]}},
+                  "bsdf": diffuse([0, 0, 0])},
+    }
+    sphere = {"type": "sphere", "center": [-0.22827, 1.2, 0.152505], "radius": 0.3,
+              "bsdf": {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}}
+    if medium:
+        gas = {"type": "homogeneous", "albedo": {"type": "rgb", "value": [1, 1, 1]}, "sigma_t": 1.0}
+        e = 1e-4
+        d["gas"] = {"type": "cube", "to_world": T().translate([0, 1, 0]).scale([1 - e, 1 - e, 1 - e]),
+                    "bsdf": {"type": "null"}, "interior": gas}
+        sphere["exterior"] = gas
+        d["light"]["exterior"] = gas
+    d["sphere"] = sphere
+    return mi.load_dict(d)
+
+
+def mitsuba_checks(bitterli, work, spp=256):
+    import mitsuba as mi
+    mi.set_variant("scalar_rgb")
+
+    def line(label, img, ref):
+        ratio, p50, p90, _ = measures(img, ref)
+        print(f"  {label}: ratio {ratio[0]:.4f} {ratio[1]:.4f} {ratio[2]:.4f}, "
+              f"block error median {p50:.3f}, 90 % {p90:.3f}")
+
+    for scene in ["cornell-box", "volumetric-caustic"]:
+        ref = box_down(read_exr(os.path.join(bitterli, scene, "pbrt", "TungstenRender.exr")), 8)
+        h, w, _ = ref.shape
+        sahara, _, _ = render(scene_file(bitterli, scene), w, h, spp, 0, os.path.join(work, "s.exr"))
+        print(f"{scene}, {w} x {h}, {spp} spp:")
+        line("Sahara / Tungsten", sahara, ref)
+        if scene == "cornell-box":
+            xml = os.path.join(bitterli, scene, "mitsuba", "scene_v3.xml")
+            for depth in ["5", "65"]:
+                s = mi.load_file(xml, max_depth=depth, spp=str(spp), resx=str(w), resy=str(h))
+                img = np.asarray(mi.render(s, spp=spp), dtype=np.float64)[..., :3]
+                line(f"Mitsuba max_depth {depth} / Tungsten", img, ref)
+                line(f"Sahara / Mitsuba max_depth {depth}", sahara, img)
+        else:
+            for medium, mspp in [(False, spp), (True, 2 * spp)]:
+                img = mi.render(mitsuba_volumetric_caustic(mi, medium, mspp, w), spp=mspp)
+                img = np.asarray(img, dtype=np.float64)[..., :3]
+                name = "with its medium" if medium else "without a medium"
+                line(f"Mitsuba {name}, {mspp} spp / Tungsten", img, ref)
+                line(f"Sahara / Mitsuba {name}", sahara, img)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--bitterli", required=True, help="a checkout of the pbrt-v4 Bitterli scenes")
+    ap.add_argument("--write", action="store_true", help="write the test's files and references")
+    ap.add_argument("--seeds", type=int, default=0, help="measure the spread over seeds 1..N")
+    ap.add_argument("--sheet", action="store_true", help="write the contact sheet")
+    ap.add_argument("--survey", action="store_true", help="render every scene Sahara reads")
+    ap.add_argument("--survey-spp", type=int, default=256)
+    ap.add_argument("--causes", action="store_true", help="render the variants of CAUSES")
+    ap.add_argument("--mitsuba", action="store_true", help="the checks with Mitsuba 3")
+    ap.add_argument("--keep-mb", type=float, default=10.0,
+                    help="largest scene (its files, MB) kept in the repository (default 10)")
+    ap.add_argument("--only", default="", help="comma-separated scene names")
+    args = ap.parse_args()
+    only = [s for s in args.only.split(",") if s]
+    scenes = [s for s in GALLERY if not only or s in only]
+    if not (args.write or args.seeds or args.sheet or args.survey or args.causes or args.mitsuba):
+        args.write, args.seeds, args.sheet = True, 8, True
+    with tempfile.TemporaryDirectory() as work:
+        if args.write:
+            write(args.bitterli, scenes, args.keep_mb)
+        if args.seeds:
+            spread(args.bitterli, scenes, args.seeds, work)
+        if args.sheet:
+            sheet(args.bitterli, scenes, work)
+        if args.survey:
+            survey(args.bitterli, args.survey_spp, only, work)
+        if args.causes:
+            causes(args.bitterli, args.survey_spp, only, work)
+        if args.mitsuba:
+            mitsuba_checks(args.bitterli, work)
+
+
+if __name__ == "__main__":
+    main()
