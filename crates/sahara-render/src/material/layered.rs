@@ -272,6 +272,11 @@ impl Layered {
 
     /// Probability of sampling the specular lobe from `wo`.
     fn spec_probability(&self, wo: Vec3) -> f32 {
+        if self.terms.iter().all(Option::is_none) {
+            // A lone specular lobe (a conductor without the multiple
+            // scattering term): no albedo tables needed to choose it.
+            return 1.0;
+        }
         let spec = luminance(self.fresnel.albedo(&self.mf, wo.z, self.roughness)).max(0.0);
         let mut rest = 0.0;
         for t in self.terms.iter().flatten() {

@@ -111,19 +111,7 @@ impl Microfacet {
                 let tan2 = ((1.0 - c2) / c2).max(0.0);
                 0.5 * (-1.0 + (1.0 + self.alpha * self.alpha * tan2).sqrt())
             }
-            Distribution::Beckmann => {
-                let tan2 = (w.x * w.x + w.y * w.y) / c2;
-                if tan2 == 0.0 {
-                    return 0.0;
-                }
-                // a = cot(theta) / alpha; Lambda = (erf(a) - 1) / 2 +
-                // exp(-a^2) / (2 a sqrt(pi)), in f64: the two terms cancel
-                // for large a.
-                let a = 1.0 / (self.alpha as f64 * (tan2 as f64).sqrt());
-                let l = 0.5 * (libm::erf(a) - 1.0)
-                    + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt());
-                l.max(0.0) as f32
-            }
+            Distribution::Beckmann => beckmann_lambda(self.alpha, (w.x * w.x + w.y * w.y) / c2),
         }
     }
 
@@ -151,6 +139,7 @@ impl Microfacet {
 
     /// A microfacet normal drawn from the visible normals seen from `wo`
     /// (`wo.z > 0`).
+    #[inline]
     pub fn sample_visible(&self, wo: Vec3, u: Vec2) -> Vec3 {
         match self.distribution {
             Distribution::Ggx => self.sample_visible_ggx(wo, u),
@@ -160,6 +149,7 @@ impl Microfacet {
 
     /// GGX: stretch to the unit-roughness configuration, sample the
     /// projected hemisphere there, unstretch.
+    #[inline]
     fn sample_visible_ggx(&self, wo: Vec3, u: Vec2) -> Vec3 {
         let a = self.alpha;
         let vh = Vec3::new(a * wo.x, a * wo.y, wo.z).normalize();
@@ -201,6 +191,20 @@ impl Microfacet {
         let (xr, yr) = (cos_p * x - sin_p * y, sin_p * x + cos_p * y);
         Vec3::new(-a * xr, -a * yr, 1.0).normalize()
     }
+}
+
+/// Beckmann's Smith Lambda for a direction of `tan^2 theta` = `tan2`:
+/// with `a = cot(theta) / alpha`, `(erf(a) - 1) / 2 + exp(-a^2) / (2 a
+/// sqrt(pi))`, in f64 (the two terms cancel for large a). Kept out of line
+/// so that GGX's Lambda, beside it, stays small enough to inline.
+#[inline(never)]
+fn beckmann_lambda(alpha: f32, tan2: f32) -> f32 {
+    if tan2 == 0.0 {
+        return 0.0;
+    }
+    let a = 1.0 / (alpha as f64 * (tan2 as f64).sqrt());
+    let l = 0.5 * (libm::erf(a) - 1.0) + (-a * a).exp() / (2.0 * a * std::f64::consts::PI.sqrt());
+    l.max(0.0) as f32
 }
 
 /// The slope `x` along the incident azimuth of a visible microfacet of the
