@@ -25,51 +25,26 @@ use sahara_kd::{Aabb, BuildParams, KdTree, Primitive, Ray, Triangle};
 
 /// Inner nodes visited, inner nodes before the first leaf, non-empty leaves
 /// visited; with `tight`, nodes whose bounds the ray misses are skipped.
-fn walk(tree: &KdTree, tight: Option<&[Aabb]>, ray: &Ray, tmax: f32) -> Option<(u32, u32, u32)> {
-    let nodes = tree.nodes();
+fn walk(tree: &KdTree, tight: Option<&[Aabb]>, ray: &Ray, tmax: f32) -> (u32, u32, u32) {
     let inv = Vec3::ONE / ray.dir;
-    let (t0, t1) = tree
-        .bounds()
-        .intersect_ray(ray.origin, inv, ray.tmin, tmax)?;
     let (mut inner, mut descent, mut leaves, mut seen_leaf) = (0, 0, 0, false);
-    let mut todo = vec![(0u32, t0, t1)];
-    while let Some((i, a, b)) = todo.pop() {
-        let n = &nodes[i as usize];
+    sahara_bench::walk::front_to_back(tree, ray, tmax, |i, n, a, b| {
         if let Some(tight) = tight {
             let tb = &tight[i as usize];
             if tb.is_empty() || tb.intersect_ray(ray.origin, inv, a, b).is_none() {
-                continue;
+                return false;
             }
         }
         if n.is_leaf() {
             seen_leaf = true;
             leaves += (n.leaf_count() > 0) as u32;
-            continue;
-        }
-        inner += 1;
-        descent += (!seen_leaf) as u32;
-        let axis = n.axis();
-        let (o, d) = (ray.origin[axis], ray.dir[axis]);
-        let t = (n.split() - o) * inv[axis];
-        let below_first = o < n.split() || (o == n.split() && d <= 0.0);
-        let (near, far) = if below_first {
-            (i + 1, n.above_child())
         } else {
-            (n.above_child(), i + 1)
-        };
-        if t.is_nan() {
-            todo.push((far, a, b));
-            todo.push((near, a, b));
-        } else if t > b || t <= 0.0 {
-            todo.push((near, a, b));
-        } else if t < a {
-            todo.push((far, a, b));
-        } else {
-            todo.push((far, t, b));
-            todo.push((near, a, t));
+            inner += 1;
+            descent += (!seen_leaf) as u32;
         }
-    }
-    Some((inner, descent, leaves))
+        true
+    });
+    (inner, descent, leaves)
 }
 
 fn main() {
@@ -115,12 +90,18 @@ fn main() {
     let (mut n, mut plain, mut culled) = (0u64, [0u64; 3], [0u64; 3]);
     for ray in &rays {
         let tmax = tree.closest_hit(ray).map_or(ray.tmax, |h| h.t);
-        let (Some(a), Some(b)) = (
+        let inv = Vec3::ONE / ray.dir;
+        if tree
+            .bounds()
+            .intersect_ray(ray.origin, inv, ray.tmin, tmax)
+            .is_none()
+        {
+            continue;
+        }
+        let (a, b) = (
             walk(&tree, None, ray, tmax),
             walk(&tree, Some(&tight), ray, tmax),
-        ) else {
-            continue;
-        };
+        );
         n += 1;
         for (s, v) in plain.iter_mut().zip([a.0, a.1, a.2]) {
             *s += v as u64;
