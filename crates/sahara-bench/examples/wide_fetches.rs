@@ -19,36 +19,12 @@
 use std::collections::HashSet;
 use std::path::Path;
 
+use sahara_bench::walk::heap;
 use sahara_kd::{Aabb, BuildParams, KdTree, Node, Triangle};
 
 fn area(b: &Aabb) -> f32 {
     let d = b.max - b.min;
     2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
-}
-
-/// The wide node of every inner node (leaves: `u32::MAX`), grouping each
-/// wide node's first `levels` binary levels.
-fn heap(nodes: &[Node], levels: u32) -> Vec<u32> {
-    let mut of = vec![u32::MAX; nodes.len()];
-    let (mut count, mut roots) = (0, vec![0u32]);
-    while let Some(root) = roots.pop() {
-        let mut todo = vec![(root, 0)];
-        while let Some((i, depth)) = todo.pop() {
-            let n = &nodes[i as usize];
-            if n.is_leaf() {
-                continue;
-            }
-            if depth == levels {
-                roots.push(i);
-                continue;
-            }
-            of[i as usize] = count;
-            todo.push((i + 1, depth + 1));
-            todo.push((n.above_child(), depth + 1));
-        }
-        count += 1;
-    }
-    of
 }
 
 /// The wide node of every inner node, each wide node a treelet of up to

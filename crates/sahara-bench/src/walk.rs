@@ -50,3 +50,29 @@ pub fn front_to_back(
         }
     }
 }
+
+/// The wide node of every inner node of `nodes` (leaves: `u32::MAX`) when
+/// each wide node holds `levels` whole binary levels below its root, as
+/// the tree's own wide nodes hold 3.
+pub fn heap(nodes: &[Node], levels: u32) -> Vec<u32> {
+    let mut of = vec![u32::MAX; nodes.len()];
+    let (mut count, mut roots) = (0, vec![0u32]);
+    while let Some(root) = roots.pop() {
+        let mut todo = vec![(root, 0)];
+        while let Some((i, depth)) = todo.pop() {
+            let n = &nodes[i as usize];
+            if n.is_leaf() {
+                continue;
+            }
+            if depth == levels {
+                roots.push(i);
+                continue;
+            }
+            of[i as usize] = count;
+            todo.push((i + 1, depth + 1));
+            todo.push((n.above_child(), depth + 1));
+        }
+        count += 1;
+    }
+    of
+}
