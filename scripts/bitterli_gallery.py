@@ -73,10 +73,44 @@ GALLERY = {
         why="the box is full of a scattering medium, which Sahara does not render: the image is the "
             "box without it (as Mitsuba 3 renders that, block for block), and its mean is carried "
             "by rare paths from the tiny light through the glass sphere, hence the wide bounds"),
+    "veach-ajar": dict(
+        factor=16, spp=64,
+        # The file names two images that the collection does not have; Sahara reads each as grey.
+        missing=["textures/landscape-with-a-lake.tga", "textures/Good Textures_005844.tga"],
+        why="the floor of the file is the bare rough metal, where Tungsten's (as Bitterli's own "
+            "Mitsuba file of the scene says) scales its reflection by a checkerboard of 0.8 and 0.2: "
+            "Mitsuba 3 renders the file to Sahara's image (Sahara / Mitsuba 0.997, 1.002, 1.004) and, "
+            "with that checkerboard added, to 1.01, 1.04, 1.09 of Tungsten's with block median 0.08. "
+            "The rest is the two missing images (grey here; black gives 0.94-0.98, white 1.15-1.27 "
+            "in Mitsuba) and `maxdepth 13` (64 bounces add 2 %). Path tracing at 64 samples leaves "
+            "fireflies, hence the bounds"),
+    "water-caustic": dict(
+        factor=8, spp=32,
+        # The light seen directly, 5 x 4 mm at a radiance of 5.4e5, covers half of one pixel of
+        # Tungsten's 1024 x 1024 image (and holds infinity there, out of the half floats' range):
+        # these pixels of Tungsten's size (x0, x1, y0, y1, ends excluded; the test's pixel of the
+        # light and those around it) are left out of every measure, in both images.
+        mask=(496, 520, 72, 96),
+        why="the light seen directly (0.07 of a pixel at a radiance of 5.4e5: half of the image's "
+            "red mean, found by a sample or not, and infinity in Tungsten's half floats) is left "
+            "out of the measures. Tungsten's image also shows the light through the waves of the "
+            "water (light, refraction, refraction, camera) in some 30 pixels, 7-9 % of the rest of "
+            "its mean; Sahara's camera paths carry the same light there (17300 against 16300 in "
+            "red, `distribution` at 4096 samples on that window of the full size), but a render "
+            "at this size finds it once in some 65 (seed 4 of those measured) and then adds about 4 "
+            "to the ratio: no bound on the ratio, the blocks hold the scene. Without those spots the image is 1.06, 1.02, "
+            "0.98 of Tungsten's; without the water, Sahara's sppm renders the box as Mitsuba 3 "
+            "does (0.998, 1.000, 0.999)"),
+    "veach-bidir": dict(
+        factor=16, spp=32,
+        why="Mitsuba 3's path tracer renders the file to Sahara's image (Sahara / Mitsuba 1.004, "
+            "1.004, 1.003, block median 0.011 at 256 samples of Sahara's bdpt), and Mitsuba's image "
+            "is 1.010, 1.006, 1.002 of Tungsten's at `maxdepth 7` as at 64 bounces: the file and "
+            "Tungsten's scene differ by 1 %"),
 }
 
-# Scenes left to a separate comparison: their files and Tungsten's renders differ in ways measured
-# there.
+# Scenes left out of the survey: veach-mis, whose file and Tungsten's scene differ in ways measured
+# apart, and the held scenes made for other integrators than path tracing, measured by --seeds.
 SKIPPED = {"veach-mis", "veach-ajar", "water-caustic", "veach-bidir"}
 
 # Scenes whose files are complete and read, but not held, and why.
@@ -177,8 +211,23 @@ def box_down(img, k):
     return img.reshape(h // k, k, w // k, k, 3).mean(axis=(1, 3))
 
 
-def measures(img, ref):
-    """(ratio per channel, block error median, block error 90th percentile), as the test has them."""
+def test_mask(scene):
+    """The pixels of the test's image left out of the measures, (x0, x1, y0, y1) with the ends
+    excluded, or None: the scene's `mask` in Tungsten's pixels divided by its factor."""
+    m = GALLERY[scene].get("mask")
+    if m is None:
+        return None
+    k = GALLERY[scene]["factor"]
+    return (m[0] // k, -(-m[1] // k), m[2] // k, -(-m[3] // k))
+
+
+def measures(img, ref, mask=None):
+    """(ratio per channel, block error median, block error 90th percentile), as the test has them;
+    the pixels of `mask` (x0, x1, y0, y1) are zero in both images."""
+    if mask is not None:
+        img, ref = img.copy(), ref.copy()
+        for a in (img, ref):
+            a[mask[2]:mask[3], mask[0]:mask[1]] = 0.0
     ratio = img.reshape(-1, 3).mean(0) / ref.reshape(-1, 3).mean(0)
     h, w, _ = img.shape
     hb, wb = h // BLOCK, w // BLOCK
@@ -216,6 +265,7 @@ def held_size(bitterli, scene):
 def check_held(bitterli, scene):
     pbrt = scene_file(bitterli, scene)
     present, missing = references(pbrt)
+    missing = [f for f in missing if f not in GALLERY[scene].get("missing", [])]
     if missing:
         sys.exit(f"{scene}: held, but its files are incomplete: {missing}")
     if licence(os.path.dirname(pbrt)) is None:
@@ -257,7 +307,7 @@ def spread(bitterli, scenes, seeds, work):
                                        os.path.join(work, f"{scene}-{seed}.exr"))
             if img is None:
                 sys.exit(f"{scene}: Sahara failed: {warnings}")
-            ratio, p50, p90, _ = measures(img, ref)
+            ratio, p50, p90, _ = measures(img, ref, test_mask(scene))
             runs.append(np.array([*ratio, p50, p90]))
             times.append(dt)
         m = np.array(runs[:-1])
@@ -279,6 +329,8 @@ def spread(bitterli, scenes, seeds, work):
         print(f'        scene: "{scene}",')
         print(f"        kept: {'true' if kept else 'false'},")
         print(f"        width: {w},\n        height: {h},\n        spp: {spp},")
+        mask = test_mask(scene)
+        print(f"        mask: {'None' if mask is None else f'Some({list(mask)})'},")
         print(f"        ratio: [{mean[0]:.4f}, {mean[1]:.4f}, {mean[2]:.4f}],")
         print(f"        ratio_tol: [{tol[0]:.4f}, {tol[1]:.4f}, {tol[2]:.4f}],")
         print(f"        block_p50: ({mean[3]:.4f}, {tol[3]:.4f}),")
@@ -301,7 +353,7 @@ def sheet(bitterli, scenes, work):
         ref, w, h = held_size(bitterli, scene)
         img, _, _ = render(scene_file(bitterli, scene), w, h, GALLERY[scene]["spp"], TEST_SEED,
                            os.path.join(work, f"{scene}-sheet.exr"))
-        ratio, p50, p90, _ = measures(img, ref)
+        ratio, p50, p90, _ = measures(img, ref, test_mask(scene))
         gap, caption = 4, 28
         pic = Image.new("RGB", (2 * w + gap, h + caption), (255, 255, 255))
         pic.paste(Image.fromarray(srgb8(img)), (0, 0))
