@@ -98,9 +98,9 @@ GALLERY = {
         # these pixels of Tungsten's size (x0, x1, y0, y1, ends excluded; the test's pixel of the
         # light and those around it) are left out of every measure, in both images.
         mask=(496, 520, 72, 96),
-        why="the light seen directly (0.07 of a pixel at a radiance of 5.4e5: half of the image's "
-            "red mean, found by a sample or not, and infinity in Tungsten's half floats) is left "
-            "out of the measures. Tungsten's image also shows the light through the waves of the "
+        why="the light seen directly (0.008 of a pixel at a radiance of 5.4e5: half of the "
+            "image's red mean, found by a sample or not, and infinity in Tungsten's half floats) is "
+            "left out of the measures. Tungsten's image also shows the light through the waves of the "
             "water (light, refraction, refraction, camera) in some 30 pixels, 7-9 % of the rest of "
             "its mean; Sahara's camera paths carry the same light there (17300 against 16300 in "
             "red, `distribution` at 4096 samples on that window of the full size), but a render "
@@ -362,7 +362,8 @@ def sheet(bitterli, scenes, work):
                            os.path.join(work, f"{scene}-sheet.exr"))
         ratio, p50, p90, _ = measures(img, ref, test_mask(scene))
         gap, caption = 4, 28
-        pic = Image.new("RGB", (2 * w + gap, h + caption), (255, 255, 255))
+        # At least as wide as the caption.
+        pic = Image.new("RGB", (max(2 * w + gap, 176), h + caption), (255, 255, 255))
         pic.paste(Image.fromarray(srgb8(img)), (0, 0))
         pic.paste(Image.fromarray(srgb8(ref)), (w + gap, 0))
         draw = ImageDraw.Draw(pic)

@@ -133,7 +133,7 @@ const CASES: [Case; 6] = [
         block_p50: (0.5856, 0.2054),
         block_p90: (1.3824, 0.4295),
     },
-    // water-caustic: the light seen directly (0.07 of a pixel at a radiance
+    // water-caustic: the light seen directly (0.008 of a pixel at a radiance
     // of 5.4e5: half of the image's red mean, found by a sample or not, and
     // infinity in Tungsten's half floats) is masked out. Tungsten's image
     // also shows the light through the waves of the water (light,
