@@ -115,6 +115,27 @@ def cases():
             two({"type": "principled", "base_color": rgb((0.9, 0.6, 0.3)), "metallic": 1.0, "roughness": r,
                  "specular": 0.5}),
             "sphere")
+    # Beckmann, Mitsuba's default distribution for its rough bsdfs: a metal on the sphere and on the plate
+    # (the small, bright highlights show the lobe's shape), rough glass, and the coated diffuse.
+    for a in (0.01, 0.05, 0.3):
+        tag = f"{a:g}".replace(".", "p")
+        gold = (['type = "conductor"', f"eta = {list(GOLD_ETA)}", f"k = {list(GOLD_K)}",
+                 "multiple_scattering = false", 'distribution = "beckmann"', f"roughness = {math.sqrt(a)!r}"],
+                two({"type": "roughconductor", "distribution": "beckmann", "alpha": a,
+                     "eta": rgb(GOLD_ETA), "k": rgb(GOLD_K)}))
+        out[f"beckmann_gold_{tag}"] = (*gold, "sphere")
+        if a == 0.01:
+            out[f"beckmann_gold_plate_{tag}"] = (*gold, "plate")
+    out["beckmann_rough_glass_0p3"] = (
+        ['type = "rough_dielectric"', "ior = 1.5", 'distribution = "beckmann"', f"roughness = {math.sqrt(0.3)!r}"],
+        {"type": "roughdielectric", "distribution": "beckmann", "alpha": 0.3, "int_ior": 1.5, "ext_ior": 1.0},
+        "sphere")
+    out["beckmann_coated_0p05"] = (
+        ['type = "coated_diffuse"', "albedo = [0.2, 0.45, 0.7]", "ior = 1.5", 'distribution = "beckmann"',
+         f"roughness = {math.sqrt(0.05)!r}"],
+        two({"type": "roughplastic", "distribution": "beckmann", "alpha": 0.05, "int_ior": 1.5, "ext_ior": 1.0,
+             "diffuse_reflectance": rgb((0.2, 0.45, 0.7)), "nonlinear": True}),
+        "sphere")
     return out
 
 

@@ -52,7 +52,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Affine2, Vec2, Vec3};
-use sahara_render::{AlphaMode, Bsdf, Material, Texture};
+use sahara_render::{AlphaMode, Bsdf, Distribution, Material, Texture};
 use sahara_render::{Channel, Encoding, ScalarMap, TextureMap, Wrap};
 use sahara_render::{Clearcoat, NormalMap, OcclusionMap};
 
@@ -203,6 +203,7 @@ pub fn mtl_bsdf(m: &MtlMaterial) -> Bsdf {
         Bsdf::Conductor {
             color: ks,
             roughness: phong_roughness(m.ns),
+            distribution: Distribution::Ggx,
         }
     } else {
         Bsdf::Diffuse { albedo: kd }
@@ -254,7 +255,11 @@ pub fn gltf_bsdf(m: &GltfMaterial) -> Bsdf {
         return if m.thickness.is_nan() || m.thickness <= 0.0 {
             Bsdf::ThinDielectric { ior }
         } else if roughness > 0.0 {
-            Bsdf::RoughDielectric { ior, roughness }
+            Bsdf::RoughDielectric {
+                ior,
+                roughness,
+                distribution: Distribution::Ggx,
+            }
         } else {
             Bsdf::Dielectric { ior }
         };

@@ -63,7 +63,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
-use sahara_render::{Filter, Integrator, SamplerKind, Shape, ToneMap};
+use sahara_render::{Distribution, Filter, Integrator, SamplerKind, Shape, ToneMap};
 
 use crate::FormatError;
 
@@ -143,16 +143,19 @@ pub enum MaterialKind {
         /// Texture file multiplying `albedo` (resolved; exists).
         texture: Option<PathBuf>,
     },
-    /// Rough metal (`type = "conductor"` or `"glossy"`): GGX with Schlick Fresnel.
+    /// Rough metal (`type = "conductor"` or `"glossy"`): microfacets with
+    /// Schlick Fresnel.
     Conductor {
         /// Reflectance at normal incidence, in [0, 1].
         color: Vec3,
         /// Perceptual roughness in [0, 1].
         roughness: f32,
+        /// `distribution` (default GGX).
+        distribution: Distribution,
     },
     /// A metal given by its complex index of refraction (`type =
-    /// "conductor"` with `metal = "gold"` or `eta` and `k`): GGX with the
-    /// exact conductor Fresnel term.
+    /// "conductor"` with `metal = "gold"` or `eta` and `k`): microfacets
+    /// with the exact conductor Fresnel term.
     ComplexConductor {
         /// Real part of the index per RGB channel (> 0).
         eta: Vec3,
@@ -160,6 +163,8 @@ pub enum MaterialKind {
         k: Vec3,
         /// Perceptual roughness in [0, 1].
         roughness: f32,
+        /// `distribution` (default GGX).
+        distribution: Distribution,
         /// `multiple_scattering` (default true): add the light that
         /// bounces between microfacets.
         multiple_scattering: bool,
@@ -191,6 +196,8 @@ pub enum MaterialKind {
         ior: f32,
         /// Perceptual roughness of the coat in [0, 1] (default 0.1).
         roughness: f32,
+        /// `distribution` of the coat (default GGX).
+        distribution: Distribution,
     },
     /// A thin pane of glass.
     ThinDielectric {
@@ -213,6 +220,8 @@ pub enum MaterialKind {
         ior: f32,
         /// Perceptual roughness in [0, 1].
         roughness: f32,
+        /// `distribution` (default GGX).
+        distribution: Distribution,
     },
     /// A light-emitting surface that also reflects diffusely with `albedo`
     /// (default 0: black but for its emission).

@@ -167,11 +167,13 @@ fn material_kind_of(m: &MaterialSpec) -> Material {
             eta,
             k,
             roughness,
+            distribution,
             multiple_scattering,
         } => Material::new(Bsdf::ComplexConductor {
             eta: *eta,
             k: *k,
             roughness: *roughness,
+            distribution: *distribution,
             multiple_scattering: *multiple_scattering,
         }),
         MaterialKind::MetallicRoughness {
@@ -194,18 +196,36 @@ fn material_kind_of(m: &MaterialSpec) -> Material {
             albedo,
             ior,
             roughness,
+            distribution,
             ..
         } => Material::new(Bsdf::CoatedDiffuse {
             albedo: *albedo,
             ior: *ior,
             roughness: *roughness,
+            distribution: *distribution,
         }),
         MaterialKind::ThinDielectric { ior } => Material::new(Bsdf::ThinDielectric { ior: *ior }),
         MaterialKind::Diffuse { albedo, .. } => Material::diffuse(*albedo),
-        MaterialKind::Conductor { color, roughness } => Material::conductor(*color, *roughness),
+        MaterialKind::Conductor {
+            color,
+            roughness,
+            distribution,
+        } => Material::new(Bsdf::Conductor {
+            color: *color,
+            roughness: *roughness,
+            distribution: *distribution,
+        }),
         MaterialKind::Mirror { color } => Material::mirror(*color),
         MaterialKind::Dielectric { ior } => Material::glass(*ior),
-        MaterialKind::RoughDielectric { ior, roughness } => Material::rough_glass(*ior, *roughness),
+        MaterialKind::RoughDielectric {
+            ior,
+            roughness,
+            distribution,
+        } => Material::new(Bsdf::RoughDielectric {
+            ior: *ior,
+            roughness: *roughness,
+            distribution: *distribution,
+        }),
         MaterialKind::Emission {
             radiance,
             two_sided,

@@ -51,8 +51,8 @@ pub use scene::{Scene, ShapeInstance};
 pub use light::environment::{coordinates as environment_uv, direction as environment_direction};
 pub use light::{Environment, Light};
 pub use material::{
-    fresnel, metals, AlphaMode, Bsdf, Clearcoat, Material, MaterialTextures, NormalMap,
-    OcclusionMap,
+    fresnel, metals, AlphaMode, Bsdf, Clearcoat, Distribution, Material, MaterialTextures,
+    NormalMap, OcclusionMap,
 };
 pub use texture::footprint::UvFootprint;
 pub use texture::{

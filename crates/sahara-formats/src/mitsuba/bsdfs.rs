@@ -4,10 +4,10 @@
 //! | Mitsuba | Sahara | lost (warned) |
 //! |---|---|---|
 //! | `diffuse` | diffuse | |
-//! | `conductor`, `roughconductor` (`material`: every preset Mitsuba ships, see [`super::metals`]; `eta`, `k`, `specular_reflectance`) | complex-IOR conductor, scattering once between microfacets as Mitsuba's does, tinted by `specular_reflectance` | Beckmann (GGX of the same alpha), anisotropy (the mean alpha), textured `eta` / `k` |
-//! | `dielectric`, `roughdielectric` (`int_ior`, `ext_ior`) | glass / rough glass of index `int_ior / ext_ior` | tinted `specular_reflectance` / `specular_transmittance`; Beckmann |
+//! | `conductor`, `roughconductor` (`material`: every preset Mitsuba ships, see [`super::metals`]; `eta`, `k`, `specular_reflectance`; `distribution` `beckmann` (the default) or `ggx`) | complex-IOR conductor, scattering once between microfacets as Mitsuba's does, tinted by `specular_reflectance` | anisotropy (the mean alpha), textured `eta` / `k` |
+//! | `dielectric`, `roughdielectric` (`int_ior`, `ext_ior`, `distribution`) | glass / rough glass of index `int_ior / ext_ior` | tinted `specular_reflectance` / `specular_transmittance` |
 //! | `thindielectric` | thin dielectric | |
-//! | `plastic`, `roughplastic` | coated diffuse: a dielectric coat of index `int_ior / ext_ior` over a base whose albedo gives Mitsuba's diffuse light (`nonlinear` false: `diffuse_reflectance / (1 - F_i)`; true: as given) | a `specular_reflectance` other than 1; a textured base read as `nonlinear`; Beckmann |
+//! | `plastic`, `roughplastic` (`distribution`) | coated diffuse: a dielectric coat of index `int_ior / ext_ior` over a base whose albedo gives Mitsuba's diffuse light (`nonlinear` false: `diffuse_reflectance / (1 - F_i)`; true: as given) | a `specular_reflectance` other than 1; a textured base read as `nonlinear` |
 //! | `principled` | glTF metallic-roughness (`base_color`, `metallic`, `roughness`, `eta`), with a clear coat (`clearcoat`, `clearcoat_gloss`) | `anisotropic`, `sheen`, `spec_trans`, `spec_tint`, `flatness` |
 //! | `twosided` | the nested bsdf, scattering on both faces | a different back bsdf (the front one is used) |
 //! | `mask` (`opacity`) | the nested bsdf, cut by stochastic transparency | |
@@ -19,13 +19,15 @@
 //!
 //! Mitsuba's bsdfs are one-sided: a surface seen from its back is black,
 //! and so it is here, unless wrapped in `twosided` (glass has two sides
-//! by nature). Roughness: Mitsuba's `alpha` is GGX's alpha, Sahara's
-//! roughness its square root.
+//! by nature). Roughness: Mitsuba's `alpha` is the distribution's alpha
+//! (GGX's or Beckmann's), Sahara's roughness its square root.
 
 use glam::Vec3;
 use std::sync::Arc;
 
-use sahara_render::{AlphaMode, Bsdf, Clearcoat, Material, NormalMap, Texture, TextureMap};
+use sahara_render::{
+    AlphaMode, Bsdf, Clearcoat, Distribution, Material, NormalMap, Texture, TextureMap,
+};
 
 use super::build::{key, Builder};
 use super::properties::Object;
@@ -200,24 +202,16 @@ impl<'a> Builder<'a> {
         }
     }
 
-    /// The roughness of a rough bsdf (`alpha`, or the mean of `alpha_u`
-    /// and `alpha_v`), with its `distribution` checked.
-    fn alpha(&mut self, o: &Object<'a>, default: f64) -> Result<f32, FormatError> {
-        match o.string("distribution")?.unwrap_or("beckmann") {
-            "ggx" => {}
-            "beckmann" => self.w.add(
-                format!(
-                    "{}: the Beckmann distribution is replaced by GGX of the same alpha",
-                    o.what()
-                ),
-                &o.node.loc,
-            ),
-            other => {
-                return Err(o.error(format!(
-                    "unknown microfacet distribution '{other}' (expected beckmann or ggx)"
-                )))
-            }
-        }
+    /// The microfacet distribution and roughness of a rough bsdf
+    /// (`distribution`, Beckmann by default as in Mitsuba; `alpha`, or the
+    /// mean of `alpha_u` and `alpha_v`).
+    fn alpha(&mut self, o: &Object<'a>, default: f64) -> Result<(Distribution, f32), FormatError> {
+        let name = o.string("distribution")?.unwrap_or("beckmann");
+        let distribution = Distribution::from_name(name).ok_or_else(|| {
+            o.error(format!(
+                "unknown microfacet distribution '{name}' (expected beckmann or ggx)"
+            ))
+        })?;
         o.get("sample_visible");
         let a = self.number(o, "alpha", default)?;
         let u = self.number(o, "alpha_u", a)?;
@@ -231,7 +225,7 @@ impl<'a> Builder<'a> {
                 &o.node.loc,
             );
         }
-        Ok(roughness(0.5 * (u + v)))
+        Ok((distribution, roughness(0.5 * (u + v))))
     }
 
     /// The single bsdf nested in `o` (a wrapper's).
@@ -274,10 +268,10 @@ impl<'a> Builder<'a> {
                 Usage::Reflectance,
             )?)),
             "conductor" | "roughconductor" => {
-                let r = if o.ty == "roughconductor" {
+                let (distribution, r) = if o.ty == "roughconductor" {
                     self.alpha(&o, 0.1)?
                 } else {
-                    0.0
+                    (Distribution::Ggx, 0.0)
                 };
                 let tint = self.tint(&o, "specular_reflectance", Vec3::ONE, Usage::Reflectance)?;
                 let (eta, k) = self.metal(&o)?;
@@ -286,6 +280,7 @@ impl<'a> Builder<'a> {
                         eta: eta.max(Vec3::ZERO),
                         k: k.max(Vec3::ZERO),
                         roughness: r,
+                        distribution,
                         multiple_scattering: false,
                     },
                     &tint,
@@ -312,8 +307,12 @@ impl<'a> Builder<'a> {
                     "thindielectric" => Material::new(Bsdf::ThinDielectric { ior: eta }),
                     "dielectric" => Material::glass(eta),
                     _ => {
-                        let r = self.alpha(&o, 0.1)?;
-                        Material::rough_glass(eta, r)
+                        let (distribution, roughness) = self.alpha(&o, 0.1)?;
+                        Material::new(Bsdf::RoughDielectric {
+                            ior: eta,
+                            roughness,
+                            distribution,
+                        })
                     }
                 }
             }
@@ -330,10 +329,10 @@ impl<'a> Builder<'a> {
                 let ext = self.ior(&o, "ext_ior", 1.000277)?;
                 let eta = ((int / ext) as f32).max(1.0);
                 let nonlinear = o.bool("nonlinear", false)?;
-                let r = if o.ty == "roughplastic" {
+                let (distribution, r) = if o.ty == "roughplastic" {
                     self.alpha(&o, 0.1)?
                 } else {
-                    0.0
+                    (Distribution::Ggx, 0.0)
                 };
                 let rho = base.color.clamp(Vec3::ZERO, Vec3::ONE);
                 let albedo = if nonlinear || base.image.is_some() {
@@ -352,6 +351,7 @@ impl<'a> Builder<'a> {
                         albedo,
                         ior: eta,
                         roughness: r,
+                        distribution,
                     },
                     &Tint {
                         color: Vec3::ONE,

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use glam::{Affine3A, Vec3};
 use sahara_render::{
-    render, AlphaMode, Bsdf, Environment, Filter, Integrator, Light, Material, RenderSettings,
-    SamplerKind, Scene, Shape,
+    render, AlphaMode, Bsdf, Distribution, Environment, Filter, Integrator, Light, Material,
+    RenderSettings, SamplerKind, Scene, Shape,
 };
 
 use super::{described, load_mitsuba, read_mitsuba_with, xml};
@@ -552,7 +552,7 @@ fn bsdfs_map_onto_sahara_materials() {
     };
     let f = sahara_render::fresnel::conductor(0.3, eta, k);
     assert!(f.min_element() > 0.999, "{f}");
-    let Bsdf::RoughDielectric { ior, roughness } = material(&d, 4).bsdf else {
+    let Bsdf::RoughDielectric { ior, roughness, .. } = material(&d, 4).bsdf else {
         panic!()
     };
     assert!((ior - 1.5046 / 1.00028).abs() < 1e-6 && (roughness - 0.3).abs() < 1e-6);
@@ -562,7 +562,8 @@ fn bsdfs_map_onto_sahara_materials() {
         Bsdf::CoatedDiffuse {
             albedo: Vec3::new(0.5, 0.25, 0.125),
             ior: 1.5,
-            roughness: 0.0
+            roughness: 0.0,
+            distribution: Distribution::Ggx,
         }
     );
     let Bsdf::MetallicRoughness {
@@ -602,12 +603,31 @@ fn bsdfs_map_onto_sahara_materials() {
 }
 
 #[test]
-fn a_roughconductor_without_distribution_is_beckmann_replaced_by_ggx() {
-    let d = describe("<shape type=\"sphere\"><bsdf type=\"roughconductor\"/></shape>\n<shape type=\"disk\"><bsdf type=\"roughconductor\"/></shape>");
-    assert_eq!(
-        d.warnings,
-        vec!["t.xml:2:22: bsdf 'roughconductor': the Beckmann distribution is replaced by GGX of the same alpha (2 times; the first here)"]
+fn the_rough_bsdfs_take_their_distribution_beckmann_by_default() {
+    let d = describe(
+        "<shape type=\"sphere\"><bsdf type=\"roughconductor\"/></shape>\n\
+         <shape type=\"disk\"><bsdf type=\"roughdielectric\"><string name=\"distribution\" value=\"ggx\"/></bsdf></shape>\n\
+         <shape type=\"disk\"><bsdf type=\"roughplastic\"><string name=\"distribution\" value=\"beckmann\"/></bsdf></shape>",
     );
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+    let dist = |i| match material(&d, i).bsdf {
+        Bsdf::ComplexConductor { distribution, .. }
+        | Bsdf::RoughDielectric { distribution, .. }
+        | Bsdf::CoatedDiffuse { distribution, .. } => distribution,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(
+        [dist(0), dist(1), dist(2)],
+        [
+            Distribution::Beckmann,
+            Distribution::Ggx,
+            Distribution::Beckmann
+        ]
+    );
+    assert!(err(
+        "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"phong\"/></bsdf></shape>"
+    )
+    .contains("unknown microfacet distribution 'phong' (expected beckmann or ggx)"));
 }
 
 #[test]

@@ -24,7 +24,7 @@
 //! pbrt-v3's `opacity` (uber) becomes stochastic transparency.
 
 use glam::Vec3;
-use sahara_render::{AlphaMode, Bsdf, Material};
+use sahara_render::{AlphaMode, Bsdf, Distribution, Material};
 
 use super::declarations::Entity;
 use super::params::SpectrumParam;
@@ -32,6 +32,9 @@ use super::spectrum::{self, Use};
 use super::textures::{rgb_of, spectral_samples, Textures, Tint};
 use super::warnings::Warnings;
 use crate::FormatError;
+
+/// pbrt's one microfacet distribution, Trowbridge-Reitz (GGX).
+const TROWBRIDGE_REITZ: Distribution = Distribution::Ggx;
 
 /// What a pbrt material becomes.
 #[derive(Clone, Debug, PartialEq)]
@@ -203,12 +206,14 @@ fn conductor(metal: Metal, roughness: f32) -> Material {
             eta: eta.max(Vec3::ZERO),
             k: k.max(Vec3::ZERO),
             roughness,
+            distribution: TROWBRIDGE_REITZ,
             multiple_scattering: false,
         }),
         Metal::Reflectance(r) => tinted(
             Bsdf::Conductor {
                 color: Vec3::ONE,
                 roughness,
+                distribution: TROWBRIDGE_REITZ,
             },
             &r,
         ),
@@ -391,6 +396,7 @@ pub(crate) fn map_material(
                     eta: Vec3::ONE,
                     k: Vec3::splat(1e4),
                     roughness: 0.0,
+                    distribution: TROWBRIDGE_REITZ,
                     multiple_scattering: false,
                 },
                 &kr,
@@ -417,6 +423,7 @@ pub(crate) fn map_material(
                     albedo: base.color.clamp(Vec3::ZERO, Vec3::ONE),
                     ior: eta.max(1.0),
                     roughness: r,
+                    distribution: TROWBRIDGE_REITZ,
                 },
                 &Tint {
                     color: Vec3::ONE,
@@ -615,6 +622,7 @@ mod tests {
             k,
             roughness,
             multiple_scattering: false,
+            ..
         } = m.bsdf
         else {
             panic!("{:?}", m.bsdf)
@@ -640,7 +648,8 @@ mod tests {
             Bsdf::CoatedDiffuse {
                 albedo: Vec3::new(0.6, 0.3, 0.2),
                 ior: 1.4,
-                roughness: 0.5
+                roughness: 0.5,
+                distribution: TROWBRIDGE_REITZ,
             }
         );
         let (m, _) = material_of("Material \"thindielectric\" \"float eta\" 1.33");
@@ -654,6 +663,7 @@ mod tests {
                 eta: Vec3::new(0.2, 0.3, 0.4),
                 k: Vec3::new(2.0, 1.5, 1.0),
                 roughness: 0.0,
+                distribution: TROWBRIDGE_REITZ,
                 multiple_scattering: false,
             }
         );

@@ -472,7 +472,7 @@ fn the_fuzz_seed_with_every_directive_loads() {
         Vec3::new(36.1267, 2.3372, 1.7213),
     );
     assert!(scene.materials.iter().any(|m| matches!(m.bsdf,
-        sahara_render::Bsdf::ComplexConductor { eta: e, k: kk, roughness, multiple_scattering: false } if e == eta && kk == k && roughness == 0.1f32.sqrt().sqrt())));
+        sahara_render::Bsdf::ComplexConductor { eta: e, k: kk, roughness, multiple_scattering: false, .. } if e == eta && kk == k && roughness == 0.1f32.sqrt().sqrt())));
     assert!(
         w.iter()
             .any(|l| l.contains("material 'mix': the blend is replaced")),

@@ -76,6 +76,7 @@ pub(super) struct RawMaterial {
     pub texture: Opt<String>,
     pub color: Opt<V3>,
     pub roughness: Opt<f32>,
+    pub distribution: Opt<String>,
     pub ior: Opt<f32>,
     pub radiance: Opt<V3>,
     pub two_sided: Opt<bool>,

@@ -5,7 +5,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use sahara_render::defaults;
+use sahara_render::{defaults, Distribution};
 use sahara_render::{
     Adaptive, Filter, FilterKind, Integrator, IntegratorKind, Named, Parameter, SamplerKind, Shape,
     ShapeKind, ToneMap,
@@ -386,6 +386,7 @@ impl Ctx<'_> {
             ("texture", span(&m.texture)),
             ("color", span(&m.color)),
             ("roughness", span(&m.roughness)),
+            ("distribution", span(&m.distribution)),
             ("ior", span(&m.ior)),
             ("radiance", span(&m.radiance)),
             ("two_sided", span(&m.two_sided)),
@@ -410,11 +411,12 @@ impl Ctx<'_> {
                 "k",
                 "multiple_scattering",
                 "roughness",
+                "distribution",
                 "two_sided",
             ],
             MaterialType::Mirror => &["color", "two_sided"],
             MaterialType::Dielectric => &["ior"],
-            MaterialType::RoughDielectric => &["ior", "roughness"],
+            MaterialType::RoughDielectric => &["ior", "roughness", "distribution"],
             MaterialType::ThinDielectric => &["ior"],
             MaterialType::MetallicRoughness => &[
                 "base_color",
@@ -426,7 +428,14 @@ impl Ctx<'_> {
                 "specular_color",
                 "two_sided",
             ],
-            MaterialType::CoatedDiffuse => &["albedo", "texture", "ior", "roughness", "two_sided"],
+            MaterialType::CoatedDiffuse => &[
+                "albedo",
+                "texture",
+                "ior",
+                "roughness",
+                "distribution",
+                "two_sided",
+            ],
             MaterialType::Emission => &["radiance", "two_sided", "albedo"],
         };
         let with_alpha: Vec<&str>;
@@ -460,6 +469,7 @@ impl Ctx<'_> {
                 "between 0 and 1",
             )
         };
+        let distribution = self.distribution(&m.distribution)?;
         let ior = || self.number(&m.ior, "ior", 1.5, |n| n > 0.0, "greater than 0");
         let texture = || {
             m.texture
@@ -481,7 +491,7 @@ impl Ctx<'_> {
                 albedo: self.reflectance(&m.albedo, "albedo", Vec3::splat(0.5))?,
                 texture: texture()?,
             },
-            MaterialType::Conductor => self.conductor(m, roughness(0.2)?)?,
+            MaterialType::Conductor => self.conductor(m, roughness(0.2)?, distribution)?,
             MaterialType::Mirror => MaterialKind::Mirror {
                 color: self.reflectance(&m.color, "color", Vec3::ONE)?,
             },
@@ -489,6 +499,7 @@ impl Ctx<'_> {
             MaterialType::RoughDielectric => MaterialKind::RoughDielectric {
                 ior: ior()?,
                 roughness: roughness(0.2)?,
+                distribution,
             },
             MaterialType::ThinDielectric => MaterialKind::ThinDielectric { ior: ior()? },
             MaterialType::MetallicRoughness => MaterialKind::MetallicRoughness {
@@ -505,6 +516,7 @@ impl Ctx<'_> {
                 texture: texture()?,
                 ior: self.number(&m.ior, "ior", 1.5, |n| n > 1.0, "greater than 1")?,
                 roughness: roughness(0.1)?,
+                distribution,
             },
             MaterialType::Emission => MaterialKind::Emission {
                 radiance: self.power(
@@ -556,9 +568,32 @@ impl Ctx<'_> {
         })
     }
 
+    /// A material's microfacet `distribution` (`ggx` if absent).
+    fn distribution(&self, value: &Opt<String>) -> Result<Distribution, FormatError> {
+        let Some(v) = value else {
+            return Ok(Distribution::Ggx);
+        };
+        Distribution::from_name(v.get_ref()).ok_or_else(|| {
+            let names: Vec<_> = Distribution::ALL.iter().map(|d| d.name()).collect();
+            self.at(
+                v.span(),
+                format!(
+                    "no microfacet distribution is named '{}' (known: {})",
+                    v.get_ref(),
+                    names.join(", ")
+                ),
+            )
+        })
+    }
+
     /// A `conductor`: by `color` (Schlick), by a `metal` preset, or by
     /// `eta` and `k`; one of the three at most (default: `color`).
-    fn conductor(&self, m: &RawMaterial, roughness: f32) -> Result<MaterialKind, FormatError> {
+    fn conductor(
+        &self,
+        m: &RawMaterial,
+        roughness: f32,
+        distribution: Distribution,
+    ) -> Result<MaterialKind, FormatError> {
         let given = [
             ("color", span(&m.color)),
             ("metal", span(&m.metal)),
@@ -587,6 +622,7 @@ impl Ctx<'_> {
                 eta,
                 k,
                 roughness,
+                distribution,
                 multiple_scattering,
             });
         }
@@ -611,6 +647,7 @@ impl Ctx<'_> {
                 eta,
                 k,
                 roughness,
+                distribution,
                 multiple_scattering,
             });
         }
@@ -625,6 +662,7 @@ impl Ctx<'_> {
         Ok(MaterialKind::Conductor {
             color: self.reflectance(&m.color, "color", Vec3::splat(0.9))?,
             roughness,
+            distribution,
         })
     }
 

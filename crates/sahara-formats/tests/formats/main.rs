@@ -1,5 +1,6 @@
 //! Tests for `sahara-formats`: glTF extensions, scene files and their conversion to renderer scenes, images in and out, and the shared scenes.
 
+mod bitterli_gallery;
 // Shared with `sahara-readers`' tests (one copy of the helpers).
 mod blocks;
 mod bsdf_reference;

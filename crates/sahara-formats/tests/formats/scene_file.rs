@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Quat, Vec3};
 use sahara_formats::scene_file::*;
-use sahara_render::{Filter, Integrator, SamplerKind, Shape, ToneMap};
+use sahara_render::{Distribution, Filter, Integrator, SamplerKind, Shape, ToneMap};
 
 use crate::common::TempDir;
 
@@ -185,7 +185,8 @@ fn a_complete_scene_parses_into_the_expected_values() {
                 name: "gold".into(),
                 kind: MaterialKind::Conductor {
                     color: Vec3::new(1.0, 0.8, 0.3),
-                    roughness: 0.1
+                    roughness: 0.1,
+                    distribution: Distribution::Ggx,
                 },
                 two_sided: true,
                 alpha_mode: sahara_render::AlphaMode::Opaque,
@@ -209,7 +210,8 @@ fn a_complete_scene_parses_into_the_expected_values() {
                 name: "frosted".into(),
                 kind: MaterialKind::RoughDielectric {
                     ior: 1.5,
-                    roughness: 0.4
+                    roughness: 0.4,
+                    distribution: Distribution::Ggx,
                 },
                 two_sided: true,
                 alpha_mode: sahara_render::AlphaMode::Opaque,
@@ -717,6 +719,7 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
             texture: None,
             ior: 1.5,
             roughness: 0.1,
+            distribution: Distribution::Ggx,
         }
     );
     assert_eq!(m[3].kind, MaterialKind::ThinDielectric { ior: 1.52 });
@@ -727,6 +730,7 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
             eta,
             k,
             roughness: 0.1,
+            distribution: Distribution::Ggx,
             multiple_scattering: true,
         }
     );
@@ -736,6 +740,7 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
             eta: Vec3::new(0.2, 0.9, 1.1),
             k: Vec3::new(3.9, 2.4, 2.1),
             roughness: 0.2,
+            distribution: Distribution::Ggx,
             multiple_scattering: false,
         }
     );
@@ -783,6 +788,39 @@ fn bad_conductor_and_layered_keys_are_errors_at_the_value() {
         m.contains("line 10:") && m.contains("greater than 1"),
         "{m}"
     );
+}
+
+#[test]
+fn rough_materials_take_a_microfacet_distribution() {
+    let m = materials_of(
+        "[[material]]\nname = \"a\"\ntype = \"conductor\"\nmetal = \"copper\"\ndistribution = \"beckmann\"\n\
+         [[material]]\nname = \"b\"\ntype = \"rough_dielectric\"\ndistribution = \"ggx\"\n\
+         [[material]]\nname = \"c\"\ntype = \"coated_diffuse\"\ndistribution = \"beckmann\"\n\
+         [[material]]\nname = \"d\"\ntype = \"conductor\"\n",
+    );
+    let dist: Vec<_> = m
+        .iter()
+        .map(|m| match m.kind {
+            MaterialKind::ComplexConductor { distribution, .. }
+            | MaterialKind::RoughDielectric { distribution, .. }
+            | MaterialKind::CoatedDiffuse { distribution, .. }
+            | MaterialKind::Conductor { distribution, .. } => distribution,
+            ref other => panic!("{other:?}"),
+        })
+        .collect();
+    use Distribution::{Beckmann, Ggx};
+    assert_eq!(dist, [Beckmann, Ggx, Beckmann, Ggx]);
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"conductor\"\ndistribution = \"phong\"\n",
+    ));
+    assert!(
+        m.contains("line 10:") && m.contains("'phong' (known: ggx, beckmann)"),
+        "{m}"
+    );
+    let m = error_of(&with_head(
+        "[[material]]\nname = \"m\"\ntype = \"diffuse\"\ndistribution = \"ggx\"\n",
+    ));
+    assert!(m.contains("`distribution` does not apply"), "{m}");
 }
 
 #[test]

@@ -7,7 +7,7 @@ use sahara_formats::mesh_scene::load_mesh_scene;
 use sahara_formats::scene_load::load_scene;
 use sahara_readers::gltf::GltfMaterial;
 use sahara_readers::mtl::MtlMaterial;
-use sahara_render::{AlphaMode, Bsdf, Integrator, Light, Placement, Shape};
+use sahara_render::{AlphaMode, Bsdf, Distribution, Integrator, Light, Placement, Shape};
 
 use crate::common::{scenes_dir, TempDir};
 use crate::gltf_data::{base64, triangle_buffer, triangle_json};
@@ -67,7 +67,8 @@ fn mtl_parameters_choose_the_bsdf() {
         glossy,
         Bsdf::Conductor {
             color: Vec3::new(0.9, 0.6, 0.3),
-            roughness: r
+            roughness: r,
+            distribution: Distribution::Ggx,
         }
     );
     assert!((phong_roughness(98.0) - r).abs() < 1e-7);
@@ -128,7 +129,8 @@ fn gltf_materials_become_the_metallic_roughness_bsdf_or_glass() {
         gltf_bsdf(&m),
         Bsdf::RoughDielectric {
             ior: 1.5,
-            roughness: 0.3
+            roughness: 0.3,
+            distribution: Distribution::Ggx,
         }
     );
     m.roughness = 0.0;

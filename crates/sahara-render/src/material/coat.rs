@@ -25,7 +25,7 @@ use glam::{Vec2, Vec3};
 use super::albedo;
 use super::fresnel::{reflect, schlick_f90};
 use super::layered::{to_side, upper};
-use super::microfacet::Ggx;
+use super::microfacet::{Distribution, Microfacet};
 use super::{Bsdf, BsdfEval, BsdfSample};
 use crate::math::warp::Frame;
 
@@ -85,7 +85,16 @@ impl Coat {
     /// The coat's reflected fraction from `mu`, times its strength.
     #[inline]
     fn albedo(&self, mu: f32) -> f32 {
-        self.factor * albedo::schlick(Vec3::splat(self.f0), Vec3::ONE, mu.abs(), self.roughness).x
+        let ggx = Distribution::Ggx;
+        self.factor
+            * albedo::schlick(
+                ggx,
+                Vec3::splat(self.f0),
+                Vec3::ONE,
+                mu.abs(),
+                self.roughness,
+            )
+            .x
     }
 
     #[inline]
@@ -107,13 +116,13 @@ impl Coat {
     /// True if the coat's lobe is a delta.
     #[inline]
     pub fn is_smooth(&self) -> bool {
-        Ggx::from_roughness(self.roughness).is_smooth()
+        Microfacet::ggx(self.roughness).is_smooth()
     }
 
     /// The coat lobe alone for `wo` and `wi` in the coat's frame, its
     /// value scaled to the shading frame, where `wi` has cosine `cos_i`.
     fn lobe(&self, wo: Vec3, wi: Vec3, cos_i: f32) -> BsdfEval {
-        let ggx = Ggx::from_roughness(self.roughness);
+        let ggx = Microfacet::ggx(self.roughness);
         if ggx.is_smooth() || wo.z <= 0.0 || wi.z <= 0.0 || cos_i <= 0.0 {
             return BsdfEval::ZERO;
         }
@@ -168,7 +177,7 @@ impl Coat {
                 return None;
             }
             let to_shading = |w: Vec3| frame.as_ref().map_or(w, |f| f.to_world(w));
-            let ggx = Ggx::from_roughness(self.roughness);
+            let ggx = Microfacet::ggx(self.roughness);
             if ggx.is_smooth() {
                 let wi = to_shading(Vec3::new(-co.x, -co.y, co.z));
                 if wi.z <= 0.0 {

@@ -5,7 +5,7 @@
 use glam::{Vec2, Vec3};
 
 use super::fresnel::reflect;
-use super::microfacet::Ggx;
+use super::microfacet::Microfacet;
 use super::{BsdfEval, BsdfSample};
 
 /// Mirror `w` into the upper hemisphere (reflection-only BSDFs are
@@ -21,7 +21,7 @@ fn upper(w: Vec3, flip: bool) -> Vec3 {
 
 /// Value and density of the rough conductor whose Fresnel reflectance at
 /// the microfacet cosine `c` is `fresnel(c)`.
-pub fn eval(fresnel: impl Fn(f32) -> Vec3, ggx: &Ggx, wo: Vec3, wi: Vec3) -> BsdfEval {
+pub fn eval(fresnel: impl Fn(f32) -> Vec3, mf: &Microfacet, wo: Vec3, wi: Vec3) -> BsdfEval {
     if wo.z * wi.z <= 0.0 {
         return BsdfEval::ZERO;
     }
@@ -32,30 +32,35 @@ pub fn eval(fresnel: impl Fn(f32) -> Vec3, ggx: &Ggx, wo: Vec3, wi: Vec3) -> Bsd
     if oh <= 0.0 {
         return BsdfEval::ZERO;
     }
-    let f = fresnel(oh) * (ggx.d(h) * ggx.g(wo, wi) / (4.0 * wo.z * wi.z));
+    let f = fresnel(oh) * (mf.d(h) * mf.g(wo, wi) / (4.0 * wo.z * wi.z));
     BsdfEval {
         f,
-        pdf: ggx.pdf_visible(wo, h) / (4.0 * oh),
+        pdf: mf.pdf_visible(wo, h) / (4.0 * oh),
     }
 }
 
 /// A direction reflected about a visible microfacet normal.
-pub fn sample(fresnel: impl Fn(f32) -> Vec3, ggx: &Ggx, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+pub fn sample(
+    fresnel: impl Fn(f32) -> Vec3,
+    mf: &Microfacet,
+    wo: Vec3,
+    u: Vec2,
+) -> Option<BsdfSample> {
     if wo.z == 0.0 {
         return None;
     }
     let flip = wo.z < 0.0;
     let wo = upper(wo, flip);
-    let m = ggx.sample_visible(wo, u);
+    let m = mf.sample_visible(wo, u);
     let om = wo.dot(m);
     let wi = reflect(wo, m);
     if wi.z <= 0.0 || om <= 0.0 {
         return None;
     }
-    let pdf = ggx.pdf_visible(wo, m) / (4.0 * om);
+    let pdf = mf.pdf_visible(wo, m) / (4.0 * om);
     // f cos / pdf = F D G / (4 wo.z) / (G1 D (wo.m) / wo.z / (4 wo.m))
     //             = F G / G1: D and the Jacobian cancel.
-    let weight = fresnel(om) * (ggx.g(wo, wi) / ggx.g1(wo));
+    let weight = fresnel(om) * (mf.g(wo, wi) / mf.g1(wo));
     Some(BsdfSample {
         wi: upper(wi, flip),
         weight,

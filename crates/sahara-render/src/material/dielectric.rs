@@ -10,7 +10,7 @@
 use glam::{Vec2, Vec3};
 
 use super::fresnel::{dielectric as fresnel, reflect, refract};
-use super::microfacet::Ggx;
+use super::microfacet::Microfacet;
 use super::{BsdfEval, BsdfSample};
 
 /// Mirror `w`'s z when `wo` is inside, and the relative index `eta` seen
@@ -95,7 +95,7 @@ fn half_vector(wo: Vec3, wi: Vec3, eta: f32) -> (Vec3, bool) {
 }
 
 /// Value and density of the rough dielectric.
-pub fn eval_rough(ior: f32, ggx: &Ggx, wo: Vec3, wi: Vec3) -> BsdfEval {
+pub fn eval_rough(ior: f32, mf: &Microfacet, wo: Vec3, wi: Vec3) -> BsdfEval {
     if wo.z == 0.0 || wi.z == 0.0 {
         return BsdfEval::ZERO;
     }
@@ -107,9 +107,9 @@ pub fn eval_rough(ior: f32, ggx: &Ggx, wo: Vec3, wi: Vec3) -> BsdfEval {
         return BsdfEval::ZERO;
     }
     let f = fresnel(oh, eta);
-    let d = ggx.d(h);
-    let g = ggx.g(wo, wi);
-    let pdf_h = ggx.pdf_visible(wo, h);
+    let d = mf.d(h);
+    let g = mf.g(wo, wi);
+    let pdf_h = mf.pdf_visible(wo, h);
     if reflection {
         if ih <= 0.0 {
             return BsdfEval::ZERO;
@@ -136,13 +136,19 @@ pub fn eval_rough(ior: f32, ggx: &Ggx, wo: Vec3, wi: Vec3) -> BsdfEval {
 }
 
 /// Reflection or refraction about a visible microfacet normal.
-pub fn sample_rough(ior: f32, ggx: &Ggx, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+pub fn sample_rough(
+    ior: f32,
+    mf: &Microfacet,
+    wo: Vec3,
+    u_lobe: f32,
+    u: Vec2,
+) -> Option<BsdfSample> {
     if wo.z == 0.0 {
         return None;
     }
     let (flip, eta) = orient(wo, ior);
     let wo = flip_z(wo, flip);
-    let m = ggx.sample_visible(wo, u);
+    let m = mf.sample_visible(wo, u);
     let om = wo.dot(m);
     if om <= 0.0 {
         return None;
@@ -154,16 +160,16 @@ pub fn sample_rough(ior: f32, ggx: &Ggx, wo: Vec3, u_lobe: f32, u: Vec2) -> Opti
             return None;
         }
         // F G / G1 divided by the lobe probability F.
-        (wi, ggx.g(wo, wi) / ggx.g1(wo))
+        (wi, mf.g(wo, wi) / mf.g1(wo))
     } else {
         let wi = refract(wo, m, eta)?;
         if wi.z >= 0.0 {
             return None;
         }
         // (1 - F) G / (G1 eta^2) divided by the lobe probability 1 - F.
-        (wi, ggx.g(wo, wi) / (ggx.g1(wo) * eta * eta))
+        (wi, mf.g(wo, wi) / (mf.g1(wo) * eta * eta))
     };
-    let e = eval_rough(ior, ggx, flip_z(wo, flip), flip_z(wi, flip));
+    let e = eval_rough(ior, mf, flip_z(wo, flip), flip_z(wi, flip));
     if e.pdf <= 0.0 {
         return None;
     }

@@ -32,7 +32,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 
 use super::albedo;
 use super::fresnel::{conductor, reflect, schlick_f90};
-use super::microfacet::Ggx;
+use super::microfacet::{Distribution, Microfacet};
 use super::{BsdfEval, BsdfSample};
 use crate::math::warp::{cosine_hemisphere, luminance};
 
@@ -77,7 +77,8 @@ impl Fresnel {
     /// form through its normal-incidence value: only the choice of lobe
     /// and the multiple-scattering colour use it).
     #[inline]
-    fn albedo(&self, mu: f32, roughness: f32) -> Vec3 {
+    fn albedo(&self, mf: &Microfacet, mu: f32, roughness: f32) -> Vec3 {
+        let d = mf.distribution;
         match *self {
             Fresnel::Blend {
                 w_d,
@@ -86,16 +87,17 @@ impl Fresnel {
                 w_m,
                 metal_f0,
             } => {
-                w_d * albedo::schlick(f0, f90, mu, roughness)
-                    + w_m * albedo::schlick(metal_f0, Vec3::ONE, mu, roughness)
+                w_d * albedo::schlick(d, f0, f90, mu, roughness)
+                    + w_m * albedo::schlick(d, metal_f0, Vec3::ONE, mu, roughness)
             }
-            Fresnel::Conductor { .. } => albedo::schlick(self.f0(), Vec3::ONE, mu, roughness),
+            Fresnel::Conductor { .. } => albedo::schlick(d, self.f0(), Vec3::ONE, mu, roughness),
         }
     }
 }
 
 /// A diffuse-like term `c (1 - E(wo)) (1 - E(wi))`, `E` the albedo of a
-/// GGX lobe (of the BSDF's roughness) with Schlick's `(f0, f90)`.
+/// microfacet lobe (of the BSDF's distribution) with Schlick's
+/// `(f0, f90)`.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Term {
     c: Vec3,
@@ -107,7 +109,7 @@ pub(crate) struct Term {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Layered {
     roughness: f32,
-    ggx: Ggx,
+    mf: Microfacet,
     fresnel: Fresnel,
     terms: [Option<Term>; 2],
 }
@@ -137,7 +139,8 @@ impl Layered {
         let r0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
         let f0 = (Vec3::splat(r0) * specular_color).min(Vec3::ONE) * specular;
         let f90 = Vec3::splat(specular);
-        let e_avg = albedo::schlick_avg(f0, f90, roughness);
+        let mf = Microfacet::ggx(roughness);
+        let e_avg = albedo::schlick_avg(mf.distribution, f0, f90, roughness);
         let diffuse = Term {
             c: (1.0 - m) * base_color * FRAC_1_PI / complement(e_avg),
             f0,
@@ -145,7 +148,7 @@ impl Layered {
         };
         let mut l = Self {
             roughness,
-            ggx: Ggx::from_roughness(roughness),
+            mf,
             fresnel: Fresnel::Blend {
                 w_d: 1.0 - m,
                 f0,
@@ -162,12 +165,18 @@ impl Layered {
         l
     }
 
-    /// A dielectric coat of index `ior` and `roughness` over a diffuse base
-    /// of reflectance `albedo`.
-    pub fn coated_diffuse(albedo: Vec3, ior: f32, roughness: f32) -> Self {
+    /// A dielectric coat of index `ior`, microfacet `distribution` and
+    /// `roughness` over a diffuse base of reflectance `albedo`.
+    pub fn coated_diffuse(
+        albedo: Vec3,
+        ior: f32,
+        distribution: Distribution,
+        roughness: f32,
+    ) -> Self {
+        let mf = Microfacet::new(distribution, roughness);
         let eta = ior.max(1.0 + 1e-4);
         let f0 = Vec3::splat(((eta - 1.0) / (eta + 1.0)).powi(2));
-        let e_avg = albedo::schlick_avg(f0, Vec3::ONE, roughness);
+        let e_avg = albedo::schlick_avg(mf.distribution, f0, Vec3::ONE, roughness);
         let f_inside = Vec3::ONE - complement(e_avg) / (eta * eta);
         let base = Term {
             c: albedo * FRAC_1_PI / (eta * eta * (Vec3::ONE - albedo * f_inside)),
@@ -176,7 +185,7 @@ impl Layered {
         };
         Self {
             roughness,
-            ggx: Ggx::from_roughness(roughness),
+            mf,
             fresnel: Fresnel::Blend {
                 w_d: 1.0,
                 f0,
@@ -188,20 +197,21 @@ impl Layered {
         }
     }
 
-    /// A conductor of complex index `eta + i k` (Fresnel times `tint`),
-    /// with the energy of multiple scattering between microfacets added if
+    /// A conductor of complex index `eta + i k` (Fresnel times `tint`)
+    /// with microfacet `distribution` and `roughness`, with the energy of
+    /// multiple scattering between microfacets added if
     /// `multiple_scattering`.
     pub fn conductor(
         eta: Vec3,
         k: Vec3,
         tint: Vec3,
-        roughness: f32,
+        (distribution, roughness): (Distribution, f32),
         multiple_scattering: bool,
     ) -> Self {
         let fresnel = Fresnel::Conductor { eta, k, tint };
         let mut l = Self {
             roughness,
-            ggx: Ggx::from_roughness(roughness),
+            mf: Microfacet::new(distribution, roughness),
             fresnel,
             terms: [None, None],
         };
@@ -215,7 +225,8 @@ impl Layered {
     /// The Kulla-Conty term of a conductor of average Fresnel `f_avg`,
     /// weighted by `w`.
     fn multiple_scattering(&self, f_avg: Vec3, w: f32) -> Term {
-        let e1_avg = albedo::schlick_avg(Vec3::ONE, Vec3::ONE, self.roughness);
+        let e1_avg =
+            albedo::schlick_avg(self.mf.distribution, Vec3::ONE, Vec3::ONE, self.roughness);
         let loss = complement(e1_avg);
         let f_ms = f_avg * f_avg * e1_avg / (Vec3::ONE - f_avg * (Vec3::ONE - e1_avg));
         Term {
@@ -228,7 +239,7 @@ impl Layered {
     /// True if the specular lobe is a delta.
     #[inline]
     pub fn smooth_specular(&self) -> bool {
-        self.ggx.is_smooth()
+        self.mf.is_smooth()
     }
 
     /// True if every lobe is a delta (a smooth specular lobe and no term
@@ -245,7 +256,8 @@ impl Layered {
     /// `1 - E` of term `t` at `mu`.
     #[inline]
     fn one_minus_e(&self, t: &Term, mu: f32) -> Vec3 {
-        (Vec3::ONE - albedo::schlick(t.f0, t.f90, mu, self.roughness)).max(Vec3::ZERO)
+        let d = self.mf.distribution;
+        (Vec3::ONE - albedo::schlick(d, t.f0, t.f90, mu, self.roughness)).max(Vec3::ZERO)
     }
 
     /// The terms' value for `(wo, wi)` (both above the surface).
@@ -260,10 +272,15 @@ impl Layered {
 
     /// Probability of sampling the specular lobe from `wo`.
     fn spec_probability(&self, wo: Vec3) -> f32 {
-        let spec = luminance(self.fresnel.albedo(wo.z, self.roughness)).max(0.0);
+        if self.terms.iter().all(Option::is_none) {
+            // A lone specular lobe (a conductor without the multiple
+            // scattering term): no albedo tables needed to choose it.
+            return 1.0;
+        }
+        let spec = luminance(self.fresnel.albedo(&self.mf, wo.z, self.roughness)).max(0.0);
         let mut rest = 0.0;
         for t in self.terms.iter().flatten() {
-            let avg = albedo::schlick_avg(t.f0, t.f90, self.roughness);
+            let avg = albedo::schlick_avg(self.mf.distribution, t.f0, t.f90, self.roughness);
             rest += luminance(t.c * self.one_minus_e(t, wo.z) * PI * complement(avg)).max(0.0);
         }
         if spec + rest <= 0.0 {
@@ -281,7 +298,7 @@ impl Layered {
             let h = (wo + wi).normalize();
             let oh = wo.dot(h);
             if oh > 0.0 {
-                let g = &self.ggx;
+                let g = &self.mf;
                 f += self.fresnel.eval(oh) * (g.d(h) * g.g(wo, wi) / (4.0 * wo.z * wi.z));
                 pdf += p_spec * g.pdf_visible(wo, h) / (4.0 * oh);
             }
@@ -318,7 +335,7 @@ impl Layered {
                     delta: true,
                 });
             }
-            let m = self.ggx.sample_visible(wo, u);
+            let m = self.mf.sample_visible(wo, u);
             if wo.dot(m) <= 0.0 {
                 return None;
             }

@@ -26,7 +26,8 @@ pub use coat::Coat;
 use fresnel::schlick;
 use layered::Layered;
 pub use maps::{Clearcoat, MaterialTextures, NormalMap, OcclusionMap};
-use microfacet::Ggx;
+pub use microfacet::Distribution;
+use microfacet::Microfacet;
 
 /// The scattering model of a material.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,12 +37,14 @@ pub enum Bsdf {
         /// Reflectance in `[0, 1]` per channel.
         albedo: Vec3,
     },
-    /// Rough metal: GGX microfacets, Schlick Fresnel tinted by `color`.
+    /// Rough metal: microfacets, Schlick Fresnel tinted by `color`.
     Conductor {
         /// Reflectance at normal incidence.
         color: Vec3,
         /// Perceptual roughness in `[0, 1]` (`alpha = roughness^2`).
         roughness: f32,
+        /// The microfacet distribution.
+        distribution: Distribution,
     },
     /// A perfect mirror (Schlick Fresnel tinted by `color`).
     Mirror {
@@ -59,9 +62,11 @@ pub enum Bsdf {
         ior: f32,
         /// Perceptual roughness in `[0, 1]`.
         roughness: f32,
+        /// The microfacet distribution.
+        distribution: Distribution,
     },
     /// A metal of complex index of refraction `eta + i k` per channel:
-    /// GGX microfacets with the exact conductor Fresnel term, optionally
+    /// microfacets with the exact conductor Fresnel term, optionally
     /// plus the light that bounces between microfacets (so a perfect
     /// reflector stays white when rough). [`metals::preset`] gives
     /// measured values.
@@ -72,6 +77,8 @@ pub enum Bsdf {
         k: Vec3,
         /// Perceptual roughness in `[0, 1]`.
         roughness: f32,
+        /// The microfacet distribution.
+        distribution: Distribution,
         /// Add the energy of multiple scattering between microfacets
         /// (Kulla and Conty 2017). Sahara's own scenes do; pbrt-v4's and
         /// Mitsuba 3's conductors scatter once, so scenes read from their
@@ -100,7 +107,7 @@ pub enum Bsdf {
         specular_color: Vec3,
     },
     /// A diffuse base under a clear dielectric coat (varnish, plastic):
-    /// GGX reflection off the coat, and diffuse light that crosses it,
+    /// microfacet reflection off the coat, and diffuse light that crosses it,
     /// including the part the coat reflects back down.
     CoatedDiffuse {
         /// Reflectance of the base.
@@ -109,6 +116,8 @@ pub enum Bsdf {
         ior: f32,
         /// Perceptual roughness of the coat in `[0, 1]`.
         roughness: f32,
+        /// The coat's microfacet distribution.
+        distribution: Distribution,
     },
     /// A thin pane of glass (a window): reflection by both faces, and
     /// transmission straight through without refraction.
@@ -155,9 +164,7 @@ impl Bsdf {
             Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => true,
             Bsdf::Conductor { roughness, .. }
             | Bsdf::RoughDielectric { roughness, .. }
-            | Bsdf::ComplexConductor { roughness, .. } => {
-                Ggx::from_roughness(roughness).is_smooth()
-            }
+            | Bsdf::ComplexConductor { roughness, .. } => Microfacet::ggx(roughness).is_smooth(),
             Bsdf::MetallicRoughness { .. } => self.layered(Vec3::ONE).is_some_and(|l| l.is_delta()),
             Bsdf::Diffuse { .. } | Bsdf::CoatedDiffuse { .. } => false,
         }
@@ -179,8 +186,9 @@ impl Bsdf {
                 eta,
                 k,
                 roughness,
+                distribution,
                 multiple_scattering,
-            } => Layered::conductor(eta, k, tint, roughness, multiple_scattering),
+            } => Layered::conductor(eta, k, tint, (distribution, roughness), multiple_scattering),
             Bsdf::MetallicRoughness {
                 base_color,
                 metallic,
@@ -200,7 +208,8 @@ impl Bsdf {
                 albedo,
                 ior,
                 roughness,
-            } => Layered::coated_diffuse(albedo * tint, ior, roughness),
+                distribution,
+            } => Layered::coated_diffuse(albedo * tint, ior, distribution, roughness),
             _ => return None,
         })
     }
@@ -216,13 +225,17 @@ impl Bsdf {
     pub fn eval(&self, tint: Vec3, wo: Vec3, wi: Vec3) -> BsdfEval {
         match *self {
             Bsdf::Diffuse { albedo } => diffuse::eval(albedo * tint, wo, wi),
-            Bsdf::Conductor { color, roughness } => {
-                let ggx = Ggx::from_roughness(roughness);
-                if ggx.is_smooth() {
+            Bsdf::Conductor {
+                color,
+                roughness,
+                distribution,
+            } => {
+                let mf = Microfacet::new(distribution, roughness);
+                if mf.is_smooth() {
                     return BsdfEval::ZERO;
                 }
                 let color = color * tint;
-                conductor::eval(|c| schlick(color, c), &ggx, wo, wi)
+                conductor::eval(|c| schlick(color, c), &mf, wo, wi)
             }
             Bsdf::Mirror { .. } | Bsdf::Dielectric { .. } | Bsdf::ThinDielectric { .. } => {
                 BsdfEval::ZERO
@@ -233,12 +246,16 @@ impl Bsdf {
                 Some(l) => l.eval(wo, wi),
                 None => BsdfEval::ZERO,
             },
-            Bsdf::RoughDielectric { ior, roughness } => {
-                let ggx = Ggx::from_roughness(roughness);
-                if ggx.is_smooth() {
+            Bsdf::RoughDielectric {
+                ior,
+                roughness,
+                distribution,
+            } => {
+                let mf = Microfacet::new(distribution, roughness);
+                if mf.is_smooth() {
                     return BsdfEval::ZERO;
                 }
-                dielectric::eval_rough(ior, &ggx, wo, wi)
+                dielectric::eval_rough(ior, &mf, wo, wi)
             }
         }
     }
@@ -248,13 +265,17 @@ impl Bsdf {
     pub fn sample(&self, tint: Vec3, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let s = match *self {
             Bsdf::Diffuse { albedo } => diffuse::sample(albedo * tint, wo, u),
-            Bsdf::Conductor { color, roughness } => {
-                let ggx = Ggx::from_roughness(roughness);
+            Bsdf::Conductor {
+                color,
+                roughness,
+                distribution,
+            } => {
+                let mf = Microfacet::new(distribution, roughness);
                 let color = color * tint;
-                if ggx.is_smooth() {
+                if mf.is_smooth() {
                     conductor::sample_mirror(|c| schlick(color, c), wo)
                 } else {
-                    conductor::sample(|c| schlick(color, c), &ggx, wo, u)
+                    conductor::sample(|c| schlick(color, c), &mf, wo, u)
                 }
             }
             Bsdf::Mirror { color } => {
@@ -266,12 +287,16 @@ impl Bsdf {
             | Bsdf::MetallicRoughness { .. }
             | Bsdf::CoatedDiffuse { .. } => self.layered(tint)?.sample(wo, u_lobe, u),
             Bsdf::Dielectric { ior } => dielectric::sample_smooth(ior, wo, u_lobe),
-            Bsdf::RoughDielectric { ior, roughness } => {
-                let ggx = Ggx::from_roughness(roughness);
-                if ggx.is_smooth() {
+            Bsdf::RoughDielectric {
+                ior,
+                roughness,
+                distribution,
+            } => {
+                let mf = Microfacet::new(distribution, roughness);
+                if mf.is_smooth() {
                     dielectric::sample_smooth(ior, wo, u_lobe)
                 } else {
-                    dielectric::sample_rough(ior, &ggx, wo, u_lobe, u)
+                    dielectric::sample_rough(ior, &mf, wo, u_lobe, u)
                 }
             }
         }?;
@@ -347,9 +372,13 @@ impl Material {
         Self::new(Bsdf::Diffuse { albedo })
     }
 
-    /// A rough metal.
+    /// A rough metal (GGX).
     pub fn conductor(color: Vec3, roughness: f32) -> Self {
-        Self::new(Bsdf::Conductor { color, roughness })
+        Self::new(Bsdf::Conductor {
+            color,
+            roughness,
+            distribution: Distribution::Ggx,
+        })
     }
 
     /// A perfect mirror.
@@ -362,9 +391,13 @@ impl Material {
         Self::new(Bsdf::Dielectric { ior })
     }
 
-    /// Rough glass.
+    /// Rough glass (GGX).
     pub fn rough_glass(ior: f32, roughness: f32) -> Self {
-        Self::new(Bsdf::RoughDielectric { ior, roughness })
+        Self::new(Bsdf::RoughDielectric {
+            ior,
+            roughness,
+            distribution: Distribution::Ggx,
+        })
     }
 
     /// A black emitter of radiance `radiance`.
@@ -664,60 +697,82 @@ mod tests {
         (sampled / n, quad / n, pdf_integral / n, accepted as f64 / n)
     }
 
-    fn non_delta() -> Vec<Bsdf> {
+    /// The microfacet BSDFs of distribution `d` at a few roughnesses.
+    fn rough(d: Distribution) -> Vec<Bsdf> {
         vec![
-            Bsdf::Diffuse { albedo: Vec3::ONE },
             Bsdf::Conductor {
                 color: Vec3::ONE,
                 roughness: 0.3,
+                distribution: d,
             },
             Bsdf::Conductor {
                 color: Vec3::new(0.9, 0.6, 0.3),
                 roughness: 0.8,
+                distribution: d,
             },
             Bsdf::RoughDielectric {
                 ior: 1.5,
                 roughness: 0.4,
+                distribution: d,
             },
             Bsdf::RoughDielectric {
                 ior: 1.33,
                 roughness: 0.8,
+                distribution: d,
             },
-            gold(0.3),
-            gold(0.8),
-            metallic_roughness(Vec3::new(0.8, 0.5, 0.2), 0.0, 0.3),
-            metallic_roughness(Vec3::new(0.8, 0.5, 0.2), 0.5, 0.8),
-            metallic_roughness(Vec3::ONE, 1.0, 0.4),
+            gold(d, 0.3),
+            gold(d, 0.8),
             Bsdf::CoatedDiffuse {
                 albedo: Vec3::new(0.7, 0.2, 0.1),
                 ior: 1.5,
                 roughness: 0.3,
+                distribution: d,
             },
             Bsdf::CoatedDiffuse {
                 albedo: Vec3::ONE,
                 ior: 1.8,
                 roughness: 0.8,
+                distribution: d,
             },
         ]
     }
 
-    fn gold(roughness: f32) -> Bsdf {
+    fn non_delta() -> Vec<Bsdf> {
+        let mut v = vec![
+            Bsdf::Diffuse { albedo: Vec3::ONE },
+            metallic_roughness(Vec3::new(0.8, 0.5, 0.2), 0.0, 0.3),
+            metallic_roughness(Vec3::new(0.8, 0.5, 0.2), 0.5, 0.8),
+            metallic_roughness(Vec3::ONE, 1.0, 0.4),
+        ];
+        for d in Distribution::ALL {
+            v.extend(rough(d));
+        }
+        v
+    }
+
+    fn gold(distribution: Distribution, roughness: f32) -> Bsdf {
         let (eta, k) = metals::preset("gold").unwrap();
         Bsdf::ComplexConductor {
             eta,
             k,
             roughness,
+            distribution,
             multiple_scattering: true,
         }
     }
 
     /// A conductor that reflects everything at every microfacet (eta 1,
     /// k huge), with or without multiple scattering.
-    fn perfect_conductor(roughness: f32, multiple_scattering: bool) -> Bsdf {
+    fn perfect_conductor(
+        distribution: Distribution,
+        roughness: f32,
+        multiple_scattering: bool,
+    ) -> Bsdf {
         Bsdf::ComplexConductor {
             eta: Vec3::ONE,
             k: Vec3::splat(1e4),
             roughness,
+            distribution,
             multiple_scattering,
         }
     }
@@ -733,52 +788,62 @@ mod tests {
         }
     }
 
-    /// Every BSDF kind at a roughness, and whether it loses no energy
-    /// (white, no absorption).
+    /// Every BSDF kind at a roughness (the microfacet ones with each
+    /// distribution), and whether it loses no energy (white, no
+    /// absorption).
     fn furnace_set(roughness: f32) -> Vec<(Bsdf, bool)> {
-        vec![
+        let mut v = vec![
             (Bsdf::Diffuse { albedo: Vec3::ONE }, true),
-            (
-                Bsdf::Conductor {
-                    color: Vec3::ONE,
-                    roughness,
-                },
-                false,
-            ),
             (Bsdf::Mirror { color: Vec3::ONE }, true),
-            (gold(roughness), false),
-            (perfect_conductor(roughness, true), true),
-            (perfect_conductor(roughness, false), false),
             (metallic_roughness(Vec3::ONE, 0.0, roughness), true),
             (metallic_roughness(Vec3::ONE, 1.0, roughness), true),
             (metallic_roughness(Vec3::ONE, 0.5, roughness), true),
             (metallic_roughness(Vec3::splat(0.5), 0.3, roughness), false),
-            (
-                Bsdf::CoatedDiffuse {
-                    albedo: Vec3::ONE,
-                    ior: 1.5,
-                    roughness,
-                },
-                true,
-            ),
-            (
-                Bsdf::CoatedDiffuse {
-                    albedo: Vec3::splat(0.5),
-                    ior: 1.5,
-                    roughness,
-                },
-                false,
-            ),
             (Bsdf::ThinDielectric { ior: 1.5 }, true),
             (Bsdf::Dielectric { ior: 1.5 }, false),
-            (
-                Bsdf::RoughDielectric {
-                    ior: 1.5,
-                    roughness,
-                },
-                false,
-            ),
-        ]
+        ];
+        for d in Distribution::ALL {
+            v.extend([
+                (
+                    Bsdf::Conductor {
+                        color: Vec3::ONE,
+                        roughness,
+                        distribution: d,
+                    },
+                    false,
+                ),
+                (gold(d, roughness), false),
+                (perfect_conductor(d, roughness, true), true),
+                (perfect_conductor(d, roughness, false), false),
+                (
+                    Bsdf::CoatedDiffuse {
+                        albedo: Vec3::ONE,
+                        ior: 1.5,
+                        roughness,
+                        distribution: d,
+                    },
+                    true,
+                ),
+                (
+                    Bsdf::CoatedDiffuse {
+                        albedo: Vec3::splat(0.5),
+                        ior: 1.5,
+                        roughness,
+                        distribution: d,
+                    },
+                    false,
+                ),
+                (
+                    Bsdf::RoughDielectric {
+                        ior: 1.5,
+                        roughness,
+                        distribution: d,
+                    },
+                    false,
+                ),
+            ]);
+        }
+        v
     }
 
     /// White furnace: the albedo (the mean sample weight, per channel) of
@@ -856,16 +921,16 @@ mod tests {
         for (roughness, cos, least_loss) in
             [(0.9f32, 0.2f32, 0.1), (0.9, 1.0, 0.02), (0.5, 0.1, 0.02)]
         {
-            let multi = albedo(perfect_conductor(roughness, true), cos);
-            let single = albedo(perfect_conductor(roughness, false), cos);
+            let multi = albedo(perfect_conductor(Distribution::Ggx, roughness, true), cos);
+            let single = albedo(perfect_conductor(Distribution::Ggx, roughness, false), cos);
             assert!(multi > 0.985, "roughness {roughness} cos {cos}: {multi}");
             assert!(
                 multi - single > least_loss,
                 "roughness {roughness} cos {cos}: {multi} vs {single}"
             );
         }
-        let multi = albedo(perfect_conductor(0.1, true), 0.7);
-        let single = albedo(perfect_conductor(0.1, false), 0.7);
+        let multi = albedo(perfect_conductor(Distribution::Ggx, 0.1, true), 0.7);
+        let single = albedo(perfect_conductor(Distribution::Ggx, 0.1, false), 0.7);
         assert!((multi - single).abs() < 2e-3, "smooth: {multi} vs {single}");
     }
 
