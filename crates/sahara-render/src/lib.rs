@@ -85,6 +85,7 @@ pub use render::{
 #[doc(hidden)]
 pub mod internals {
     pub use crate::math::hash::hash2;
+    pub use crate::render::render_world;
     pub use crate::sampler::{dims, PixelSampler, SampleId};
     pub use crate::world::World;
 }

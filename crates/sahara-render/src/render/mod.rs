@@ -354,13 +354,31 @@ pub fn render_watched(
     scene: &Scene,
     settings: &RenderSettings,
     progress: &(dyn Fn(Progress) + Sync),
-    mut preview: Option<Preview<'_>>,
+    preview: Option<Preview<'_>>,
 ) -> RenderResult {
     let start = Instant::now();
     let mut world = World::new(scene, &settings.build);
+    let build_time = start.elapsed();
+    render_world(&mut world, settings, progress, preview, start, build_time)
+}
+
+/// Renders a scene already prepared for tracing (`world`, built with
+/// `settings.build`), as [`render_watched`] does after its build; `start`
+/// is when the render began (its time limit counts from there) and
+/// `build_time` what the build took. The criterion benchmarks render this
+/// way to time the render loop without the tree builds.
+#[doc(hidden)]
+pub fn render_world(
+    world: &mut World,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(Progress) + Sync),
+    mut preview: Option<Preview<'_>>,
+    start: Instant,
+    build_time: Duration,
+) -> RenderResult {
     let (w, h) = (settings.width.max(1), settings.height.max(1));
     world.set_film(h, u64::from(settings.spp.max(1)));
-    let build_time = start.elapsed();
+    let world = &*world;
     let window = settings
         .window
         .unwrap_or(PixelWindow::full(w, h))
@@ -425,7 +443,7 @@ pub fn render_watched(
             radius,
             photons: photons as u64,
         };
-        return sppm::render(&world, settings, params, progress, stats, start);
+        return sppm::render(world, settings, params, progress, stats, start);
     }
     let render_start = Instant::now();
     let cpu_start = process_cpu_time();
@@ -487,7 +505,7 @@ pub fn render_watched(
                     abandon.store(true, Ordering::Relaxed);
                     return None;
                 }
-                let out = render_tile(&world, settings, *tile, &window, samples, &stop_pixel);
+                let out = render_tile(world, settings, *tile, &window, samples, &stop_pixel);
                 if out.pixels_done < tile.pixels() {
                     abandon.store(true, Ordering::Relaxed);
                 }
@@ -598,7 +616,7 @@ pub fn render_watched(
         .as_mut()
         .filter(|_| wants(Aov::Object) || wants(Aov::Material))
     {
-        let ids = ids::pixel_centres(&world, &window, w, h);
+        let ids = ids::pixel_centres(world, &window, w, h);
         if wants(Aov::Object) {
             aux.images.object = ids.objects;
         }
