@@ -603,11 +603,12 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
         s.rays() as f64 / secs.max(1e-9) / 1e6,
         s.time_split
             .shares()
-            .map(|(t, sh, rest)| format!(
-                " (tracing {:.0}%, shading {:.0}%, the rest {:.0}%)",
-                t * 100.0,
-                sh * 100.0,
-                rest * 100.0
+            .map(|s| format!(
+                " (tracing {:.0}%, shading {:.0}%, film {:.0}%, the rest {:.0}%)",
+                s.tracing * 100.0,
+                s.shading * 100.0,
+                s.film * 100.0,
+                s.rest * 100.0
             ))
             .unwrap_or_default(),
         if s.nan_samples > 0 {
