@@ -435,6 +435,17 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
             .unwrap_or_default(),
         plural(threads as u64),
     );
+    if let Some(a) = settings.adaptive {
+        if settings.spp != UNLIMITED_SPP && a.min_spp >= settings.spp {
+            eprintln!(
+                "warning: adaptive: every pixel takes all {spp} samples, as at least {min} are \
+                 taken before the noise is tested; raise --spp (the cap) above {min}, or lower \
+                 --min-spp, for pixels to stop early",
+                spp = settings.spp,
+                min = a.min_spp
+            );
+        }
+    }
     // Started after the line above, so that it does not draw over it.
     let bar = progress_bar(settings);
     let unlimited = settings.spp == UNLIMITED_SPP;
@@ -561,6 +572,19 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
         return Ok(finish);
     }
     if s.passes == 0 && s.first_pass_pixels == 0 {
+        if partial {
+            // Stopped by a signal: the exit code says interrupted (130), as
+            // for any stopped render, not failed.
+            eprintln!(
+                "interrupted before the first pixel was finished: no image written{}",
+                if job.output_existed {
+                    format!(" ({} left as it was)", job.output.display())
+                } else {
+                    String::new()
+                }
+            );
+            return Ok(finish);
+        }
         bail!("stopped before the first pixel was finished: no image written");
     }
     let mut output = job.output_at(partial);
@@ -619,7 +643,7 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
     if let Some(a) = &s.adaptive {
         eprintln!(
             "adaptive: {} samples, {:.1}% of the {} spp budget; {} of {} pixels ({:.1}%) \
-             stopped below the noise threshold",
+             stopped early, below the noise threshold",
             a.samples,
             100.0 * a.samples as f64 / a.budget.max(1) as f64,
             s.spp,

@@ -417,6 +417,76 @@ fn a_render_that_cannot_fit_in_memory_is_refused_with_an_estimate() {
 }
 
 #[test]
+fn a_misspelt_command_or_option_gets_the_nearest_one() {
+    for (args, what) in [
+        (&["rendr"][..], "did you mean: sahara render"),
+        (&["render", "--sp", "16"], "did you mean: --spp"),
+        (
+            &["render", "--integrater", "path"],
+            "did you mean: --integrator",
+        ),
+    ] {
+        let out = sahara(args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(what), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn an_output_that_is_a_folder_is_refused_as_a_folder() {
+    let dir = temp_dir("output-folder");
+    let out = sahara(&["render", "--spp", "1", "-o", dir.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&format!("{}: is a folder", dir.display())),
+        "{err}"
+    );
+    assert!(!err.contains("extension"), "{err}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn adaptive_sampling_at_its_minimum_says_no_pixel_can_stop_early() {
+    let dir = temp_dir("adaptive-min");
+    let png = dir.join("a.png");
+    let run = |spp: &str| {
+        let out = sahara(&[
+            "render",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--spp",
+            spp,
+            "--noise-threshold",
+            "0.5",
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        let err = stderr(&out);
+        assert!(out.status.success(), "{err}");
+        err
+    };
+    // The cap equals the default minimum of 16: every pixel takes 16
+    // samples, and the log neither claims pixels stopped early nor hides why.
+    let err = run("16");
+    assert!(err.contains("every pixel takes all 16 samples"), "{err}");
+    assert!(err.contains("100.0% of the 16 spp budget"), "{err}");
+    assert!(
+        err.contains("0 of 1024 pixels (0.0%) stopped early"),
+        "{err}"
+    );
+    // With room above the minimum, pixels stop early and no warning is given.
+    let err = run("256");
+    assert!(!err.contains("every pixel takes all"), "{err}");
+    assert!(!err.contains(" 0 of 1024 pixels"), "{err}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn two_identical_exr_renders_are_byte_identical() {
     let dir = temp_dir("exr-repeat");
     let mut files = Vec::new();
