@@ -343,8 +343,26 @@ fn a_log_that_is_not_a_terminal_gets_plain_progress_lines() {
         .unwrap();
     let err = stderr(&o);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("progress: pass 1/2"), "{err}");
-    assert!(err.contains("progress: pass 2/2"), "{err}");
+    // Each line gives the whole render's share, the time elapsed and left,
+    // and the speed; the tiles are said to be the pass's.
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("progress: "))
+        .collect();
+    assert!(!lines.is_empty(), "{err}");
+    for line in &lines {
+        assert!(
+            line.contains("% done, ")
+                && line.contains(" elapsed, eta ")
+                && line.contains(" Mrays/s (pass ")
+                && line.contains(" of this pass)"),
+            "{line}"
+        );
+    }
+    assert!(err.contains("(pass 1/2, tile "), "{err}");
+    assert!(err.contains("(pass 2/2, tile "), "{err}");
+    // The last tile of the last pass is the whole render.
+    assert!(err.contains("progress: 100.0% done"), "{err}");
     let _ = fs::remove_dir_all(&dir);
 }
 
