@@ -1587,3 +1587,95 @@ fn the_log_says_why_the_default_sky_was_added() {
     );
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// The glTF scenes of `tests/assets/` (written by its
+/// `make_framing_scenes.py`).
+fn asset(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/assets")
+        .join(name)
+}
+
+/// Renders `model` with its object ids at 40 x 30; returns the log and the
+/// name of the object each pixel shows (`nothing` for the sky).
+fn render_objects(model: &Path, dir: &Path) -> (String, Vec<String>) {
+    let exr = dir.join("objects.exr");
+    let out = sahara(&[
+        "render",
+        model.to_str().unwrap(),
+        "--width",
+        "40",
+        "--height",
+        "30",
+        "--spp",
+        "4",
+        "--aov",
+        "object",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    let ids = &exr_channels(&exr)["object.id"];
+    let names: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(dir.join("objects.names.json")).unwrap()).unwrap();
+    let objects = ids
+        .iter()
+        .map(|&id| match id {
+            0.0 => "nothing".to_string(),
+            // `FILE/NODE`: the node's name.
+            id => names["object"][format!("{id}")]
+                .as_str()
+                .unwrap()
+                .rsplit('/')
+                .next()
+                .unwrap()
+                .to_string(),
+        })
+        .collect();
+    (err, objects)
+}
+
+/// A small island with a palm in a huge, glowing, gently waved sea: the
+/// automatic camera frames the island, not the sea, and the sea's glow does
+/// not switch the default sky off.
+#[test]
+fn a_subject_in_a_huge_glowing_sea_fills_the_frame_under_the_sky() {
+    let dir = temp_dir("island-sea");
+    let (err, objects) = render_objects(&asset("island_sea.gltf"), &dir);
+    assert!(
+        err.contains("framing 9 objects; 1 flat or emissive object"),
+        "{err}"
+    );
+    assert!(err.contains("light: default sky and sun"), "{err}");
+    let share = |what: &dyn Fn(&str) -> bool| {
+        objects.iter().filter(|o| what(o)).count() as f64 / objects.len() as f64
+    };
+    // The island and what stands on it fill a good part of the frame; the
+    // sea and the sky the rest.
+    let subject = share(&|o| o != "Sea" && o != "nothing");
+    assert!(subject > 0.3, "the island fills {subject} of the frame");
+    let palm = share(&|o| o == "Trunk" || o.starts_with("Leaf"));
+    assert!(palm > 0.03, "the palm fills {palm} of the frame");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A Cornell box (five one-sided walls, open at +z) without a camera is
+/// looked into through its open side: every wall is seen from inside.
+#[test]
+fn a_room_open_on_one_side_is_looked_into_through_it() {
+    let dir = temp_dir("open-room");
+    let (err, objects) = render_objects(&asset("open_room.gltf"), &dir);
+    assert!(err.contains("a room open on its +z side"), "{err}");
+    let at = |x: usize, y: usize| objects[y * 40 + x].as_str();
+    // The opening fills the frame's height: the left wall on the left, the
+    // right wall on the right, the floor below, the ceiling above, the
+    // back wall in the middle; the sky only beside the box.
+    assert_eq!(at(9, 15), "Left", "{objects:?}");
+    assert_eq!(at(31, 15), "Right", "{objects:?}");
+    assert_eq!(at(20, 26), "Floor", "{objects:?}");
+    assert_eq!(at(20, 4), "Ceiling", "{objects:?}");
+    assert_eq!(at(25, 10), "Back", "{objects:?}");
+    assert_eq!(at(1, 15), "nothing", "{objects:?}");
+    let _ = fs::remove_dir_all(&dir);
+}
