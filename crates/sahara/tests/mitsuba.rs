@@ -55,10 +55,9 @@ fn a_mitsuba_scene_renders_with_its_film_parameters_and_warnings_counted() {
     ]);
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
-    assert!(
-        err.contains("s.xml:11:24: bsdf 'roughplastic': the Beckmann distribution is replaced by GGX of the same alpha (2 times; the first here)"),
-        "{err}"
-    );
+    // roughplastic's default Beckmann distribution is rendered as it is.
+    assert!(!err.contains("Beckmann distribution is replaced"), "{err}");
+    assert!(!err.contains("warning"), "{err}");
     assert!(err.contains("2 spp"), "{err}");
     let mean = checked_mean(&png, 12, 6);
     assert!(mean > 0.1, "a lit sphere on a white sky: {mean}");
