@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the glTF scenes of the automatic camera's end-to-end tests
-(crates/sahara/tests/render.rs), each a small .gltf with its buffer inline:
+(crates/sahara/tests/end_to_end/render.rs), each a small .gltf with its buffer inline:
 
 - island_sea.gltf: a palm of sorts (a trunk and four flat leaves, about 6
   units tall) on an island of sand 20 units across, in a sea 392 units

@@ -7,9 +7,7 @@ use std::process::Output;
 
 use sahara_formats::image_in::load_rgb_f32;
 
-mod common;
-
-use common::{denoiser_missing, sahara, temp_dir};
+use crate::common::{denoiser_missing, sahara, temp_dir};
 
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
@@ -199,7 +197,7 @@ fn command_line_options_override_the_scene_file() {
          [film]\nwidth = 12\nheight = 6\noutput = \"from_file.png\"\n",
     )
     .unwrap();
-    let out = std::process::Command::new(common::SAHARA)
+    let out = std::process::Command::new(crate::common::SAHARA)
         .args(["render", scene.to_str().unwrap(), "--spp", "1"])
         .current_dir(&dir)
         .output()
@@ -335,7 +333,7 @@ fn every_output_is_checked_before_the_scene_is_loaded() {
 fn a_log_that_is_not_a_terminal_gets_plain_progress_lines() {
     let dir = temp_dir("plain-progress");
     let out = dir.join("p.png");
-    let o = std::process::Command::new(common::SAHARA)
+    let o = std::process::Command::new(crate::common::SAHARA)
         .args(["render", "--width", "40", "--height", "40", "--spp", "4"])
         .args(["--pass-spp", "2", "-o", out.to_str().unwrap()])
         .env("SAHARA_PROGRESS_EVERY", "0")
@@ -636,7 +634,7 @@ fn a_scene_files_output_goes_to_the_working_folder() {
          output = \"out.png\"\n[sampler]\nspp = 1\n",
     )
     .unwrap();
-    let o = std::process::Command::new(common::SAHARA)
+    let o = std::process::Command::new(crate::common::SAHARA)
         .args(["render", scene.to_str().unwrap()])
         .current_dir(&work)
         .output()

@@ -8,9 +8,7 @@ use std::io::{BufRead, BufReader, Read};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
-
-use common::{temp_dir, SAHARA};
+use crate::common::{temp_dir, SAHARA};
 
 /// The `sahara:*` text attributes of an EXR file.
 fn exr_text(path: &std::path::Path, key: &str) -> Option<String> {
