@@ -1698,3 +1698,61 @@ fn a_room_open_on_one_side_is_looked_into_through_it() {
     assert_eq!(objects[15 * 40 + 20], "Block");
     let _ = fs::remove_dir_all(&dir);
 }
+
+/// A glTF whose only texture is a KTX2 image (`KHR_texture_basisu`, no PNG
+/// fallback; `crates/sahara-readers/tests/data/`, written by its
+/// `make_ktx2.py`) renders with it: the square's four quadrants, red and
+/// green above, blue and white below, seen where they are.
+#[test]
+fn a_gltf_with_ktx2_textures_renders_with_them() {
+    let dir = temp_dir("ktx2");
+    let model = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../sahara-readers/tests/data/quad_basisu.gltf");
+    let exr = dir.join("quad.exr");
+    let out = sahara(&[
+        "render",
+        model.to_str().unwrap(),
+        "--width",
+        "48",
+        "--height",
+        "36",
+        "--spp",
+        "4",
+        "--aov",
+        "albedo",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let c = exr_channels(&exr);
+    let n = 48 * 36;
+    let albedo = |k: usize| [c["albedo.R"][k], c["albedo.G"][k], c["albedo.B"][k]];
+    let beauty = |k: usize| [c["R"][k], c["G"][k], c["B"][k]];
+    // The pixels whose albedo is each quadrant's colour (linear, as the
+    // sRGB codes 255 and 0 decode), their mean position and beauty.
+    let quadrant = |want: [f32; 3]| {
+        let at: Vec<usize> = (0..n)
+            .filter(|&k| (0..3).all(|i| (albedo(k)[i] - want[i]).abs() < 0.01))
+            .collect();
+        assert!(at.len() > 20, "{want:?}: {} pixels", at.len());
+        let mean = |f: &dyn Fn(usize) -> f32| at.iter().map(|&k| f(k)).sum::<f32>() / at.len() as f32;
+        (
+            [mean(&|k| (k % 48) as f32), mean(&|k| (k / 48) as f32)],
+            [0, 1, 2].map(|i| mean(&|k| beauty(k)[i])),
+        )
+    };
+    let (red, red_light) = quadrant([1.0, 0.0, 0.0]);
+    let (green, green_light) = quadrant([0.0, 1.0, 0.0]);
+    let (blue, blue_light) = quadrant([0.0, 0.0, 1.0]);
+    let (white, _) = quadrant([1.0, 1.0, 1.0]);
+    // Red left of green and above blue; white right of blue, below green.
+    assert!(red[0] < green[0] && blue[0] < white[0], "{red:?} {green:?} {blue:?} {white:?}");
+    assert!(red[1] < blue[1] && green[1] < white[1], "{red:?} {green:?} {blue:?} {white:?}");
+    // And the light they reflect is theirs.
+    assert!(red_light[0] > 10.0 * red_light[1].max(red_light[2]), "{red_light:?}");
+    assert!(green_light[1] > 10.0 * green_light[0].max(green_light[2]), "{green_light:?}");
+    assert!(blue_light[2] > 10.0 * blue_light[0].max(blue_light[1]), "{blue_light:?}");
+    let _ = fs::remove_dir_all(&dir);
+}
