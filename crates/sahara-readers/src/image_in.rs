@@ -130,7 +130,10 @@ fn decode_ktx2(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
     let fail =
         |e: Error| FormatError::in_file(name, format!("cannot read the KTX2 texture: {}", why(e)));
     ktx2_sound(bytes).map_err(|what| {
-        FormatError::in_file(name, format!("cannot read the KTX2 texture: its {what} is corrupt"))
+        FormatError::in_file(
+            name,
+            format!("cannot read the KTX2 texture: its {what} is corrupt"),
+        )
     })?;
     let texture = Transcoder::new(bytes).map_err(fail)?;
     let (width, height) = texture.base_dimensions();
@@ -161,7 +164,9 @@ fn decode_ktx2(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
 /// out of bounds (a panic). `Err` names the part that is wrong.
 fn ktx2_sound(bytes: &[u8]) -> Result<(), &'static str> {
     let u32_at = |at: usize| -> Option<u64> {
-        Some(u64::from(u32::from_le_bytes(bytes.get(at..at + 4)?.try_into().ok()?)))
+        Some(u64::from(u32::from_le_bytes(
+            bytes.get(at..at + 4)?.try_into().ok()?,
+        )))
     };
     let u64_at = |at: usize| -> Option<u64> {
         Some(u64::from_le_bytes(bytes.get(at..at + 8)?.try_into().ok()?))

@@ -97,7 +97,11 @@ fn ktx2_textures_decode_to_their_colours_within_the_codecs_error() {
                     "{file} ({x}, {y}): {texel:?} for {want:?}"
                 );
                 if file == "quad_etc1s.ktx2" {
-                    assert_eq!(texel[..3], etc1s_reference[x / 4 + 2 * (y / 4)], "({x}, {y})");
+                    assert_eq!(
+                        texel[..3],
+                        etc1s_reference[x / 4 + 2 * (y / 4)],
+                        "({x}, {y})"
+                    );
                 }
             }
         }
@@ -158,7 +162,10 @@ fn bad_ktx2_data_is_a_one_line_error_naming_the_file() {
     let e = decode_raw(&ktx2("quad_uastc.ktx2")[..12], "bad.ktx2")
         .unwrap_err()
         .to_string();
-    assert!(e.starts_with("bad.ktx2: cannot read the KTX2 texture"), "{e}");
+    assert!(
+        e.starts_with("bad.ktx2: cannot read the KTX2 texture"),
+        "{e}"
+    );
     let mut raw = ktx2("quad_uastc.ktx2");
     raw[12..16].copy_from_slice(&37u32.to_le_bytes());
     let e = decode_raw(&raw, "raw.ktx2").unwrap_err().to_string();

@@ -1706,8 +1706,8 @@ fn a_room_open_on_one_side_is_looked_into_through_it() {
 #[test]
 fn a_gltf_with_ktx2_textures_renders_with_them() {
     let dir = temp_dir("ktx2");
-    let model = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../sahara-readers/tests/data/quad_basisu.gltf");
+    let model =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../sahara-readers/tests/data/quad_basisu.gltf");
     let exr = dir.join("quad.exr");
     let out = sahara(&[
         "render",
@@ -1737,7 +1737,8 @@ fn a_gltf_with_ktx2_textures_renders_with_them() {
             .filter(|&k| (0..3).all(|i| (albedo(k)[i] - want[i]).abs() < 0.01))
             .collect();
         assert!(at.len() > 20, "{want:?}: {} pixels", at.len());
-        let mean = |f: &dyn Fn(usize) -> f32| at.iter().map(|&k| f(k)).sum::<f32>() / at.len() as f32;
+        let mean =
+            |f: &dyn Fn(usize) -> f32| at.iter().map(|&k| f(k)).sum::<f32>() / at.len() as f32;
         (
             [mean(&|k| (k % 48) as f32), mean(&|k| (k / 48) as f32)],
             [0, 1, 2].map(|i| mean(&|k| beauty(k)[i])),
@@ -1748,11 +1749,26 @@ fn a_gltf_with_ktx2_textures_renders_with_them() {
     let (blue, blue_light) = quadrant([0.0, 0.0, 1.0]);
     let (white, _) = quadrant([1.0, 1.0, 1.0]);
     // Red left of green and above blue; white right of blue, below green.
-    assert!(red[0] < green[0] && blue[0] < white[0], "{red:?} {green:?} {blue:?} {white:?}");
-    assert!(red[1] < blue[1] && green[1] < white[1], "{red:?} {green:?} {blue:?} {white:?}");
+    assert!(
+        red[0] < green[0] && blue[0] < white[0],
+        "{red:?} {green:?} {blue:?} {white:?}"
+    );
+    assert!(
+        red[1] < blue[1] && green[1] < white[1],
+        "{red:?} {green:?} {blue:?} {white:?}"
+    );
     // And the light they reflect is theirs.
-    assert!(red_light[0] > 10.0 * red_light[1].max(red_light[2]), "{red_light:?}");
-    assert!(green_light[1] > 10.0 * green_light[0].max(green_light[2]), "{green_light:?}");
-    assert!(blue_light[2] > 10.0 * blue_light[0].max(blue_light[1]), "{blue_light:?}");
+    assert!(
+        red_light[0] > 10.0 * red_light[1].max(red_light[2]),
+        "{red_light:?}"
+    );
+    assert!(
+        green_light[1] > 10.0 * green_light[0].max(green_light[2]),
+        "{green_light:?}"
+    );
+    assert!(
+        blue_light[2] > 10.0 * blue_light[0].max(blue_light[1]),
+        "{blue_light:?}"
+    );
     let _ = fs::remove_dir_all(&dir);
 }
