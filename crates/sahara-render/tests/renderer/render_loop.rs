@@ -1,13 +1,11 @@
 //! The render loop and whole scenes: determinism, the Cornell box, no NaN
 //! anywhere, progressive passes and cancellation, instancing.
 
-mod common;
-
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Duration;
 
-use common::{run, settings};
+use crate::common::{run, settings};
 use glam::{Affine3A, Quat, Vec3};
 use sahara_kd::KdTree;
 use sahara_render::internals::World;
