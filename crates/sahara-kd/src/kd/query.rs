@@ -473,7 +473,10 @@ mod tests {
                 several += (hits.len() > 1) as usize;
             }
         }
-        assert!(found > 1000 && several > 100, "{found} hits, {several} rays with several");
+        assert!(
+            found > 1000 && several > 100,
+            "{found} hits, {several} rays with several"
+        );
         tree_without_triangles_has_no_hits();
     }
 
