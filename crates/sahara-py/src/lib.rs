@@ -7,13 +7,22 @@
 mod arrays;
 mod pool;
 mod rays;
+mod render;
 
 use pyo3::prelude::*;
 
-/// The native module: `RayScene`, and the version.
+/// The native module: `RayScene`; `Scene`, `load`, `cornell_box`,
+/// `render`, `write`, `names`, `FormatError`; the version.
 #[pymodule]
 fn _sahara(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<rays::RayScene>()?;
+    m.add_class::<render::Scene>()?;
+    m.add_function(wrap_pyfunction!(render::load, m)?)?;
+    m.add_function(wrap_pyfunction!(render::cornell_box, m)?)?;
+    m.add_function(wrap_pyfunction!(render::render, m)?)?;
+    m.add_function(wrap_pyfunction!(render::write, m)?)?;
+    m.add_function(wrap_pyfunction!(render::names, m)?)?;
+    m.add("FormatError", m.py().get_type::<render::FormatError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -1,6 +1,6 @@
 """Type stubs of the native module `sahara._sahara` (see `sahara`)."""
 
-from typing import Any, Dict, Optional, Union
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -80,3 +80,55 @@ class RayScene:
         """Inside tests by ray parity (majority of ``samples`` directions)."""
     def stats(self) -> Dict[str, Any]:
         """The tree's statistics, the SAH cost included."""
+
+class FormatError(ValueError):
+    """A file Sahara cannot read or write; the message names the file and line."""
+
+class Scene:
+    """A scene loaded from a file (or the built-in Cornell box)."""
+
+    name: str
+    description: str
+    warnings: List[str]
+    object_names: List[str]
+    material_names: List[str]
+    framing: Optional[str]
+    @property
+    def file_settings(self) -> Optional[Dict[str, Any]]: ...
+    @property
+    def triangle_count(self) -> int: ...
+
+def load(
+    path: str,
+    *,
+    camera: Optional[str] = None,
+    sky: Optional[str] = None,
+    defines: Optional[List[Tuple[str, str]]] = None,
+) -> Scene: ...
+def cornell_box(*, camera: Optional[str] = None, sky: Optional[str] = None) -> Scene: ...
+def render(
+    scene: Scene,
+    *,
+    spp: Optional[int] = None,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
+    integrator: Optional[str] = None,
+    seed: Optional[int] = None,
+    threads: Optional[int] = None,
+    aovs: Optional[List[str]] = None,
+    denoise: bool = False,
+    sampler: Optional[str] = None,
+    filter: Optional[str] = None,
+    pass_spp: Optional[int] = None,
+    builder: Optional[str] = None,
+    progress: Optional[Callable[[int, int], Any]] = None,
+) -> Tuple[npt.NDArray[np.float32], Dict[str, np.ndarray]]: ...
+def write(
+    path: str,
+    image: npt.ArrayLike,
+    *,
+    exposure: float = 0.0,
+    tonemap: str = "clamp",
+    metadata: Optional[List[Tuple[str, str]]] = None,
+) -> None: ...
+def names() -> Dict[str, List[str]]: ...
