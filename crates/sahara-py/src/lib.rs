@@ -12,7 +12,7 @@ mod render;
 use pyo3::prelude::*;
 
 /// The native module: `RayScene`; `Scene`, `load`, `cornell_box`,
-/// `render`, `write`, `names`, `FormatError`; the version.
+/// `render`, `write`, `names`, `read_mesh`, `FormatError`; the version.
 #[pymodule]
 fn _sahara(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<rays::RayScene>()?;
@@ -22,6 +22,7 @@ fn _sahara(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_function(wrap_pyfunction!(render::write, m)?)?;
     m.add_function(wrap_pyfunction!(render::names, m)?)?;
+    m.add_function(wrap_pyfunction!(render::read_mesh, m)?)?;
     m.add("FormatError", m.py().get_type::<render::FormatError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())

@@ -575,3 +575,37 @@ pub fn names(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("tonemap", PyList::new(py, ToneMap::names())?)?;
     Ok(d)
 }
+
+/// Vertices and faces as numpy arrays.
+type MeshArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<u32>>);
+
+/// A mesh file's triangles as the command line reads them (`.obj`,
+/// `.ply`, `.gltf`, `.glb`; a glTF file's meshes merged in scene order,
+/// polygons fan-triangulated): (N, 3) float32 vertices and (M, 3) uint32
+/// faces, for `RayScene`.
+#[pyfunction]
+pub fn read_mesh<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<MeshArrays<'py>> {
+    if !path.exists() {
+        return Err(PyFileNotFoundError::new_err(format!(
+            "{}: not found",
+            path.display()
+        )));
+    }
+    let mesh = py
+        .detach(|| sahara_formats::load_mesh(&path))
+        .map_err(format_error)?;
+    let v = PyArray2::<f32>::zeros(py, [mesh.positions.len(), 3], false);
+    let f = PyArray2::<u32>::zeros(py, [mesh.indices.len(), 3], false);
+    // SAFETY: made here, held by no one else.
+    let (vs, fs) = unsafe { (v.as_slice_mut()?, f.as_slice_mut()?) };
+    for (o, p) in vs.chunks_exact_mut(3).zip(&mesh.positions) {
+        o.copy_from_slice(&p.to_array());
+    }
+    for (o, t) in fs.chunks_exact_mut(3).zip(&mesh.indices) {
+        o.copy_from_slice(t);
+    }
+    Ok((v, f))
+}

@@ -218,3 +218,44 @@ def test_the_same_bits_as_the_rust_queries(tmp_path, sahara_bin):
             assert (got["triangle"] >= 0).sum() > 5000
             np.testing.assert_array_equal(got["t"].view(np.uint32), want["t"].view(np.uint32))
             np.testing.assert_array_equal(got["triangle"].astype(np.int64) & 0xFFFFFFFF, want["i"])
+
+
+def test_read_mesh_gives_the_command_lines_triangles(tmp_path):
+    v, f = icosphere(1)
+    path = tmp_path / "s.obj"
+    write_obj(path, v, f)
+    vv, ff = sahara.read_mesh(path)
+    assert vv.dtype == np.float32 and ff.dtype == np.uint32
+    # The same triangles in the same order (the vertices numbered as the reader numbers them).
+    np.testing.assert_array_equal(vv[ff], v.astype(np.float32)[f])
+    with pytest.raises(FileNotFoundError):
+        sahara.read_mesh(tmp_path / "none.ply")
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nf 1 2 3\n")
+    with pytest.raises(sahara.FormatError, match="bad.obj: line 2"):
+        sahara.read_mesh(bad)
+
+
+def test_agreement_with_embree_on_the_shared_meshes(tmp_path, sahara_bin, shared_scenes):
+    """The benchmark protocol's agreement rule against Embree (embreex):
+    hit counts within 0.01% of the rays, t-sums within 1e-4 relative."""
+    embreex = pytest.importorskip("embreex.rtcore_scene")
+    from embreex.mesh_construction import TriangleMesh
+
+    mesh = shared_scenes / "bunny" / "bunny.ply"
+    rays = tmp_path / "rays.bin"
+    subprocess.run([sahara_bin, "bench", str(mesh), "--sets", "primary,diffuse", "--runs", "1",
+                    "--threads", "1", "--dump-rays", "diffuse", str(rays)], check=True, capture_output=True)
+    r = np.fromfile(rays, np.float32).reshape(-1, 8)
+    o, d, tmin, tmax = np.ascontiguousarray(r[:, :3]), np.ascontiguousarray(r[:, 4:7]), r[:, 3], r[:, 7]
+    v, f = sahara.read_mesh(mesh)
+    ours = sahara.RayScene(v, f).cast_rays(o, d, tmin, tmax)["t"]
+    scene = embreex.EmbreeScene()
+    TriangleMesh(scene=scene, vertices=v, indices=f.astype(np.int32))
+    e = scene.run(o, d, dists=tmax.copy(), output=1)
+    theirs = np.where(e["primID"] >= 0, e["tfar"], np.inf)
+    hit_o, hit_t = np.isfinite(ours), np.isfinite(theirs)
+    assert hit_o.sum() > 10000
+    assert abs(int(hit_o.sum()) - int(hit_t.sum())) <= 1e-4 * len(o)
+    s_o, s_t = ours[hit_o].sum(dtype=np.float64), theirs[hit_t].sum(dtype=np.float64)
+    assert abs(s_o - s_t) <= 1e-4 * s_o

@@ -6,6 +6,7 @@ Sahara's renderer.
   arrays, without the GIL, on Sahara's threads.
 - ``sahara.trimesh.RayMeshIntersector``: the same queries behind trimesh's
   intersector interface (trimesh is an optional dependency).
+- ``read_mesh``: a mesh file's vertices and faces as Sahara reads them.
 - ``load``, ``cornell_box``, ``render``, ``write``: scenes read as the
   ``sahara`` command line reads them, rendered to numpy arrays (the same
   image for the same seed), written as PNG or EXR by the same writer.
@@ -23,7 +24,7 @@ from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Unio
 import numpy as np
 
 from . import _sahara
-from ._sahara import FormatError, RayScene, Scene, __version__, cornell_box, names
+from ._sahara import FormatError, RayScene, Scene, __version__, cornell_box, names, read_mesh
 
 __all__ = [
     "FormatError",
@@ -33,6 +34,7 @@ __all__ = [
     "cornell_box",
     "load",
     "names",
+    "read_mesh",
     "render",
     "write",
 ]
