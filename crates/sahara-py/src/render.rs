@@ -584,10 +584,7 @@ type MeshArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<u32>>);
 /// polygons fan-triangulated): (N, 3) float32 vertices and (M, 3) uint32
 /// faces, for `RayScene`.
 #[pyfunction]
-pub fn read_mesh<'py>(
-    py: Python<'py>,
-    path: PathBuf,
-) -> PyResult<MeshArrays<'py>> {
+pub fn read_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<MeshArrays<'py>> {
     if !path.exists() {
         return Err(PyFileNotFoundError::new_err(format!(
             "{}: not found",
