@@ -19,37 +19,12 @@
 use std::collections::HashSet;
 use std::path::Path;
 
-use glam::Vec3;
+use sahara_bench::walk::heap;
 use sahara_kd::{Aabb, BuildParams, KdTree, Node, Triangle};
 
 fn area(b: &Aabb) -> f32 {
     let d = b.max - b.min;
     2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
-}
-
-/// The wide node of every inner node (leaves: `u32::MAX`), grouping each
-/// wide node's first `levels` binary levels.
-fn heap(nodes: &[Node], levels: u32) -> Vec<u32> {
-    let mut of = vec![u32::MAX; nodes.len()];
-    let (mut count, mut roots) = (0, vec![0u32]);
-    while let Some(root) = roots.pop() {
-        let mut todo = vec![(root, 0)];
-        while let Some((i, depth)) = todo.pop() {
-            let n = &nodes[i as usize];
-            if n.is_leaf() {
-                continue;
-            }
-            if depth == levels {
-                roots.push(i);
-                continue;
-            }
-            of[i as usize] = count;
-            todo.push((i + 1, depth + 1));
-            todo.push((n.above_child(), depth + 1));
-        }
-        count += 1;
-    }
-    of
 }
 
 /// The wide node of every inner node, each wide node a treelet of up to
@@ -81,41 +56,14 @@ fn treelets(nodes: &[Node], cells: &[Aabb], size: usize) -> Vec<u32> {
 
 /// The inner nodes `ray` visits up to its closest hit, front to back.
 fn visited(tree: &KdTree, ray: &sahara_kd::Ray) -> Vec<u32> {
-    let nodes = tree.nodes();
     let tmax = tree.closest_hit(ray).map_or(ray.tmax, |h| h.t);
-    let inv = Vec3::ONE / ray.dir;
     let mut out = Vec::new();
-    let Some((t0, t1)) = tree.bounds().intersect_ray(ray.origin, inv, ray.tmin, tmax) else {
-        return out;
-    };
-    let mut todo = vec![(0u32, t0, t1)];
-    while let Some((i, a, b)) = todo.pop() {
-        let n = &nodes[i as usize];
-        if n.is_leaf() {
-            continue;
+    sahara_bench::walk::front_to_back(tree, ray, tmax, |i, n, _, _| {
+        if !n.is_leaf() {
+            out.push(i);
         }
-        out.push(i);
-        let axis = n.axis();
-        let (o, d) = (ray.origin[axis], ray.dir[axis]);
-        let t = (n.split() - o) * inv[axis];
-        let below_first = o < n.split() || (o == n.split() && d <= 0.0);
-        let (near, far) = if below_first {
-            (i + 1, n.above_child())
-        } else {
-            (n.above_child(), i + 1)
-        };
-        if t.is_nan() {
-            todo.push((far, a, b));
-            todo.push((near, a, b));
-        } else if t > b || t <= 0.0 {
-            todo.push((near, a, b));
-        } else if t < a {
-            todo.push((far, a, b));
-        } else {
-            todo.push((far, t, b));
-            todo.push((near, a, t));
-        }
-    }
+        true
+    });
     out
 }
 

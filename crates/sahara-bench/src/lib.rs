@@ -7,7 +7,9 @@
 //!   program `shared/bench/embree/embree_bench.c` does ([`protocol`]),
 //! - reads and writes the protocol's ray and hit files ([`files`]),
 //! - traces, times and counts ([`runner`]) and reports the results as plain
-//!   serialisable structs ([`report`]).
+//!   serialisable structs ([`report`]);
+//! - walks the binary tree node by node for the counts of its examples
+//!   ([`walk`]).
 //!
 //! One ray's result is a [`record::HitRecord`], the hit file's record.
 
@@ -18,6 +20,7 @@ pub mod protocol;
 pub mod record;
 pub mod report;
 pub mod runner;
+pub mod walk;
 
 pub use protocol::{ImageSize, ProtocolCamera, SceneFrame, SetKind, SplitMix64};
 pub use record::HitRecord;

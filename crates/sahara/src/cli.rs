@@ -114,7 +114,9 @@ pub struct RenderArgs {
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub height: Option<u32>,
     /// Light transport, with its default parameters (or the scene file's,
-    /// if it names the same one) [default: the scene file's, else path].
+    /// if it names the same one; path, bdpt, lightpath and sppm keep the
+    /// file's max_depth of any of them) [default: the scene file's, else
+    /// path].
     #[arg(long, value_name = "NAME", value_parser = NameParser::<IntegratorKind>::new())]
     pub integrator: Option<IntegratorKind>,
     /// Sample generator [default: the scene file's, else sobol].

@@ -43,8 +43,18 @@ pub fn resolve(
 ) -> Result<RenderOptions> {
     // A kind named on the command line takes its default parameters,
     // unless the file names the same kind: then the file's parameters hold.
+    // Between `path`, `bdpt`, `lightpath` and `sppm`, which count a path's
+    // length alike, the file's length holds too, so that switching the
+    // estimator renders the same image.
     let integrator = match (args.integrator, file) {
         (Some(kind), Some(f)) if f.integrator.kind() == kind => f.integrator,
+        (Some(kind), Some(f)) => {
+            let new = Integrator::from(kind);
+            match (f.integrator.path_length(), new.path_length()) {
+                (Some(n), Some(_)) => new.with_path_length(n),
+                _ => new,
+            }
+        }
         (Some(kind), _) => Integrator::from(kind),
         (None, Some(f)) => f.integrator,
         (None, None) => Integrator::default(),
@@ -173,6 +183,43 @@ mod tests {
         assert_eq!(s.integrator, file().integrator);
         assert_eq!(s.filter, Filter::from(FilterKind::Tent));
         assert_eq!(o.output, PathBuf::from("y.png"));
+    }
+
+    #[test]
+    fn another_estimator_keeps_the_files_path_length() {
+        let mut f = file();
+        f.integrator = Integrator::Bdpt { max_depth: 20 };
+        let with = |kind| {
+            let args = RenderArgs {
+                integrator: Some(kind),
+                ..Default::default()
+            };
+            resolve(&args, Some(&f), "s").unwrap().settings.integrator
+        };
+        assert_eq!(
+            with(IntegratorKind::Path),
+            Integrator::Path {
+                max_depth: 20,
+                rr_depth: sahara_render::defaults::RR_DEPTH
+            }
+        );
+        assert_eq!(with(IntegratorKind::LightPath).path_length(), Some(20));
+        assert_eq!(with(IntegratorKind::Sppm).path_length(), Some(20));
+        // `distribution` counts its depth otherwise: its default holds.
+        assert_eq!(
+            with(IntegratorKind::Distribution),
+            Integrator::from(IntegratorKind::Distribution)
+        );
+        // And a file's `distribution` depth does not become a path length.
+        let args = RenderArgs {
+            integrator: Some(IntegratorKind::Path),
+            ..Default::default()
+        };
+        let o = resolve(&args, Some(&file()), "s").unwrap();
+        assert_eq!(
+            o.settings.integrator,
+            Integrator::from(IntegratorKind::Path)
+        );
     }
 
     #[test]

@@ -57,6 +57,9 @@ struct Case {
     height: u32,
     /// Sahara's samples per pixel.
     spp: u32,
+    /// Pixels left out of the measures, zero in both images: `[x0, x1, y0,
+    /// y1]`, the ends excluded.
+    mask: Option<[usize; 4]>,
     /// Sahara's image mean over Tungsten's, per channel, and its bound.
     ratio: [f32; 3],
     ratio_tol: [f32; 3],
@@ -68,7 +71,7 @@ struct Case {
 
 /// The held scenes, as `scripts/bitterli_gallery.py --seeds 8` prints them
 /// (measured on 2 cores of an AMD EPYC).
-const CASES: [Case; 5] = [
+const CASES: [Case; 8] = [
     // cornell-box: the file asks for `maxdepth 4` where Tungsten traced 64
     // bounces: 3-4 % of the light, most in red, is missing. Mitsuba 3
     // renders Bitterli's own Mitsuba file of the scene at max_depth 5 (4
@@ -81,6 +84,7 @@ const CASES: [Case; 5] = [
         width: 128,
         height: 128,
         spp: 64,
+        mask: None,
         ratio: [0.9575, 0.9697, 0.9885],
         ratio_tol: [0.0021, 0.0021, 0.0026],
         block_p50: (0.0312, 0.0035),
@@ -95,6 +99,7 @@ const CASES: [Case; 5] = [
         width: 100,
         height: 125,
         spp: 64,
+        mask: None,
         ratio: [1.0069, 1.0047, 0.9937],
         ratio_tol: [0.0050, 0.0062, 0.0080],
         block_p50: (0.0136, 0.0038),
@@ -113,6 +118,7 @@ const CASES: [Case; 5] = [
         width: 128,
         height: 128,
         spp: 64,
+        mask: None,
         ratio: [1.2655, 1.1738, 1.0133],
         ratio_tol: [2.1511, 2.2253, 2.3415],
         block_p50: (0.4970, 0.0087),
@@ -132,6 +138,7 @@ const CASES: [Case; 5] = [
         width: 160,
         height: 90,
         spp: 64,
+        mask: None,
         ratio: [1.6251, 1.4603, 1.4055],
         ratio_tol: [0.0692, 0.0622, 0.0604],
         block_p50: (0.1789, 0.0108),
@@ -152,10 +159,77 @@ const CASES: [Case; 5] = [
         width: 160,
         height: 90,
         spp: 64,
+        mask: None,
         ratio: [0.9892, 0.9880, 0.9876],
         ratio_tol: [0.1156, 0.1254, 0.1287],
         block_p50: (0.0056, 0.0013),
         block_p90: (0.0269, 0.0115),
+    },
+    // veach-ajar: the floor of the file is the bare rough metal, where
+    // Tungsten's (as Bitterli's own Mitsuba file of the scene says) scales
+    // its reflection by a checkerboard of 0.8 and 0.2. Mitsuba 3 renders the
+    // file to Sahara's image (Sahara / Mitsuba 0.997, 1.002, 1.004) and, with
+    // that checkerboard added, to 1.01, 1.04, 1.09 of Tungsten's (block
+    // median 0.08). The rest is the two images missing from the collection
+    // (grey here; black gives 0.94-0.98, white 1.15-1.27) and `maxdepth 13`
+    // (64 bounces add 2 %). Path tracing at 64 samples leaves fireflies,
+    // hence the bounds.
+    Case {
+        name: "veach-ajar",
+        scene: "veach-ajar",
+        file: "scene-v4.pbrt",
+        kept: true,
+        width: 80,
+        height: 45,
+        spp: 64,
+        mask: None,
+        ratio: [1.4690, 1.5475, 1.6356],
+        ratio_tol: [0.1090, 0.1242, 0.1351],
+        block_p50: (0.5856, 0.2054),
+        block_p90: (1.3824, 0.4295),
+    },
+    // water-caustic: the light seen directly (0.008 of a pixel at a radiance
+    // of 5.4e5: half of the image's red mean, found by a sample or not, and
+    // infinity in Tungsten's half floats) is masked out. Tungsten's image
+    // also shows the light through the waves of the water (light,
+    // refraction, refraction, camera) in some 30 pixels, 7-9 % of the rest
+    // of its mean; Sahara's camera paths carry the same light there, but a
+    // render of this size finds it once in some 65 (seed 4 of those
+    // measured) and then adds about 4 to the ratio: no bound on the ratio,
+    // the blocks hold the scene. Without those spots the image is 1.06,
+    // 1.02, 0.98 of Tungsten's.
+    Case {
+        name: "water-caustic",
+        scene: "water-caustic",
+        file: "scene-v4.pbrt",
+        kept: true,
+        width: 128,
+        height: 128,
+        spp: 32,
+        mask: Some([62, 65, 9, 12]),
+        ratio: [1.5029, 1.5370, 1.6448],
+        ratio_tol: [6.0111, 6.7307, 8.4246],
+        block_p50: (0.0371, 0.0089),
+        block_p90: (0.1102, 0.0273),
+    },
+    // veach-bidir: Mitsuba 3's path tracer renders the file to Sahara's
+    // image (Sahara's bdpt at 256 samples / Mitsuba at 4096: 1.000, 1.001,
+    // 1.001, block median 0.011), and Mitsuba's image is 1.012, 1.007, 1.003
+    // of Tungsten's (1.02, 1.01, 1.01 at 64 bounces): the file and
+    // Tungsten's scene differ by 1-2 %.
+    Case {
+        name: "veach-bidir",
+        scene: "veach-bidir",
+        file: "scene-v4.pbrt",
+        kept: true,
+        width: 64,
+        height: 64,
+        spp: 32,
+        mask: None,
+        ratio: [1.0168, 1.0123, 1.0088],
+        ratio_tol: [0.0117, 0.0125, 0.0134],
+        block_p50: (0.0310, 0.0124),
+        block_p90: (0.0655, 0.0142),
     },
 ];
 
@@ -217,13 +291,24 @@ fn reference(case: &Case) -> Vec<Vec3> {
     rgb.chunks(3).map(Vec3::from_slice).collect()
 }
 
-/// The measures of an image against a reference of `w x h` pixels: the
+/// The measures of an image against a reference of the case's size: the
 /// ratio of the means per channel, the block errors' median and 90th
-/// percentile.
-fn measures(image: &[Vec3], reference: &[Vec3], w: u32, h: u32) -> (Vec3, f32, f32) {
+/// percentile; the case's mask is zero in both.
+fn measures(image: &[Vec3], reference: &[Vec3], case: &Case) -> (Vec3, f32, f32) {
+    let (w, h) = (case.width as usize, case.height as usize);
+    let masked = |img: &[Vec3]| {
+        let mut img = img.to_vec();
+        if let Some([x0, x1, y0, y1]) = case.mask {
+            for y in y0..y1 {
+                img[y * w + x0..y * w + x1].fill(Vec3::ZERO);
+            }
+        }
+        img
+    };
+    let (image, reference) = (masked(image), masked(reference));
     let mean = |img: &[Vec3]| img.iter().copied().sum::<Vec3>() / img.len() as f32;
-    let ratio = mean(image) / mean(reference);
-    let blocks = block_errors(image, reference, w as usize, h as usize);
+    let ratio = mean(&image) / mean(&reference);
+    let blocks = block_errors(&image, &reference, w, h);
     (
         ratio,
         blocks[blocks.len() / 2],
@@ -275,13 +360,13 @@ fn bitterli_scenes_agree_with_tungsten() {
         let a = loaded.unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let image = render_image(&a, case);
         let reference = reference(case);
-        match check(case, measures(&image, &reference, case.width, case.height)) {
+        match check(case, measures(&image, &reference, case)) {
             Ok(line) => println!("{line}"),
             Err(line) => failures.push(line),
         }
         // The same image against a reference 10 % brighter is caught.
         let brighter: Vec<Vec3> = reference.iter().map(|p| *p * 1.1).collect();
-        let verdict = check(case, measures(&image, &brighter, case.width, case.height));
+        let verdict = check(case, measures(&image, &brighter, case));
         if verdict.is_ok() {
             failures.push(format!(
                 "{}: a reference 10 % brighter is not caught: {verdict:?}",

@@ -325,6 +325,32 @@ impl Integrator {
     pub fn name(&self) -> &'static str {
         self.kind().name()
     }
+
+    /// The largest number of scattering events of a light transport
+    /// integrator whose paths are counted the same way (`path`, `bdpt`,
+    /// `lightpath`, `sppm`: 1 is direct light); `None` for the others
+    /// (`distribution` counts specular bounces only).
+    pub fn path_length(&self) -> Option<u32> {
+        match *self {
+            Integrator::Path { max_depth, .. }
+            | Integrator::Bdpt { max_depth }
+            | Integrator::LightPath { max_depth }
+            | Integrator::Sppm { max_depth, .. } => Some(max_depth),
+            _ => None,
+        }
+    }
+
+    /// This integrator with [`Self::path_length`] `n`, if it has one.
+    pub fn with_path_length(mut self, n: u32) -> Self {
+        match &mut self {
+            Integrator::Path { max_depth, .. }
+            | Integrator::Bdpt { max_depth }
+            | Integrator::LightPath { max_depth }
+            | Integrator::Sppm { max_depth, .. } => *max_depth = n,
+            _ => {}
+        }
+        self
+    }
 }
 
 /// Work counted while tracing.
