@@ -224,18 +224,13 @@ pub fn render<'py>(
             )));
         }
     }
-    let integrator = match (
+    let integrator = Integrator::chosen(
         integrator
             .as_deref()
             .map(named::<IntegratorKind>)
             .transpose()?,
-        file,
-    ) {
-        (Some(kind), Some(f)) if f.integrator.kind() == kind => f.integrator,
-        (Some(kind), _) => Integrator::from(kind),
-        (None, Some(f)) => f.integrator,
-        (None, None) => Integrator::default(),
-    };
+        file.map(|f| f.integrator),
+    );
     let sampler = match sampler {
         Some(s) => named::<SamplerKind>(&s)?,
         None => file.map(|f| f.sampler).unwrap_or_default(),

@@ -32,6 +32,8 @@ def metadata(integrator, spp, seed, w, h):
         (None, ["--integrator", "distribution"]),
         (SCENES / "cornell_glossy_glass.toml", []),
         (SCENES / "cornell_box.xml", ["-D", "spp=3"]),
+        # Another estimator keeps the file's path length (3 here, not 8).
+        (SCENES / "cornell_box.xml", ["-D", "max_depth=3", "--integrator", "bdpt"]),
         (SCENES / "assets" / "bunny.ply", ["--integrator", "path"]),
     ],
 )
@@ -42,7 +44,7 @@ def test_a_render_is_the_command_lines_bytes(tmp_path, sahara_bin, scene, args):
         cmd = [sahara_bin, "render"] + ([str(scene)] if scene else []) + args + [
             "--width", str(w), "--height", str(h), "--spp", str(spp), "--seed", str(seed), "-o", str(cli)]
         subprocess.run(cmd, check=True, capture_output=True)
-        defines = {"spp": 3} if "-D" in args else {}
+        defines = dict(args[i + 1].split("=") for i, a in enumerate(args) if a == "-D")
         s = sahara.load(scene, **defines) if scene else sahara.cornell_box()
         fs = s.file_settings or {}
         integrator = args[args.index("--integrator") + 1] if "--integrator" in args else fs.get("integrator", "path")
