@@ -202,7 +202,10 @@ impl<'py> PerRay<'py> {
     pub(crate) fn view(&self) -> PerRayView<'_> {
         match self {
             PerRay::One(v) => PerRayView::One(*v),
-            PerRay::F32(a) => PerRayView::F32(a.as_array()),
+            PerRay::F32(a) => match a.as_slice() {
+                Ok(s) => PerRayView::Flat(s),
+                Err(_) => PerRayView::F32(a.as_array()),
+            },
             PerRay::F64(a) => PerRayView::F64(a.as_array()),
         }
     }
@@ -212,6 +215,8 @@ impl<'py> PerRay<'py> {
 #[derive(Clone, Copy)]
 pub(crate) enum PerRayView<'a> {
     One(f32),
+    /// Contiguous float32, read in place.
+    Flat(&'a [f32]),
     F32(ArrayView1<'a, f32>),
     F64(ArrayView1<'a, f64>),
 }
@@ -222,8 +227,21 @@ impl PerRayView<'_> {
     pub(crate) fn get(&self, i: usize) -> f32 {
         match self {
             PerRayView::One(v) => *v,
+            PerRayView::Flat(s) => s[i],
             PerRayView::F32(a) => a[i],
             PerRayView::F64(a) => a[i] as f32,
+        }
+    }
+
+    /// The values of rays `start..start + len`, if they can be read
+    /// without a branch per ray: `Ok` for one value for all, `Err` for a
+    /// slice.
+    #[inline(always)]
+    pub(crate) fn run(&self, start: usize, len: usize) -> Option<Result<f32, &[f32]>> {
+        match self {
+            PerRayView::One(v) => Some(Ok(*v)),
+            PerRayView::Flat(s) => Some(Err(&s[start..start + len])),
+            _ => None,
         }
     }
 }

@@ -4,8 +4,10 @@
 use std::sync::{Arc, Mutex};
 
 use glam::Vec3;
-use numpy::{PyArray1, PyArray2, PyArrayMethods};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use numpy::{
+    PyArray1, PyArray2, PyArrayMethods, PyReadwriteArray1, PyReadwriteArray2, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
@@ -31,6 +33,9 @@ impl Geometry {
     /// The mesh of global face `f` and its index within that mesh.
     #[inline(always)]
     fn locate(starts: &[u32], f: u32) -> (i32, i32) {
+        if starts.len() == 2 {
+            return (0, f as i32);
+        }
         let mesh = starts.partition_point(|&s| s <= f) - 1;
         (mesh as i32, (f - starts[mesh]) as i32)
     }
@@ -157,8 +162,11 @@ impl RayScene {
     /// inf on a miss), `triangle` and `mesh` (int32, -1 on a miss), `u`,
     /// `v` (float32 barycentrics: the point is `(1-u-v) v0 + u v1 + v v2`)
     /// and `normal` (N, 3) (float32, the unit geometric normal
-    /// `(v1-v0) x (v2-v0)`, 0 on a miss).
-    #[pyo3(signature = (origins, directions, tmin=None, tmax=None, *, threads=None))]
+    /// `(v1-v0) x (v2-v0)`, 0 on a miss). `out`: the dict an earlier call
+    /// with as many rays returned, whose arrays are written over and which
+    /// is returned (no new memory: for queries in a loop).
+    #[pyo3(signature = (origins, directions, tmin=None, tmax=None, *, out=None, threads=None))]
+    #[allow(clippy::too_many_arguments)]
     fn cast_rays<'py>(
         &self,
         py: Python<'py>,
@@ -166,37 +174,27 @@ impl RayScene {
         directions: &Bound<'py, PyAny>,
         tmin: Option<&Bound<'py, PyAny>>,
         tmax: Option<&Bound<'py, PyAny>>,
+        out: Option<&Bound<'py, PyAny>>,
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let rays = RayArgs::extract(origins, directions, tmin, tmax)?;
         let n = rays.n;
         let snap = self.snapshot(py, threads)?;
-        // Uninitialised (every element is written below): zeroed arrays
-        // would take fresh pages from the system on every call, and their
-        // page faults cost a tenth of a fast query.
-        // SAFETY: every element is written before the arrays are returned.
-        let (t, tri, mesh, u, v, normal) = unsafe {
-            (
-                PyArray1::<f32>::new(py, n, false),
-                PyArray1::<i32>::new(py, n, false),
-                PyArray1::<i32>::new(py, n, false),
-                PyArray1::<f32>::new(py, n, false),
-                PyArray1::<f32>::new(py, n, false),
-                PyArray2::<f32>::new(py, [n, 3], false),
-            )
+        let (dict, arrays) = match out {
+            Some(o) if !o.is_none() => {
+                let d = o.cast::<PyDict>().map_err(|_| {
+                    PyTypeError::new_err("out: expected the dict of arrays cast_rays returned")
+                })?;
+                (d.clone(), HitArrays::from_dict(d, n)?)
+            }
+            _ => {
+                let a = HitArrays::new(py, n);
+                (a.dict(py)?, a)
+            }
         };
         {
-            // SAFETY: the arrays were made here and no one else holds them.
-            let (ts, tris, meshes, us, vs, ns) = unsafe {
-                (
-                    t.as_slice_mut()?,
-                    tri.as_slice_mut()?,
-                    mesh.as_slice_mut()?,
-                    u.as_slice_mut()?,
-                    v.as_slice_mut()?,
-                    normal.as_slice_mut()?,
-                )
-            };
+            let mut w = arrays.borrow()?;
+            let (ts, tris, meshes, us, vs, ns) = w.slices()?;
             let view = rays.view();
             let threads = threads.or(self.threads);
             py.detach(|| {
@@ -227,8 +225,6 @@ impl RayScene {
                                         mesh[j] = m;
                                         u[j] = h.u;
                                         v[j] = h.v;
-                                        let n = snap.normal(h.tri);
-                                        nrm[3 * j..3 * j + 3].copy_from_slice(&n.to_array());
                                     }
                                     None => {
                                         t[j] = f32::INFINITY;
@@ -236,22 +232,20 @@ impl RayScene {
                                         mesh[j] = -1;
                                         u[j] = 0.0;
                                         v[j] = 0.0;
-                                        nrm[3 * j..3 * j + 3].fill(0.0);
                                     }
                                 }
+                            }
+                            // The normals in a loop of their own: its loads,
+                            // scattered over the mesh, overlap.
+                            for (h, n) in hits[..k].iter().zip(nrm.chunks_exact_mut(3)) {
+                                let v = h.map_or(Vec3::ZERO, |h| snap.normal(h.tri));
+                                n.copy_from_slice(&v.to_array());
                             }
                         })
                 })
             })?;
         }
-        let d = PyDict::new(py);
-        d.set_item("t", t)?;
-        d.set_item("triangle", tri)?;
-        d.set_item("mesh", mesh)?;
-        d.set_item("u", u)?;
-        d.set_item("v", v)?;
-        d.set_item("normal", normal)?;
-        Ok(d)
+        Ok(dict)
     }
 
     /// Occlusion: True where a triangle is hit with `t` in `(tmin, tmax]`
@@ -552,6 +546,155 @@ impl Snapshot {
     }
 }
 
+/// The arrays of `cast_rays`'s answers.
+struct HitArrays<'py> {
+    t: Bound<'py, PyArray1<f32>>,
+    triangle: Bound<'py, PyArray1<i32>>,
+    mesh: Bound<'py, PyArray1<i32>>,
+    u: Bound<'py, PyArray1<f32>>,
+    v: Bound<'py, PyArray1<f32>>,
+    normal: Bound<'py, PyArray2<f32>>,
+}
+
+/// [`HitArrays`] held for writing.
+struct HitWriter<'py> {
+    t: PyReadwriteArray1<'py, f32>,
+    triangle: PyReadwriteArray1<'py, i32>,
+    mesh: PyReadwriteArray1<'py, i32>,
+    u: PyReadwriteArray1<'py, f32>,
+    v: PyReadwriteArray1<'py, f32>,
+    normal: PyReadwriteArray2<'py, f32>,
+}
+
+/// The slices of a [`HitWriter`]: t, triangle, mesh, u, v, normal.
+type HitSlices<'a> = (
+    &'a mut [f32],
+    &'a mut [i32],
+    &'a mut [i32],
+    &'a mut [f32],
+    &'a mut [f32],
+    &'a mut [f32],
+);
+
+impl<'py> HitArrays<'py> {
+    /// New arrays for `n` rays.
+    fn new(py: Python<'py>, n: usize) -> Self {
+        // Uninitialised: every element is written by the query, and zeroed
+        // arrays would be written twice.
+        // SAFETY: the arrays are written in full before they are returned.
+        unsafe {
+            HitArrays {
+                t: PyArray1::new(py, n, false),
+                triangle: PyArray1::new(py, n, false),
+                mesh: PyArray1::new(py, n, false),
+                u: PyArray1::new(py, n, false),
+                v: PyArray1::new(py, n, false),
+                normal: PyArray2::new(py, [n, 3], false),
+            }
+        }
+    }
+
+    /// The arrays of `d` (a dict `cast_rays` returned), checked to answer
+    /// `n` rays.
+    fn from_dict(d: &Bound<'py, PyDict>, n: usize) -> PyResult<Self> {
+        fn get<'py, A: pyo3::PyTypeCheck>(
+            d: &Bound<'py, PyDict>,
+            key: &str,
+            what: &str,
+        ) -> PyResult<Bound<'py, A>> {
+            let item = d
+                .get_item(key)?
+                .ok_or_else(|| PyValueError::new_err(format!("out: no '{key}' array")))?;
+            item.cast_into::<A>()
+                .map_err(|_| PyValueError::new_err(format!("out['{key}']: expected {what}")))
+        }
+        let a = HitArrays {
+            t: get(d, "t", "a float32 array")?,
+            triangle: get(d, "triangle", "an int32 array")?,
+            mesh: get(d, "mesh", "an int32 array")?,
+            u: get(d, "u", "a float32 array")?,
+            v: get(d, "v", "a float32 array")?,
+            normal: get(d, "normal", "a float32 array of shape (N, 3)")?,
+        };
+        for (key, shape) in [
+            ("t", a.t.shape()),
+            ("triangle", a.triangle.shape()),
+            ("mesh", a.mesh.shape()),
+            ("u", a.u.shape()),
+            ("v", a.v.shape()),
+            ("normal", a.normal.shape()),
+        ] {
+            let (want, got) = if key == "normal" {
+                (format!("({n}, 3)"), format!("({}, {})", shape[0], shape[1]))
+            } else {
+                (format!("({n},)"), format!("({},)", shape[0]))
+            };
+            if want != got {
+                return Err(PyValueError::new_err(format!(
+                    "out['{key}']: expected shape {want} (the rays of this call), got {got}"
+                )));
+            }
+        }
+        Ok(a)
+    }
+
+    /// A dict of the arrays, by name.
+    fn dict(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("t", &self.t)?;
+        d.set_item("triangle", &self.triangle)?;
+        d.set_item("mesh", &self.mesh)?;
+        d.set_item("u", &self.u)?;
+        d.set_item("v", &self.v)?;
+        d.set_item("normal", &self.normal)?;
+        Ok(d)
+    }
+
+    /// The arrays held for writing: refused if one is read-only, or in
+    /// use elsewhere (an input of the same call, another of the arrays).
+    fn borrow(&self) -> PyResult<HitWriter<'py>> {
+        fn w<A>(r: Result<A, numpy::BorrowError>, key: &str) -> PyResult<A> {
+            r.map_err(|e| PyValueError::new_err(format!("out['{key}']: cannot be written ({e})")))
+        }
+        Ok(HitWriter {
+            t: w(self.t.try_readwrite(), "t")?,
+            triangle: w(self.triangle.try_readwrite(), "triangle")?,
+            mesh: w(self.mesh.try_readwrite(), "mesh")?,
+            u: w(self.u.try_readwrite(), "u")?,
+            v: w(self.v.try_readwrite(), "v")?,
+            normal: w(self.normal.try_readwrite(), "normal")?,
+        })
+    }
+}
+
+impl HitWriter<'_> {
+    /// The arrays as slices: refused unless each is C-contiguous.
+    fn slices(&mut self) -> PyResult<HitSlices<'_>> {
+        fn s<'a, T>(
+            r: Result<&'a mut [T], numpy::AsSliceError>,
+            key: &str,
+        ) -> PyResult<&'a mut [T]> {
+            r.map_err(|_| {
+                PyValueError::new_err(format!("out['{key}']: expected a C-contiguous array"))
+            })
+        }
+        if !self.normal.is_c_contiguous() {
+            return Err(PyValueError::new_err(
+                "out['normal']: expected a C-contiguous array",
+            ));
+        }
+        let normal = s(self.normal.as_slice_mut(), "normal")?;
+        Ok((
+            s(self.t.as_slice_mut(), "t")?,
+            s(self.triangle.as_slice_mut(), "triangle")?,
+            s(self.mesh.as_slice_mut(), "mesh")?,
+            s(self.u.as_slice_mut(), "u")?,
+            s(self.v.as_slice_mut(), "v")?,
+            normal,
+        ))
+    }
+}
+
 /// The rays of a query, as given.
 struct RayArgs<'py> {
     origins: Rows3<'py>,
@@ -637,32 +780,45 @@ impl RayView<'_> {
     #[inline(always)]
     fn fill(&self, start: usize, out: &mut [Ray]) {
         let k = out.len();
-        // The common case, C-contiguous float32 rows and one interval for
-        // all rays, read without a branch per ray.
-        if let (
-            Rows3View::Flat(o),
-            Rows3View::Flat(d),
-            false,
-            false,
-            PerRayView::One(tmin),
-            PerRayView::One(tmax),
-        ) = (
+        // The common case, C-contiguous float32 rows and intervals (one
+        // for all rays or contiguous float32 arrays), read without a
+        // branch per ray.
+        if let (Rows3View::Flat(o), Rows3View::Flat(d), false, false, Some(tmin), Some(tmax)) = (
             self.origins,
             self.directions,
             self.one_origin,
             self.one_direction,
-            self.tmin,
-            self.tmax,
+            self.tmin.run(start, k),
+            self.tmax.run(start, k),
         ) {
             let o = &o[3 * start..3 * (start + k)];
             let d = &d[3 * start..3 * (start + k)];
-            for ((r, o), d) in out.iter_mut().zip(o.chunks_exact(3)).zip(d.chunks_exact(3)) {
-                *r = Ray::with_interval(
-                    Vec3::new(o[0], o[1], o[2]),
-                    Vec3::new(d[0], d[1], d[2]),
-                    tmin,
-                    tmax,
-                );
+            let rays = out.iter_mut().zip(o.chunks_exact(3)).zip(d.chunks_exact(3));
+            let at = |r: Result<f32, &[f32]>, j: usize| match r {
+                Ok(v) => v,
+                Err(s) => s[j],
+            };
+            match (tmin, tmax) {
+                (Ok(tmin), Ok(tmax)) => {
+                    for ((r, o), d) in rays {
+                        *r = Ray::with_interval(
+                            Vec3::from_slice(o),
+                            Vec3::from_slice(d),
+                            tmin,
+                            tmax,
+                        );
+                    }
+                }
+                (tmin, tmax) => {
+                    for (j, ((r, o), d)) in rays.enumerate() {
+                        *r = Ray::with_interval(
+                            Vec3::from_slice(o),
+                            Vec3::from_slice(d),
+                            at(tmin, j),
+                            at(tmax, j),
+                        );
+                    }
+                }
             }
             return;
         }

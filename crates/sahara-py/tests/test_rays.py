@@ -97,6 +97,64 @@ def test_bad_inputs_are_value_errors_that_say_what(make, message):
     assert message in str(e.value)
 
 
+def test_out_reuses_the_arrays_of_an_earlier_call():
+    v, f = icosphere(2)
+    s = sahara.RayScene(v, f)
+    o, d = random_rays(1000, spread=1.5)
+    o2, d2 = random_rays(1000, seed=2, spread=1.5)
+    out = s.cast_rays(o, d)
+    arrays = {k: a for k, a in out.items()}
+    again = s.cast_rays(o2, d2, out=out)
+    assert again is out and all(out[k] is arrays[k] for k in arrays)
+    want = s.cast_rays(o2, d2)
+    for k in want:
+        np.testing.assert_array_equal(out[k], want[k], err_msg=k)
+
+
+def out_with(**changes):
+    out = sahara.RayScene(SQUARE_V, SQUARE_F).cast_rays(np.zeros((4, 3)), [0, 0, 1])
+    for k, a in changes.items():
+        out[k] = a(out[k]) if callable(a) else a
+    return out
+
+
+def read_only(a):
+    a.flags.writeable = False
+    return a
+
+
+@pytest.mark.parametrize(
+    "out, error, message",
+    [
+        ([], TypeError, "out: expected the dict of arrays cast_rays returned"),
+        (out_with(t=None), ValueError, "out['t']: expected a float32 array"),
+        (out_with(u=lambda a: a.astype(np.float64)), ValueError, "out['u']: expected a float32 array"),
+        (out_with(triangle=lambda a: a[:3]), ValueError, "out['triangle']: expected shape (4,) (the rays of this call), got (3,)"),
+        (out_with(normal=lambda a: np.zeros((4, 2), np.float32)), ValueError, "out['normal']: expected shape (4, 3) (the rays of this call), got (4, 2)"),
+        (out_with(normal=np.asfortranarray), ValueError, "out['normal']: expected a C-contiguous array"),
+        (out_with(v=lambda a: np.zeros(8, np.float32)[::2]), ValueError, "out['v']: expected a C-contiguous array"),
+        (out_with(mesh=read_only), ValueError, "out['mesh']: cannot be written"),
+        (out_with(v=lambda a: a, u=None), ValueError, "out['u']: expected a float32 array"),
+    ],
+)
+def test_bad_out_arrays_are_refused(out, error, message):
+    s = sahara.RayScene(SQUARE_V, SQUARE_F)
+    with pytest.raises(error) as e:
+        s.cast_rays(np.zeros((4, 3), np.float32), np.array([0, 0, 1], np.float32), out=out)
+    assert message in str(e.value)
+
+
+def test_out_may_not_share_memory_with_the_rays_or_itself():
+    s = sahara.RayScene(SQUARE_V, SQUARE_F)
+    o = np.zeros((4, 3), np.float32)
+    out = s.cast_rays(o, [0, 0, 1])
+    with pytest.raises(ValueError, match="out\\['normal'\\]: cannot be written"):
+        s.cast_rays(out["normal"], [0, 0, 1], out=out)
+    out["u"] = out["v"]
+    with pytest.raises(ValueError, match="out\\['v'\\]: cannot be written"):
+        s.cast_rays(o, [0, 0, 1], out=out)
+
+
 def test_meshes_have_ids_and_triangles_count_within_their_mesh():
     s = sahara.RayScene()
     assert s.mesh_count == 0 and s.cast_rays([0, 0, 0], [0, 0, 1])["mesh"].tolist() == [-1]

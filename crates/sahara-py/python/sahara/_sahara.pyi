@@ -38,10 +38,12 @@ class RayScene:
         tmin: Optional[_Floats] = None,
         tmax: Optional[_Floats] = None,
         *,
+        out: Optional[Dict[str, np.ndarray]] = None,
         threads: Optional[int] = None,
     ) -> Dict[str, np.ndarray]:
         """Closest hits: ``t`` (inf on a miss), ``triangle``, ``mesh`` (-1 on a
-        miss), ``u``, ``v``, ``normal`` (N, 3)."""
+        miss), ``u``, ``v``, ``normal`` (N, 3). ``out``: the dict an earlier
+        call with as many rays returned, written over and returned."""
     def occluded(
         self,
         origins: npt.ArrayLike,
