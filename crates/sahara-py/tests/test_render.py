@@ -124,6 +124,25 @@ def test_files_at_fault_are_named_with_the_line(tmp_path):
         sahara.write(tmp_path / "out.png", np.zeros((2, 2)))
 
 
+@pytest.mark.parametrize(
+    "name, text, message",
+    [
+        ("bad.pbrt", 'WorldBegin\nShape "trianglemesh" "point3 P" [0 0 0 1 0 0]\n', "line 2: column 1: trianglemesh needs"),
+        ("bad.xml", '<scene version="3.0.0">\n  <shape type="obj">\n  </shape>\n<scene>\n', "line 4: column 8: the file ends inside an element that is not closed"),
+        ("bad.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 1000\nproperty float x\nend_header\n\x01",
+         "line 3: element vertex has no property 'y'"),
+        ("bad.gltf", '{"asset": {"version": "2.0"}, "meshes": [', "line 1: column 41: invalid glTF JSON"),
+        ("bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 9\n", "line 3: face refers to a vertex that does not exist"),
+    ],
+)
+def test_every_format_names_the_file_and_line_at_fault(tmp_path, name, text, message):
+    path = tmp_path / name
+    path.write_bytes(text.encode())
+    with pytest.raises(sahara.FormatError) as e:
+        sahara.load(path)
+    assert str(e.value).startswith(f"{path}: ") and message in str(e.value)
+
+
 def test_progress_is_reported_to_the_end():
     seen = []
     sahara.render(sahara.cornell_box(), width=64, height=64, spp=8, pass_spp=2,
