@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use glam::Vec3;
 use numpy::{PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray3, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyFileNotFoundError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyFileNotFoundError, PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use sahara_formats::description::FileSettings;
@@ -18,7 +18,7 @@ use sahara_formats::{LoadOptions, Loaded};
 use sahara_kd::{BuildParams, Builder};
 use sahara_render::{
     defaults, render_watched, Aov, Film, Filter, FilterKind, Integrator, IntegratorKind, Named,
-    Progress, RenderResult, RenderSettings, SamplerKind, Scene as RenderScene, ToneMap,
+    PixelSum, Progress, RenderResult, RenderSettings, SamplerKind, Scene as RenderScene, ToneMap,
 };
 
 use crate::pool::pool;
@@ -305,6 +305,19 @@ pub fn render<'py>(
             )));
         }
         settings.window = Some(w);
+    }
+    // The film's sums, its image and the passes are allocated in the
+    // render's threads, where a failed allocation aborts the process: the
+    // memory is asked for here first, so that a size beyond the machine
+    // is a MemoryError.
+    let pixels = width as usize * height as usize;
+    let per_pixel = std::mem::size_of::<PixelSum>() + 16 * (2 + settings.aovs.len());
+    let bytes = pixels.saturating_mul(per_pixel);
+    if Vec::<u8>::new().try_reserve_exact(bytes).is_err() {
+        return Err(PyMemoryError::new_err(format!(
+            "a {width}x{height} render needs about {:.1} GB, more than this machine gives",
+            bytes as f64 / 1e9
+        )));
     }
     let denoiser = if denoise {
         Some(

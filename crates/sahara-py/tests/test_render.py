@@ -102,6 +102,20 @@ def test_bad_settings_are_value_errors(kwargs, message):
         sahara.render(sahara.cornell_box(), progress=False, **kwargs)
 
 
+def overcommit_mode():
+    try:
+        return open("/proc/sys/vm/overcommit_memory").read().strip()
+    except OSError:
+        return None
+
+
+@pytest.mark.skipif(overcommit_mode() not in ("0", "2"),
+                    reason="where the system promises any amount of memory, the render would start")
+def test_a_render_beyond_the_machines_memory_is_a_memory_error():
+    with pytest.raises(MemoryError, match="a 65536x65536 render needs about"):
+        sahara.render(sahara.cornell_box(), width=65536, height=65536, spp=1, progress=False)
+
+
 def test_files_at_fault_are_named_with_the_line(tmp_path):
     with pytest.raises(FileNotFoundError, match="nope.toml: not found"):
         sahara.load(tmp_path / "nope.toml")
