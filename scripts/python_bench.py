@@ -15,21 +15,28 @@ Every library's hits are checked against Sahara's by the protocol's
 agreement rule (hit counts within 0.01% of the rays, t-sums within 1e-4
 relative); the `same` column says whether they agree. `overhead` is the
 Python call's extra time over the Rust query alone on one thread
-(`sahara bench --rays FILE`'s one-call batch figure, by CPU time).
+(`sahara bench --rays FILE`'s one-call batch figure, by CPU time): with
+new result arrays (the default), and with the arrays of an earlier call
+reused (`out=`). `call` is the fixed cost of a call, a one-ray query, in
+microseconds.
 
 Usage (from the repository root, after `pip install ./crates/sahara-py
 embreex trimesh rtree` in the Python that runs it):
-  python scripts/python_bench.py [--meshes bunny,dragon,sponza] [--runs 3]
+  python scripts/python_bench.py [--meshes bunny,dragon,sponza] [--runs 5] [--trimesh-rays 5000]
 """
 
 import argparse
 import json
 import os
+
+# numpy's BLAS threads would add their spinning to the process's CPU time.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import subprocess
 import sys
 import tempfile
 import threading
 import time
+import timeit
 
 import numpy as np
 
@@ -177,6 +184,12 @@ def main():
                 row["trimesh_1t"] = done / (time.process_time() - t0) / 1e6
                 row["trimesh_rays"] = done
                 row["overhead"] = rust / row["sahara_1t"] - 1.0
+                out = scene.cast_rays(o, d, tmin, tmax)
+                sec, _ = best(lambda: scene.cast_rays(o, d, tmin, tmax, out=out, threads=1), args.runs, True)
+                row["overhead_out"] = rust * sec / n * 1e6 - 1.0
+                one_o, one_d = o[:1].copy(), d[:1].copy()
+                row["call_us"] = min(timeit.repeat(lambda: scene.cast_rays(one_o, one_d, threads=1),
+                                                   number=2000, repeat=3)) / 2000 * 1e6
                 rows.append(row)
                 print(json.dumps(row), file=sys.stderr, flush=True)
 
@@ -184,8 +197,9 @@ def main():
         return "-" if x is None else f"{x:.{digits}f}"
 
     print("| mesh | set | rays | Sahara 1T | Sahara 2T | embreex 1T | embreex 2T | Open3D 1T | Open3D 2T "
-          "| trimesh 1T, rays/s | Sahara / embreex 1T, 2T | Sahara / trimesh | overhead | same hits |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+          "| trimesh 1T, rays/s | Sahara / embreex 1T, 2T | Sahara / trimesh | overhead, out= | call, us "
+          "| same hits |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         e1, e2 = r.get("embree_1t"), r.get("embree_2t")
         same = [k for k in ("embree", "open3d") if f"{k}_same" in r]
@@ -193,7 +207,8 @@ def main():
               f"| {fmt(e1)} | {fmt(e2)} | {fmt(r.get('open3d_1t'))} | {fmt(r.get('open3d_2t'))} "
               f"| {r['trimesh_1t'] * 1e6:,.0f} "
               f"| {fmt(r['sahara_1t'] / e1 if e1 else None)}, {fmt(r['sahara_2t'] / e2 if e2 else None)} "
-              f"| {r['sahara_1t'] / r['trimesh_1t']:.0f}x | {100 * r['overhead']:+.1f}% "
+              f"| {r['sahara_1t'] / r['trimesh_1t']:,.0f}x "
+              f"| {100 * r['overhead']:+.1f}%, {100 * r['overhead_out']:+.1f}% | {r['call_us']:.0f} "
               f"| {', '.join(k + (' yes' if r[f'{k}_same'] else ' NO') for k in same)} |")
 
 
