@@ -5,8 +5,8 @@ Seeds are small files made from the benchmark meshes ($SAHARA_SCENES, else
 ../shared/scenes beside the repository; the Cornell box and the bunny PLY
 fall back to the copies in scenes/assets): the Cornell box whole, the first lines of
 the big OBJ files, PLY files cut down to their first vertices and the faces
-among them (in every encoding), a tiny glTF and GLB, tiny PNG/HDR images and a
-small JPEG texture; plus the hand-made seeds in fuzz/seeds/<target>/. Nothing
+among them (in every encoding), a tiny glTF and GLB, tiny PNG/HDR images, the
+KTX2 test textures and a small JPEG texture; plus the hand-made seeds in fuzz/seeds/<target>/. Nothing
 here is committed: the corpus folder is rebuilt (seeds are only added; inputs
 libFuzzer found before are kept). Missing scene files are skipped.
 """
@@ -327,6 +327,9 @@ def image_seeds():
     put("image", "grey16.png", png(3, 1, 0, 16, [struct.pack(">3H", 0, 30000, 65535)]))
     put("image", "rgba.png", png(1, 2, 6, 8, [bytes([1, 2, 3, 4]), bytes([5, 6, 7, 8])]))
     put("image", "tiny.hdr", b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 2\n" + bytes([128, 64, 32, 129]) * 4)
+    # KTX2 with Basis Universal payloads (UASTC with Zstandard, ETC1S).
+    for name in ["quad_uastc.ktx2", "quad_etc1s.ktx2"]:
+        put("image", name, (REPO / "crates/sahara-readers/tests/data" / name).read_bytes())
     for rel in ["sponza/textures/00_skap.jpg"]:
         data = read(rel)
         if data:

@@ -60,7 +60,7 @@ struct Input {
 
 /// Finite raw values are kept within 1e-3..1e4 times the grid's scale (or
 /// made 0). Without that limit this target found three problems at extreme
-/// ratios, all tests in crates/sahara-kd/tests/bad_input.rs: false hits with
+/// ratios, all tests in crates/sahara-kd/tests/kd/bad_input.rs: false hits with
 /// NaN barycentrics at ~1e38 and a 1e18 triangle lost from a thin cell (both
 /// fixed since), and a t = 0 vertex hit 1e-27 outside a 1e9 scene's bounds
 /// (open, an ignored test). NaN and the infinities are kept.

@@ -2,13 +2,25 @@
 //! 64x64 pass on one thread (tree build included: 32 triangles) with the
 //! path tracer and the distribution ray tracer, which the loop traces in
 //! batches (camera packets, octant-grouped bounce and shadow rays), and
-//! with ambient occlusion, which it traces one path at a time.
+//! with ambient occlusion, which it traces one path at a time; and the
+//! render loop alone on the Mitsuba comparison kit's two scenes
+//! (`dragon_glossy`, `sponza_sun`): one 64x64 pass of the file's
+//! integrator, sampler and filter on one thread, the scene's trees built
+//! once outside the timing. The kit's scene files are those
+//! `../shared/compare/mitsuba/scenes.py OUTDIR` (or its `compare.sh`)
+//! writes; the benchmark reads them from `SAHARA_KIT` (default
+//! `${TMPDIR:-/tmp}/sahara-mitsuba-compare/scenes`) and says which it
+//! skips.
 //!
 //! `cargo bench -p sahara-bench --bench render`
 
 use std::hint::black_box;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use sahara_formats::scene_load::load_scene;
+use sahara_render::internals::{render_world, World};
 use sahara_render::{builtin, render, Integrator, RenderSettings};
 
 const SIZE: u32 = 64;
@@ -38,5 +50,66 @@ fn cornell(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, cornell);
+/// Where the kit's scene files are.
+fn kit_dir() -> PathBuf {
+    if let Some(dir) = std::env::var_os("SAHARA_KIT") {
+        return dir.into();
+    }
+    std::env::temp_dir().join("sahara-mitsuba-compare/scenes")
+}
+
+fn kit(c: &mut Criterion) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a one-thread pool");
+    let dir = kit_dir();
+    let mut g = c.benchmark_group("render_kit_64px");
+    g.sample_size(10);
+    for name in ["dragon_glossy", "sponza_sun"] {
+        let path = dir.join(format!("{name}.toml"));
+        let assembled = match load_scene(&path) {
+            Ok(a) => a,
+            Err(e) => {
+                eprintln!(
+                    "SKIPPED: render_kit_64px/{name}: {e} (write the kit's scenes with \
+                     ../shared/compare/mitsuba/scenes.py DIR and set SAHARA_KIT=DIR)"
+                );
+                continue;
+            }
+        };
+        let file = assembled.settings.expect("a scene file's settings");
+        let mut scene = assembled.scene;
+        scene.camera.aspect = 1.0;
+        let settings = RenderSettings {
+            width: SIZE,
+            height: SIZE,
+            spp: file.spp,
+            integrator: file.integrator,
+            sampler: file.sampler,
+            filter: file.filter,
+            seed: file.seed,
+            ..Default::default()
+        };
+        let mut world = World::new(&scene, &settings.build);
+        g.throughput(Throughput::Elements(u64::from(SIZE * SIZE * file.spp)));
+        g.bench_function(BenchmarkId::from_parameter(name), |b| {
+            b.iter(|| {
+                pool.install(|| {
+                    black_box(render_world(
+                        &mut world,
+                        &settings,
+                        &|_| {},
+                        None,
+                        Instant::now(),
+                        Duration::ZERO,
+                    ))
+                })
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, cornell, kit);
 criterion_main!(benches);

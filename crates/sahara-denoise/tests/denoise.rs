@@ -14,11 +14,23 @@ fn denoiser() -> Option<Denoiser> {
     match Denoiser::load() {
         Ok(d) => Some(d),
         Err(e @ DenoiseError::NotFound { .. }) if !required() => {
-            println!("note: {e}; skipping (set SAHARA_REQUIRE_OIDN=1 to fail instead)");
+            skip_note(&format!(
+                "the denoiser's tests ({e}; set SAHARA_REQUIRE_OIDN=1 to fail instead)"
+            ));
             None
         }
         Err(e) => panic!("{e}"),
     }
+}
+
+/// Says once, on the test binary's own stderr (which `cargo test` shows
+/// without `--nocapture`), that the tests are skipped and why.
+fn skip_note(reason: &str) {
+    use std::io::Write;
+    static SAID: std::sync::Once = std::sync::Once::new();
+    SAID.call_once(|| {
+        let _ = std::io::stderr().write_all(format!("SKIPPED: {reason}\n").as_bytes());
+    });
 }
 
 /// Whether `SAHARA_REQUIRE_OIDN` asks for the library.

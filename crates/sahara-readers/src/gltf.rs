@@ -287,7 +287,12 @@ fn load(path: &Path) -> Result<GltfScene, FormatError> {
     }
     let folder = path.parent().unwrap_or(Path::new(""));
     let pre = extensions::prescan(&bytes, &name)?;
-    let ::gltf::Gltf { document, blob } = parse(&bytes, &name)?;
+    // Textures stored only as KTX2 (KHR_texture_basisu) name that image as
+    // their source, which the `gltf` crate requires.
+    let patched = pre
+        .as_ref()
+        .and_then(|p| extensions::with_basisu_sources(&bytes, &p.json));
+    let ::gltf::Gltf { document, blob } = parse(patched.as_deref().unwrap_or(&bytes), &name)?;
     let buffers = load_buffers(&document, blob, folder, &name)?;
     let (json, warnings) = match pre {
         Some(p) => (p.json, p.warnings),

@@ -76,7 +76,7 @@ pub use math::warp::luminance;
 pub use render::digest::frame_digest;
 pub use render::{
     cost_maps, render, render_watched, Aov, Aux, AuxImages, AuxSums, CostMaps, Preview, Progress,
-    RenderResult, RenderStats, TimeSplit,
+    RenderResult, RenderStats, TimeShares, TimeSplit,
 };
 
 /// Internals for the repository's tests and benchmarks: the scene prepared
@@ -85,6 +85,7 @@ pub use render::{
 #[doc(hidden)]
 pub mod internals {
     pub use crate::math::hash::hash2;
+    pub use crate::render::render_world;
     pub use crate::sampler::{dims, PixelSampler, SampleId};
     pub use crate::world::World;
 }

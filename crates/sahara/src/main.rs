@@ -81,12 +81,31 @@ fn argument_error(e: clap::Error) -> ExitCode {
         first = format!("{first} {}", named.join(", "));
     }
     // `sahara scene.toml`, as pbrt and Mitsuba take a scene: say how.
+    // Else clap's nearest subcommand, option or value for a misspelt one
+    // (`sahara rendr`, `--sp 16`), which its own tip lines would give.
     let hint = match (e.kind(), std::env::args().nth(1)) {
         (ErrorKind::InvalidSubcommand, Some(arg)) if std::path::Path::new(&arg).exists() => {
             format!(" (did you mean: sahara render {arg})")
         }
-        _ => String::new(),
+        _ => suggestion(&e)
+            .map(|s| format!(" (did you mean: {s})"))
+            .unwrap_or_default(),
     };
     eprintln!("{first}{hint}");
     ExitCode::FAILURE
+}
+
+/// The subcommand, option or value clap found nearest to a misspelt one:
+/// `sahara render` for `rendr`, `--spp` for `--sp`.
+fn suggestion(e: &clap::Error) -> Option<String> {
+    use clap::error::{ContextKind, ContextValue};
+    let first = |kind| match e.get(kind)? {
+        ContextValue::String(s) => Some(s.clone()),
+        ContextValue::Strings(v) => v.first().cloned(),
+        _ => None,
+    };
+    if let Some(sub) = first(ContextKind::SuggestedSubcommand) {
+        return Some(format!("sahara {sub}"));
+    }
+    first(ContextKind::SuggestedArg).or_else(|| first(ContextKind::SuggestedValue))
 }

@@ -14,6 +14,14 @@ use sahara_render::{Aov, AuxImages, Integrator, Named, RenderResult, RenderSetti
 /// folder where it can be written, and that an existing file there may be
 /// replaced (not read-only).
 pub(crate) fn check_output(path: &Path, part: bool) -> Result<()> {
+    if path.is_dir() {
+        bail!(
+            "{}: is a folder; name an image file in it, e.g. {}",
+            path.display(),
+            path.join(if part { "part.exr" } else { "image.png" })
+                .display()
+        );
+    }
     let format = ImageFormat::from_path(path).map_err(|e| anyhow!("{e}"))?;
     if part && format != ImageFormat::Exr {
         bail!(

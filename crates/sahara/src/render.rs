@@ -436,6 +436,17 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
             .unwrap_or_default(),
         plural(threads as u64),
     );
+    if let Some(a) = settings.adaptive {
+        if settings.spp != UNLIMITED_SPP && a.min_spp >= settings.spp {
+            eprintln!(
+                "warning: adaptive: every pixel takes all {spp} samples, as at least {min} are \
+                 taken before the noise is tested; raise --spp (the cap) above {min}, or lower \
+                 --min-spp, for pixels to stop early",
+                spp = settings.spp,
+                min = a.min_spp
+            );
+        }
+    }
     // Started after the line above, so that it does not draw over it.
     let bar = progress_bar(settings);
     let unlimited = settings.spp == UNLIMITED_SPP;
@@ -460,10 +471,8 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
             if last.elapsed() >= every {
                 *last = Instant::now();
                 eprintln!(
-                    "progress: {message}, tile {}/{}, {:.0} s",
-                    p.tiles_done,
-                    p.tiles,
-                    p.elapsed.as_secs_f64()
+                    "{}",
+                    plain_progress_line(&p, unlimited, settings.time_limit)
                 );
             }
         }
@@ -562,6 +571,19 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
         return Ok(finish);
     }
     if s.passes == 0 && s.first_pass_pixels == 0 {
+        if partial {
+            // Stopped by a signal: the exit code says interrupted (130), as
+            // for any stopped render, not failed.
+            eprintln!(
+                "interrupted before the first pixel was finished: no image written{}",
+                if job.output_existed {
+                    format!(" ({} left as it was)", job.output.display())
+                } else {
+                    String::new()
+                }
+            );
+            return Ok(finish);
+        }
         bail!("stopped before the first pixel was finished: no image written");
     }
     let mut output = job.output_at(partial);
@@ -604,11 +626,12 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
         s.rays() as f64 / secs.max(1e-9) / 1e6,
         s.time_split
             .shares()
-            .map(|(t, sh, rest)| format!(
-                " (tracing {:.0}%, shading {:.0}%, the rest {:.0}%)",
-                t * 100.0,
-                sh * 100.0,
-                rest * 100.0
+            .map(|s| format!(
+                " (tracing {:.0}%, shading {:.0}%, film {:.0}%, the rest {:.0}%)",
+                s.tracing * 100.0,
+                s.shading * 100.0,
+                s.film * 100.0,
+                s.rest * 100.0
             ))
             .unwrap_or_default(),
         if s.nan_samples > 0 {
@@ -620,7 +643,7 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
     if let Some(a) = &s.adaptive {
         eprintln!(
             "adaptive: {} samples, {:.1}% of the {} spp budget; {} of {} pixels ({:.1}%) \
-             stopped below the noise threshold",
+             stopped early, below the noise threshold",
             a.samples,
             100.0 * a.samples as f64 / a.budget.max(1) as f64,
             s.spp,
@@ -694,6 +717,42 @@ fn progress_bar(settings: &RenderSettings) -> ProgressBar {
     bar
 }
 
+/// A progress line for a log that is not a terminal: the whole render's
+/// share done, the time elapsed and left, the pass and its tiles, and the
+/// rays per second so far, e.g. `progress: 37.5% done, 00:00:12 elapsed,
+/// eta 00:00:20, 3.2 Mrays/s (pass 2/4, tile 53/260 of this pass)`. With
+/// only a time limit the share and the time left are the limit's.
+fn plain_progress_line(p: &Progress, unlimited: bool, time_limit: Option<Duration>) -> String {
+    let hms = |d: Duration| {
+        let s = d.as_secs_f64().round() as u64;
+        format!("{:02}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60)
+    };
+    let mrays = p.rays as f64 / p.elapsed.as_secs_f64().max(1e-9) / 1e6;
+    let (percent, eta, pass) = match time_limit.filter(|_| unlimited) {
+        Some(limit) => (
+            100.0 * (p.elapsed.as_secs_f64() / limit.as_secs_f64().max(1e-9)).min(1.0),
+            hms(limit.saturating_sub(p.elapsed)),
+            format!("pass {}", p.pass + 1),
+        ),
+        None => {
+            let len = u64::from(p.passes) * u64::from(p.tiles);
+            let pos = u64::from(p.pass) * u64::from(p.tiles) + u64::from(p.tiles_done);
+            (
+                100.0 * pos as f64 / len.max(1) as f64,
+                eta_text(pos, Some(len), p.elapsed),
+                format!("pass {}/{}", p.pass + 1, p.passes),
+            )
+        }
+    };
+    format!(
+        "progress: {percent:.1}% done, {} elapsed, eta {eta}, {mrays:.1} Mrays/s \
+         ({pass}, tile {}/{} of this pass)",
+        hms(p.elapsed),
+        p.tiles_done,
+        p.tiles
+    )
+}
+
 /// The time left, from the average rate since the start (`HH:MM:SS`), or
 /// `--:--:--` until 5% of the work or 3 seconds have passed. indicatif's
 /// own estimate follows the rate of the last few tiles, and the first
@@ -713,8 +772,37 @@ fn eta_text(pos: u64, len: Option<u64>, elapsed: Duration) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::eta_text;
+    use super::{eta_text, plain_progress_line};
+    use sahara_render::Progress;
     use std::time::Duration;
+
+    #[test]
+    fn a_plain_progress_line_gives_the_whole_renders_share_and_time_left() {
+        // Pass 2 of 4, 130 of its 260 tiles: 3/8 of the render in 12 s.
+        let p = Progress {
+            pass: 1,
+            passes: 4,
+            tiles_done: 130,
+            tiles: 260,
+            elapsed: Duration::from_secs(12),
+            rays: 36_000_000,
+        };
+        assert_eq!(
+            plain_progress_line(&p, false, None),
+            "progress: 37.5% done, 00:00:12 elapsed, eta 00:00:20, 3.0 Mrays/s \
+             (pass 2/4, tile 130/260 of this pass)"
+        );
+        // Bounded by a time limit alone: the limit's share and the time left.
+        let p = Progress {
+            passes: u32::MAX,
+            ..p
+        };
+        assert_eq!(
+            plain_progress_line(&p, true, Some(Duration::from_secs(60))),
+            "progress: 20.0% done, 00:00:12 elapsed, eta 00:00:48, 3.0 Mrays/s \
+             (pass 2, tile 130/260 of this pass)"
+        );
+    }
 
     #[test]
     fn the_eta_waits_for_enough_work_then_follows_the_average_rate() {

@@ -62,21 +62,18 @@ impl std::fmt::Display for SkyUsed {
 /// lights (intensity times the solid angle they light), directional
 /// lights and the environment (what they shed on the bounding sphere of
 /// radius `radius`). An emissive ground (a flat object many times the
-/// size of the rest, such as glowing water: see the automatic camera's
-/// `grounds`) counts at most what it could shed on the rest: most of a
-/// sea's emission goes to the sky and lights nothing the camera sees. The
-/// bound is its emission per unit area over `2π r²` of area, as if it
-/// filled the half of the sky below the bounding sphere (radius `r`) of
-/// everything that is not ground, which then intercepts `2π · π r² · L`
-/// of it per emitting face.
+/// size of the rest, such as glowing water or a lit floor: see the
+/// automatic camera's `grounds`) does not count: it is context, lighting
+/// the subject from below, and cannot stand in for a sky above it.
 pub fn own_power(scene: &Scene, radius: f32) -> f32 {
-    let (ground, subject) = super::camera::grounds(scene);
+    let grounds = super::camera::grounds(scene);
     let mut power = 0.0f64;
     for (i, inst) in scene.instances.iter().enumerate() {
+        if grounds.is_ground(i) {
+            continue;
+        }
         let mesh = &scene.meshes[inst.mesh as usize];
         let xf = inst.placement.at(0.0);
-        let mut own = 0.0f64;
-        let mut emitting_area = 0.0f64;
         for (t, idx) in mesh.mesh.indices.iter().enumerate() {
             let Some(m) = scene
                 .materials
@@ -96,18 +93,10 @@ pub fn own_power(scene: &Scene, radius: f32) -> f32 {
                     .emission
                     .as_ref()
                     .map_or(1.0, |t| luminance(t.texture.mean()));
-                own +=
+                power +=
                     (area * std::f32::consts::PI * luminance(m.emission) * texture * faces) as f64;
-                emitting_area += area as f64;
             }
         }
-        power += match subject {
-            Some((lo, hi)) if ground[i] && emitting_area > 0.0 => {
-                let r = 0.5 * (hi - lo).length() as f64;
-                own * (2.0 * std::f64::consts::PI * r * r / emitting_area).min(1.0)
-            }
-            _ => own,
-        };
     }
     let sphere = std::f32::consts::PI * radius * radius;
     for l in &scene.lights {
@@ -166,8 +155,9 @@ pub fn scene_radius(scene: &Scene) -> f32 {
 /// automatic camera frames it): a large ground plane does not make the
 /// default sky and sun seem stronger than the lights of what stands on it.
 pub fn own_share(scene: &Scene) -> f32 {
-    let r = match super::camera::grounds(scene) {
-        (ground, Some((lo, hi))) if ground.contains(&true) => (0.5 * (hi - lo).length()).max(1e-6),
+    let g = super::camera::grounds(scene);
+    let r = match g.subject {
+        Some((lo, hi)) if g.context.contains(&true) => (0.5 * (hi - lo).length()).max(1e-6),
         _ => scene_radius(scene),
     };
     own_power(scene, r) / default_power(r)
@@ -244,17 +234,20 @@ mod tests {
     }
 
     #[test]
-    fn a_dim_glowing_sea_does_not_switch_the_sky_off() {
-        // Radiance 0.05 over a million square units: as power, 3000 times
-        // the default sky and sun's on the sphere; what it can shed on the
-        // sphere is 3 % of theirs.
-        let mut scene = sphere_on_a_sea(Vec3::splat(0.05), &[]);
-        let (used, share) = apply(&mut scene, &Sky::Auto).unwrap();
-        let share = share.unwrap();
-        assert_eq!(used, SkyUsed::Default, "share {share}");
-        assert!(share > 0.02 && share < WEAK_FRACTION, "{share}");
-        // A bright one does light the sphere from below.
-        let mut scene = sphere_on_a_sea(Vec3::splat(0.5), &[]);
+    fn a_glowing_sea_does_not_switch_the_sky_off() {
+        // Radiance 0.05, and 1 (a glTF emissive factor of [1, 1, 1]) over
+        // a million square units: as power, 3000 and 60000 times the
+        // default sky and sun's on the sphere. The sea is context: it does
+        // not count, and the sky stays on.
+        for glow in [0.05, 1.0] {
+            let mut scene = sphere_on_a_sea(Vec3::splat(glow), &[]);
+            let (used, share) = apply(&mut scene, &Sky::Auto).unwrap();
+            assert_eq!(used, SkyUsed::Default, "glow {glow}: share {share:?}");
+            assert_eq!(share, Some(0.0), "glow {glow}");
+        }
+        // With a sun of its own the scene keeps its own light.
+        let sun = Light::directional(Vec3::NEG_Y, Vec3::splat(1.0));
+        let mut scene = sphere_on_a_sea(Vec3::ONE, &[sun]);
         assert_eq!(apply(&mut scene, &Sky::Auto).unwrap().0, SkyUsed::Own);
     }
 

@@ -251,11 +251,11 @@ fn scene_file(case: &Case) -> Option<PathBuf> {
                 .join(case.file),
         ),
         _ => {
-            eprintln!(
-                "note: bitterli gallery: {} skipped: its files are too large to keep in the \
-                 repository; set BITTERLI to a checkout of the pbrt-v4 Bitterli scenes to hold it",
+            crate::common::skip_note(&format!(
+                "the Bitterli gallery's {} (its files are too large to keep in the \
+                 repository; set BITTERLI to a checkout of the pbrt-v4 Bitterli scenes)",
                 case.name
-            );
+            ));
             None
         }
     }

@@ -1,5 +1,8 @@
-//! Tests for `sahara-formats`: glTF extensions, scene files and their conversion to renderer scenes, images in and out, and the shared scenes.
+//! Tests for `sahara-formats`: bad input to the readers, glTF extensions, scene files and their conversion to renderer scenes, images in and out, and the shared scenes.
 
+// Its counting allocator is the whole binary's global allocator; it only
+// notes each thread's largest allocation.
+mod bad_input;
 mod bitterli_gallery;
 // Shared with `sahara-readers`' tests (one copy of the helpers).
 mod blocks;

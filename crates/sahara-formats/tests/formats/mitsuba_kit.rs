@@ -30,7 +30,7 @@ use sahara_formats::mitsuba::read_mitsuba_with;
 use sahara_render::{render, RenderSettings};
 
 use crate::blocks::block_errors;
-use crate::common::{scenes_dir, TempDir};
+use crate::common::{scenes_dir, skip_note, TempDir};
 
 /// One kit scene and how close Sahara must come to Mitsuba on it.
 struct Case {
@@ -147,11 +147,11 @@ fn scenes_for(case: &Case) -> Option<PathBuf> {
     if dir.join(case.mesh).exists() {
         Some(dir)
     } else {
-        println!(
-            "note: {} not found (set SAHARA_SCENES); skipping {}",
-            dir.join(case.mesh).display(),
-            case.name
-        );
+        skip_note(&format!(
+            "the Mitsuba kit's {} ({} not found; set SAHARA_SCENES)",
+            case.name,
+            dir.join(case.mesh).display()
+        ));
         None
     }
 }

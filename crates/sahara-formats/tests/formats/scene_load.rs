@@ -9,7 +9,7 @@ use sahara_readers::gltf::GltfMaterial;
 use sahara_readers::mtl::MtlMaterial;
 use sahara_render::{AlphaMode, Bsdf, Distribution, Integrator, Light, Placement, Shape};
 
-use crate::common::{scenes_dir, TempDir};
+use crate::common::{scenes_dir, skip_note, TempDir};
 use crate::gltf_data::{base64, triangle_buffer, triangle_json};
 
 const QUAD_OBJ: &str = "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl MAT\nf 1/1 2/2 3/3 4/4\n";
@@ -175,7 +175,10 @@ fn an_emissive_mtl_is_an_emitter_and_needs_no_default_light() {
 fn the_shared_cornell_box_light_emits_17_12_4() {
     let path = scenes_dir().join("cornell_box/cornell_box.obj");
     if !path.exists() {
-        println!("note: {} not found; skipping", path.display());
+        skip_note(&format!(
+            "the shared Cornell box's light ({} not found; set SAHARA_SCENES)",
+            path.display()
+        ));
         return;
     }
     let s = load_mesh_scene(&path).unwrap();

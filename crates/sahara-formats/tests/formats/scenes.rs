@@ -7,7 +7,7 @@ use sahara_formats::render_mesh;
 use sahara_readers::camera::{read_sidecar, sidecar_path};
 use sahara_readers::load_mesh;
 
-use crate::common::{corners, scenes_dir};
+use crate::common::{corners, scenes_dir, skip_note};
 
 /// `<scenes>/<name>/<file>`, or `None` (with a note) if the scene set is absent.
 fn scene(name: &str, file: &str) -> Option<PathBuf> {
@@ -15,7 +15,10 @@ fn scene(name: &str, file: &str) -> Option<PathBuf> {
     if path.exists() {
         Some(path)
     } else {
-        println!("note: {} not found; skipping", path.display());
+        skip_note(&format!(
+            "the shared scene set's {name} ({} not found; set SAHARA_SCENES)",
+            path.display()
+        ));
         None
     }
 }

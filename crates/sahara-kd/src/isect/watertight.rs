@@ -117,7 +117,7 @@ impl RayShear {
         // starting 1e-27 outside a 1e9-wide scene at a vertex, pointing
         // away, computes t = 0 there (the origin vanishes in `v0 - o`), and no
         // cell of a tree holds that point (fuzz regression in
-        // `tests/bad_input.rs`). Written so that NaN fails the test; `+ 0.0`
+        // `tests/kd/bad_input.rs`). Written so that NaN fails the test; `+ 0.0`
         // turns -0 into +0 for a negative `tmin`.
         if !(t > tmin && t <= tmax) {
             return None;

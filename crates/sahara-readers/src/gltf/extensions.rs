@@ -2,9 +2,11 @@
 //!
 //! A file is read as plain JSON first, so that what Sahara cannot render
 //! is said in words rather than as a parser's complaint about a field:
-//! glTF 1.0 files, required extensions Sahara lacks (Draco, KTX2/Basis and
-//! meshopt compression each by name), and optional extensions it ignores
-//! (one warning each, with the number of places the file uses it).
+//! glTF 1.0 files, required extensions Sahara lacks (Draco and meshopt
+//! compression each by name), and optional extensions it ignores (one
+//! warning each, with the number of places the file uses it). Textures
+//! given only as KTX2 (`KHR_texture_basisu`) are given that image as their
+//! `source` here, before the `gltf` crate, which requires one, reads them.
 
 use serde_json::Value;
 
@@ -21,6 +23,7 @@ pub const SUPPORTED: &[&str] = &[
     "KHR_materials_transmission",
     "KHR_materials_volume",
     "KHR_mesh_quantization",
+    "KHR_texture_basisu",
     "KHR_texture_transform",
 ];
 
@@ -105,9 +108,6 @@ pub(crate) fn prescan(bytes: &[u8], name: &str) -> Result<Option<Prescan>, Forma
                  save the file without mesh compression"
                     .to_owned()
             }
-            "KHR_texture_basisu" => "KTX2/Basis Universal textures (KHR_texture_basisu) are not \
-                                     supported; convert the textures to PNG or JPEG"
-                .to_owned(),
             "EXT_meshopt_compression" | "KHR_meshopt_compression" => format!(
                 "meshopt-compressed buffers ({ext}) are not supported; \
                  save the file without buffer compression"
@@ -145,4 +145,49 @@ pub(crate) fn count_uses(v: &Value, ext: &str) -> usize {
         Value::Array(items) => items.iter().map(|c| count_uses(c, ext)).sum(),
         _ => 0,
     }
+}
+
+/// The file's bytes with each texture that has a `KHR_texture_basisu`
+/// source but no `source` of its own given that image as its `source`, so
+/// that the `gltf` crate (which requires one) reads the KTX2 image; `None`
+/// when no texture needs it. A texture with both keeps its own (a PNG or
+/// JPEG fallback). A `.glb` keeps its binary chunk as it was.
+pub(crate) fn with_basisu_sources(bytes: &[u8], json: &Value) -> Option<Vec<u8>> {
+    let textures = json.get("textures")?.as_array()?;
+    let needs = |t: &Value| {
+        t.get("source").is_none()
+            && t.pointer("/extensions/KHR_texture_basisu/source")
+                .is_some_and(Value::is_u64)
+    };
+    if !textures.iter().any(needs) {
+        return None;
+    }
+    let mut json = json.clone();
+    for t in json.get_mut("textures")?.as_array_mut()? {
+        if needs(t) {
+            let source = t.pointer("/extensions/KHR_texture_basisu/source")?.clone();
+            t.as_object_mut()?.insert("source".to_owned(), source);
+        }
+    }
+    let mut text = serde_json::to_vec(&json).ok()?;
+    if !bytes.starts_with(b"glTF") {
+        return Some(text);
+    }
+    // GLB: a 12-byte header, then the JSON chunk (length, type, data) and
+    // the rest (the binary chunk) as it was.
+    let word = |at: usize| -> Option<usize> {
+        Some(u32::from_le_bytes(bytes.get(at..at + 4)?.try_into().ok()?) as usize)
+    };
+    let json_end = 20usize.checked_add(word(12)?)?;
+    let rest = bytes.get(json_end..)?;
+    text.resize(text.len().div_ceil(4) * 4, b' ');
+    let total = 20 + text.len() + rest.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend_from_slice(&bytes[..8]);
+    out.extend_from_slice(&u32::try_from(total).ok()?.to_le_bytes());
+    out.extend_from_slice(&u32::try_from(text.len()).ok()?.to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&text);
+    out.extend_from_slice(rest);
+    Some(out)
 }

@@ -51,3 +51,20 @@ pub fn scenes_dir() -> PathBuf {
         _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes"),
     }
 }
+
+/// Says that a group of tests is skipped and why, once per reason, on the
+/// test binary's own stderr: `cargo test` shows it without `--nocapture`
+/// (the harness captures only `print!` and `eprint!`).
+pub fn skip_note(reason: &str) {
+    use std::io::Write;
+    static SAID: std::sync::Mutex<std::collections::BTreeSet<String>> =
+        std::sync::Mutex::new(std::collections::BTreeSet::new());
+    let first = SAID
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(reason.to_string());
+    if first {
+        // One write, so that lines of tests running in parallel stay whole.
+        let _ = std::io::stderr().write_all(format!("SKIPPED: {reason}\n").as_bytes());
+    }
+}

@@ -287,6 +287,69 @@ fn glb_with_an_embedded_image_and_a_triangle_strip() {
 }
 
 #[test]
+fn glb_textures_stored_as_ktx2_are_read_through_khr_texture_basisu() {
+    // A square with two materials' textures: one given only as a KTX2 image
+    // in the binary chunk (KHR_texture_basisu, no `source`), one with a KTX2
+    // image and a PNG fallback as its `source`, which stays the image read.
+    let ktx2 = std::fs::read(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/quad_uastc.ktx2"),
+    )
+    .unwrap();
+    let mut bin = f32s(&[0., 0., 0., 1., 0., 0., 0., 1., 0., 1., 1., 0.]); // 0..48
+    bin.extend(&ktx2);
+    let json = format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "extensionsUsed": ["KHR_texture_basisu"],
+  "extensionsRequired": ["KHR_texture_basisu"],
+  "buffers": [{{"byteLength": {}}}],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": 48}},
+    {{"buffer": 0, "byteOffset": 48, "byteLength": {}}}
+  ],
+  "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"}}],
+  "meshes": [
+    {{"primitives": [{{"attributes": {{"POSITION": 0}}, "mode": 5, "material": 0}}]}},
+    {{"primitives": [{{"attributes": {{"POSITION": 0}}, "mode": 5, "material": 1}}]}}
+  ],
+  "materials": [
+    {{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 0}}}}}},
+    {{"pbrMetallicRoughness": {{"baseColorTexture": {{"index": 1}}}}}}
+  ],
+  "textures": [
+    {{"extensions": {{"KHR_texture_basisu": {{"source": 0}}}}}},
+    {{"source": 1, "extensions": {{"KHR_texture_basisu": {{"source": 0}}}}}}
+  ],
+  "images": [{{"bufferView": 1, "mimeType": "image/ktx2"}}, {{"uri": "fallback.png"}}],
+  "nodes": [{{"mesh": 0}}, {{"mesh": 1}}],
+  "scenes": [{{"nodes": [0, 1]}}]
+}}"#,
+        bin.len(),
+        ktx2.len()
+    );
+    let dir = TempDir::new("glb-ktx2");
+    let fallback = dir.write("fallback.png", b"\x89PNG");
+    let path = dir.write("square.glb", glb(&json, &bin));
+    let scene = load_gltf(&path).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let texture = |m: usize| scene.materials[m].base_color_texture.as_ref().unwrap();
+    assert_eq!(
+        (&texture(0).image, texture(0).image_index),
+        (
+            &GltfImage::Embedded {
+                mime_type: Some("image/ktx2".into()),
+                bytes: ktx2
+            },
+            0
+        )
+    );
+    assert_eq!(
+        (&texture(1).image, texture(1).image_index),
+        (&GltfImage::File(fallback), 1)
+    );
+}
+
+#[test]
 fn malformed_files_are_errors_naming_the_file() {
     let dir = TempDir::new("gltf-bad");
     let bin = triangle_buffer();

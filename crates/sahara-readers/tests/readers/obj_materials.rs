@@ -6,13 +6,16 @@ use glam::{Vec2, Vec3};
 use sahara_readers::mtl::MtlMaterial;
 use sahara_readers::obj::{load_obj, load_obj_with_materials};
 
-use crate::common::{corners, scenes_dir, TempDir};
+use crate::common::{corners, scenes_dir, skip_note, TempDir};
 
 #[test]
 fn cornell_box_materials_and_ids() {
     let path = scenes_dir().join("cornell_box/cornell_box.obj");
     if !path.exists() {
-        println!("note: {} not found; skipping", path.display());
+        skip_note(&format!(
+            "the shared Cornell box's materials ({} not found; set SAHARA_SCENES)",
+            path.display()
+        ));
         return;
     }
     let scene = load_obj_with_materials(&path).unwrap();
@@ -46,7 +49,10 @@ fn cornell_box_materials_and_ids() {
 fn sponza_textures_resolve_next_to_the_mtl() {
     let path = scenes_dir().join("sponza/sponza.obj");
     if !path.exists() {
-        println!("note: {} not found; skipping", path.display());
+        skip_note(&format!(
+            "the shared Sponza's textures ({} not found; set SAHARA_SCENES)",
+            path.display()
+        ));
         return;
     }
     let scene = load_obj_with_materials(&path).unwrap();

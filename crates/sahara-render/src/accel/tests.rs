@@ -251,6 +251,61 @@ fn the_layout_merges_what_is_static_unshared_and_not_ignorable() {
     assert_eq!(accel.tree_count(), 1 + 5);
 }
 
+/// A small box on a ground plane forty times its size, and a wall (flat,
+/// but not dwarfing the box): the plane stays out of the world tree, the
+/// box and the wall go in, and the hits are still the oracle's.
+#[test]
+fn a_ground_that_dwarfs_the_rest_keeps_its_own_tree() {
+    let quad = |corner: Vec3, edge_u: Vec3, edge_v: Vec3| {
+        Shape::Quad {
+            corner,
+            edge_u,
+            edge_v,
+        }
+        .to_mesh()
+    };
+    let meshes = vec![
+        quad(
+            Vec3::new(-20.0, 0.0, -20.0),
+            Vec3::new(0.0, 0.0, 40.0),
+            Vec3::new(40.0, 0.0, 0.0),
+        ),
+        Shape::Box {
+            min: Vec3::new(-0.5, 0.0, -0.5),
+            max: Vec3::new(0.5, 1.0, 0.5),
+        }
+        .to_mesh(),
+        quad(
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        ),
+    ];
+    let instances: Vec<Instance> = (0..3)
+        .map(|m| Instance::new(m, Affine3A::IDENTITY, None))
+        .collect();
+    let accel = Accel::build(&meshes, &instances, &BuildParams::default(), &[]);
+    let merged: Vec<bool> = (0..3).map(|i| accel.is_merged(i)).collect();
+    assert_eq!(merged, [false, true, true]);
+    let (rays, s) = rays(&meshes, &instances, 2000);
+    let mut hits = 0;
+    for (r, &s) in rays.iter().zip(&s) {
+        let got = accel.closest(r, s, &mut NoCounters);
+        assert_eq!(
+            got,
+            oracle_closest(&accel, &meshes, &instances, r, s),
+            "ray {r:?}"
+        );
+        hits += usize::from(got.is_some());
+        assert_eq!(
+            accel.occluded(r, s, None),
+            oracle_occluded(&accel, &meshes, &instances, r, s, None),
+            "ray {r:?}"
+        );
+    }
+    assert!(hits > 600, "{hits} hits");
+}
+
 #[test]
 fn hits_equal_the_brute_force_oracle() {
     for shared in [0, 3, 12] {

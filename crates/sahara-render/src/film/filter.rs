@@ -1,5 +1,7 @@
 //! Pixel reconstruction filters (separable, evaluated in pixel units).
 
+use glam::Vec4;
+
 use crate::names::{name_table, Accepts, Named, Parameter};
 
 /// A reconstruction filter; pixel estimates are `sum w L / sum w` over the
@@ -173,43 +175,182 @@ impl Filter {
     /// One factor of the separable filter.
     #[inline]
     pub fn eval_1d(&self, x: f32) -> f32 {
-        let x = x.abs();
         match *self {
-            Filter::Box { radius } => {
-                if x < radius {
-                    1.0
-                } else {
-                    0.0
-                }
-            }
-            Filter::Tent { radius } => (1.0 - x / radius).max(0.0),
-            Filter::Gaussian { radius, sigma } => {
-                if x >= radius {
-                    return 0.0;
-                }
-                let g = |v: f32| (-v * v / (2.0 * sigma * sigma)).exp();
-                (g(x) - g(radius)).max(0.0)
-            }
-            Filter::Mitchell { radius, b, c } => {
-                if x >= radius {
-                    return 0.0;
-                }
-                // The cubic is defined on [0, 2]; rescale the support.
-                let x = 2.0 * x / radius;
-                if x < 1.0 {
-                    ((12.0 - 9.0 * b - 6.0 * c) * x * x * x
-                        + (-18.0 + 12.0 * b + 6.0 * c) * x * x
-                        + (6.0 - 2.0 * b))
-                        / 6.0
-                } else {
-                    ((-b - 6.0 * c) * x * x * x
-                        + (6.0 * b + 30.0 * c) * x * x
-                        + (-12.0 * b - 48.0 * c) * x
-                        + (8.0 * b + 24.0 * c))
-                        / 6.0
-                }
-            }
+            Filter::Box { radius } => BoxKernel { radius }.eval(x),
+            Filter::Tent { radius } => TentKernel { radius }.eval(x),
+            Filter::Gaussian { radius, sigma } => GaussianKernel::new(radius, sigma).eval(x),
+            Filter::Mitchell { radius, b, c } => MitchellKernel { radius, b, c }.eval(x),
         }
+    }
+}
+
+/// One factor of a separable filter, with what it needs computed once:
+/// the film's splats are monomorphised over it, so that a sample's taps
+/// are weighed inline with no dispatch on the filter's kind. Each kind
+/// gives the same bits as [`Filter::eval_1d`], which calls it.
+pub(crate) trait Kernel: Copy {
+    /// True when [`Kernel::eval`] calls nothing (no `exp`): weighing a few
+    /// columns more than a sample needs then costs less than choosing how
+    /// many, and the weights vectorise.
+    const PLAIN: bool;
+
+    /// The weight at offset `x` (pixels) from a pixel centre, without
+    /// branches on `x` where the kind allows (a splat's offsets are
+    /// unpredictable, and a mispredicted branch costs more than the other
+    /// side's arithmetic).
+    fn eval(&self, x: f32) -> f32;
+
+    /// [`Kernel::eval`] of four offsets: the same operations lane by lane,
+    /// so the same bits, in one vector where the kind allows.
+    #[inline(always)]
+    fn eval4(&self, x: Vec4) -> Vec4 {
+        Vec4::new(
+            self.eval(x.x),
+            self.eval(x.y),
+            self.eval(x.z),
+            self.eval(x.w),
+        )
+    }
+}
+
+/// [`Filter::Box`]'s factor.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BoxKernel {
+    pub radius: f32,
+}
+
+impl Kernel for BoxKernel {
+    const PLAIN: bool = true;
+
+    #[inline(always)]
+    fn eval(&self, x: f32) -> f32 {
+        if x.abs() < self.radius {
+            1.0
+        } else {
+            0.0
+        }
+    }
+
+    #[inline(always)]
+    fn eval4(&self, x: Vec4) -> Vec4 {
+        Vec4::select(
+            x.abs().cmplt(Vec4::splat(self.radius)),
+            Vec4::ONE,
+            Vec4::ZERO,
+        )
+    }
+}
+
+/// [`Filter::Tent`]'s factor.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TentKernel {
+    pub radius: f32,
+}
+
+impl Kernel for TentKernel {
+    const PLAIN: bool = true;
+
+    #[inline(always)]
+    fn eval(&self, x: f32) -> f32 {
+        (1.0 - x.abs() / self.radius).max(0.0)
+    }
+
+    #[inline(always)]
+    fn eval4(&self, x: Vec4) -> Vec4 {
+        (Vec4::ONE - x.abs() / self.radius).max(Vec4::ZERO)
+    }
+}
+
+/// [`Filter::Gaussian`]'s factor, with its value at the radius computed
+/// once rather than at every tap.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct GaussianKernel {
+    radius: f32,
+    /// `2 sigma^2`.
+    two_sigma2: f32,
+    /// The Gaussian at the radius, subtracted so the filter reaches zero.
+    at_radius: f32,
+}
+
+impl GaussianKernel {
+    /// The factor of a Gaussian of standard deviation `sigma` cut at `radius`.
+    pub fn new(radius: f32, sigma: f32) -> Self {
+        let two_sigma2 = 2.0 * sigma * sigma;
+        Self {
+            radius,
+            two_sigma2,
+            at_radius: gaussian(radius, two_sigma2),
+        }
+    }
+}
+
+/// `exp(-v^2 / (2 sigma^2))`.
+#[inline(always)]
+fn gaussian(v: f32, two_sigma2: f32) -> f32 {
+    (-v * v / two_sigma2).exp()
+}
+
+impl Kernel for GaussianKernel {
+    const PLAIN: bool = false;
+
+    #[inline(always)]
+    fn eval(&self, x: f32) -> f32 {
+        let x = x.abs();
+        if x >= self.radius {
+            return 0.0;
+        }
+        (gaussian(x, self.two_sigma2) - self.at_radius).max(0.0)
+    }
+}
+
+/// [`Filter::Mitchell`]'s factor.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MitchellKernel {
+    pub radius: f32,
+    pub b: f32,
+    pub c: f32,
+}
+
+impl Kernel for MitchellKernel {
+    const PLAIN: bool = true;
+
+    #[inline(always)]
+    fn eval(&self, x: f32) -> f32 {
+        let (radius, b, c) = (self.radius, self.b, self.c);
+        let x = x.abs();
+        // The cubic is defined on [0, 2]; rescale the support. Both
+        // pieces' numerators are computed and one is chosen before the one
+        // division, so that the choice is a cheap select, not a branch.
+        let t = 2.0 * x / radius;
+        let near = (12.0 - 9.0 * b - 6.0 * c) * t * t * t
+            + (-18.0 + 12.0 * b + 6.0 * c) * t * t
+            + (6.0 - 2.0 * b);
+        let far = (-b - 6.0 * c) * t * t * t
+            + (6.0 * b + 30.0 * c) * t * t
+            + (-12.0 * b - 48.0 * c) * t
+            + (8.0 * b + 24.0 * c);
+        let v = if t < 1.0 { near } else { far } / 6.0;
+        if x >= radius {
+            0.0
+        } else {
+            v
+        }
+    }
+
+    #[inline(always)]
+    fn eval4(&self, x: Vec4) -> Vec4 {
+        let (radius, b, c) = (self.radius, self.b, self.c);
+        let x = x.abs();
+        let t = 2.0 * x / radius;
+        let near = (12.0 - 9.0 * b - 6.0 * c) * t * t * t
+            + (-18.0 + 12.0 * b + 6.0 * c) * t * t
+            + (6.0 - 2.0 * b);
+        let far = (-b - 6.0 * c) * t * t * t
+            + (6.0 * b + 30.0 * c) * t * t
+            + (-12.0 * b - 48.0 * c) * t
+            + (8.0 * b + 24.0 * c);
+        let v = Vec4::select(t.cmplt(Vec4::ONE), near, far) / 6.0;
+        Vec4::select(x.cmpge(Vec4::splat(radius)), Vec4::ZERO, v)
     }
 }
 
@@ -257,6 +398,59 @@ mod tests {
         assert!((sum - 1.0).abs() < 1e-3, "{sum}");
         assert!(f.eval_1d(2.0).abs() < 1e-6);
         assert!(f.eval_1d(1.5) < 0.0);
+    }
+
+    #[test]
+    fn every_kernel_weighs_four_offsets_as_it_weighs_one() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for filter in [
+            Filter::Box { radius: 0.5 },
+            Filter::Box { radius: 1.3 },
+            Filter::Tent { radius: 1.0 },
+            Filter::Tent { radius: 2.7 },
+            Filter::Mitchell {
+                radius: 2.0,
+                b: 1.0 / 3.0,
+                c: 1.0 / 3.0,
+            },
+            Filter::Mitchell {
+                radius: 3.1,
+                b: -0.4,
+                c: 0.9,
+            },
+        ] {
+            for i in 0..4000 {
+                // Offsets across and beyond the support, and the edges.
+                let r = filter.radius();
+                let x = match i % 8 {
+                    0 => r,
+                    1 => -r,
+                    2 => 0.5 * r,
+                    _ => (next() - 0.5) * 3.0 * r,
+                };
+                let xs = Vec4::new(x, -x, x * 0.5 + next(), next() - 0.5);
+                let kernel = |v: Vec4| match filter {
+                    Filter::Box { radius } => BoxKernel { radius }.eval4(v),
+                    Filter::Tent { radius } => TentKernel { radius }.eval4(v),
+                    Filter::Mitchell { radius, b, c } => MitchellKernel { radius, b, c }.eval4(v),
+                    Filter::Gaussian { .. } => unreachable!(),
+                };
+                let four = kernel(xs).to_array();
+                for (lane, &x) in xs.to_array().iter().enumerate() {
+                    assert_eq!(
+                        four[lane].to_bits(),
+                        filter.eval_1d(x).to_bits(),
+                        "{filter:?} at {x}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! The rendered image: linear RGB floats, and conversions for display.
 
 pub mod filter;
+pub(crate) mod splat;
 pub mod sums;
 pub mod window;
 

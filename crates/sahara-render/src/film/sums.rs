@@ -14,9 +14,14 @@
 //!
 //! The conversion rounds toward zero below `2^-52` (far below what an `f32`
 //! pixel can show) and clamps a contribution to `±2^40`, so that no sum of
-//! fewer than `2^35` contributions overflows. It takes a handful of
-//! instructions: the integer part and the fraction are converted as two
-//! `i64`, which avoids the slow general `f64` to `i128` conversion.
+//! fewer than `2^35` contributions overflows. A contribution below `2^11`
+//! in magnitude (nearly all of them) is one multiplication by `2^52`, which
+//! is exact, and one truncating conversion to `i64`; larger ones convert
+//! the integer part and the fraction as two `i64`, which avoids the slow
+//! general `f64` to `i128` conversion. Both give the same bits.
+//!
+//! A render's samples are splatted into these sums in bulk, a few
+//! instructions per tap, by [`crate::film::splat`].
 
 use glam::{Vec2, Vec3};
 
@@ -28,9 +33,32 @@ pub const FRACTION_BITS: i32 = 52;
 /// Largest magnitude of one contribution; larger ones are clamped.
 const MAX_CONTRIBUTION: f64 = (1u64 << 40) as f64;
 
+/// `2^FRACTION_BITS`: a contribution times this is its fixed-point value
+/// before truncation (exactly: scaling by a power of two is exact).
+const ONE: f64 = (1u64 << FRACTION_BITS) as f64;
+
+/// Scaled contributions below this magnitude (`2^63`, a contribution of
+/// `2^11`) convert to `i64` directly.
+const FAST_BELOW: f64 = 9_223_372_036_854_775_808.0;
+
 /// One contribution as a fixed-point number, truncated toward zero.
 #[inline]
 fn fixed(v: f64) -> i128 {
+    let s = v * ONE;
+    if s.abs() < FAST_BELOW {
+        // SAFETY: |s| < 2^63, so s truncated fits an i64 (NaN fails the test).
+        // The same bits as the general case: `whole * 2^52` is an integer
+        // and the fraction's part has the sign of `v`, so truncating their
+        // sum truncates the fraction's part alone.
+        return i128::from(unsafe { s.to_int_unchecked::<i64>() });
+    }
+    fixed_general(v)
+}
+
+/// [`fixed`] for any contribution: the integer part and the fraction
+/// converted apart.
+#[cold]
+fn fixed_general(v: f64) -> i128 {
     let v = v.clamp(-MAX_CONTRIBUTION, MAX_CONTRIBUTION);
     let whole = v as i64;
     // Exact (|v| < 2^52), with the sign of v; scaling by a power of two is
@@ -38,9 +66,6 @@ fn fixed(v: f64) -> i128 {
     let fraction = ((v - whole as f64) * (2.0f64).powi(FRACTION_BITS)) as i64;
     ((whole as i128) << FRACTION_BITS) + fraction as i128
 }
-
-/// Filter taps per row whose weights a splat computes once per sample.
-const MAX_TAPS: usize = 16;
 
 /// A fixed-point sum as a float (rounded to nearest).
 #[inline]
@@ -50,7 +75,10 @@ fn float(v: i128) -> f64 {
 
 /// The sums of one pixel: filter-weighted radiance per channel and the
 /// filter weights, in fixed point (`FRACTION_BITS` fractional bits).
+///
+/// Aligned to 64 bytes, its size: one cache line each.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(align(64))]
 pub struct PixelSum {
     /// `sum w L` for R, G and B.
     pub rgb: [i128; 3],
@@ -146,50 +174,6 @@ impl SumBuffer {
     pub(crate) fn index(&self, x: u32, y: u32) -> Option<usize> {
         let (i, j) = (x.checked_sub(self.x0)?, y.checked_sub(self.y0)?);
         (i < self.width && j < self.height).then(|| j as usize * self.width as usize + i as usize)
-    }
-
-    /// Splats a sample of pixel `(x, y)` at film position `pos` (pixel
-    /// units) with radiance `l` into every pixel of the buffer whose centre
-    /// lies within the filter's radius; `margin` is the filter's reach in
-    /// whole pixels (`filter_margin`).
-    #[inline]
-    pub fn splat(&mut self, filter: &Filter, margin: u32, x: u32, y: u32, pos: Vec2, l: Vec3) {
-        if self.width == 0 || self.height == 0 {
-            return;
-        }
-        let r = filter.radius();
-        let px0 = x.saturating_sub(margin).max(self.x0);
-        let px1 = (x.saturating_add(margin)).min(self.x0 + self.width - 1);
-        let py0 = y.saturating_sub(margin).max(self.y0);
-        let py1 = (y.saturating_add(margin)).min(self.y0 + self.height - 1);
-        // The columns' weights, once per sample rather than once per row.
-        let mut wx = [0.0f32; MAX_TAPS];
-        let taps = (px1 + 1).saturating_sub(px0) as usize;
-        let cached = taps <= MAX_TAPS;
-        if cached {
-            for (k, w) in wx[..taps].iter_mut().enumerate() {
-                *w = filter.eval_1d(pos.x - ((px0 + k as u32) as f32 + 0.5));
-            }
-        }
-        for py in py0..=py1 {
-            let dy = pos.y - (py as f32 + 0.5);
-            if dy.abs() > r {
-                continue;
-            }
-            let wy = filter.eval_1d(dy);
-            let row = (py - self.y0) as usize * self.width as usize;
-            for px in px0..=px1 {
-                let w = if cached {
-                    wx[(px - px0) as usize]
-                } else {
-                    filter.eval_1d(pos.x - (px as f32 + 0.5))
-                };
-                let wt = wy * w;
-                if wt != 0.0 {
-                    self.sums[row + (px - self.x0) as usize].add_sample(l, wt);
-                }
-            }
-        }
     }
 
     /// Adds light that arrives at film position `pos` (pixel units) from
@@ -351,6 +335,27 @@ mod tests {
         }
         assert_eq!(fixed(0.5), 1i128 << (FRACTION_BITS - 1));
         assert_eq!(fixed(-2.25), -(9i128 << (FRACTION_BITS - 2)));
+    }
+
+    #[test]
+    fn the_one_step_conversion_gives_the_general_bits() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut values = vec![
+            0.0, -0.0, 2047.999, -2047.999, 2048.0, -2048.0, 1e-300, -5e-324,
+        ];
+        for _ in 0..20_000 {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            // Magnitudes from 2^-60 to 2^14, both signs, fractions of all kinds.
+            let m = (state >> 11) as f64 / (1u64 << 53) as f64;
+            let e = (state % 75) as i32 - 60;
+            let v = m * (2.0f64).powi(e);
+            values.push(if state & 1 == 0 { v } else { -v });
+        }
+        for v in values {
+            assert_eq!(fixed(v), fixed_general(v), "{v:e}");
+        }
     }
 
     #[test]

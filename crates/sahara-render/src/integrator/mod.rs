@@ -4,7 +4,7 @@
 pub(crate) mod bdpt;
 pub mod debug;
 mod distribution;
-mod laps;
+pub(crate) mod laps;
 mod path;
 mod queries;
 pub(crate) mod sppm;

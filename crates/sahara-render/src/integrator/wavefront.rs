@@ -8,7 +8,7 @@
 //! bit for bit; what changes is that the tree sees rays in batches, which
 //! lets coherent ones share a traversal.
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use sahara_kd::{Ray, PACKET16};
 
@@ -43,7 +43,7 @@ pub(crate) struct Wavefront {
 impl Wavefront {
     /// The time spent tracing and shading since the last call, and resets
     /// both.
-    pub fn take_times(&mut self) -> (Duration, Duration) {
+    pub fn take_times(&mut self) -> Laps {
         self.laps.take()
     }
 

@@ -310,7 +310,9 @@ impl Convergence {
             for x in window.x0..window.x1 {
                 let i = self.index(x, y);
                 st.samples += u64::from(self.sums[i].count);
-                st.converged += self.converged[i] as u64;
+                // A pixel below the threshold only at the cap took every
+                // sample: it did not stop early.
+                st.converged += (self.converged[i] && self.sums[i].count < spp) as u64;
             }
         }
         st

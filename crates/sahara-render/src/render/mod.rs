@@ -26,11 +26,13 @@ use sahara_kd::BuildParams;
 use crate::accel::AccelLayout;
 use crate::cpu_time::process_cpu_time;
 use crate::film::filter::Filter;
+use crate::film::splat::{Pixels, SplatSums, Splatter};
 use crate::film::sums::{filter_margin, SumBuffer};
 use crate::film::window::PixelWindow;
 use crate::film::{heat_color, Film};
 use crate::integrator::bdpt::batch::{BdptBatch, CameraSample};
 use crate::integrator::bdpt::Splat;
+use crate::integrator::laps::{Lap, Laps};
 use crate::integrator::wavefront::Wavefront;
 use crate::integrator::{defaults, AuxSample, Context, Integrator, PathState, TraceStats};
 use crate::math::hash::hash2;
@@ -190,33 +192,52 @@ pub struct RenderStats {
 /// Where the render threads' time went, summed over the threads: finding
 /// hits and answering shadow rays (the kd-tree walks and the instance
 /// layer), the paths' steps between them (surface interaction, textures,
-/// BSDF and light sampling, MIS), and the rest of each tile (camera rays,
-/// the sampler's set-up, splatting into the film). Measured for the
-/// integrators that trace their samples in batches (`path`,
-/// `distribution`, `bdpt`, `lightpath`); zero for the others.
+/// BSDF and light sampling, MIS), adding the samples into the film's sums,
+/// and the rest of each tile (camera rays, the sampler's set-up, the
+/// strip's buffers). Measured for the integrators that trace their samples
+/// in batches (`path`, `distribution`, `bdpt`, `lightpath`); zero for the
+/// others.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TimeSplit {
     /// Time in the batch traversals.
     pub tracing: Duration,
     /// Time in the paths' steps.
     pub shading: Duration,
-    /// Time in tiles altogether (tracing and shading included).
+    /// Time splatting the samples into the tiles' sums.
+    pub film: Duration,
+    /// Time in tiles altogether (tracing, shading and film included).
     pub total: Duration,
 }
 
+/// [`TimeSplit`] as shares of its total, each in `[0, 1]`, adding up to 1.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TimeShares {
+    /// The batch traversals.
+    pub tracing: f64,
+    /// The paths' steps.
+    pub shading: f64,
+    /// Splatting into the film.
+    pub film: f64,
+    /// Everything else in the tiles.
+    pub rest: f64,
+}
+
 impl TimeSplit {
-    /// The shares of tracing, shading and the rest of the total, in
-    /// `[0, 1]`; `None` when nothing was measured.
-    pub fn shares(&self) -> Option<(f64, f64, f64)> {
+    /// The shares of tracing, shading, the film and the rest of the total;
+    /// `None` when nothing was measured.
+    pub fn shares(&self) -> Option<TimeShares> {
         let total = self.total.as_secs_f64();
         if self.tracing.is_zero() || total <= 0.0 {
             return None;
         }
-        let (t, s) = (
-            self.tracing.as_secs_f64() / total,
-            self.shading.as_secs_f64() / total,
-        );
-        Some((t, s, (1.0 - t - s).max(0.0)))
+        let share = |d: Duration| d.as_secs_f64() / total;
+        let (tracing, shading, film) = (share(self.tracing), share(self.shading), share(self.film));
+        Some(TimeShares {
+            tracing,
+            shading,
+            film,
+            rest: (1.0 - tracing - shading - film).max(0.0),
+        })
     }
 }
 
@@ -224,6 +245,7 @@ impl std::ops::AddAssign for TimeSplit {
     fn add_assign(&mut self, o: Self) {
         self.tracing += o.tracing;
         self.shading += o.shading;
+        self.film += o.film;
         self.total += o.total;
     }
 }
@@ -332,13 +354,31 @@ pub fn render_watched(
     scene: &Scene,
     settings: &RenderSettings,
     progress: &(dyn Fn(Progress) + Sync),
-    mut preview: Option<Preview<'_>>,
+    preview: Option<Preview<'_>>,
 ) -> RenderResult {
     let start = Instant::now();
     let mut world = World::new(scene, &settings.build);
+    let build_time = start.elapsed();
+    render_world(&mut world, settings, progress, preview, start, build_time)
+}
+
+/// Renders a scene already prepared for tracing (`world`, built with
+/// `settings.build`), as [`render_watched`] does after its build; `start`
+/// is when the render began (its time limit counts from there) and
+/// `build_time` what the build took. The criterion benchmarks render this
+/// way to time the render loop without the tree builds.
+#[doc(hidden)]
+pub fn render_world(
+    world: &mut World,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(Progress) + Sync),
+    mut preview: Option<Preview<'_>>,
+    start: Instant,
+    build_time: Duration,
+) -> RenderResult {
     let (w, h) = (settings.width.max(1), settings.height.max(1));
     world.set_film(h, u64::from(settings.spp.max(1)));
-    let build_time = start.elapsed();
+    let world = &*world;
     let window = settings
         .window
         .unwrap_or(PixelWindow::full(w, h))
@@ -403,7 +443,7 @@ pub fn render_watched(
             radius,
             photons: photons as u64,
         };
-        return sppm::render(&world, settings, params, progress, stats, start);
+        return sppm::render(world, settings, params, progress, stats, start);
     }
     let render_start = Instant::now();
     let cpu_start = process_cpu_time();
@@ -465,7 +505,7 @@ pub fn render_watched(
                     abandon.store(true, Ordering::Relaxed);
                     return None;
                 }
-                let out = render_tile(&world, settings, *tile, &window, samples, &stop_pixel);
+                let out = render_tile(world, settings, *tile, &window, samples, &stop_pixel);
                 if out.pixels_done < tile.pixels() {
                     abandon.store(true, Ordering::Relaxed);
                 }
@@ -576,7 +616,7 @@ pub fn render_watched(
         .as_mut()
         .filter(|_| wants(Aov::Object) || wants(Aov::Material))
     {
-        let ids = ids::pixel_centres(&world, &window, w, h);
+        let ids = ids::pixel_centres(world, &window, w, h);
         if wants(Aov::Object) {
             aux.images.object = ids.objects;
         }
@@ -681,18 +721,18 @@ fn render_tile(
 ) -> TileOut {
     let convergence = samples.convergence();
     let (w, h) = (s.width.max(1), s.height.max(1));
-    let m = filter_margin(&s.filter);
+    let splatter = Splatter::new(&s.filter);
     let reach = PixelWindow {
         x0: t.x0,
         x1: t.x1,
         y0: t.y0,
         y1: t.y1,
     }
-    .grow(m, w, h)
+    .grow(splatter.margin(), w, h)
     .intersect(window);
     let tile_start = Instant::now();
     let mut out = TileOut {
-        sums: SumBuffer::new(reach.x0, reach.y0, reach.width(), reach.height()),
+        sums: SumBuffer::new(0, 0, 0, 0),
         stats: TraceStats::default(),
         split: TimeSplit::default(),
         aux: (!s.aovs.is_empty()).then(|| {
@@ -714,11 +754,13 @@ fn render_tile(
     let batched = s.integrator.is_stepped() || s.integrator.bidirectional().is_some();
     let depth_view = matches!(s.integrator, Integrator::Depth);
     let rows = if batched { STRIP_ROWS } else { 1 };
+    let mut laps = Laps::default();
+    let mut film = SplatSums::new(reach.x0, reach.y0, reach.width(), reach.height());
     // The strip's buffers, kept by the thread from tile to tile.
     STRIP.with_borrow_mut(|strip| {
         for y0 in (t.y0..t.y1).step_by(rows as usize) {
             if stop() {
-                return;
+                break;
             }
             let y1 = (y0 + rows).min(t.y1);
             if convergence.is_some_and(|c| !c.any_active(t.x0, t.x1, y0, y1)) {
@@ -726,62 +768,64 @@ fn render_tile(
                 continue;
             }
             strip.render(world, s, t.x0, t.x1, y0, y1, samples, &mut out.stats);
+            let clock = Instant::now();
             for mut splat in strip.splats.drain(..) {
                 splat.l = guard(splat.l, &mut out.nan, &mut out.negative);
                 out.splats.push(splat);
             }
-            if convergence.is_none() && out.aux.is_none() {
-                // The plain render: every pixel, nothing besides the beauty.
-                let mut k = 0;
-                for y in y0..y1 {
-                    for x in t.x0..t.x1 {
-                        for _ in samples.of(x, y) {
-                            let pos = strip.pos[k];
-                            let l = strip.radiance[k];
-                            k += 1;
-                            if depth_view && l == Vec3::ZERO {
-                                continue;
-                            }
-                            let l = guard(l, &mut out.nan, &mut out.negative);
-                            out.sums.splat(&s.filter, m, x, y, pos, l);
-                        }
-                    }
-                }
-                out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
-                continue;
-            }
+            // Each sample guarded in place (and given to the other sums),
+            // pixel by pixel, rows top to bottom, as the strip holds them.
+            let (nan, negative) = (&mut out.nan, &mut out.negative);
+            let plain = convergence.is_none() && out.aux.is_none();
             let mut k = 0;
             for y in y0..y1 {
                 for x in t.x0..t.x1 {
                     for _ in samples.of(x, y) {
-                        let pos = strip.pos[k];
                         let raw = strip.radiance[k];
-                        let l = guard(raw, &mut out.nan, &mut out.negative);
-                        if let Some(aux) = &mut out.aux {
-                            aux.add_sample(x, y, &strip.aux[k], l);
+                        let l = guard(raw, nan, negative);
+                        if !plain {
+                            if let Some(aux) = &mut out.aux {
+                                aux.add_sample(x, y, &strip.aux[k], l);
+                            }
+                            if let Some(own) = &mut out.own {
+                                own.at(x, y).add(l);
+                            }
                         }
-                        if let Some(own) = &mut out.own {
-                            own.at(x, y).add(l);
-                        }
-                        k += 1;
                         // The depth view averages the distances of the
                         // samples that hit (a miss is 0, never a hit):
                         // mixing misses in would draw a near halo at every
-                        // silhouette. A pixel no sample hit stays 0.
-                        if depth_view && raw == Vec3::ZERO {
-                            continue;
-                        }
-                        out.sums.splat(&s.filter, m, x, y, pos, l);
+                        // silhouette. A pixel no sample hit stays 0. NaN
+                        // tells the film to leave a sample out.
+                        strip.radiance[k] = if depth_view && raw == Vec3::ZERO {
+                            Vec3::NAN
+                        } else {
+                            l
+                        };
+                        k += 1;
                     }
                 }
             }
+            let pixels = Pixels {
+                x0: t.x0,
+                x1: t.x1,
+                y0,
+                y1,
+                first: &strip.first,
+            };
+            film.splat_each(&splatter, pixels, &strip.pos, &strip.radiance);
+            laps.lap(clock, Lap::Film);
             out.pixels_done += (y1 - y0) * (t.x1 - t.x0);
         }
         // One of the two traced the strip's samples.
-        let (wt, ws) = strip.wavefront.take_times();
-        let (bt, bs) = strip.bdpt.take_times();
-        (out.split.tracing, out.split.shading) = (wt + bt, ws + bs);
+        laps += strip.wavefront.take_times();
+        laps += strip.bdpt.take_times();
     });
+    // The parts of the splats folded into the tile's exact sums.
+    let clock = Instant::now();
+    out.sums = film.into_sums();
+    laps.lap(clock, Lap::Film);
+    (out.split.tracing, out.split.shading, out.split.film) =
+        (laps.tracing, laps.shading, laps.film);
     out.split.total = tile_start.elapsed();
     out
 }

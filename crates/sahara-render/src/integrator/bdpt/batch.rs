@@ -9,7 +9,7 @@
 //! the order [`super::sample`] sums them: the image is the same bit for
 //! bit, the tree sees rays in batches.
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use glam::{Vec2, Vec3};
 use sahara_kd::Ray;
@@ -84,7 +84,7 @@ pub(crate) struct BdptBatch {
 impl BdptBatch {
     /// The time spent tracing and shading since the last call, and resets
     /// both.
-    pub fn take_times(&mut self) -> (Duration, Duration) {
+    pub fn take_times(&mut self) -> Laps {
         self.laps.take()
     }
 

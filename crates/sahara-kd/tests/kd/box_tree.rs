@@ -1,7 +1,5 @@
 //! Trees over boxes answer like a loop over all objects.
 
-mod common;
-
 use glam::Vec3;
 use sahara_kd::{Aabb, BoxTree, BuildParams, Builder, Ray};
 
@@ -22,7 +20,7 @@ fn sphere_hit(c: Vec3, r: f32, ray: &Ray, tmax: f32) -> Option<f32> {
 
 #[test]
 fn box_tree_closest_and_any_match_a_loop() {
-    let mut rng = common::Rng(99);
+    let mut rng = crate::common::Rng(99);
     let spheres: Vec<(Vec3, f32)> = (0..300)
         .map(|_| {
             (

@@ -2,9 +2,7 @@
 //! the decisions do not depend on threads or on the frame being split into
 //! windows; a threshold no pixel reaches renders the plain image.
 
-mod common;
-
-use common::pixel_inside_sphere;
+use crate::common::pixel_inside_sphere;
 use glam::Vec3;
 use sahara_render::{
     builtin, render, tile, Adaptive, Filter, FilterKind, Material, PixelWindow, RenderResult,

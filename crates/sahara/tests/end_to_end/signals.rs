@@ -8,9 +8,7 @@ use std::io::{BufRead, BufReader, Read};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
-
-use common::{temp_dir, SAHARA};
+use crate::common::{temp_dir, SAHARA};
 
 /// The `sahara:*` text attributes of an EXR file.
 fn exr_text(path: &std::path::Path, key: &str) -> Option<String> {
@@ -287,4 +285,57 @@ fn sigterm_leaves_a_part_marked_partial_that_merge_refuses() {
         .unwrap();
     let e = String::from_utf8_lossy(&m.stderr);
     assert!(!m.status.success() && e.contains("a partial part"), "{e}");
+}
+
+/// A binary PLY of `n` small triangles scattered through a unit cube: a
+/// tree build of a second or more on one thread.
+fn write_soup_ply(path: &std::path::Path, n: u32) {
+    let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let mut data = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\n\
+         property float x\nproperty float y\nproperty float z\n\
+         element face {n}\nproperty list uchar int vertex_indices\nend_header\n",
+        3 * n
+    )
+    .into_bytes();
+    for _ in 0..n {
+        let c = [next(), next(), next()];
+        for _ in 0..3 {
+            for a in c {
+                data.extend_from_slice(&(a + 0.02 * next()).to_le_bytes());
+            }
+        }
+    }
+    for i in 0..n {
+        data.push(3);
+        for k in 0..3 {
+            data.extend_from_slice(&((3 * i + k) as i32).to_le_bytes());
+        }
+    }
+    fs::write(path, data).unwrap();
+}
+
+#[test]
+fn a_render_stopped_before_its_first_pixel_exits_130_and_writes_nothing() {
+    let dir = temp_dir("before-first-pixel");
+    let mesh = dir.join("soup.ply");
+    write_soup_ply(&mesh, 600_000);
+    let out = dir.join("image.png");
+    // The signal comes as the render starts, while the tree is being built.
+    let args = [mesh.to_str().unwrap(), "--width", "8", "--height", "8"];
+    let (code, log) = interrupt_render(&args, &out, "-INT", Duration::ZERO);
+    assert_eq!(code, Some(130), "{log}");
+    assert!(
+        log.contains("interrupted before the first pixel was finished: no image written"),
+        "{log}"
+    );
+    assert!(!log.contains("error:"), "{log}");
+    assert!(!out.exists());
+    let _ = fs::remove_dir_all(&dir);
 }

@@ -4,11 +4,9 @@
 //! indirect light; emission textures light the scene where they are
 //! bright.
 
-mod common;
-
 use std::sync::Arc;
 
-use common::{path, run, settings};
+use crate::common::{path, run, settings};
 use glam::{Affine3A, Vec2, Vec3};
 use sahara_render::{Camera, Light, Material, Scene, Texture, TextureMap};
 use sahara_render::{Channel, ScalarMap};

@@ -6,8 +6,6 @@
 //! nodes) and for batches walked over the wide nodes, interleaved, and over
 //! the binary ones. And every tree passes the structural validator.
 
-mod common;
-
 use glam::Vec3;
 use proptest::prelude::*;
 use sahara_kd::internals::BatchWalk;
@@ -325,13 +323,13 @@ proptest! {
 
 #[test]
 fn closed_meshes_match_brute_force() {
-    let mut rng = common::Rng(0x1234_5678_9abc_def1);
+    let mut rng = crate::common::Rng(0x1234_5678_9abc_def1);
     let mut scenes = vec![
-        common::uv_sphere(Vec3::new(0.1, -0.2, 0.3), 1.5, 12, 16),
-        common::subdivided_cube(-1.0, 1.0, 4),
+        crate::common::uv_sphere(Vec3::new(0.1, -0.2, 0.3), 1.5, 12, 16),
+        crate::common::subdivided_cube(-1.0, 1.0, 4),
     ];
     let mut both = scenes[0].clone();
-    both.extend(common::subdivided_cube(1.0, 3.0, 3));
+    both.extend(crate::common::subdivided_cube(1.0, 3.0, 3));
     scenes.push(both);
     for tris in scenes {
         let specs: Vec<RaySpec> = (0..400)

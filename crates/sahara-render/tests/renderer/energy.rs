@@ -1,8 +1,6 @@
 //! Energy tests with closed-form answers: furnaces, mirror and glass.
 
-mod common;
-
-use common::{masked_mean, path, pixel_inside_sphere, run, settings};
+use crate::common::{masked_mean, path, pixel_inside_sphere, run, settings};
 use glam::Vec3;
 use sahara_render::{Camera, Environment, Integrator, Material, Scene, Shape};
 

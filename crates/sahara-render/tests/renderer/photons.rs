@@ -3,9 +3,7 @@
 //! (where no other integrator finds it), and to itself across thread
 //! counts and windows.
 
-mod common;
-
-use common::{run, settings};
+use crate::common::{run, settings};
 use glam::Vec3;
 use sahara_render::{builtin, render, Integrator, PixelWindow, RenderSettings, Scene};
 
@@ -23,7 +21,7 @@ fn sppm(max_depth: u32, photons: u32) -> Integrator {
 #[test]
 fn sppm_agrees_with_the_path_tracer_on_a_diffuse_box() {
     let scene = builtin::cornell_box();
-    let reference = run(&scene, &settings(32, 32, 1024, common::path(6)));
+    let reference = run(&scene, &settings(32, 32, 1024, crate::common::path(6)));
     let s = run(&scene, &settings(32, 32, 64, sppm(6, 10_000)));
     let (ma, mb) = (reference.film.mean(0, 0, 32, 32), s.film.mean(0, 0, 32, 32));
     let rel = ((mb - ma).abs() / ma).max_element();
@@ -41,11 +39,11 @@ fn sppm_agrees_with_the_path_tracer_on_a_diffuse_box() {
 /// The slab's caustic, seen directly and through the slab itself
 /// (specular, diffuse, specular: a point light's caustic that neither the
 /// path tracer nor bidirectional path tracing can see), matches the
-/// analytic estimate (see `common::glass_slab`).
+/// analytic estimate (see `crate::common::glass_slab`).
 #[test]
 fn sppm_sees_the_slab_caustic_directly_and_through_the_glass() {
     for from_above in [false, true] {
-        let (scene, expected) = common::glass_slab(from_above);
+        let (scene, expected) = crate::common::glass_slab(from_above);
         // Enough depth for the photons' two refractions and the camera's
         // two, and none for light bouncing inside the slab.
         let mut s = settings(32, 32, 32, sppm(3, 100_000));
@@ -86,7 +84,7 @@ fn bits(threads: usize, scene: &Scene, s: &RenderSettings) -> Vec<u32> {
 /// a frame splits by tiles exactly).
 #[test]
 fn sppm_is_deterministic_across_threads_and_windows() {
-    let (scene, _) = common::glass_slab(false);
+    let (scene, _) = crate::common::glass_slab(false);
     let s = settings(24, 20, 6, sppm(5, 3000));
     let one = bits(1, &scene, &s);
     assert!(one == bits(2, &scene, &s), "1 and 2 threads differ");

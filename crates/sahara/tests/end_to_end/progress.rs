@@ -8,9 +8,7 @@ use std::io::Read;
 use std::os::fd::{FromRawFd, OwnedFd};
 use std::process::{Command, Stdio};
 
-mod common;
-
-use common::{temp_dir, SAHARA};
+use crate::common::{temp_dir, SAHARA};
 
 /// A pseudo-terminal of `cols` columns: (controller, terminal).
 fn pty(cols: u16) -> (OwnedFd, OwnedFd) {

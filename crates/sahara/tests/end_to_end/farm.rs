@@ -6,9 +6,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-mod common;
-
-use common::{denoiser_missing, sahara, temp_dir};
+use crate::common::{denoiser_missing, sahara, temp_dir};
 use sahara_formats::part_file::{read_part, write_part};
 
 /// The frame of every test: small, a few passes (the last one shorter), a

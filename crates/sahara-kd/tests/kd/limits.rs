@@ -1,7 +1,5 @@
 //! Pathological inputs cannot blow up a build's memory: the reference cap.
 
-mod common;
-
 use glam::Vec3;
 use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
 
@@ -9,7 +7,7 @@ use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
 /// split plane cuts nearly all of them, so each level would double the
 /// references without a cap.
 fn crossing_slivers(n: usize) -> Vec<Triangle> {
-    let mut rng = common::Rng(0xdead_beef);
+    let mut rng = crate::common::Rng(0xdead_beef);
     (0..n)
         .map(|_| {
             let a = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 2.0 - Vec3::ONE;
@@ -22,7 +20,7 @@ fn crossing_slivers(n: usize) -> Vec<Triangle> {
 #[test]
 fn reference_cap_bounds_every_builder() {
     let tris = crossing_slivers(3000);
-    let mut rng = common::Rng(5);
+    let mut rng = crate::common::Rng(5);
     let rays: Vec<Ray> = (0..300)
         .map(|_| {
             Ray::new(

@@ -1,9 +1,7 @@
 //! Camera effects against geometry: depth of field, motion blur,
 //! antialiasing of an edge.
 
-mod common;
-
-use common::{path, run, settings};
+use crate::common::{path, run, settings};
 use glam::{Affine3A, Vec3};
 use sahara_render::{Camera, Instance, Material, SamplerKind, Scene, Shape, Srt};
 

@@ -37,6 +37,23 @@ pub fn denoiser_missing(out: &Output) -> bool {
         std::env::var_os("SAHARA_REQUIRE_OIDN").is_none(),
         "SAHARA_REQUIRE_OIDN is set: {err}"
     );
-    eprintln!("skipped: Open Image Denoise is not installed here (pip install pyoidn)");
+    skip_note("the denoiser's end-to-end tests (Open Image Denoise is not installed here: pip install pyoidn)");
     true
+}
+
+/// Says that a group of tests is skipped and why, once per reason, on the
+/// test binary's own stderr: `cargo test` shows it without `--nocapture`
+/// (the harness captures only `print!` and `eprint!`).
+pub fn skip_note(reason: &str) {
+    use std::io::Write;
+    static SAID: std::sync::Mutex<std::collections::BTreeSet<String>> =
+        std::sync::Mutex::new(std::collections::BTreeSet::new());
+    let first = SAID
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .insert(reason.to_string());
+    if first {
+        // One write, so that lines of tests running in parallel stay whole.
+        let _ = std::io::stderr().write_all(format!("SKIPPED: {reason}\n").as_bytes());
+    }
 }

@@ -8,9 +8,7 @@ use std::process::Output;
 
 use sahara_formats::image_in::load_rgb_f32;
 
-mod common;
-
-use common::{sahara, temp_dir};
+use crate::common::{sahara, temp_dir};
 
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()

@@ -2,9 +2,7 @@
 //! polygon formula), the inverse-square law, and grazing light far from the
 //! origin (no self-shadowing acne).
 
-mod common;
-
-use common::{path, run, settings};
+use crate::common::{path, run, settings};
 use glam::{DVec3, Vec2, Vec3};
 use sahara_render::{Camera, Integrator, Light, Material, Scene, Shape};
 use std::f64::consts::PI;

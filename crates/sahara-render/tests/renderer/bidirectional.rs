@@ -2,9 +2,7 @@
 //! where both converge, to an analytic caustic where the path tracer
 //! cannot, and to themselves across thread counts.
 
-mod common;
-
-use common::{run, settings};
+use crate::common::{run, settings};
 use glam::Vec3;
 use sahara_render::{
     builtin, render, Camera, Environment, Filter, FilterKind, Integrator, Light, Material,
@@ -18,7 +16,7 @@ fn bdpt(max_depth: u32) -> Integrator {
 /// The path tracer without Russian roulette (which the bidirectional
 /// integrators do not use either; both are then cut at the same depth).
 fn path(max_depth: u32) -> Integrator {
-    common::path(max_depth)
+    crate::common::path(max_depth)
 }
 
 /// Mean of each `b x b` block of pixels, per channel.
@@ -150,12 +148,12 @@ fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
 }
 
 /// A spot light shining down through a thick glass slab onto a white
-/// floor ([`common::glass_slab`]): the path tracer cannot find this light
+/// floor ([`crate::common::glass_slab`]): the path tracer cannot find this light
 /// (a point light seen through glass), light tracing can, with the
 /// energy the analytic estimate gives.
 #[test]
 fn light_through_a_glass_slab_casts_the_caustic_an_analytic_estimate_gives() {
-    let (scene, expected) = common::glass_slab(false);
+    let (scene, expected) = crate::common::glass_slab(false);
     let mut s = settings(64, 64, 256, bdpt(3));
     s.tile_size = 64;
     let img = run(&scene, &s);

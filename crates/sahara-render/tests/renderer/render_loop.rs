@@ -1,13 +1,11 @@
 //! The render loop and whole scenes: determinism, the Cornell box, no NaN
 //! anywhere, progressive passes and cancellation, instancing.
 
-mod common;
-
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Duration;
 
-use common::{run, settings};
+use crate::common::{run, settings};
 use glam::{Affine3A, Quat, Vec3};
 use sahara_kd::KdTree;
 use sahara_render::internals::World;
@@ -389,17 +387,18 @@ fn the_built_in_cornell_light_is_a_white_diffuser_that_emits() {
     );
 }
 
-/// The path tracer says where its threads' time went, in shares that add up
-/// to one; integrators that do not trace in batches say nothing.
+/// The path tracer says where its threads' time went (tracing, shading,
+/// the film, the rest), in shares that add up to one; integrators that do not trace in batches say nothing.
 #[test]
 fn the_time_split_covers_the_path_tracer_only() {
     let scene = builtin::cornell_box();
     let r = render(&scene, &settings(16, 16, 4, Integrator::default()), &|_| {});
     let split = r.stats.time_split;
-    let (t, s, rest) = split.shares().expect("the path tracer measures its split");
-    assert!(t > 0.0 && s > 0.0 && rest >= 0.0, "{t} {s} {rest}");
-    assert!((t + s + rest - 1.0).abs() < 1e-9, "{t} {s} {rest}");
-    assert!(split.tracing + split.shading <= split.total);
+    let shares = split.shares().expect("the path tracer measures its split");
+    let (t, s, f, rest) = (shares.tracing, shares.shading, shares.film, shares.rest);
+    assert!(t > 0.0 && s > 0.0 && f > 0.0 && rest >= 0.0, "{shares:?}");
+    assert!((t + s + f + rest - 1.0).abs() < 1e-9, "{shares:?}");
+    assert!(split.tracing + split.shading + split.film <= split.total);
     let ao = Integrator::Ao {
         samples: 1,
         distance: 0.0,

@@ -7,9 +7,7 @@ use std::process::Output;
 
 use sahara_formats::image_in::load_rgb_f32;
 
-mod common;
-
-use common::{denoiser_missing, sahara, temp_dir};
+use crate::common::{denoiser_missing, sahara, temp_dir};
 
 fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
@@ -199,7 +197,7 @@ fn command_line_options_override_the_scene_file() {
          [film]\nwidth = 12\nheight = 6\noutput = \"from_file.png\"\n",
     )
     .unwrap();
-    let out = std::process::Command::new(common::SAHARA)
+    let out = std::process::Command::new(crate::common::SAHARA)
         .args(["render", scene.to_str().unwrap(), "--spp", "1"])
         .current_dir(&dir)
         .output()
@@ -335,7 +333,7 @@ fn every_output_is_checked_before_the_scene_is_loaded() {
 fn a_log_that_is_not_a_terminal_gets_plain_progress_lines() {
     let dir = temp_dir("plain-progress");
     let out = dir.join("p.png");
-    let o = std::process::Command::new(common::SAHARA)
+    let o = std::process::Command::new(crate::common::SAHARA)
         .args(["render", "--width", "40", "--height", "40", "--spp", "4"])
         .args(["--pass-spp", "2", "-o", out.to_str().unwrap()])
         .env("SAHARA_PROGRESS_EVERY", "0")
@@ -343,8 +341,26 @@ fn a_log_that_is_not_a_terminal_gets_plain_progress_lines() {
         .unwrap();
     let err = stderr(&o);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("progress: pass 1/2"), "{err}");
-    assert!(err.contains("progress: pass 2/2"), "{err}");
+    // Each line gives the whole render's share, the time elapsed and left,
+    // and the speed; the tiles are said to be the pass's.
+    let lines: Vec<&str> = err
+        .lines()
+        .filter(|l| l.starts_with("progress: "))
+        .collect();
+    assert!(!lines.is_empty(), "{err}");
+    for line in &lines {
+        assert!(
+            line.contains("% done, ")
+                && line.contains(" elapsed, eta ")
+                && line.contains(" Mrays/s (pass ")
+                && line.contains(" of this pass)"),
+            "{line}"
+        );
+    }
+    assert!(err.contains("(pass 1/2, tile "), "{err}");
+    assert!(err.contains("(pass 2/2, tile "), "{err}");
+    // The last tile of the last pass is the whole render.
+    assert!(err.contains("progress: 100.0% done"), "{err}");
     let _ = fs::remove_dir_all(&dir);
 }
 
@@ -414,6 +430,76 @@ fn a_render_that_cannot_fit_in_memory_is_refused_with_an_estimate() {
         "{err}"
     );
     assert!(!out_png.exists());
+}
+
+#[test]
+fn a_misspelt_command_or_option_gets_the_nearest_one() {
+    for (args, what) in [
+        (&["rendr"][..], "did you mean: sahara render"),
+        (&["render", "--sp", "16"], "did you mean: --spp"),
+        (
+            &["render", "--integrater", "path"],
+            "did you mean: --integrator",
+        ),
+    ] {
+        let out = sahara(args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(what), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn an_output_that_is_a_folder_is_refused_as_a_folder() {
+    let dir = temp_dir("output-folder");
+    let out = sahara(&["render", "--spp", "1", "-o", dir.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&format!("{}: is a folder", dir.display())),
+        "{err}"
+    );
+    assert!(!err.contains("extension"), "{err}");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn adaptive_sampling_at_its_minimum_says_no_pixel_can_stop_early() {
+    let dir = temp_dir("adaptive-min");
+    let png = dir.join("a.png");
+    let run = |spp: &str| {
+        let out = sahara(&[
+            "render",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--spp",
+            spp,
+            "--noise-threshold",
+            "0.5",
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        let err = stderr(&out);
+        assert!(out.status.success(), "{err}");
+        err
+    };
+    // The cap equals the default minimum of 16: every pixel takes 16
+    // samples, and the log neither claims pixels stopped early nor hides why.
+    let err = run("16");
+    assert!(err.contains("every pixel takes all 16 samples"), "{err}");
+    assert!(err.contains("100.0% of the 16 spp budget"), "{err}");
+    assert!(
+        err.contains("0 of 1024 pixels (0.0%) stopped early"),
+        "{err}"
+    );
+    // With room above the minimum, pixels stop early and no warning is given.
+    let err = run("256");
+    assert!(!err.contains("every pixel takes all"), "{err}");
+    assert!(!err.contains(" 0 of 1024 pixels"), "{err}");
+    let _ = fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -548,7 +634,7 @@ fn a_scene_files_output_goes_to_the_working_folder() {
          output = \"out.png\"\n[sampler]\nspp = 1\n",
     )
     .unwrap();
-    let o = std::process::Command::new(common::SAHARA)
+    let o = std::process::Command::new(crate::common::SAHARA)
         .args(["render", scene.to_str().unwrap()])
         .current_dir(&work)
         .output()
@@ -1496,6 +1582,193 @@ fn the_log_says_why_the_default_sky_was_added() {
     assert!(
         log.contains("light: default sky and sun (auto: own lights at 0.000 of the default sky and sun's power, below 0.05)"),
         "{log}"
+    );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// The glTF scenes of `tests/assets/` (written by its
+/// `make_framing_scenes.py`).
+fn asset(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/assets")
+        .join(name)
+}
+
+/// Renders `model` with its object ids at `width` x `height`; returns the
+/// log and the name of the object each pixel shows (`nothing` for the sky).
+fn render_objects(model: &Path, dir: &Path, width: u32, height: u32) -> (String, Vec<String>) {
+    let exr = dir.join("objects.exr");
+    let out = sahara(&[
+        "render",
+        model.to_str().unwrap(),
+        "--width",
+        &width.to_string(),
+        "--height",
+        &height.to_string(),
+        "--spp",
+        "4",
+        "--aov",
+        "object",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    let ids = &exr_channels(&exr)["object.id"];
+    let names: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(dir.join("objects.names.json")).unwrap()).unwrap();
+    let objects = ids
+        .iter()
+        .map(|&id| match id {
+            0.0 => "nothing".to_string(),
+            // `FILE/NODE`: the node's name.
+            id => names["object"][format!("{id}")]
+                .as_str()
+                .unwrap()
+                .rsplit('/')
+                .next()
+                .unwrap()
+                .to_string(),
+        })
+        .collect();
+    (err, objects)
+}
+
+/// A small island with a palm in a huge, glowing, gently waved sea: the
+/// automatic camera frames the island, not the sea, and the sea's glow does
+/// not switch the default sky off.
+#[test]
+fn a_subject_in_a_huge_glowing_sea_fills_the_frame_under_the_sky() {
+    let dir = temp_dir("island-sea");
+    let (err, objects) = render_objects(&asset("island_sea.gltf"), &dir, 80, 60);
+    assert!(
+        err.contains("framing 9 objects; 1 flat or emissive object"),
+        "{err}"
+    );
+    assert!(err.contains("light: default sky and sun"), "{err}");
+    let share = |what: &dyn Fn(&str) -> bool| {
+        objects.iter().filter(|o| what(o)).count() as f64 / objects.len() as f64
+    };
+    // The island (20 units across, 7 with the palm) and what stands on it
+    // are framed, seen from above: their bounding sphere fills the frame's
+    // height, the island about 8 % of the frame and the palm 0.6 %. Framed
+    // with the 392-unit sea (seen from 724 units) they would take under
+    // 0.1 % and 0.01 %.
+    let subject = share(&|o| o != "Sea" && o != "nothing");
+    assert!(subject > 0.03, "the island fills {subject} of the frame");
+    let palm = share(&|o| o == "Trunk" || o.starts_with("Leaf"));
+    assert!(palm > 0.002, "the palm fills {palm} of the frame");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A Cornell box (five one-sided walls, open at +z) without a camera is
+/// looked into through its open side: every wall is seen from inside.
+#[test]
+fn a_room_open_on_one_side_is_looked_into_through_it() {
+    let dir = temp_dir("open-room");
+    let (err, objects) = render_objects(&asset("open_room.gltf"), &dir, 40, 30);
+    assert!(err.contains("a room open on its +z side"), "{err}");
+    // Where each wall is seen: the mean column and row of its pixels.
+    let centre = |name: &str| {
+        let at: Vec<(usize, usize)> = (0..40 * 30)
+            .filter(|&k| objects[k] == name)
+            .map(|k| (k % 40, k / 40))
+            .collect();
+        assert!(at.len() > 20, "{name}: {} pixels", at.len());
+        let n = at.len() as f64;
+        (
+            at.iter().map(|p| p.0 as f64).sum::<f64>() / n,
+            at.iter().map(|p| p.1 as f64).sum::<f64>() / n,
+        )
+    };
+    let (left, right, back) = (centre("Left"), centre("Right"), centre("Back"));
+    let (floor, ceiling) = (centre("Floor"), centre("Ceiling"));
+    // From inside the opening: the left wall on the left, the right wall on
+    // the right, the ceiling above, the floor below, the back wall between.
+    assert!(
+        left.0 < back.0 && back.0 < right.0,
+        "{left:?} {back:?} {right:?}"
+    );
+    assert!(
+        ceiling.1 < back.1 && back.1 < floor.1,
+        "{ceiling:?} {back:?} {floor:?}"
+    );
+    // The opening fills the frame's height: the sky only beside the box.
+    assert_eq!(objects[15 * 40 + 1], "nothing");
+    assert_eq!(objects[15 * 40 + 20], "Block");
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// A glTF whose only texture is a KTX2 image (`KHR_texture_basisu`, no PNG
+/// fallback; `crates/sahara-readers/tests/data/`, written by its
+/// `make_ktx2.py`) renders with it: the square's four quadrants, red and
+/// green above, blue and white below, seen where they are.
+#[test]
+fn a_gltf_with_ktx2_textures_renders_with_them() {
+    let dir = temp_dir("ktx2");
+    let model =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../sahara-readers/tests/data/quad_basisu.gltf");
+    let exr = dir.join("quad.exr");
+    let out = sahara(&[
+        "render",
+        model.to_str().unwrap(),
+        "--width",
+        "48",
+        "--height",
+        "36",
+        "--spp",
+        "4",
+        "--aov",
+        "albedo",
+        "-o",
+        exr.to_str().unwrap(),
+    ]);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let c = exr_channels(&exr);
+    let n = 48 * 36;
+    let albedo = |k: usize| [c["albedo.R"][k], c["albedo.G"][k], c["albedo.B"][k]];
+    let beauty = |k: usize| [c["R"][k], c["G"][k], c["B"][k]];
+    // The pixels whose albedo is each quadrant's colour (linear, as the
+    // sRGB codes 255 and 0 decode), their mean position and beauty.
+    let quadrant = |want: [f32; 3]| {
+        let at: Vec<usize> = (0..n)
+            .filter(|&k| (0..3).all(|i| (albedo(k)[i] - want[i]).abs() < 0.01))
+            .collect();
+        assert!(at.len() > 20, "{want:?}: {} pixels", at.len());
+        let mean =
+            |f: &dyn Fn(usize) -> f32| at.iter().map(|&k| f(k)).sum::<f32>() / at.len() as f32;
+        (
+            [mean(&|k| (k % 48) as f32), mean(&|k| (k / 48) as f32)],
+            [0, 1, 2].map(|i| mean(&|k| beauty(k)[i])),
+        )
+    };
+    let (red, red_light) = quadrant([1.0, 0.0, 0.0]);
+    let (green, green_light) = quadrant([0.0, 1.0, 0.0]);
+    let (blue, blue_light) = quadrant([0.0, 0.0, 1.0]);
+    let (white, _) = quadrant([1.0, 1.0, 1.0]);
+    // Red left of green and above blue; white right of blue, below green.
+    assert!(
+        red[0] < green[0] && blue[0] < white[0],
+        "{red:?} {green:?} {blue:?} {white:?}"
+    );
+    assert!(
+        red[1] < blue[1] && green[1] < white[1],
+        "{red:?} {green:?} {blue:?} {white:?}"
+    );
+    // And the light they reflect is theirs.
+    assert!(
+        red_light[0] > 10.0 * red_light[1].max(red_light[2]),
+        "{red_light:?}"
+    );
+    assert!(
+        green_light[1] > 10.0 * green_light[0].max(green_light[2]),
+        "{green_light:?}"
+    );
+    assert!(
+        blue_light[2] > 10.0 * blue_light[0].max(blue_light[1]),
+        "{blue_light:?}"
     );
     let _ = fs::remove_dir_all(&dir);
 }

@@ -6,9 +6,7 @@ use std::process::Output;
 
 use serde_json::Value;
 
-mod common;
-
-use common::{sahara, temp_dir};
+use crate::common::{sahara, temp_dir};
 
 fn stdout_json(out: &Output) -> Value {
     assert!(

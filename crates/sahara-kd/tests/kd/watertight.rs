@@ -1,8 +1,6 @@
 //! Watertightness: rays never slip between the triangles of closed meshes,
 //! through the kd-tree of every builder and through brute force.
 
-mod common;
-
 use glam::Vec3;
 use sahara_kd::validate;
 use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
@@ -20,7 +18,7 @@ fn trees(tris: &[Triangle]) -> Vec<(String, KdTree)> {
 
 /// Rays from inside a closed mesh, in every direction, must hit it.
 fn assert_no_escape(tris: &[Triangle], inside: &[Vec3], rays_per_point: usize) {
-    let mut rng = common::Rng(0x9e37_79b9_7f4a_7c15);
+    let mut rng = crate::common::Rng(0x9e37_79b9_7f4a_7c15);
     let trees = trees(tris);
     let mut escaped = 0;
     for &o in inside {
@@ -44,7 +42,7 @@ fn assert_no_escape(tris: &[Triangle], inside: &[Vec3], rays_per_point: usize) {
 #[test]
 fn no_ray_escapes_a_tessellated_sphere() {
     let c = Vec3::new(0.25, -0.5, 1.0);
-    let tris = common::uv_sphere(c, 2.0, 24, 48);
+    let tris = crate::common::uv_sphere(c, 2.0, 24, 48);
     let inside = [
         c,
         c + Vec3::new(0.5, 0.3, -0.2),
@@ -56,7 +54,7 @@ fn no_ray_escapes_a_tessellated_sphere() {
 
 #[test]
 fn no_ray_escapes_a_subdivided_cube() {
-    let tris = common::subdivided_cube(-1.0, 1.0, 8);
+    let tris = crate::common::subdivided_cube(-1.0, 1.0, 8);
     // The centre lies on the middle split planes of every naive tree.
     let inside = [
         Vec3::ZERO,
@@ -71,7 +69,7 @@ fn rays_at_shared_vertices_and_edges_always_hit() {
     // Grid points of the cube's faces are exactly representable, so these
     // rays pass exactly through shared vertices and along shared edges.
     let n = 8;
-    let tris = common::subdivided_cube(-1.0, 1.0, n);
+    let tris = crate::common::subdivided_cube(-1.0, 1.0, n);
     let trees = trees(&tris);
     let coord = |i: usize| -1.0 + 2.0 * i as f32 / n as f32;
     let mut targets = Vec::new();
@@ -117,7 +115,7 @@ fn a_ray_through_a_shared_edge_hits_one_of_its_triangles() {
     let a = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0));
     let b = Triangle::new(Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::Y);
     let tris = [a, b];
-    let mut rng = common::Rng(7);
+    let mut rng = crate::common::Rng(7);
     for i in 0..10_000 {
         let s = (i as f32 + 0.5) / 10_000.0;
         let target = Vec3::new(s, s, 0.0);
