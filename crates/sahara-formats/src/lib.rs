@@ -5,6 +5,8 @@
 //!   [`scene_load`] (its description), [`pbrt`] (pbrt-v4 scenes),
 //!   [`mitsuba`] (Mitsuba 3 XML scenes),
 //!   [`mesh_scene`] (a bare mesh file as a scene);
+//! - any of them by its extension: [`load`] (and [`load_builtin`], the
+//!   built-in Cornell box), read and assembled in one call;
 //! - to the renderer: [`assembly`] (a description as a
 //!   `sahara_render::Scene`: the sky rule, the automatic camera), using
 //!   [`mesh_library`] (each mesh file loaded once), [`material_map`]
@@ -29,6 +31,7 @@ pub mod description;
 pub mod gltf_scene;
 pub mod image_in;
 pub mod image_out;
+mod load;
 pub mod material_map;
 pub mod mesh_library;
 pub mod mesh_scene;
@@ -44,6 +47,7 @@ use std::path::Path;
 use sahara_readers::TriangleMesh;
 use sahara_render::Mesh;
 
+pub use load::{load, load_builtin, LoadOptions, Loaded};
 pub use sahara_readers::FormatError;
 
 /// A mesh as read as the renderer's mesh (both vectors are moved, not copied).

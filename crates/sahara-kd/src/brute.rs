@@ -45,3 +45,27 @@ pub fn any_hit(triangles: &[Triangle], ray: &Ray) -> bool {
         .iter()
         .any(|tri| tri.is_hittable() && shear.intersect(tri, ray.tmin, ray.tmax).is_some())
 }
+
+/// Every hit with `t` in `(ray.tmin, ray.tmax]`, each triangle once,
+/// ordered by `t`, then by triangle index.
+pub fn all_hits(triangles: &[Triangle], ray: &Ray) -> Vec<Hit> {
+    if !ray.is_valid() {
+        return Vec::new();
+    }
+    let shear = RayShear::from_ray(ray);
+    let mut hits: Vec<Hit> = triangles
+        .iter()
+        .enumerate()
+        .filter(|(_, tri)| tri.is_hittable())
+        .filter_map(|(i, tri)| {
+            shear.intersect(tri, ray.tmin, ray.tmax).map(|h| Hit {
+                t: h.t,
+                tri: i as u32,
+                u: h.u,
+                v: h.v,
+            })
+        })
+        .collect();
+    hits.sort_by(|a, b| a.t.total_cmp(&b.t).then(a.tri.cmp(&b.tri)));
+    hits
+}

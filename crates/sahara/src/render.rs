@@ -213,11 +213,12 @@ struct Job {
 fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
     let Input {
         mut scene,
-        file,
+        settings: file,
         name,
         description,
         mut warnings,
         names,
+        ..
     } = input;
     // The finished scene's problems, named after the file they come from.
     let from_file = args.scene.as_ref().map(|p| p.display().to_string());

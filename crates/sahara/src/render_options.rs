@@ -41,24 +41,9 @@ pub fn resolve(
     file: Option<&FileSettings>,
     name: &str,
 ) -> Result<RenderOptions> {
-    // A kind named on the command line takes its default parameters,
-    // unless the file names the same kind: then the file's parameters hold.
-    // Between `path`, `bdpt`, `lightpath` and `sppm`, which count a path's
-    // length alike, the file's length holds too, so that switching the
-    // estimator renders the same image.
-    let integrator = match (args.integrator, file) {
-        (Some(kind), Some(f)) if f.integrator.kind() == kind => f.integrator,
-        (Some(kind), Some(f)) => {
-            let new = Integrator::from(kind);
-            match (f.integrator.path_length(), new.path_length()) {
-                (Some(n), Some(_)) => new.with_path_length(n),
-                _ => new,
-            }
-        }
-        (Some(kind), _) => Integrator::from(kind),
-        (None, Some(f)) => f.integrator,
-        (None, None) => Integrator::default(),
-    };
+    // A kind named on the command line over the file's (the rules in
+    // `Integrator::chosen`, which the Python package shares).
+    let integrator = Integrator::chosen(args.integrator, file.map(|f| f.integrator));
     let sampler = args.sampler.or(file.map(|f| f.sampler)).unwrap_or_default();
     let filter = match (args.filter, file) {
         (Some(kind), Some(f)) if f.filter.kind() == kind => f.filter,

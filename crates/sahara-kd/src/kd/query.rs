@@ -154,6 +154,48 @@ impl<L: Layout, const SIMD: u8> AnyLeaf<L, SIMD> {
     }
 }
 
+/// The all-hits leaf visit of one ray: every hit within the ray's
+/// interval, whatever the others (a named type for the reason given at
+/// [`ClosestLeaf`]).
+pub(crate) struct AllLeaf<'a, L: Layout, const SIMD: u8> {
+    tree: &'a KdTree<Triangle>,
+    layout: L,
+    shear: RayShear,
+    tmin: f32,
+    tmax: f32,
+    hits: &'a mut Vec<Hit>,
+}
+
+impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for AllLeaf<'_, L, SIMD> {
+    #[inline(always)]
+    fn visit(&mut self, offset: usize, count: usize, c: &mut C, _: &mut f32) -> LeafResult {
+        // SAFETY: as in `ClosestLeaf::visit`.
+        let blocks = unsafe { self.layout.blocks(offset, count) };
+        for (b, block) in blocks.enumerate() {
+            let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
+            (0..lanes).for_each(|_| c.triangle());
+            // SAFETY: `SIMD` is the level the traversal is compiled for.
+            let (mut m, e) = unsafe { block.edges::<SIMD>(&self.shear, lanes) };
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let uvw = [e[0][l], e[1][l], e[2][l]];
+                let tri = block.triangle(l);
+                if let Some(h) = self.shear.decide(&tri, uvw, self.tmin, self.tmax) {
+                    self.hits.push(Hit {
+                        t: h.t,
+                        tri: self.tree.indices[block.run() + l],
+                        u: h.u,
+                        v: h.v,
+                    });
+                }
+            }
+        }
+        // The closest distance is left at `tmax`: every cell is visited.
+        LeafResult::Continue
+    }
+}
+
 impl KdTree<Triangle> {
     /// The highest level worth dispatching a single-ray query to: AVX-512
     /// only speeds up the compact layout's gathers, so the whole layout
@@ -196,6 +238,26 @@ impl KdTree<Triangle> {
             counters,
         };
         dispatch(self.single_ray_level(), q)
+    }
+
+    /// Every hit with `t` in `(ray.tmin, ray.tmax]`, into `hits` (cleared
+    /// first): each triangle hit once, ordered by `t`, then by triangle
+    /// index. A ray through an edge or a vertex shared by several
+    /// triangles hits each of those the watertight test accepts (at least
+    /// one). For counting surfaces crossed (inside tests by parity) and
+    /// for every hit along a ray.
+    pub fn all_hits(&self, ray: &Ray, hits: &mut Vec<Hit>) {
+        hits.clear();
+        let q = AllQuery {
+            tree: self,
+            ray,
+            hits,
+        };
+        dispatch(self.single_ray_level(), q);
+        // A triangle referenced by several leaves is found in each.
+        hits.sort_unstable_by_key(|h| h.tri);
+        hits.dedup_by_key(|h| h.tri);
+        hits.sort_by(|a, b| a.t.total_cmp(&b.t).then(a.tri.cmp(&b.tri)));
     }
 
     /// The closest-hit walk over the leaf layout `layout`, at level `SIMD`.
@@ -303,6 +365,40 @@ impl<C: Counters> Kernel for AnyQuery<'_, C> {
     }
 }
 
+/// [`KdTree::all_hits`] as a kernel for [`dispatch`].
+struct AllQuery<'a> {
+    tree: &'a KdTree<Triangle>,
+    ray: &'a Ray,
+    hits: &'a mut Vec<Hit>,
+}
+
+impl AllQuery<'_> {
+    #[inline(always)]
+    fn over<L: Layout, const SIMD: u8>(self, layout: L) {
+        let Self { tree, ray, hits } = self;
+        let mut leaf = AllLeaf::<L, SIMD> {
+            tree,
+            layout,
+            shear: RayShear::from_ray(ray),
+            tmin: ray.tmin,
+            tmax: ray.tmax,
+            hits,
+        };
+        tree.walk(ray, &mut NoCounters, &mut leaf);
+    }
+}
+
+impl Kernel for AllQuery<'_> {
+    type Output = ();
+    #[inline(always)]
+    unsafe fn run<const LEVEL: u8>(self) {
+        match &self.tree.leaf_data {
+            TriangleLeaves::Whole(v) => self.over::<_, LEVEL>(Whole(v)),
+            TriangleLeaves::Indexed(p) => self.over::<_, LEVEL>(Indexed(p)),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -347,5 +443,52 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Every hit along a ray, as brute force finds them, in both leaf
+    /// layouts; the first of them is the closest hit.
+    #[test]
+    fn all_hits_agree_with_brute_force() {
+        let mut f = floats(7);
+        let tris = soup(&mut f, 2000, 0.5);
+        let mut hits = Vec::new();
+        let (mut found, mut several) = (0, 0);
+        for compact_leaves in [false, true] {
+            let params = BuildParams {
+                compact_leaves,
+                ..BuildParams::default()
+            };
+            let tree = KdTree::build(tris.clone(), &params);
+            for k in 0..2000 {
+                let o = Vec3::new(f(), f(), f()) * 5.0;
+                let ray = match k % 3 {
+                    0 => Ray::new(o, Vec3::new(f(), f(), f())),
+                    1 => Ray::with_interval(o, Vec3::new(f(), f(), f()), 0.5, 3.0),
+                    _ => Ray::new(o, Vec3::X),
+                };
+                tree.all_hits(&ray, &mut hits);
+                assert_eq!(hits, brute::all_hits(&tris, &ray), "ray {k}");
+                assert_eq!(hits.first().copied(), tree.closest_hit(&ray), "ray {k}");
+                found += hits.len();
+                several += (hits.len() > 1) as usize;
+            }
+        }
+        assert!(
+            found > 1000 && several > 100,
+            "{found} hits, {several} rays with several"
+        );
+        tree_without_triangles_has_no_hits();
+    }
+
+    fn tree_without_triangles_has_no_hits() {
+        let tree = KdTree::build(Vec::new(), &BuildParams::default());
+        let mut hits = vec![Hit {
+            t: 1.0,
+            tri: 0,
+            u: 0.0,
+            v: 0.0,
+        }];
+        tree.all_hits(&Ray::new(Vec3::ZERO, Vec3::X), &mut hits);
+        assert!(hits.is_empty());
     }
 }

@@ -1,0 +1,258 @@
+//! Any file Sahara renders, by its extension: a scene file (TOML, pbrt,
+//! Mitsuba) or a mesh file (OBJ, PLY, glTF), read, described and assembled
+//! into a renderer scene with the settings its file asks for; and the
+//! built-in Cornell box. The command line and the Python package both load
+//! scenes through [`load`] and [`load_builtin`].
+
+use std::path::Path;
+
+use sahara_readers::camera::read_sidecar;
+use sahara_render::{builtin, Camera, Scene};
+
+use crate::assembly::{assemble, sky, SceneNames};
+use crate::description::{FileSettings, Sky};
+use crate::mesh_scene::{read_mesh_scene, CameraChoice};
+use crate::scene_load::read_scene;
+use crate::FormatError;
+
+/// What may be asked of a scene besides its file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LoadOptions {
+    /// For a mesh file or the built-in scene: a camera sidecar file (a
+    /// value that names an existing file or ends in `.json`) or the name of
+    /// one of a glTF file's cameras; an error for a scene file, which has
+    /// its own camera.
+    pub camera: Option<String>,
+    /// What lights the scene besides its own lights: `auto`, `default`,
+    /// `none` or an environment image's path; None keeps the file's choice
+    /// (`auto` for a mesh).
+    pub sky: Option<String>,
+    /// A Mitsuba scene's parameters (`$name` takes the value); an error
+    /// for any other file.
+    pub defines: Vec<(String, String)>,
+}
+
+/// A scene ready to render, with what its file says about rendering it.
+pub struct Loaded {
+    /// The scene (the camera's aspect as the file gave it, 1 for a camera
+    /// chosen automatically: the caller sets it from the image size).
+    pub scene: Scene,
+    /// The render settings of a scene file (None: a mesh or the built-in scene).
+    pub settings: Option<FileSettings>,
+    /// The scene's name: the file name without its extension
+    /// (`scene.pbrt.gz` is `scene`), `cornell_box` for the built-in scene.
+    pub name: String,
+    /// What a log calls it: the path, or `the built-in Cornell box`.
+    pub description: String,
+    /// What the scene's objects and materials are called.
+    pub names: SceneNames,
+    /// Problems that did not stop loading, one line each, naming the file.
+    pub warnings: Vec<String>,
+    /// For a mesh file (or the built-in scene with a camera sidecar):
+    /// where the camera and the light came from, one line for the log
+    /// (`camera: auto; light: default sky and sun ...`).
+    pub framing: Option<String>,
+}
+
+/// The file kinds [`load`] reads, for messages.
+const EXPECTED: &str =
+    "expected a scene file (.toml, .pbrt, .pbrt.gz, .xml) or a mesh (.obj, .ply, .gltf, .glb)";
+
+/// An error about `path` as a whole.
+fn in_file(path: &Path, message: String) -> FormatError {
+    FormatError::InFile {
+        path: path.display().to_string(),
+        message,
+    }
+}
+
+/// Loads the scene or mesh file `path`, choosing the reader by its
+/// extension (`.toml`; `.pbrt`, `.pbrt.gz`; `.xml`; `.obj`, `.ply`,
+/// `.gltf`, `.glb`), and assembles it. Every error is one line naming the
+/// file and, where the file is at fault, the line or byte offset: a folder,
+/// a missing file, an image or archive under a scene's extension, an
+/// unknown extension, `options` that do not apply to the file, a mesh
+/// without triangles.
+pub fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, FormatError> {
+    if path.is_dir() {
+        return Err(in_file(path, format!("is a folder; {EXPECTED}")));
+    }
+    if !path.exists() {
+        return Err(in_file(path, "not found".into()));
+    }
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if let Some(what) = sahara_readers::sniff::foreign_kind(path) {
+        return Err(in_file(
+            path,
+            format!("is {what}, not a scene or mesh file; {EXPECTED}"),
+        ));
+    }
+    let pbrt = crate::pbrt::is_pbrt_path(path);
+    let mitsuba = crate::mitsuba::is_mitsuba_path(path);
+    if !options.defines.is_empty() && !mitsuba {
+        return Err(in_file(
+            path,
+            "-D sets parameters of Mitsuba scenes (.xml), not of this file".into(),
+        ));
+    }
+    let camera = options.camera.as_deref();
+    let own_camera = |what: &str| {
+        Err(in_file(
+            path,
+            format!("--camera applies to meshes and the built-in scene; {what}"),
+        ))
+    };
+    let mesh = matches!(ext.as_str(), "obj" | "ply" | "gltf" | "glb");
+    let mut desc = match ext.as_str() {
+        _ if pbrt && camera.is_some() => return own_camera("a pbrt file has its own Camera"),
+        _ if pbrt => crate::pbrt::read_pbrt(path)?,
+        _ if mitsuba && camera.is_some() => {
+            return own_camera("a Mitsuba file has its own <sensor>")
+        }
+        _ if mitsuba => crate::mitsuba::read_mitsuba_with(path, &options.defines)?,
+        "toml" if camera.is_some() => return own_camera("a scene file has its own [camera]"),
+        "toml" => read_scene(path)?,
+        _ if mesh => {
+            let camera = camera.map_or(CameraChoice::Auto, CameraChoice::from_arg);
+            read_mesh_scene(path, &camera)?
+        }
+        "" => {
+            return Err(in_file(
+                path,
+                format!("the file name has no extension; {EXPECTED}"),
+            ))
+        }
+        _ => {
+            return Err(in_file(
+                path,
+                format!("cannot render .{ext} files; {EXPECTED}"),
+            ))
+        }
+    };
+    if let Some(s) = &options.sky {
+        desc.sky = Sky::parse(s, Path::new(""));
+    }
+    let a = assemble(desc)?;
+    let mut framing = None;
+    if mesh {
+        if a.scene.meshes.iter().all(|m| m.mesh.indices.is_empty()) {
+            return Err(in_file(path, "the mesh has no triangles".into()));
+        }
+        let rule = a.sky_share.map_or_else(String::new, |share| {
+            format!(
+                " (auto: own lights at {share:.3} of the default sky and sun's power, {} {})",
+                if share < sky::WEAK_FRACTION {
+                    "below"
+                } else {
+                    "at least"
+                },
+                sky::WEAK_FRACTION
+            )
+        });
+        framing = Some(format!(
+            "camera: {}; light: {}{rule}",
+            a.camera_source, a.sky
+        ));
+    }
+    Ok(Loaded {
+        scene: a.scene,
+        settings: a.settings,
+        name: stem(path),
+        description: path.display().to_string(),
+        names: a.names,
+        warnings: a.warnings,
+        framing,
+    })
+}
+
+/// The built-in Cornell box, seen by `options.camera` (a sidecar file) if
+/// given and lit as `options.sky` says. `options.defines` must be empty
+/// (the caller says so in its own words).
+pub fn load_builtin(options: &LoadOptions) -> Result<Loaded, FormatError> {
+    let mut scene = builtin::cornell_box();
+    let mut framing = None;
+    if let Some(file) = &options.camera {
+        let c = read_sidecar(Path::new(file))?;
+        scene.camera = Camera::look_at(c.eye, c.target, c.up, c.vfov_deg, 1.0);
+        framing = Some(format!("camera: {file}"));
+    }
+    if let Some(s) = &options.sky {
+        sky::apply(&mut scene, &Sky::parse(s, Path::new("")))?;
+    }
+    Ok(Loaded {
+        names: SceneNames::numbered(&scene),
+        scene,
+        settings: None,
+        name: "cornell_box".into(),
+        description: "the built-in Cornell box".into(),
+        warnings: Vec::new(),
+        framing,
+    })
+}
+
+/// The scene's name: the file name without its extension (`scene.pbrt.gz`
+/// is `scene`).
+fn stem(path: &Path) -> String {
+    let stem = path
+        .file_stem()
+        .map_or("render".into(), |s| s.to_string_lossy().into_owned());
+    match stem.strip_suffix(".pbrt") {
+        Some(s) if !s.is_empty() => s.to_owned(),
+        _ => stem,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn message(r: Result<Loaded, FormatError>) -> String {
+        match r {
+            Ok(_) => panic!("loaded"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    #[test]
+    fn the_reader_is_chosen_by_extension_and_refusals_name_the_file() {
+        let dir = std::env::temp_dir().join(format!("sahara-load-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let obj = dir.join("tri.obj");
+        std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        let loaded = load(&obj, &LoadOptions::default()).unwrap();
+        assert_eq!(loaded.name, "tri");
+        assert!(loaded.settings.is_none());
+        assert!(loaded.framing.unwrap().starts_with("camera: auto"));
+        let toml = dir.join("s.pbrt.gz");
+        std::fs::write(&toml, "").unwrap();
+        assert_eq!(stem(&toml), "s");
+
+        let missing = dir.join("nope.toml");
+        assert_eq!(
+            message(load(&missing, &LoadOptions::default())),
+            format!("{}: not found", missing.display())
+        );
+        let odd = dir.join("x.stl");
+        std::fs::write(&odd, "solid").unwrap();
+        assert!(message(load(&odd, &LoadOptions::default())).contains("cannot render .stl files"));
+        let defines = LoadOptions {
+            defines: vec![("a".into(), "1".into())],
+            ..Default::default()
+        };
+        assert!(message(load(&obj, &defines)).starts_with(&format!("{}: -D", obj.display())));
+        assert!(message(load(&dir, &LoadOptions::default())).contains("is a folder"));
+        let empty = dir.join("empty.obj");
+        std::fs::write(&empty, "v 0 0 0\n").unwrap();
+        assert!(
+            message(load(&empty, &LoadOptions::default())).ends_with("the mesh has no triangles")
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+
+        let cornell = load_builtin(&LoadOptions::default()).unwrap();
+        assert_eq!(cornell.name, "cornell_box");
+        assert!(cornell.framing.is_none());
+    }
+}

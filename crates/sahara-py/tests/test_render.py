@@ -1,0 +1,189 @@
+"""Loading, rendering and writing: the command line's scenes, messages,
+images and bytes; progress and Ctrl-C."""
+
+import _thread
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import sahara
+from conftest import ROOT
+
+SCENES = ROOT / "scenes"
+
+
+def metadata(integrator, spp, seed, w, h):
+    """What the command line writes beside a complete image."""
+    return {
+        "sahara:integrator": integrator,
+        "sahara:spp": str(spp),
+        "sahara:seed": str(seed),
+        "sahara:partial": "false",
+        "sahara:finished_pixels": str(w * h),
+    }
+
+
+@pytest.mark.parametrize(
+    "scene, args",
+    [
+        (None, ["--integrator", "distribution"]),
+        (SCENES / "cornell_glossy_glass.toml", []),
+        (SCENES / "cornell_box.xml", ["-D", "spp=3"]),
+        # Another estimator keeps the file's path length (3 here, not 8).
+        (SCENES / "cornell_box.xml", ["-D", "max_depth=3", "--integrator", "bdpt"]),
+        (SCENES / "assets" / "bunny.ply", ["--integrator", "path"]),
+    ],
+)
+def test_a_render_is_the_command_lines_bytes(tmp_path, sahara_bin, scene, args):
+    w, h, spp, seed = 40, 30, 4, 5
+    for ext in ["exr", "png"]:
+        cli = tmp_path / f"cli.{ext}"
+        cmd = [sahara_bin, "render"] + ([str(scene)] if scene else []) + args + [
+            "--width", str(w), "--height", str(h), "--spp", str(spp), "--seed", str(seed), "-o", str(cli)]
+        subprocess.run(cmd, check=True, capture_output=True)
+        defines = dict(args[i + 1].split("=") for i, a in enumerate(args) if a == "-D")
+        s = sahara.load(scene, **defines) if scene else sahara.cornell_box()
+        fs = s.file_settings or {}
+        integrator = args[args.index("--integrator") + 1] if "--integrator" in args else fs.get("integrator", "path")
+        image = sahara.render(s, width=w, height=h, spp=spp, seed=seed, integrator=integrator if "--integrator" in args else None, progress=False)
+        assert image.shape == (h, w, 3) and image.dtype == np.float32
+        ours = tmp_path / f"py.{ext}"
+        # The file's exposure and tone map apply to its PNG, as on the command line.
+        sahara.write(ours, image, exposure=fs.get("exposure", 0.0), tonemap=fs.get("tonemap", "clamp"),
+                     metadata=metadata(integrator, spp, seed, w, h))
+        assert ours.read_bytes() == cli.read_bytes(), (scene, ext)
+
+
+def test_the_same_seed_gives_the_same_image_and_another_seed_another():
+    s = sahara.cornell_box()
+    a = sahara.render(s, width=24, height=24, spp=2, seed=1, progress=False, threads=1)
+    b = sahara.render(s, width=24, height=24, spp=2, seed=1, progress=False, threads=2)
+    c = sahara.render(s, width=24, height=24, spp=2, seed=2, progress=False)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, c)
+
+
+def test_file_settings_hold_unless_given():
+    s = sahara.load(SCENES / "cornell_box.xml", spp=3)
+    assert s.file_settings["spp"] == 3
+    assert sahara.load(SCENES / "cornell_box.xml", defines={"spp": 5}).file_settings["spp"] == 5
+    fs = s.file_settings
+    image = sahara.render(s, width=16, height=12, progress=False)
+    assert image.shape == (12, 16, 3)
+    assert s.name == "cornell_box" and fs["integrator"]
+
+
+def test_render_passes_come_as_arrays():
+    image, passes = sahara.render(sahara.cornell_box(), width=20, height=10, spp=2, progress=False,
+                                  aovs=["albedo", "normal", "depth", "uv", "object"])
+    assert set(passes) == {"albedo", "normal", "depth", "uv", "object"}
+    assert passes["albedo"].shape == (10, 20, 3) and passes["depth"].shape == (10, 20)
+    assert passes["uv"].shape == (10, 20, 2) and passes["object"].dtype == np.uint32
+    assert (passes["depth"] > 0).mean() > 0.4 and passes["object"].max() >= 1
+    with pytest.raises(ValueError, match="aovs needs the path or distribution integrator, not bdpt"):
+        sahara.render(sahara.cornell_box(), integrator="bdpt", aovs=["depth"], progress=False)
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"integrator": "whitted"}, "unknown integrator 'whitted'"),
+        ({"aovs": ["colour"]}, "unknown render pass 'colour'"),
+        ({"spp": 0}, "spp must be at least 1"),
+        ({"width": 0}, "width must be 1..=65536"),
+        ({"builder": "bvh"}, "builder: unknown builder 'bvh'"),
+    ],
+)
+def test_bad_settings_are_value_errors(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        sahara.render(sahara.cornell_box(), progress=False, **kwargs)
+
+
+def overcommit_mode():
+    try:
+        return open("/proc/sys/vm/overcommit_memory").read().strip()
+    except OSError:
+        return None
+
+
+@pytest.mark.skipif(overcommit_mode() not in ("0", "2"),
+                    reason="where the system promises any amount of memory, the render would start")
+def test_a_render_beyond_the_machines_memory_is_a_memory_error():
+    with pytest.raises(MemoryError, match="a 65536x65536 render needs about"):
+        sahara.render(sahara.cornell_box(), width=65536, height=65536, spp=1, progress=False)
+
+
+def test_files_at_fault_are_named_with_the_line(tmp_path):
+    with pytest.raises(FileNotFoundError, match="nope.toml: not found"):
+        sahara.load(tmp_path / "nope.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[camera]\nfov = 40\n")
+    with pytest.raises(sahara.FormatError) as e:
+        sahara.load(bad)
+    assert str(e.value).startswith(f"{bad}: line 2: ")
+    stl = tmp_path / "mesh.stl"
+    stl.write_text("solid x\n")
+    with pytest.raises(sahara.FormatError, match=r"mesh.stl: cannot render .stl files"):
+        sahara.load(stl)
+    obj = tmp_path / "m.obj"
+    obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    with pytest.raises(sahara.FormatError, match="-D sets parameters of Mitsuba scenes"):
+        sahara.load(obj, spp=3)
+    with pytest.raises(sahara.FormatError, match=r"out.bmp"):
+        sahara.write(tmp_path / "out.bmp", np.zeros((2, 2, 3)))
+    with pytest.raises(ValueError, match="image: expected an array of shape"):
+        sahara.write(tmp_path / "out.png", np.zeros((2, 2)))
+
+
+@pytest.mark.parametrize(
+    "name, text, message",
+    [
+        ("bad.pbrt", 'WorldBegin\nShape "trianglemesh" "point3 P" [0 0 0 1 0 0]\n', "line 2: column 1: trianglemesh needs"),
+        ("bad.xml", '<scene version="3.0.0">\n  <shape type="obj">\n  </shape>\n<scene>\n', "line 4: column 8: the file ends inside an element that is not closed"),
+        ("bad.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 1000\nproperty float x\nend_header\n\x01",
+         "line 3: element vertex has no property 'y'"),
+        ("bad.gltf", '{"asset": {"version": "2.0"}, "meshes": [', "line 1: column 41: invalid glTF JSON"),
+        ("bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 9\n", "line 3: face refers to a vertex that does not exist"),
+    ],
+)
+def test_every_format_names_the_file_and_line_at_fault(tmp_path, name, text, message):
+    path = tmp_path / name
+    path.write_bytes(text.encode())
+    with pytest.raises(sahara.FormatError) as e:
+        sahara.load(path)
+    assert str(e.value).startswith(f"{path}: ") and message in str(e.value)
+
+
+def test_progress_is_reported_to_the_end():
+    seen = []
+    sahara.render(sahara.cornell_box(), width=64, height=64, spp=8, pass_spp=2,
+                  progress=lambda done, total: seen.append((done, total)))
+    assert seen and seen[-1][0] == seen[-1][1] > 0
+    assert all(a[0] <= b[0] for a, b in zip(seen, seen[1:]))
+
+
+def test_ctrl_c_stops_the_render_with_keyboard_interrupt():
+    scene = sahara.cornell_box()
+    before = threading.active_count()
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        sahara.render(scene, width=256, height=256, spp=100000, progress=False)
+    stopped = time.monotonic() - start
+    timer.join()
+    assert stopped < 10, f"took {stopped:.1f} s to stop"
+    assert threading.active_count() == before
+    # The threads are free: the next render runs.
+    assert sahara.render(scene, width=8, height=8, spp=1, progress=False).shape == (8, 8, 3)
+
+
+def test_an_exception_in_the_progress_function_stops_the_render():
+    def fail(done, total):
+        raise RuntimeError("stop here")
+
+    with pytest.raises(RuntimeError, match="stop here"):
+        sahara.render(sahara.cornell_box(), width=128, height=128, spp=100000, progress=fail)
