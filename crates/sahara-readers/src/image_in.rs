@@ -184,6 +184,17 @@ fn ktx2_sound(bytes: &[u8]) -> Result<(), &'static str> {
     let Some(([width, height, layers, faces], levels, scheme, (kvd_at, kvd_len))) = header else {
         return Ok(());
     };
+    // A level's byte offset plus its length past 2^64 (the transcoder adds
+    // them unchecked).
+    for level in 0..levels.clamp(1, 32) {
+        let at = 80 + 24 * level as usize;
+        let (Some(offset), Some(length)) = (u64_at(at), u64_at(at + 8)) else {
+            break;
+        };
+        if offset.checked_add(length).is_none() {
+            return Err("level index");
+        }
+    }
     const ZSTANDARD: u64 = 2;
     if scheme == ZSTANDARD {
         // 16 bytes per 4 x 4 block (UASTC and ASTC blocks), for each layer

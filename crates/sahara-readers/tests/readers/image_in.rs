@@ -150,6 +150,15 @@ fn bad_ktx2_data_is_a_one_line_error_naming_the_file() {
         e,
         "huge.ktx2: cannot read the KTX2 texture: its level index is corrupt"
     );
+    // A level whose offset plus length passes 2^64 (the transcoder adds
+    // them unchecked: a panic where overflow is checked).
+    let mut wraps = ktx2("quad_uastc.ktx2");
+    wraps[80..88].copy_from_slice(&u64::MAX.to_le_bytes());
+    let e = decode_raw(&wraps, "wraps.ktx2").unwrap_err().to_string();
+    assert_eq!(
+        e,
+        "wraps.ktx2: cannot read the KTX2 texture: its level index is corrupt"
+    );
     let mut kvd = ktx2("quad_uastc.ktx2");
     kvd[60..64].copy_from_slice(&35u32.to_le_bytes());
     let e = decode_raw(&kvd, "kvd.ktx2").unwrap_err().to_string();
