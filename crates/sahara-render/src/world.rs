@@ -11,6 +11,7 @@ use crate::light::{AreaLight, EnvLight, LightSample, LightSource};
 use crate::material::Material;
 use crate::math::piecewise::Distribution1D;
 use crate::math::warp::Frame;
+use crate::medium::{Medium, MediumInterface};
 use crate::scene::mesh::SceneMesh;
 use crate::scene::shape::Shape;
 use crate::scene::Scene;
@@ -127,6 +128,11 @@ pub struct World<'a> {
     pub center: Vec3,
     /// Radius of the scene's bounding sphere.
     pub radius: f32,
+    /// The media on the two sides of each instance's surface (empty when
+    /// the scene has no media).
+    interfaces: Vec<Option<MediumInterface>>,
+    /// Whether light travels through media ([`Scene::has_media`]).
+    has_media: bool,
 }
 
 impl<'a> World<'a> {
@@ -161,7 +167,39 @@ impl<'a> World<'a> {
             spread: None,
             center,
             radius,
+            interfaces: if scene.has_media() {
+                let mut v = vec![None; scene.instances.len()];
+                for &(i, m) in &scene.medium_interfaces {
+                    if let Some(slot) = v.get_mut(i as usize) {
+                        *slot = Some(m);
+                    }
+                }
+                v
+            } else {
+                Vec::new()
+            },
+            has_media: scene.has_media(),
         }
+    }
+
+    /// True if light travels through media in this scene (see
+    /// [`Scene::has_media`]).
+    #[inline]
+    pub fn has_media(&self) -> bool {
+        self.has_media
+    }
+
+    /// The media on the two sides of `instance`'s surface, if it bounds
+    /// any.
+    #[inline]
+    pub fn medium_interface(&self, instance: u32) -> Option<&MediumInterface> {
+        self.interfaces.get(instance as usize)?.as_ref()
+    }
+
+    /// Medium `i` of the scene.
+    #[inline]
+    pub fn medium(&self, i: u32) -> &Medium {
+        &self.scene.media[i as usize]
     }
 
     /// Sets the footprint of texture lookups from the film: `height`

@@ -970,7 +970,9 @@ impl Strip {
             }
             return;
         }
-        if !s.integrator.is_stepped() {
+        // A scene with media takes the volumetric path tracer, one path at
+        // a time.
+        if !s.integrator.is_stepped() || world.has_media() {
             for y in y0..y1 {
                 for x in x0..x1 {
                     for g in samples.of(x, y) {
