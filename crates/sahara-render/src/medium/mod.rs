@@ -16,17 +16,21 @@
 //! unbiased in every channel and no channel's noise explodes where
 //! another's extinction dominates.
 
+mod grid;
 mod phase;
 
 use glam::Vec3;
 
+pub use grid::{DensityGrid, GridMedium};
 pub use phase::HenyeyGreenstein;
 
 /// A participating medium.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Medium {
     /// The same coefficients everywhere.
     Homogeneous(Homogeneous),
+    /// Coefficients scaled by a density on a grid.
+    Grid(Box<GridMedium>),
 }
 
 /// A medium whose coefficients are the same everywhere.
@@ -97,28 +101,23 @@ impl Medium {
     /// coefficients, an asymmetry outside (-1, 1)), in one line; `None` if
     /// it can.
     pub fn problem(&self) -> Option<String> {
-        match self {
-            Medium::Homogeneous(h) => {
-                let bad = |v: Vec3| !v.is_finite() || v.min_element() < 0.0;
-                if bad(h.sigma_a) {
-                    Some(format!(
-                        "absorption {} must be finite and not negative",
-                        h.sigma_a
-                    ))
-                } else if bad(h.sigma_s) {
-                    Some(format!(
-                        "scattering {} must be finite and not negative",
-                        h.sigma_s
-                    ))
-                } else if !(h.phase.g > -1.0 && h.phase.g < 1.0) {
-                    Some(format!(
-                        "phase asymmetry g = {} must lie in (-1, 1)",
-                        h.phase.g
-                    ))
-                } else {
-                    None
-                }
-            }
+        let (sigma_a, sigma_s, g) = match self {
+            Medium::Homogeneous(h) => (h.sigma_a, h.sigma_s, h.phase.g),
+            Medium::Grid(m) => (m.sigma_a, m.sigma_s, m.phase.g),
+        };
+        let bad = |v: Vec3| !v.is_finite() || v.min_element() < 0.0;
+        if bad(sigma_a) {
+            Some(format!(
+                "absorption {sigma_a} must be finite and not negative"
+            ))
+        } else if bad(sigma_s) {
+            Some(format!(
+                "scattering {sigma_s} must be finite and not negative"
+            ))
+        } else if !(g > -1.0 && g < 1.0) {
+            Some(format!("phase asymmetry g = {g} must lie in (-1, 1)"))
+        } else {
+            None
         }
     }
 
@@ -127,54 +126,82 @@ impl Medium {
     pub fn phase(&self) -> HenyeyGreenstein {
         match self {
             Medium::Homogeneous(h) => h.phase,
+            Medium::Grid(m) => m.phase,
         }
     }
 
-    /// The fraction of light that crosses distance `d` (infinite: none,
-    /// except in channels that do not attenuate).
+    /// The fraction of light that crosses the segment `origin + t dir`,
+    /// `t` in `[0, d]` (`dir` a unit vector; `d` infinite for a ray that
+    /// meets nothing): exact in a homogeneous medium, estimated by ratio
+    /// tracking with numbers from `draw` in a grid.
     #[inline]
-    pub fn transmittance(&self, d: f32) -> Vec3 {
+    pub fn transmittance(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        d: f32,
+        draw: &mut dyn FnMut() -> f32,
+    ) -> Vec3 {
         match self {
             Medium::Homogeneous(h) => exp_neg(h.sigma_a + h.sigma_s, d),
+            Medium::Grid(m) => m.transmittance(origin, dir, d, draw),
         }
     }
 
-    /// A scattering distance along a segment of length `t_max` (infinite
-    /// for a ray that meets nothing), from `u_channel` (which channel's
-    /// density to draw from) and `u` (the distance).
+    /// Where the medium scatters a ray `origin + t dir` that would reach
+    /// a surface at `t_max` (infinite if none), with numbers from `draw`.
     #[inline]
-    pub(crate) fn sample_free_flight(&self, u_channel: f32, u: f32, t_max: f32) -> FreeFlight {
+    pub(crate) fn free_flight(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        draw: &mut dyn FnMut() -> f32,
+    ) -> FreeFlight {
         match self {
             Medium::Homogeneous(h) => {
-                let sigma_t = h.sigma_a + h.sigma_s;
-                let c = ((u_channel * 3.0) as usize).min(2);
-                let s = sigma_t[c];
-                let t = if s > 0.0 {
-                    -(1.0 - u).ln() / s
+                let u_channel = draw();
+                h.free_flight(u_channel, draw(), t_max)
+            }
+            Medium::Grid(m) => m.free_flight(origin, dir, t_max, draw),
+        }
+    }
+}
+
+impl Homogeneous {
+    /// A scattering distance along a segment of length `t_max`, from
+    /// `u_channel` (which channel's density to draw from) and `u` (the
+    /// distance).
+    #[inline]
+    fn free_flight(&self, u_channel: f32, u: f32, t_max: f32) -> FreeFlight {
+        let h = self;
+        let sigma_t = h.sigma_a + h.sigma_s;
+        let c = ((u_channel * 3.0) as usize).min(2);
+        let s = sigma_t[c];
+        let t = if s > 0.0 {
+            -(1.0 - u).ln() / s
+        } else {
+            f32::INFINITY
+        };
+        if t < t_max {
+            let tr = exp_neg(sigma_t, t);
+            let density = (sigma_t * tr).element_sum() / 3.0;
+            FreeFlight {
+                t,
+                scattered: true,
+                weight: if density > 0.0 {
+                    h.sigma_s * tr / density
                 } else {
-                    f32::INFINITY
-                };
-                if t < t_max {
-                    let tr = exp_neg(sigma_t, t);
-                    let density = (sigma_t * tr).element_sum() / 3.0;
-                    FreeFlight {
-                        t,
-                        scattered: true,
-                        weight: if density > 0.0 {
-                            h.sigma_s * tr / density
-                        } else {
-                            Vec3::ZERO
-                        },
-                    }
-                } else {
-                    let tr = exp_neg(sigma_t, t_max);
-                    let pass = tr.element_sum() / 3.0;
-                    FreeFlight {
-                        t: t_max,
-                        scattered: false,
-                        weight: if pass > 0.0 { tr / pass } else { Vec3::ZERO },
-                    }
-                }
+                    Vec3::ZERO
+                },
+            }
+        } else {
+            let tr = exp_neg(sigma_t, t_max);
+            let pass = tr.element_sum() / 3.0;
+            FreeFlight {
+                t: t_max,
+                scattered: false,
+                weight: if pass > 0.0 { tr / pass } else { Vec3::ZERO },
             }
         }
     }
@@ -202,12 +229,13 @@ mod tests {
     #[test]
     fn transmittance_is_exponential_per_channel() {
         let m = fog();
-        let tr = m.transmittance(2.0);
+        let tr = |m: &Medium, d: f32| m.transmittance(Vec3::ZERO, Vec3::X, d, &mut || 0.5);
+        let tr_2 = tr(&m, 2.0);
         let want = Vec3::new((-2.0f32).exp(), (-2.0f32).exp(), (-2.4f32).exp());
-        assert!((tr - want).abs().max_element() < 1e-6, "{tr} {want}");
-        assert_eq!(m.transmittance(f32::INFINITY), Vec3::ZERO);
+        assert!((tr_2 - want).abs().max_element() < 1e-6, "{tr_2} {want}");
+        assert_eq!(tr(&m, f32::INFINITY), Vec3::ZERO);
         let clear = Medium::homogeneous(Vec3::new(0.0, 1.0, 1.0), Vec3::ZERO, 0.0);
-        assert_eq!(clear.transmittance(f32::INFINITY), Vec3::new(1.0, 0.0, 0.0));
+        assert_eq!(tr(&clear, f32::INFINITY), Vec3::new(1.0, 0.0, 0.0));
     }
 
     /// The free-flight estimator's mean over a segment is what reaches its
@@ -217,7 +245,9 @@ mod tests {
     #[test]
     fn free_flight_is_unbiased_per_channel() {
         let m = fog();
-        let Medium::Homogeneous(h) = m;
+        let Medium::Homogeneous(h) = m else {
+            unreachable!()
+        };
         let sigma_t = h.sigma_a + h.sigma_s;
         let d = 1.7;
         let n = 400_000;
@@ -225,7 +255,7 @@ mod tests {
         for i in 0..n {
             let u = (i as f32 + 0.5) / n as f32;
             // Stratified in the distance, every channel in turn.
-            let f = m.sample_free_flight((i % 3) as f32 / 3.0 + 0.1, u, d);
+            let f = h.free_flight((i % 3) as f32 / 3.0 + 0.1, u, d);
             if f.scattered {
                 assert!(f.t < d);
                 scatter += f.weight;
@@ -235,7 +265,7 @@ mod tests {
             }
         }
         let (pass, scatter) = (pass / n as f32, scatter / n as f32);
-        let want_pass = m.transmittance(d);
+        let want_pass = m.transmittance(Vec3::ZERO, Vec3::X, d, &mut || 0.5);
         let want_scatter = h.sigma_s * (Vec3::ONE - want_pass) / sigma_t;
         assert!(
             (pass - want_pass).abs().max_element() < 2e-3,
