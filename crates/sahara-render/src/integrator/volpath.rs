@@ -444,4 +444,50 @@ mod tests {
             );
         }
     }
+
+    /// Single scattering in a slab of thickness h lit from straight above
+    /// by a directional light of irradiance E and seen from straight
+    /// above: light scattered once at depth s has crossed s on the way
+    /// down and s on the way up, so
+    /// `L = σs E p ∫ exp(-2 σt s) ds = σs E (1 - exp(-2 σt h)) / (8 π σt)`
+    /// with the isotropic p = 1 / (4π), per channel (a coloured medium:
+    /// the channels' extinctions differ, which the spectral sampling must
+    /// weigh). One scattering event only (`max_depth` 1). The image
+    /// mean's relative deviation over six seeds is at most 0.4 %; the
+    /// tolerance is 1.5 %.
+    #[test]
+    fn single_scattering_in_a_slab_matches_the_closed_form() {
+        let cam = Camera::look_at(Vec3::new(0.0, 5.0, 0.0), Vec3::ZERO, Vec3::Z, 1.0, 1.0);
+        let mut scene = Scene::new(cam);
+        let e = Vec3::splat(10.0);
+        scene.add_light(crate::light::Light::Directional {
+            direction: -Vec3::Y,
+            irradiance: e,
+        });
+        let mat = scene.add_material(Material::diffuse(Vec3::ONE));
+        let h = 1.0;
+        let slab = scene.add_shape(
+            Shape::Box {
+                min: Vec3::new(-50.0, 0.0, -50.0),
+                max: Vec3::new(50.0, h, 50.0),
+            },
+            mat,
+        );
+        let (sigma_a, sigma_s) = (Vec3::new(0.5, 0.2, 0.0), Vec3::new(0.3, 1.0, 2.5));
+        let m = scene.add_medium(Medium::homogeneous(sigma_a, sigma_s, 0.0));
+        scene.set_medium_interface(
+            slab,
+            MediumInterface {
+                inside: Some(m),
+                outside: None,
+                index_matched: true,
+            },
+        );
+        let got = mean(&scene, 24, 64, 1);
+        let sigma_t = sigma_a + sigma_s;
+        let want = sigma_s * e * (Vec3::ONE - (-2.0 * sigma_t * h).exp())
+            / (8.0 * std::f32::consts::PI * sigma_t);
+        let rel = ((got - want) / want).abs().max_element();
+        assert!(rel < 0.015, "got {got}, want {want}");
+    }
 }
