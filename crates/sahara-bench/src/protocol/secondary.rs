@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 use sahara_kd::Ray;
-use sahara_render::Mesh;
+use sahara_kd::Mesh;
 
 use super::arith::{add, cross, dot, len, mul, normalize, sub};
 use super::frame::{check_mesh, SceneFrame};

@@ -2,7 +2,7 @@
 
 use rayon::ThreadPoolBuildError;
 use sahara_kd::{BuildParams, KdTree, Ray, TreeStats};
-use sahara_render::Mesh;
+use sahara_kd::Mesh;
 
 use super::build::{build_timed, BUILD_RUNS};
 use super::counters::count_set;
