@@ -68,4 +68,3 @@ impl Mesh {
             .fold(Aabb::EMPTY, |b, p| b.grow(p))
     }
 }
-
