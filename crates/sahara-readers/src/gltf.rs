@@ -627,6 +627,10 @@ impl<T: Copy> Gathered<T> {
 
 impl Loader<'_> {
     /// The index in `scene.meshes` of glTF mesh `mesh`, converting it on first use.
+    ///
+    /// One piece: its primitives are merged into one mesh in one loop whose
+    /// attribute buffers (normals, tangents, two uv sets) are kept only if
+    /// every primitive has them, decided as the loop goes.
     fn mesh(&mut self, mesh: &::gltf::Mesh) -> Result<usize, FormatError> {
         if let Some(&slot) = self.mesh_slot.get(&mesh.index()) {
             return Ok(slot);

@@ -220,14 +220,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn denoising_goes_with_the_render_passes() {
-        for &kind in IntegratorKind::ALL {
-            let s = kind.supports();
-            assert_eq!(s.get(Feature::Denoise), s.aovs, "{kind}");
-        }
-    }
-
-    #[test]
     fn an_unsupported_feature_says_which_integrator_and_why_in_one_line() {
         let e = IntegratorKind::Sppm.require(Feature::Adaptive).unwrap_err();
         let text = e.to_string();

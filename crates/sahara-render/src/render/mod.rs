@@ -1130,8 +1130,67 @@ struct Strip {
     bdpt: BdptBatch,
 }
 
+/// The pixels `[x0, x1) x [y0, y1)` of a strip.
+#[derive(Clone, Copy)]
+struct StripPixels {
+    x0: u32,
+    x1: u32,
+    y0: u32,
+    y1: u32,
+}
+
+impl StripPixels {
+    /// The pixels, rows top to bottom.
+    fn iter(self) -> impl Iterator<Item = (u32, u32)> {
+        (self.y0..self.y1).flat_map(move |y| (self.x0..self.x1).map(move |x| (x, y)))
+    }
+}
+
+/// Where the samples of a strip's camera come from: sample `g` of pixel
+/// `(x, y)` has its sampler, film position and camera ray.
+struct CameraSamples<'a> {
+    s: &'a RenderSettings,
+    camera: &'a crate::scene::camera::Camera,
+    w: u32,
+    inv: Vec2,
+    /// Samples per pixel of a pass.
+    spp: u32,
+}
+
+impl CameraSamples<'_> {
+    #[inline]
+    fn at(&self, x: u32, y: u32, g: u32) -> (PixelSampler, Vec2, sahara_kd::Ray, f32) {
+        let stream = hash2(self.s.seed, (y as u64) * self.w as u64 + x as u64);
+        let sampler = PixelSampler::new(
+            self.s.sampler,
+            SampleId {
+                stream,
+                pass: g / self.spp,
+                index: g % self.spp,
+                count: self.spp,
+            },
+        );
+        let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
+        let (ray, time) = self.camera.generate_ray(
+            pos * self.inv,
+            sampler.get_2d(dims::LENS),
+            sampler.get_1d(dims::TIME),
+        );
+        (sampler, pos, ray, time)
+    }
+}
+
+/// Where sample `g` of pixel `(x, y)` of a strip goes in its buffers.
+#[inline]
+fn slot(first: &[u32], samples: RoundSamples, p: StripPixels, x: u32, y: u32, g: u32) -> usize {
+    let start = samples.of(x, y).start;
+    (first[((y - p.y0) * (p.x1 - p.x0) + (x - p.x0)) as usize] + g - start) as usize
+}
+
 impl Strip {
-    /// Renders the round's `samples` of pixels `[x0, x1) x [y0, y1)`.
+    /// Renders the round's `samples` of pixels `[x0, x1) x [y0, y1)`: lays
+    /// out the strip's buffers, then traces the samples as the integrator
+    /// does (bidirectional, stepped in batches, or one at a time).
     #[allow(clippy::too_many_arguments)]
     fn render(
         &mut self,
@@ -1145,69 +1204,18 @@ impl Strip {
         stats: &mut TraceStats,
     ) {
         let (w, h) = (s.width.max(1), s.height.max(1));
-        let camera = &world.scene.camera;
-        let inv = Vec2::new(1.0 / w as f32, 1.0 / h as f32);
-        let spp = s.pass_size();
-        // Where each pixel's samples start in the strip's buffers.
-        self.first.clear();
-        let mut n = 0usize;
-        for y in y0..y1 {
-            for x in x0..x1 {
-                self.first.push(n as u32);
-                n += samples.of(x, y).len();
-            }
-        }
-        self.pos.clear();
-        self.pos.resize(n, Vec2::ZERO);
-        self.radiance.clear();
-        self.radiance.resize(n, Vec3::ZERO);
-        self.aux.clear();
-        let aux = !s.aovs.is_empty();
-        if aux {
-            self.aux.resize(n, AuxSample::default());
-        }
-        // Sample `g` of pixel (x, y): its sampler, film position and
-        // camera ray.
-        let camera_sample = |x: u32, y: u32, g: u32| {
-            let stream = hash2(s.seed, (y as u64) * w as u64 + x as u64);
-            let sampler = PixelSampler::new(
-                s.sampler,
-                SampleId {
-                    stream,
-                    pass: g / spp,
-                    index: g % spp,
-                    count: spp,
-                },
-            );
-            let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
-            let (ray, time) = camera.generate_ray(
-                pos * inv,
-                sampler.get_2d(dims::LENS),
-                sampler.get_1d(dims::TIME),
-            );
-            (sampler, pos, ray, time)
-        };
-        let first = &self.first;
-        let slot_of = |x: u32, y: u32, g: u32| {
-            let start = samples.of(x, y).start;
-            (first[((y - y0) * (x1 - x0) + (x - x0)) as usize] + g - start) as usize
+        let pixels = StripPixels { x0, x1, y0, y1 };
+        self.lay_out(pixels, samples, !s.aovs.is_empty());
+        let cameras = CameraSamples {
+            s,
+            camera: &world.scene.camera,
+            w,
+            inv: Vec2::new(1.0 / w as f32, 1.0 / h as f32),
+            spp: s.pass_size(),
         };
         let film = Vec2::new(w as f32, h as f32);
         if let Some((max_depth, strategies)) = s.integrator.bidirectional() {
-            // The samples pixel by pixel, rows top to bottom.
-            self.cameras.clear();
-            self.slot.clear();
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    for g in samples.of(x, y) {
-                        let (sampler, pos, ray, time) = camera_sample(x, y, g);
-                        let k = slot_of(x, y, g);
-                        self.pos[k] = pos;
-                        self.slot.push(k as u32);
-                        self.cameras.push(CameraSample { ray, time, sampler });
-                    }
-                }
-            }
+            self.cameras_in_pixel_order(&cameras, pixels, samples);
             self.samples.clear();
             self.samples.resize(self.cameras.len(), Vec3::ZERO);
             self.bdpt.trace(
@@ -1223,31 +1231,80 @@ impl Strip {
             for (&l, &k) in self.samples.iter().zip(&self.slot) {
                 self.radiance[k as usize] = l;
             }
-            return;
-        }
-        if !s.integrator.is_stepped() {
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    for g in samples.of(x, y) {
-                        let (sampler, pos, ray, time) = camera_sample(x, y, g);
-                        let mut ctx = Context {
-                            world,
-                            sampler,
-                            stats,
-                        };
-                        let k = slot_of(x, y, g);
-                        self.pos[k] = pos;
-                        self.radiance[k] =
-                            s.integrator
-                                .li_splats(&mut ctx, &ray, time, film, &mut self.splats);
-                    }
+        } else if s.integrator.is_stepped() {
+            self.trace_stepped(world, &cameras, pixels, samples, stats);
+        } else {
+            for (x, y) in pixels.iter() {
+                for g in samples.of(x, y) {
+                    let (sampler, pos, ray, time) = cameras.at(x, y, g);
+                    let mut ctx = Context {
+                        world,
+                        sampler,
+                        stats,
+                    };
+                    let k = slot(&self.first, samples, pixels, x, y, g);
+                    self.pos[k] = pos;
+                    self.radiance[k] =
+                        s.integrator
+                            .li_splats(&mut ctx, &ray, time, film, &mut self.splats);
                 }
             }
-            return;
         }
-        // The paths in camera-packet order: 4x4 pixel blocks, each block's
-        // samples index by index (the `i`-th sample of each of its pixels
-        // that takes that many).
+    }
+
+    /// Sizes the strip's buffers for the round's samples of `pixels`, and
+    /// notes where each pixel's samples start.
+    fn lay_out(&mut self, pixels: StripPixels, samples: RoundSamples, aux: bool) {
+        self.first.clear();
+        let mut n = 0usize;
+        for (x, y) in pixels.iter() {
+            self.first.push(n as u32);
+            n += samples.of(x, y).len();
+        }
+        self.pos.clear();
+        self.pos.resize(n, Vec2::ZERO);
+        self.radiance.clear();
+        self.radiance.resize(n, Vec3::ZERO);
+        self.aux.clear();
+        if aux {
+            self.aux.resize(n, AuxSample::default());
+        }
+    }
+
+    /// The bidirectional integrators' camera samples, pixel by pixel, rows
+    /// top to bottom, with the slot of each.
+    fn cameras_in_pixel_order(
+        &mut self,
+        cameras: &CameraSamples,
+        pixels: StripPixels,
+        samples: RoundSamples,
+    ) {
+        self.cameras.clear();
+        self.slot.clear();
+        for (x, y) in pixels.iter() {
+            for g in samples.of(x, y) {
+                let (sampler, pos, ray, time) = cameras.at(x, y, g);
+                let k = slot(&self.first, samples, pixels, x, y, g);
+                self.pos[k] = pos;
+                self.slot.push(k as u32);
+                self.cameras.push(CameraSample { ray, time, sampler });
+            }
+        }
+    }
+
+    /// Traces the stepped integrators' paths as batches, in camera-packet
+    /// order: 4x4 pixel blocks, each block's samples index by index (the
+    /// `i`-th sample of each of its pixels that takes that many).
+    fn trace_stepped(
+        &mut self,
+        world: &World,
+        cameras: &CameraSamples,
+        pixels: StripPixels,
+        samples: RoundSamples,
+        stats: &mut TraceStats,
+    ) {
+        let aux = !cameras.s.aovs.is_empty();
+        let StripPixels { x0, x1, y0, y1 } = pixels;
         self.paths.clear();
         self.slot.clear();
         for (bx, by) in (y0..y1)
@@ -1268,8 +1325,8 @@ impl Strip {
                         if g >= r.end {
                             continue;
                         }
-                        let (sampler, pos, ray, time) = camera_sample(x, y, g);
-                        let k = slot_of(x, y, g);
+                        let (sampler, pos, ray, time) = cameras.at(x, y, g);
+                        let k = slot(&self.first, samples, pixels, x, y, g);
                         self.pos[k] = pos;
                         self.slot.push(k as u32);
                         self.paths
@@ -1279,7 +1336,7 @@ impl Strip {
             }
         }
         self.wavefront
-            .trace(&s.integrator, world, stats, &mut self.paths);
+            .trace(&cameras.s.integrator, world, stats, &mut self.paths);
         for (p, &k) in self.paths.iter().zip(&self.slot) {
             self.radiance[k as usize] = p.l;
         }

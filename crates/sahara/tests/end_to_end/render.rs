@@ -1780,16 +1780,13 @@ fn a_gltf_with_ktx2_textures_renders_with_them() {
 /// line that names the option or scene-file key that asked for it.
 #[test]
 fn unsupported_settings_are_refused_in_one_line_naming_what_asked() {
+    const ADAPTIVE_SPHERE: &str = "[camera]\neye = [0, 1, 5]\ntarget = [0, 0, 0]\n\
+        [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n\
+        [[light]]\ntype = \"point\"\nposition = [0, 4, 2]\nintensity = [20, 20, 20]\n\
+        [sampler]\nspp = 8\nnoise_threshold = 0.05\n[film]\nwidth = 16\nheight = 16\n";
     let dir = temp_dir("unsupported");
     let scene = dir.join("s.toml");
-    fs::write(
-        &scene,
-        "[camera]\neye = [0, 1, 5]\ntarget = [0, 0, 0]\n\n\
-         [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n\n\
-         [[light]]\ntype = \"point\"\nposition = [0, 4, 2]\nintensity = [20, 20, 20]\n\n\
-         [sampler]\nspp = 8\nnoise_threshold = 0.05\n[film]\nwidth = 16\nheight = 16\n",
-    )
-    .unwrap();
+    fs::write(&scene, ADAPTIVE_SPHERE).unwrap();
     let exr = dir.join("x.exr");
     let o = exr.to_str().unwrap();
     for (args, says) in [
