@@ -18,8 +18,8 @@ use sahara_bench::protocol::{random_rays, secondary_rays, ImageSize};
 use sahara_bench::runner::PacketSize;
 use sahara_bench::{HitRecord, ProtocolCamera, SceneFrame};
 use sahara_kd::internals::{BatchWalk, Frustum, IndexedBlocks, PacketShear, RayShear, BLOCK_WIDTH};
+use sahara_kd::Mesh;
 use sahara_kd::{BuildParams, Builder, KdTree, Ray, TriangleBlock};
-use sahara_render::Mesh;
 
 /// The shared scene folder: `$SAHARA_SCENES` if set, else `shared/scenes`
 /// beside the workspace.

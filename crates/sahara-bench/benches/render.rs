@@ -44,7 +44,7 @@ fn cornell(c: &mut Criterion) {
             ..Default::default()
         };
         g.bench_function(BenchmarkId::from_parameter(name), |b| {
-            b.iter(|| pool.install(|| black_box(render(&scene, &settings, &|_| {}))))
+            b.iter(|| pool.install(|| black_box(render(&scene, &settings, &|_| {}).unwrap())))
         });
     }
     g.finish();
@@ -96,14 +96,17 @@ fn kit(c: &mut Criterion) {
         g.bench_function(BenchmarkId::from_parameter(name), |b| {
             b.iter(|| {
                 pool.install(|| {
-                    black_box(render_world(
-                        &mut world,
-                        &settings,
-                        &|_| {},
-                        None,
-                        Instant::now(),
-                        Duration::ZERO,
-                    ))
+                    black_box(
+                        render_world(
+                            &mut world,
+                            &settings,
+                            &|_| {},
+                            None,
+                            Instant::now(),
+                            Duration::ZERO,
+                        )
+                        .unwrap(),
+                    )
                 })
             })
         });

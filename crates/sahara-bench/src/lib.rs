@@ -1,7 +1,7 @@
 //! `sahara-bench`: the ray-casting benchmark protocol of
 //! `docs/bench-protocol.md` on Sahara's kd-tree.
 //!
-//! The crate reads no scene files: it takes a [`sahara_render::Mesh`]
+//! The crate reads no scene files: it takes a [`sahara_kd::Mesh`]
 //! and, optionally, a camera, and
 //! - generates the protocol's four ray sets bit for bit as the reference
 //!   program `shared/bench/embree/embree_bench.c` does ([`protocol`]),

@@ -11,8 +11,8 @@
 use glam::Vec3;
 use sahara_bench::protocol::{random::random_ray, secondary_rays};
 use sahara_bench::{HitRecord, ImageSize, ProtocolCamera, SceneFrame};
+use sahara_kd::Mesh;
 use sahara_kd::Ray;
-use sahara_render::Mesh;
 
 /// A ray as the 8 words of a ray file record.
 fn bits(r: &Ray) -> [u32; 8] {

@@ -19,7 +19,7 @@
 //! ```
 //!
 //! The crate's parts, each importing only those before it in this list:
-//! `math` (rays, boxes, triangles, clipping, float slack) and `simd`
+//! `math` (rays, boxes, triangles, indexed meshes, clipping, float slack) and `simd`
 //! (instruction-set levels and dispatch); `isect` (the watertight test and
 //! hit records); `leaf` (leaf storage and the leaf tests) and `build` (the
 //! builders); `kd` (the tree, its node, walks, queries, batches and
@@ -47,7 +47,7 @@ pub use kd::{
 };
 pub use leaf::{TriangleBlock, TriangleLeaves};
 pub use math::slack::gamma;
-pub use math::{Aabb, Ray, Triangle};
+pub use math::{Aabb, Mesh, Ray, Triangle};
 pub use stats::TreeStats;
 pub use validate::validate;
 

@@ -17,8 +17,9 @@ use sahara_formats::image_out::{write_image, Pixels};
 use sahara_formats::{LoadOptions, Loaded};
 use sahara_kd::{BuildParams, Builder};
 use sahara_render::{
-    defaults, render_watched, Aov, Film, Filter, FilterKind, Integrator, IntegratorKind, Named,
-    PixelSum, Progress, RenderResult, RenderSettings, SamplerKind, Scene as RenderScene, ToneMap,
+    defaults, render_watched, Aov, Feature, Film, Filter, FilterKind, Integrator, IntegratorKind,
+    Named, PixelSum, Progress, RenderResult, RenderSettings, SamplerKind, Scene as RenderScene,
+    SettingsError, ToneMap,
 };
 
 use crate::pool::pool;
@@ -269,17 +270,11 @@ pub fn render<'py>(
     }
     passes.sort();
     passes.dedup();
-    if !passes.is_empty()
-        && !matches!(
-            integrator,
-            Integrator::Path { .. } | Integrator::Distribution { .. }
-        )
-    {
-        return Err(PyValueError::new_err(format!(
-            "{} needs the path or distribution integrator, not {}",
-            if asked.is_empty() { "denoise" } else { "aovs" },
-            integrator.name()
-        )));
+    if denoise {
+        integrator
+            .kind()
+            .require(Feature::Denoise)
+            .map_err(|e| PyValueError::new_err(format!("denoise: {e}")))?;
     }
     let cancel = Arc::new(AtomicBool::new(false));
     let mut settings = RenderSettings {
@@ -306,6 +301,18 @@ pub fn render<'py>(
         }
         settings.window = Some(w);
     }
+    // What the integrator cannot honour (the renderer's rules), named by
+    // the argument or scene-file key that asked for it.
+    settings.check().map_err(|e| {
+        let asked = match &e {
+            SettingsError::Unsupported {
+                feature: Feature::Aovs,
+                ..
+            } => "aovs",
+            _ => "noise_threshold",
+        };
+        PyValueError::new_err(format!("{asked}: {e}"))
+    })?;
     // The film's sums, its image and the passes are allocated in the
     // render's threads, where a failed allocation aborts the process: the
     // memory is asked for here first, so that a size beyond the machine
@@ -452,7 +459,9 @@ fn run(
         }
     };
     py.detach(|| worker.join()).ok();
-    let result = result.map_err(|_| PyRuntimeError::new_err("the render failed (a panic)"))?;
+    let result = result
+        .map_err(|_| PyRuntimeError::new_err("the render failed (a panic)"))?
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
     if let Some(cb) = &progress {
         let t = total.load(Ordering::Relaxed);
         if t > 0 && shown != (t, t) {

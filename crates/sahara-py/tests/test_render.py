@@ -83,7 +83,7 @@ def test_render_passes_come_as_arrays():
     assert passes["albedo"].shape == (10, 20, 3) and passes["depth"].shape == (10, 20)
     assert passes["uv"].shape == (10, 20, 2) and passes["object"].dtype == np.uint32
     assert (passes["depth"] > 0).mean() > 0.4 and passes["object"].max() >= 1
-    with pytest.raises(ValueError, match="aovs needs the path or distribution integrator, not bdpt"):
+    with pytest.raises(ValueError, match="aovs: the bdpt integrator cannot make render passes"):
         sahara.render(sahara.cornell_box(), integrator="bdpt", aovs=["depth"], progress=False)
 
 

@@ -25,7 +25,7 @@ use std::collections::HashMap;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use crate::TriangleMesh;
+use crate::Mesh;
 use ::gltf::mesh::Mode;
 use glam::{Affine2, Mat4, Quat, Vec2, Vec3, Vec4};
 use serde_json::Value;
@@ -56,7 +56,7 @@ pub struct GltfMesh {
     /// The mesh's name in the file, if any.
     pub name: Option<String>,
     /// Positions and triangles (primitives in file order).
-    pub mesh: TriangleMesh,
+    pub mesh: Mesh,
     /// Per-vertex normals, parallel to `mesh.positions`, if every primitive has them.
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex `TEXCOORD_0`, parallel to `mesh.positions`, if any primitive has them (others get 0, 0).
@@ -627,6 +627,10 @@ impl<T: Copy> Gathered<T> {
 
 impl Loader<'_> {
     /// The index in `scene.meshes` of glTF mesh `mesh`, converting it on first use.
+    ///
+    /// One piece: its primitives are merged into one mesh in one loop whose
+    /// attribute buffers (normals, tangents, two uv sets) are kept only if
+    /// every primitive has them, decided as the loop goes.
     fn mesh(&mut self, mesh: &::gltf::Mesh) -> Result<usize, FormatError> {
         if let Some(&slot) = self.mesh_slot.get(&mesh.index()) {
             return Ok(slot);

@@ -10,7 +10,8 @@
 //! - [`sniff`]: files that are images, archives or programs, by their first
 //!   bytes (every mesh load refuses them in words).
 //!
-//! Everything comes out as plain data: [`TriangleMesh`], attribute structs
+//! Everything comes out as plain data: [`Mesh`] (`sahara-kd`'s plain
+//! arrays, the mesh type the renderer keeps too), attribute structs
 //! such as [`obj::ObjScene`], [`ply::PlyMesh`] and [`gltf::GltfScene`],
 //! [`image_in::RawImage`]. Nothing here depends on the renderer; turning
 //! the data into a scene (materials, textures, lights, colour decoding) is
@@ -30,7 +31,6 @@ pub mod error;
 pub mod fan;
 pub mod gltf;
 pub mod image_in;
-mod mesh;
 pub mod mtl;
 pub mod obj;
 pub mod ply;
@@ -39,11 +39,16 @@ pub mod sniff;
 use std::path::Path;
 
 pub use error::{in_words, one_line, FormatError};
-pub use mesh::TriangleMesh;
+pub use sahara_kd::Mesh;
+
+/// The mesh every mesh reader returns: [`Mesh`] itself (`sahara-kd`'s, the
+/// one mesh type readers, renderer and benchmarks share), by the name this
+/// crate's callers know.
+pub type TriangleMesh = Mesh;
 
 /// Loads a mesh, choosing the format by extension (`.obj`, `.ply`, `.gltf` or
 /// `.glb`, any case); see [`load_mesh_with_warnings`].
-pub fn load_mesh(path: &Path) -> Result<TriangleMesh, FormatError> {
+pub fn load_mesh(path: &Path) -> Result<Mesh, FormatError> {
     load_mesh_with_warnings(path).map(|(mesh, _)| mesh)
 }
 
@@ -53,7 +58,7 @@ pub fn load_mesh(path: &Path) -> Result<TriangleMesh, FormatError> {
 /// A glTF file becomes one triangle list: every use of a mesh by a node of
 /// the scene, in scene order, with the node's transform applied to its
 /// vertices (so triangle `k` is the same triangle the renderer sees).
-pub fn load_mesh_with_warnings(path: &Path) -> Result<(TriangleMesh, Vec<String>), FormatError> {
+pub fn load_mesh_with_warnings(path: &Path) -> Result<(Mesh, Vec<String>), FormatError> {
     if let Some(what) = sniff::foreign_kind(path) {
         return Err(FormatError::in_file(
             &path.display().to_string(),
@@ -69,7 +74,7 @@ pub fn load_mesh_with_warnings(path: &Path) -> Result<(TriangleMesh, Vec<String>
         "ply" => Ok((ply::load_ply(path)?, Vec::new())),
         "gltf" | "glb" => {
             let g = gltf::load_gltf(path)?;
-            let mut mesh = TriangleMesh::default();
+            let mut mesh = Mesh::default();
             for inst in &g.instances {
                 let part = &g.meshes[inst.mesh].mesh;
                 let base = mesh.positions.len();

@@ -19,7 +19,7 @@ use std::borrow::Cow;
 use std::fs;
 use std::path::Path;
 
-use crate::TriangleMesh;
+use crate::Mesh;
 use glam::Vec3;
 
 use crate::error::FormatError;
@@ -28,13 +28,13 @@ use crate::fan::fan_triangulate;
 pub use with_materials::{load_obj_geometry, load_obj_with_materials, ObjScene};
 
 /// Loads an OBJ file; errors name the file and, when it can be found, the line.
-pub fn load_obj(path: &Path) -> Result<TriangleMesh, FormatError> {
+pub fn load_obj(path: &Path) -> Result<Mesh, FormatError> {
     let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
     parse_obj(&bytes, &path.display().to_string())
 }
 
 /// Parses an OBJ file held in memory; `name` is used in error messages.
-pub fn parse_obj(bytes: &[u8], name: &str) -> Result<TriangleMesh, FormatError> {
+pub fn parse_obj(bytes: &[u8], name: &str) -> Result<Mesh, FormatError> {
     let source = tobj_source(bytes);
     let (models, _materials) = tobj::load_obj_buf(&mut &source[..], &obj_load_options(), |_| {
         Ok((Vec::new(), Default::default()))
@@ -182,14 +182,14 @@ fn without_overflowing_indices(bytes: &[u8]) -> Option<Vec<u8>> {
 }
 
 /// Concatenates tobj's models into one fan-triangulated mesh, checking every index.
-fn merge(models: &[tobj::Model], name: &str) -> Result<TriangleMesh, FormatError> {
+fn merge(models: &[tobj::Model], name: &str) -> Result<Mesh, FormatError> {
     let inconsistent = |what: String| {
         FormatError::in_file(
             name,
             format!("tobj returned inconsistent data ({what}); please report this file"),
         )
     };
-    let mut mesh = TriangleMesh::default();
+    let mut mesh = Mesh::default();
     mesh.positions
         .reserve(models.iter().map(|m| m.mesh.positions.len() / 3).sum());
     mesh.indices

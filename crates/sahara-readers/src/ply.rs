@@ -18,7 +18,7 @@ mod reader;
 use std::fs;
 use std::path::Path;
 
-use crate::TriangleMesh;
+use crate::Mesh;
 use glam::{Vec2, Vec3};
 
 use crate::error::FormatError;
@@ -27,13 +27,13 @@ use header::{parse_header, Element, Encoding, Header, Kind};
 use reader::{Ascii, Binary, Reader};
 
 /// Loads a PLY file; errors name the file and the header line or body line/byte offset.
-pub fn load_ply(path: &Path) -> Result<TriangleMesh, FormatError> {
+pub fn load_ply(path: &Path) -> Result<Mesh, FormatError> {
     let bytes = fs::read(path).map_err(|e| FormatError::io(path, e))?;
     parse_ply(&bytes, &path.display().to_string())
 }
 
 /// Parses a PLY file held in memory; `name` is used in error messages.
-pub fn parse_ply(bytes: &[u8], name: &str) -> Result<TriangleMesh, FormatError> {
+pub fn parse_ply(bytes: &[u8], name: &str) -> Result<Mesh, FormatError> {
     parse_ply_with_attributes(bytes, name).map(|p| p.mesh)
 }
 
@@ -41,7 +41,7 @@ pub fn parse_ply(bytes: &[u8], name: &str) -> Result<TriangleMesh, FormatError> 
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PlyMesh {
     /// Positions and triangles.
-    pub mesh: TriangleMesh,
+    pub mesh: Mesh,
     /// Normals from `nx`, `ny`, `nz`, if the vertices have all three.
     pub normals: Option<Vec<Vec3>>,
     /// Texture coordinates from `u`, `v` (or `s`, `t`, `texture_u`,
@@ -332,7 +332,7 @@ fn read_faces<R: Reader>(
     element: &Element,
     list: usize,
     vertex_count: u64,
-    mesh: &mut TriangleMesh,
+    mesh: &mut Mesh,
 ) -> Result<(), FormatError> {
     // `check_count` has bounded the count by the file size; most faces are triangles.
     mesh.indices.reserve(element.count as usize);

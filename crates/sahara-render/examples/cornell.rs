@@ -20,7 +20,7 @@ fn main() {
         integrator,
         ..Default::default()
     };
-    let r = render(&scene, &settings, &|_| {});
+    let r = render(&scene, &settings, &|_| {}).unwrap();
     let s = &r.stats;
     eprintln!(
         "{}x{} {} spp {}: {:.2?} render, {} rays ({:.1} Mrays/s), NaN {}, negative {}",

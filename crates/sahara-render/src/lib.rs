@@ -7,10 +7,16 @@
 //!
 //! let scene = builtin::cornell_box();
 //! let settings = RenderSettings { width: 16, height: 16, spp: 4, ..Default::default() };
-//! let result = render(&scene, &settings, &|_| {});
+//! let result = render(&scene, &settings, &|_| {})?;
 //! assert_eq!(result.film.pixels.len(), 256);
 //! assert_eq!(result.stats.nan_samples, 0);
+//! # Ok::<(), sahara_render::SettingsError>(())
 //! ```
+//!
+//! What each integrator supports beyond a whole frame (parts by pixels or
+//! by samples, adaptive sampling, render passes and so denoising) is
+//! declared by its kind ([`IntegratorKind::supports`]); a render asking
+//! for more is refused with a [`SettingsError`] before it starts.
 //!
 //! The crate's parts, each importing only those before it in this list:
 //! `math` (hashing, piecewise distributions, warps) and `names` (the name
@@ -66,7 +72,9 @@ pub use texture::{
 // How to render: the settings and their names.
 pub use film::filter::{Filter, FilterKind};
 pub use film::ToneMap;
-pub use integrator::{defaults, Integrator, IntegratorKind, TraceStats};
+pub use integrator::{
+    defaults, Feature, Integrator, IntegratorKind, SettingsError, Support, Supports, TraceStats,
+};
 pub use names::{one_of, Accepts, Named, Parameter, UnknownName};
 pub use render::{Adaptive, AdaptiveStats, RenderSettings, UNLIMITED_SPP};
 pub use sampler::SamplerKind;

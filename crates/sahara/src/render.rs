@@ -19,8 +19,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use sahara_render::UNLIMITED_SPP;
 use sahara_render::{
-    render_watched, Aov, Filter, FilterKind, Integrator, PixelWindow, Preview, Progress,
-    RenderResult, RenderSettings, ToneMap,
+    render_watched, Aov, Feature, Filter, FilterKind, Preview, Progress, RenderResult,
+    RenderSettings, SettingsError, ToneMap,
 };
 
 use crate::cli::RenderArgs;
@@ -98,7 +98,6 @@ fn check_args(args: &RenderArgs) -> Result<()> {
         if !(t > 0.0 && t.is_finite()) {
             bail!("--noise-threshold must be a positive number (0.01 is a good start)");
         }
-        refuse_sample_ranges(args, "--noise-threshold")?;
     }
     part::check_args(args)?;
     if let Some(output) = &args.output {
@@ -108,62 +107,73 @@ fn check_args(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// The bidirectional integrators' light tracing adds light anywhere in
-/// the frame, from every pixel's samples: a piece of the frame by pixels
-/// would miss the light of the others, and adaptive sampling would change
-/// how much light tracing each pixel's samples bring. Both are refused.
-///
-/// SPPM's iterations each shrink the search radius the next one uses: it
-/// splits by pixels exactly, not by sample ranges, and has no samples to
-/// stop adaptively.
-fn check_splatting(settings: &RenderSettings, piece: Option<&part::Piece>) -> Result<()> {
-    let integrator = settings.integrator;
-    if let Integrator::Sppm { .. } = integrator {
-        if piece.is_some_and(|p| p.samples != (0..settings.spp)) {
-            bail!(
-                "the sppm integrator's iterations each shrink the radius the next one uses: \
-                 split it by pixels (--split tiles, --crop) rather than by samples \
-                 (--split samples, --samples)"
-            );
+/// The renderer's refusal of settings the integrator cannot honour
+/// ([`RenderSettings::check`]; `sahara_render::IntegratorKind::supports`
+/// declares what each integrator supports), as one line naming the option
+/// or scene-file key that asked for it. `denoise`: the render is to be
+/// denoised.
+fn check_settings(args: &RenderArgs, settings: &RenderSettings, denoise: bool) -> Result<()> {
+    let asked_by = |e: &SettingsError| -> &'static str {
+        match e {
+            SettingsError::Unsupported {
+                feature: Feature::Denoise,
+                ..
+            } if args.denoise => "--denoise",
+            SettingsError::Unsupported {
+                feature: Feature::Denoise,
+                ..
+            } => "the scene file's `denoise`",
+            SettingsError::Unsupported {
+                feature: Feature::Aovs,
+                ..
+            } => "--aov",
+            SettingsError::Unsupported {
+                feature: Feature::Adaptive,
+                ..
+            }
+            | SettingsError::AdaptiveSampleRange { .. }
+                if args.noise_threshold.is_some() =>
+            {
+                "--noise-threshold"
+            }
+            SettingsError::Unsupported {
+                feature: Feature::Adaptive,
+                ..
+            }
+            | SettingsError::AdaptiveSampleRange { .. } => "the scene file's noise_threshold",
+            SettingsError::Unsupported {
+                feature: Feature::PixelParts,
+                ..
+            } if args.crop.is_some() => "--crop",
+            SettingsError::Unsupported {
+                feature: Feature::PixelParts,
+                ..
+            } if args.part.is_some() && args.split != Some(crate::cli::Split::Samples) => {
+                "--split tiles"
+            }
+            SettingsError::Unsupported {
+                feature: Feature::PixelParts,
+                ..
+            } => "the scene file's crop window",
+            SettingsError::Unsupported {
+                feature: Feature::SampleRanges,
+                ..
+            } if args.samples.is_some() => "--samples",
+            SettingsError::Unsupported {
+                feature: Feature::SampleRanges,
+                ..
+            } => "--split samples",
         }
-        if settings.adaptive.is_some() {
-            bail!(
-                "adaptive sampling (a noise threshold) needs the path or distribution \
-                 integrator, not sppm"
-            );
-        }
-        return Ok(());
+    };
+    let named = |e: SettingsError| anyhow!("{}: {e}", asked_by(&e));
+    if denoise {
+        settings
+            .integrator
+            .kind()
+            .require(Feature::Denoise)
+            .map_err(named)?;
     }
-    if !integrator.splats() {
-        return Ok(());
-    }
-    let full = PixelWindow::full(settings.width, settings.height);
-    if piece.is_some_and(|p| p.window != full) {
-        bail!(
-            "the {} integrator's light tracing lands anywhere in the frame: split it by samples \
-             (--split samples, --samples) rather than by pixels (--split tiles, --crop)",
-            integrator.name()
-        );
-    }
-    if settings.adaptive.is_some() {
-        bail!(
-            "adaptive sampling (a noise threshold) needs the path or distribution integrator: \
-             the {} integrator's light tracing adds to pixels that have stopped",
-            integrator.name()
-        );
-    }
-    Ok(())
-}
-
-/// Adaptive sampling cannot split a frame by sample ranges.
-fn refuse_sample_ranges(args: &RenderArgs, what: &str) -> Result<()> {
-    if args.samples.is_some() || args.split == Some(crate::cli::Split::Samples) {
-        bail!(
-            "{what} cannot be used with sample ranges (--samples, --split samples): a pixel's \
-             decision to stop needs all its samples; split the frame by tiles instead"
-        );
-    }
-    Ok(())
+    settings.check().map_err(named)
 }
 
 /// Render passes are layers of an EXR: refused for any other output.
@@ -250,7 +260,6 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
     if piece.is_none() {
         settings.window = file_window;
     }
-    check_splatting(&settings, piece.as_ref())?;
     // The output named by the scene file (the command line's was checked
     // by `check_args`).
     if args.output.is_none() {
@@ -258,9 +267,6 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         check_aov_output(args, &output)?;
     }
     // The scene file may ask for adaptive sampling and denoising too.
-    if args.noise_threshold.is_none() && settings.adaptive.is_some() {
-        refuse_sample_ranges(args, "the scene file's noise_threshold")?;
-    }
     let file_denoise = !args.denoise && file.as_ref().is_some_and(|f| f.denoise);
     let denoise = args.denoise || file_denoise;
     settings.aovs = args.aov.clone();
@@ -269,22 +275,12 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
     }
     settings.aovs.sort();
     settings.aovs.dedup();
-    if !settings.aovs.is_empty()
-        && !matches!(
-            settings.integrator,
-            Integrator::Path { .. } | Integrator::Distribution { .. }
-        )
-    {
-        bail!(
-            "{} needs the path or distribution integrator, not {}",
-            match (args.aov.is_empty(), args.denoise) {
-                (false, _) => "--aov",
-                (true, true) => "--denoise",
-                (true, false) => "the scene file's `denoise`",
-            },
-            settings.integrator.name()
-        );
+    if let Some(p) = &piece {
+        settings.part = true;
+        settings.window = Some(p.window);
+        settings.samples = Some(p.samples.clone());
     }
+    check_settings(args, &settings, denoise)?;
     // A filter wider than a pixel shares each sample between neighbours:
     // their noise is then correlated, which the denoiser (trained on
     // independent pixels) takes for detail and keeps. Figures in
@@ -335,8 +331,6 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         None => None,
         Some(p) => {
             let digest = sahara_render::frame_digest(&scene, &settings);
-            settings.window = Some(p.window);
-            settings.samples = Some(p.samples.clone());
             if args.skip_existing {
                 match part::existing_differs(&output, &digest, &p) {
                     None => {
@@ -491,7 +485,8 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
     });
     let result = pool.install(|| render_watched(&job.scene, settings, &on_progress, preview));
     bar.finish_and_clear();
-    Ok(result)
+    // The settings were checked before the render (`check_settings`).
+    Ok(result?)
 }
 
 impl Job {

@@ -126,7 +126,7 @@ impl ProtocolCamera {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sahara_render::Mesh;
+    use sahara_kd::Mesh;
 
     fn quad_mesh() -> Mesh {
         // A unit square in the plane z = 0, two triangles.

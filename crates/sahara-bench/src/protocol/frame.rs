@@ -2,7 +2,7 @@
 //! centre `c`, half diagonal `r`, offset `eps` and the point light `L`.
 
 use glam::Vec3;
-use sahara_render::Mesh;
+use sahara_kd::Mesh;
 
 use super::arith::{add, len, mul, sub};
 use super::ProtocolError;

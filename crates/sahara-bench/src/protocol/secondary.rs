@@ -1,8 +1,8 @@
 //! The `shadow` and `diffuse` sets, generated from a tracer's primary hits.
 
 use glam::Vec3;
+use sahara_kd::Mesh;
 use sahara_kd::Ray;
-use sahara_render::Mesh;
 
 use super::arith::{add, cross, dot, len, mul, normalize, sub};
 use super::frame::{check_mesh, SceneFrame};

@@ -1,8 +1,8 @@
 //! A benchmark: one built tree, its pools, and set measurements.
 
 use rayon::ThreadPoolBuildError;
+use sahara_kd::Mesh;
 use sahara_kd::{BuildParams, KdTree, Ray, TreeStats};
-use sahara_render::Mesh;
 
 use super::build::{build_timed, BUILD_RUNS};
 use super::counters::count_set;

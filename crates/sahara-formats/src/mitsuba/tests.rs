@@ -903,7 +903,7 @@ fn image(scene: &Scene, spp: u32) -> Vec<Vec3> {
     };
     let mut scene = scene.clone();
     scene.camera.aspect = 1.0;
-    render(&scene, &settings, &|_| {}).film.pixels
+    render(&scene, &settings, &|_| {}).unwrap().film.pixels
 }
 
 /// A Cornell box: walls of rectangles placed by exact matrices, two

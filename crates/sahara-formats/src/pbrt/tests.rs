@@ -357,7 +357,7 @@ fn image(scene: &Scene, spp: u32) -> Vec<Vec3> {
     };
     let mut scene = scene.clone();
     scene.camera.aspect = 1.0;
-    render(&scene, &settings, &|_| {}).film.pixels
+    render(&scene, &settings, &|_| {}).unwrap().film.pixels
 }
 
 /// The same scene in pbrt and TOML renders the same image.

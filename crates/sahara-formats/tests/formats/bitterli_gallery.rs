@@ -278,7 +278,7 @@ fn render_image(a: &AssembledScene, case: &Case) -> Vec<Vec3> {
         integrator: s.integrator,
         ..RenderSettings::default()
     };
-    let result = render(&scene, &settings, &|_| {});
+    let result = render(&scene, &settings, &|_| {}).unwrap();
     assert_eq!(result.stats.nan_samples, 0, "{}", case.name);
     result.film.pixels
 }

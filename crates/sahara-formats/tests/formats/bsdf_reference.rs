@@ -81,7 +81,7 @@ fn render_image(scene: &Scene, s: &FileSettings) -> Vec<Vec3> {
         integrator: s.integrator,
         ..RenderSettings::default()
     };
-    let result = render(scene, &settings, &|_| {});
+    let result = render(scene, &settings, &|_| {}).unwrap();
     assert_eq!(result.stats.nan_samples, 0);
     result.film.pixels
 }

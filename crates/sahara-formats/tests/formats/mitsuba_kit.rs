@@ -94,7 +94,7 @@ fn render_image(a: &AssembledScene, spp: u32) -> Vec<Vec3> {
         integrator: s.integrator,
         ..RenderSettings::default()
     };
-    let result = render(&scene, &settings, &|_| {});
+    let result = render(&scene, &settings, &|_| {}).unwrap();
     assert_eq!(result.stats.nan_samples, 0);
     result.film.pixels
 }

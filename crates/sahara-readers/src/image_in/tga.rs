@@ -72,6 +72,10 @@ fn rgba(b: &[u8], depth: u8, grey: bool) -> [u8; 4] {
 }
 
 /// Decodes a TGA file.
+///
+/// One piece, in file order (header, image id, colour map, pixels, raw or
+/// run-length, then orientation): the header's dozen fields feed every
+/// step after it, and each check names the byte offset it reads at.
 pub(super) fn decode(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
     let bad = |offset: usize, message: String| FormatError::at_byte(name, offset as u64, message);
     let Some(h) = bytes.get(..HEADER) else {

@@ -16,7 +16,7 @@ use std::collections::{HashMap, HashSet};
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use crate::TriangleMesh;
+use crate::Mesh;
 use glam::{Vec2, Vec3};
 
 use super::{locate, obj_load_options, tobj_source};
@@ -28,7 +28,7 @@ use crate::mtl::MtlMaterial;
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ObjScene {
     /// Positions (one per distinct `v/vt/vn` triple) and triangles (file order, fan-triangulated).
-    pub mesh: TriangleMesh,
+    pub mesh: Mesh,
     /// Per-vertex normals, parallel to `mesh.positions`, if the file has `vn` lines.
     ///
     /// A corner without a normal in a file that has some takes tobj's
@@ -195,7 +195,7 @@ fn warn_unknown_materials(
 
 /// The geometry part of [`ObjScene`] and how many triangles each tobj model gave.
 struct Built {
-    mesh: TriangleMesh,
+    mesh: Mesh,
     normals: Option<Vec<Vec3>>,
     uvs: Option<Vec<Vec2>>,
     triangles_per_model: Vec<usize>,
@@ -212,7 +212,7 @@ fn build(models: &[tobj::Model], name: &str) -> Result<Built, FormatError> {
     let has_uvs = models.iter().any(|m| !m.mesh.texcoord_indices.is_empty());
     let has_normals = models.iter().any(|m| !m.mesh.normal_indices.is_empty());
     let mut out = Built {
-        mesh: TriangleMesh::default(),
+        mesh: Mesh::default(),
         normals: has_normals.then(Vec::new),
         uvs: has_uvs.then(Vec::new),
         triangles_per_model: Vec::with_capacity(models.len()),

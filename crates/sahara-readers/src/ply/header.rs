@@ -134,6 +134,10 @@ pub(crate) fn shown(bytes: &[u8]) -> String {
 }
 
 /// Parses the header at the start of `bytes`; `name` is used in error messages.
+///
+/// One piece: a single pass over the header's lines, whose arms share the
+/// pass's state (the line number every error names, the element whose
+/// properties follow), checking each count before anything is allocated.
 pub(crate) fn parse_header(bytes: &[u8], name: &str) -> Result<Header, FormatError> {
     let err = |line: usize, message: String| FormatError::at_line(name, line, message);
     let mut encoding = None;

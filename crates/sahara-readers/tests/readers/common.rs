@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::Vec3;
-use sahara_readers::TriangleMesh;
+use sahara_readers::Mesh;
 
 /// A fresh, empty folder under the system temp dir, removed on drop.
 pub struct TempDir(pub PathBuf);
@@ -36,7 +36,7 @@ impl Drop for TempDir {
 }
 
 /// The corner coordinates of every triangle, in triangle order.
-pub fn corners(mesh: &TriangleMesh) -> Vec<[Vec3; 3]> {
+pub fn corners(mesh: &Mesh) -> Vec<[Vec3; 3]> {
     mesh.indices
         .iter()
         .map(|t| t.map(|i| mesh.positions[i as usize]))

@@ -1,5 +1,5 @@
 //! Light transport: the distribution ray tracer, the path tracer, and
-//! debug views.
+//! debug views; what each integrator supports ([`Supports`]).
 
 pub(crate) mod bdpt;
 pub mod debug;
@@ -9,6 +9,7 @@ mod path;
 mod queries;
 pub(crate) mod sppm;
 mod state;
+mod supports;
 pub(crate) mod volpath;
 pub(crate) mod wavefront;
 
@@ -27,6 +28,7 @@ use crate::texture::footprint::UvFootprint;
 use crate::world::{ShadowQuery, SurfaceHit, World};
 use state::Deferred;
 pub(crate) use state::{AuxSample, PathState};
+pub use supports::{Feature, SettingsError, Support, Supports};
 
 /// Which estimator computes a pixel sample's radiance.
 #[derive(Clone, Copy, Debug, PartialEq)]

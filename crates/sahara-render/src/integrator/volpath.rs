@@ -327,7 +327,7 @@ mod tests {
             },
             ..RenderSettings::default()
         };
-        let r = render(scene, &settings, &|_| {});
+        let r = render(scene, &settings, &|_| {}).unwrap();
         assert_eq!(r.stats.nan_samples, 0);
         r.film.pixels.iter().copied().sum::<Vec3>() / r.film.pixels.len() as f32
     }

@@ -15,7 +15,7 @@ pub mod digest;
 mod ids;
 mod sppm;
 
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -34,7 +34,11 @@ use crate::integrator::bdpt::batch::{BdptBatch, CameraSample};
 use crate::integrator::bdpt::Splat;
 use crate::integrator::laps::{Lap, Laps};
 use crate::integrator::wavefront::Wavefront;
-use crate::integrator::{defaults, AuxSample, Context, Integrator, PathState, TraceStats};
+#[cfg(doc)]
+use crate::integrator::Supports;
+use crate::integrator::{
+    defaults, AuxSample, Context, Feature, Integrator, PathState, SettingsError, TraceStats,
+};
 use crate::math::hash::hash2;
 use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
 use crate::scene::Scene;
@@ -79,20 +83,30 @@ pub struct RenderSettings {
     pub cost_scale: Option<f32>,
     /// The pixels whose sums the render produces (None: the whole image).
     /// Every sample whose filter footprint reaches them is rendered, so a
-    /// window's sums are those of the whole frame's render over it.
+    /// window's sums are those of the whole frame's render over it, where
+    /// the integrator splits by pixels ([`Supports::pixel_parts`]); the
+    /// light-tracing integrators render a window as a crop, whose own
+    /// pixels' light subpaths stand for the whole frame's.
     pub window: Option<PixelWindow>,
     /// The sample indices of every pixel to render, counted over all
     /// passes: sample `k` is index `k % pass_spp` of pass `k / pass_spp`
     /// (None: `0..spp`). The passes rendered are those the range meets.
+    /// A range other than `0..spp` needs an integrator that splits by
+    /// samples ([`Supports::sample_ranges`]).
     pub samples: Option<std::ops::Range<u32>>,
+    /// True when the render is a part of a frame whose parts' sums are
+    /// added up afterwards (a render farm's): its `window` must then be a
+    /// part by pixels the integrator supports ([`Supports::pixel_parts`]).
+    /// False: the window is a crop, an image of those pixels.
+    pub part: bool,
     /// The render passes to make beside the beauty, the images a denoiser
-    /// and compositing use ([`AuxImages`]; the path and distribution
-    /// integrators); empty: none.
+    /// and compositing use ([`AuxImages`]; the integrators whose
+    /// [`Supports::aovs`] says so); empty: none.
     pub aovs: Vec<Aov>,
     /// Adaptive sampling: pixels stop once their noise is low enough, and
-    /// `spp` is a cap (None: every pixel takes `spp`). Not with `samples`
-    /// other than `0..spp` (a pixel's decisions need all its samples),
-    /// which it is ignored with.
+    /// `spp` is a cap (None: every pixel takes `spp`). Needs an integrator
+    /// that supports it ([`Supports::adaptive`]), and not with `samples`
+    /// other than `0..spp` (a pixel's decisions need all its samples).
     pub adaptive: Option<Adaptive>,
 }
 
@@ -108,6 +122,58 @@ impl RenderSettings {
     /// The most passes the render takes: `spp` in passes of [`Self::pass_size`].
     pub fn passes(&self) -> u32 {
         self.spp.max(1).div_ceil(self.pass_size())
+    }
+
+    /// Refuses what the integrator cannot honour, as its kind declares
+    /// ([`IntegratorKind::supports`]): a sample range, a part by pixels,
+    /// adaptive sampling (and adaptive sampling with a sample range, which
+    /// no integrator takes), render passes. Every render runs this first.
+    ///
+    /// [`IntegratorKind::supports`]: crate::IntegratorKind::supports
+    pub fn check(&self) -> Result<(), SettingsError> {
+        let kind = self.integrator.kind();
+        let sample_range = self.samples.as_ref().filter(|r| **r != (0..self.spp));
+        if sample_range.is_some() {
+            kind.require(Feature::SampleRanges)?;
+        }
+        let (w, h) = (self.width.max(1), self.height.max(1));
+        let full = PixelWindow::full(w, h);
+        if self.part && self.window.is_some_and(|win| win.intersect(&full) != full) {
+            kind.require(Feature::PixelParts)?;
+        }
+        if self.adaptive.is_some() {
+            kind.require(Feature::Adaptive)?;
+            if let Some(r) = sample_range {
+                return Err(SettingsError::AdaptiveSampleRange {
+                    samples: r.clone(),
+                    spp: self.spp,
+                });
+            }
+        }
+        if !self.aovs.is_empty() {
+            kind.require(Feature::Aovs)?;
+        }
+        Ok(())
+    }
+
+    /// [`RenderSettings::check`], and refuses what the integrator cannot
+    /// honour in this scene: participating media (and render passes
+    /// through them, which the volumetric path tracer does not record).
+    pub fn check_for(&self, scene: &Scene) -> Result<(), SettingsError> {
+        self.check()?;
+        if scene.has_media() {
+            let kind = self.integrator.kind();
+            kind.require(Feature::Media)?;
+            if !self.aovs.is_empty() {
+                return Err(SettingsError::Unsupported {
+                    integrator: kind,
+                    feature: Feature::Aovs,
+                    why: "the volumetric path tracer, which renders scenes with media, does not \
+                          record what each sample first sees",
+                });
+            }
+        }
+        Ok(())
     }
 }
 
@@ -129,6 +195,7 @@ impl Default for RenderSettings {
             cost_scale: None,
             window: None,
             samples: None,
+            part: false,
             aovs: Vec::new(),
             adaptive: None,
         }
@@ -339,11 +406,13 @@ struct TileOut {
 
 /// Renders `scene`; `progress` is called from worker threads as tiles
 /// finish (its calls may interleave; the image does not depend on them).
+/// Settings the integrator cannot honour are refused before anything is
+/// built ([`RenderSettings::check`]).
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
     progress: &(dyn Fn(Progress) + Sync),
-) -> RenderResult {
+) -> Result<RenderResult, SettingsError> {
     render_watched(scene, settings, progress, None)
 }
 
@@ -355,7 +424,8 @@ pub fn render_watched(
     settings: &RenderSettings,
     progress: &(dyn Fn(Progress) + Sync),
     preview: Option<Preview<'_>>,
-) -> RenderResult {
+) -> Result<RenderResult, SettingsError> {
+    settings.check_for(scene)?;
     let start = Instant::now();
     let mut world = World::new(scene, &settings.build);
     let build_time = start.elapsed();
@@ -367,71 +437,31 @@ pub fn render_watched(
 /// is when the render began (its time limit counts from there) and
 /// `build_time` what the build took. The criterion benchmarks render this
 /// way to time the render loop without the tree builds.
+///
+/// The steps: plan the frame's tiles ([`Frame`]) and passes
+/// ([`PassPlan`]); per pass, stop on cancel or time limit ([`Stop`]),
+/// render the tiles ([`Run::pass`]), keep what an interrupted first pass
+/// finished, add the tiles' sums ([`Accumulated::add`]), run the adaptive
+/// round ([`Accumulated::adaptive_round`]) and show a preview
+/// ([`Previews`]); then develop the image ([`Accumulated::finish`]).
 #[doc(hidden)]
 pub fn render_world(
     world: &mut World,
     settings: &RenderSettings,
     progress: &(dyn Fn(Progress) + Sync),
-    mut preview: Option<Preview<'_>>,
+    preview: Option<Preview<'_>>,
     start: Instant,
     build_time: Duration,
-) -> RenderResult {
-    let (w, h) = (settings.width.max(1), settings.height.max(1));
-    world.set_film(h, u64::from(settings.spp.max(1)));
+) -> Result<RenderResult, SettingsError> {
+    settings.check_for(world.scene)?;
+    world.set_film(settings.height.max(1), u64::from(settings.spp.max(1)));
     let world = &*world;
-    let window = settings
-        .window
-        .unwrap_or(PixelWindow::full(w, h))
-        .intersect(&PixelWindow::full(w, h));
-    // Adaptive sampling judges each pixel by all of its samples: a piece of
-    // the frame by pixels (all samples) can use it, a range of samples not.
-    let all_samples = settings
-        .samples
-        .as_ref()
-        .is_none_or(|r| *r == (0..settings.spp));
-    let adaptive = settings.adaptive.filter(|_| all_samples);
-    // The pixels whose samples reach the window; with adaptive sampling,
-    // whole blocks of them, so that a piece of the frame judges its pixels
-    // as the whole frame does.
-    let region = window.grow(filter_margin(&settings.filter), w, h);
-    let region = match adaptive {
-        Some(_) => region.align(adaptive::BLOCK, w, h),
-        None => region,
-    };
-    let ts = settings.tile_size.max(1);
-    let tiles: Vec<Tile> = (0..region.height().div_ceil(ts))
-        .flat_map(|ty| {
-            (0..region.width().div_ceil(ts)).map(move |tx| Tile {
-                x0: region.x0 + tx * ts,
-                y0: region.y0 + ty * ts,
-                x1: (region.x0 + (tx + 1) * ts).min(region.x1),
-                y1: (region.y0 + (ty + 1) * ts).min(region.y1),
-            })
-        })
-        .collect();
-    let mut sums = SumBuffer::new(window.x0, window.y0, window.width(), window.height());
-    // Light tracing's contributions count one light subpath per sample of
-    // every pixel of the image; a window renders the samples of its
-    // region only, whose light subpaths then stand for all of them.
-    let splat_scale = (w as f64 * h as f64 / region.pixels() as f64) as f32;
-    let mut aux = (!settings.aovs.is_empty()).then(|| {
-        Aux::new(
-            &settings.aovs,
-            window.x0,
-            window.y0,
-            window.width(),
-            window.height(),
-        )
-    });
-    let mut convergence = adaptive.map(|a| {
-        let grow = settings.time_limit.is_none();
-        Convergence::new(region, a, settings.pass_size(), settings.spp.max(1), grow)
-    });
-    let mut stats = RenderStats {
+    let stats = RenderStats {
         build_time,
         layout: world.accel.layout(),
         ..Default::default()
     };
+    let mut previews = Previews::new(preview);
     if let Integrator::Sppm {
         max_depth,
         radius,
@@ -443,188 +473,433 @@ pub fn render_world(
             radius,
             photons: photons as u64,
         };
-        return sppm::render(world, settings, params, progress, stats, start);
+        return Ok(sppm::render(
+            world,
+            settings,
+            params,
+            progress,
+            &mut previews,
+            stats,
+            start,
+        ));
     }
+    let run = Run {
+        world,
+        settings,
+        frame: Frame::plan(settings),
+        stop: Stop { settings, start },
+        progress,
+        rays: AtomicU64::new(0),
+    };
+    let plan = PassPlan::new(settings);
+    let mut acc = Accumulated::new(settings, &run.frame, stats);
     let render_start = Instant::now();
     let cpu_start = process_cpu_time();
-    let mut last_preview = Instant::now();
-    let cancelled = || {
-        settings
-            .cancel
-            .as_ref()
-            .is_some_and(|c| c.load(Ordering::Relaxed))
-    };
-    let out_of_time = || settings.time_limit.is_some_and(|t| start.elapsed() >= t);
-    let spp = settings.pass_size();
-    // The passes the sample range meets, and the range within each.
-    let (first_pass, passes, first, last) = match &settings.samples {
-        None => (0, settings.passes(), 0u64, u64::from(settings.spp.max(1))),
-        Some(r) if r.start >= r.end => (0, 0, 0, 0),
-        Some(r) => (
-            r.start / spp,
-            r.end.div_ceil(spp) - r.start / spp,
-            u64::from(r.start),
-            u64::from(r.end),
-        ),
-    };
-    let indices_of = |pass: u32| {
-        let base = u64::from(pass) * u64::from(spp);
-        let i0 = first.saturating_sub(base).min(u64::from(spp)) as u32;
-        let i1 = last.saturating_sub(base).min(u64::from(spp)) as u32;
-        i0..i1
-    };
-    let rays_so_far = std::sync::atomic::AtomicU64::new(0);
-    // Pixels finished in an interrupted first pass (None: not interrupted).
-    let mut finished: Option<Vec<bool>> = None;
-    for n in 0..passes {
-        let pass = first_pass + n;
-        if cancelled() || (n > 0 && out_of_time()) {
-            stats.stopped_early = true;
+    for n in 0..plan.passes {
+        if run.stop.cancelled() || (n > 0 && run.stop.out_of_time()) {
+            acc.stats.stopped_early = true;
             break;
         }
-        let indices = indices_of(pass);
-        let samples = match &convergence {
+        let pass = plan.first_pass + n;
+        let indices = plan.indices(pass);
+        let samples = match &acc.convergence {
             Some(c) => RoundSamples::Adaptive(c),
             None => RoundSamples::Every {
-                start: pass * spp + indices.start,
-                end: pass * spp + indices.end,
+                start: pass * plan.spp + indices.start,
+                end: pass * plan.spp + indices.end,
             },
         };
-        let done = AtomicU32::new(0);
-        let abandon = AtomicBool::new(false);
-        // The first pass stops pixel by pixel on cancel, so that a long
-        // first pass still leaves the pixels it finished.
-        let stop_pixel = || n == 0 && cancelled();
-        let outs: Vec<Option<TileOut>> = tiles
-            .par_iter()
-            // One job per tile: rayon otherwise hands out a few large runs
-            // of tiles, and one costly run can leave the other cores idle.
-            .with_max_len(1)
-            .map(|tile| {
-                if abandon.load(Ordering::Relaxed) || cancelled() || (n > 0 && out_of_time()) {
-                    abandon.store(true, Ordering::Relaxed);
-                    return None;
-                }
-                let out = render_tile(world, settings, *tile, &window, samples, &stop_pixel);
-                if out.pixels_done < tile.pixels() {
-                    abandon.store(true, Ordering::Relaxed);
-                }
-                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-                let t = &out.stats;
-                let rays = rays_so_far.fetch_add(
-                    t.camera_rays + t.bounce_rays + t.shadow_rays,
-                    Ordering::Relaxed,
-                ) + t.camera_rays
-                    + t.bounce_rays
-                    + t.shadow_rays;
-                progress(Progress {
-                    pass: n,
-                    passes,
-                    tiles_done: d,
-                    tiles: tiles.len() as u32,
-                    elapsed: start.elapsed(),
-                    rays,
-                });
-                Some(out)
-            })
-            .collect();
+        let outs = run.pass(n, plan.passes, samples);
         let complete = outs
             .iter()
-            .zip(&tiles)
+            .zip(&run.frame.tiles)
             .all(|(o, t)| o.as_ref().is_some_and(|o| o.pixels_done == t.pixels()));
         if !complete && n > 0 {
             // A later pass is dropped whole: every pixel keeps the same
             // number of samples.
-            stats.stopped_early = true;
+            acc.stats.stopped_early = true;
             break;
         }
         if !complete {
             // The first pass, interrupted: keep the window's pixels it finished.
-            let mut mask = vec![false; window.pixels() as usize];
-            for (out, tile) in outs.iter().zip(&tiles) {
-                if let Some(out) = out {
-                    for k in 0..out.pixels_done {
-                        let (x, y) = tile.pixel(k);
-                        if (window.x0..window.x1).contains(&x)
-                            && (window.y0..window.y1).contains(&y)
-                        {
-                            let i = (y - window.y0) * window.width() + (x - window.x0);
-                            mask[i as usize] = true;
-                        }
-                    }
-                }
-            }
-            stats.first_pass_pixels = mask.iter().filter(|&&m| m).count() as u64;
-            finished = Some(mask);
+            acc.keep_finished(&run.frame, &outs);
         }
-        let splats: Vec<&[Splat]> = outs.iter().flatten().map(|o| &o.splats[..]).collect();
-        sums.add_splats(&settings.filter, &splats, splat_scale);
-        for out in outs.into_iter().flatten() {
-            sums.add(&out.sums);
-            stats.trace += out.stats;
-            stats.time_split += out.split;
-            if let (Some(a), Some(o)) = (&mut aux, &out.aux) {
-                a.add(o);
-            }
-            stats.nan_samples += out.nan;
-            stats.negative_samples += out.negative;
-            if let (Some(c), Some(o)) = (&mut convergence, &out.own) {
-                c.add(o);
-            }
-        }
+        acc.add(settings, outs);
         if !complete {
-            stats.stopped_early = true;
+            acc.stats.stopped_early = true;
             break;
         }
-        stats.passes += 1;
-        stats.spp += indices.len() as u32;
-        // Every pixel below the threshold: the render is complete.
-        let all_converged = convergence.as_mut().is_some_and(|c| c.update() == 0);
-        if let Some(p) = preview.as_mut() {
-            if n + 1 < passes && last_preview.elapsed() >= p.every {
-                let mut snapshot = stats;
+        acc.stats.passes += 1;
+        acc.stats.spp += indices.len() as u32;
+        let all_converged = acc.adaptive_round();
+        if n + 1 < plan.passes {
+            previews.offer(|| {
+                let mut snapshot = acc.stats;
                 snapshot.render_time = render_start.elapsed();
                 snapshot.stopped_early = true;
-                (p.show)(&finish(
-                    sums.clone(),
-                    aux.clone(),
+                finish(
+                    acc.sums.clone(),
+                    acc.aux.clone(),
                     None,
                     snapshot,
                     settings,
                     None,
-                ));
-                last_preview = Instant::now();
-            }
+                )
+            });
         }
         if all_converged {
             break;
         }
     }
-    if finished.is_some() {
-        stats.spp = indices_of(first_pass).len() as u32;
-    } else if let Some(c) = &convergence {
-        stats.spp = c.most_samples(&window);
-    }
-    stats.render_time = render_start.elapsed();
-    stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
-    stats.adaptive = convergence.as_ref().map(|c| c.stats(&window, stats.spp));
-    let samples = convergence.as_ref().map(|c| c.samples(&window));
-    let mut result = finish(sums, aux, finished.as_deref(), stats, settings, samples);
-    let wants = |a: Aov| settings.aovs.contains(&a);
-    if let Some(aux) = result
-        .aux
-        .as_mut()
-        .filter(|_| wants(Aov::Object) || wants(Aov::Material))
-    {
-        let ids = ids::pixel_centres(world, &window, w, h);
-        if wants(Aov::Object) {
-            aux.images.object = ids.objects;
+    acc.stats.render_time = render_start.elapsed();
+    acc.stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
+    Ok(acc.finish(world, settings, &run.frame, &plan))
+}
+
+/// The pixels a render covers, cut into tiles.
+struct Frame {
+    /// The image's size.
+    w: u32,
+    h: u32,
+    /// The pixels whose sums the render produces.
+    window: PixelWindow,
+    /// The pixels whose samples reach the window; with adaptive sampling,
+    /// whole blocks of them, so that a piece of the frame judges its pixels
+    /// as the whole frame does.
+    region: PixelWindow,
+    /// The region's tiles, rows top to bottom.
+    tiles: Vec<Tile>,
+}
+
+impl Frame {
+    fn plan(settings: &RenderSettings) -> Self {
+        let (w, h) = (settings.width.max(1), settings.height.max(1));
+        let window = settings
+            .window
+            .unwrap_or(PixelWindow::full(w, h))
+            .intersect(&PixelWindow::full(w, h));
+        let region = window.grow(filter_margin(&settings.filter), w, h);
+        let region = match settings.adaptive {
+            Some(_) => region.align(adaptive::BLOCK, w, h),
+            None => region,
+        };
+        let ts = settings.tile_size.max(1);
+        let tiles: Vec<Tile> = (0..region.height().div_ceil(ts))
+            .flat_map(|ty| {
+                (0..region.width().div_ceil(ts)).map(move |tx| Tile {
+                    x0: region.x0 + tx * ts,
+                    y0: region.y0 + ty * ts,
+                    x1: (region.x0 + (tx + 1) * ts).min(region.x1),
+                    y1: (region.y0 + (ty + 1) * ts).min(region.y1),
+                })
+            })
+            .collect();
+        Self {
+            w,
+            h,
+            window,
+            region,
+            tiles,
         }
-        if wants(Aov::Material) {
-            aux.images.material = ids.materials;
+    }
+}
+
+/// The passes a render's sample range meets, and the range within each.
+struct PassPlan {
+    /// Samples per pixel of a whole pass.
+    spp: u32,
+    /// The first pass rendered.
+    first_pass: u32,
+    /// Passes rendered, at most.
+    passes: u32,
+    /// The sample range, counted over all passes.
+    first: u64,
+    last: u64,
+}
+
+impl PassPlan {
+    fn new(settings: &RenderSettings) -> Self {
+        let spp = settings.pass_size();
+        let (first_pass, passes, first, last) = match &settings.samples {
+            None => (0, settings.passes(), 0u64, u64::from(settings.spp.max(1))),
+            Some(r) if r.start >= r.end => (0, 0, 0, 0),
+            Some(r) => (
+                r.start / spp,
+                r.end.div_ceil(spp) - r.start / spp,
+                u64::from(r.start),
+                u64::from(r.end),
+            ),
+        };
+        Self {
+            spp,
+            first_pass,
+            passes,
+            first,
+            last,
         }
     }
-    result
+
+    /// The sample indices of `pass` within the range.
+    fn indices(&self, pass: u32) -> std::ops::Range<u32> {
+        let (spp, base) = (u64::from(self.spp), u64::from(pass) * u64::from(self.spp));
+        let i0 = self.first.saturating_sub(base).min(spp) as u32;
+        let i1 = self.last.saturating_sub(base).min(spp) as u32;
+        i0..i1
+    }
+}
+
+/// When a render stops early: on cancel, and (after the first pass) at
+/// the time limit.
+struct Stop<'a> {
+    settings: &'a RenderSettings,
+    /// When the render began; the time limit counts from it.
+    start: Instant,
+}
+
+impl Stop<'_> {
+    fn cancelled(&self) -> bool {
+        self.settings
+            .cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::Relaxed))
+    }
+
+    fn out_of_time(&self) -> bool {
+        self.settings
+            .time_limit
+            .is_some_and(|t| self.start.elapsed() >= t)
+    }
+}
+
+/// Hands images to the caller's [`Preview`] at most once per its `every`.
+pub(super) struct Previews<'a> {
+    preview: Option<Preview<'a>>,
+    last: Instant,
+}
+
+impl<'a> Previews<'a> {
+    fn new(preview: Option<Preview<'a>>) -> Self {
+        Self {
+            preview,
+            last: Instant::now(),
+        }
+    }
+
+    /// Shows the image `image` makes, if a preview is due.
+    pub(super) fn offer(&mut self, image: impl FnOnce() -> RenderResult) {
+        if let Some(p) = self.preview.as_mut() {
+            if self.last.elapsed() >= p.every {
+                (p.show)(&image());
+                self.last = Instant::now();
+            }
+        }
+    }
+}
+
+/// What a render's passes render with: the scene, the settings, the
+/// frame's tiles and when to stop.
+struct Run<'a, 'w> {
+    world: &'a World<'w>,
+    settings: &'a RenderSettings,
+    frame: Frame,
+    stop: Stop<'a>,
+    progress: &'a (dyn Fn(Progress) + Sync),
+    /// Rays traced so far, for the progress reports.
+    rays: AtomicU64,
+}
+
+impl Run<'_, '_> {
+    /// Renders pass `n` (of `passes`) of every tile in parallel, reporting
+    /// progress after each; a tile not started once the render stops
+    /// (cancel, or the time limit after the first pass) is `None`, and in
+    /// the first pass a cancel stops tiles pixel by pixel, so that a long
+    /// first pass still leaves the pixels it finished.
+    fn pass(&self, n: u32, passes: u32, samples: RoundSamples) -> Vec<Option<TileOut>> {
+        let (settings, frame, stop) = (self.settings, &self.frame, &self.stop);
+        let done = AtomicU32::new(0);
+        let abandon = AtomicBool::new(false);
+        let stop_pixel = || n == 0 && stop.cancelled();
+        frame
+            .tiles
+            .par_iter()
+            // One job per tile: rayon otherwise hands out a few large runs
+            // of tiles, and one costly run can leave the other cores idle.
+            .with_max_len(1)
+            .map(|tile| {
+                if abandon.load(Ordering::Relaxed)
+                    || stop.cancelled()
+                    || (n > 0 && stop.out_of_time())
+                {
+                    abandon.store(true, Ordering::Relaxed);
+                    return None;
+                }
+                let out = render_tile(
+                    self.world,
+                    settings,
+                    *tile,
+                    &frame.window,
+                    samples,
+                    &stop_pixel,
+                );
+                if out.pixels_done < tile.pixels() {
+                    abandon.store(true, Ordering::Relaxed);
+                }
+                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
+                let t = &out.stats;
+                let traced = t.camera_rays + t.bounce_rays + t.shadow_rays;
+                let rays = self.rays.fetch_add(traced, Ordering::Relaxed) + traced;
+                (self.progress)(Progress {
+                    pass: n,
+                    passes,
+                    tiles_done: d,
+                    tiles: frame.tiles.len() as u32,
+                    elapsed: stop.start.elapsed(),
+                    rays,
+                });
+                Some(out)
+            })
+            .collect()
+    }
+}
+
+/// What the completed passes add up to.
+struct Accumulated {
+    /// The window's exact sums.
+    sums: SumBuffer,
+    /// The render passes' sums, when asked for.
+    aux: Option<Aux>,
+    /// The adaptive sampling state, when it is on.
+    convergence: Option<Convergence>,
+    stats: RenderStats,
+    /// Pixels finished in an interrupted first pass (None: not interrupted).
+    finished: Option<Vec<bool>>,
+    /// How much each light tracing splat counts: a window renders the
+    /// light subpaths of its region's samples only, which then stand for
+    /// every pixel's of the image.
+    splat_scale: f32,
+}
+
+impl Accumulated {
+    fn new(settings: &RenderSettings, frame: &Frame, stats: RenderStats) -> Self {
+        let window = &frame.window;
+        Self {
+            sums: SumBuffer::new(window.x0, window.y0, window.width(), window.height()),
+            aux: (!settings.aovs.is_empty()).then(|| {
+                Aux::new(
+                    &settings.aovs,
+                    window.x0,
+                    window.y0,
+                    window.width(),
+                    window.height(),
+                )
+            }),
+            convergence: settings.adaptive.map(|a| {
+                let grow = settings.time_limit.is_none();
+                Convergence::new(
+                    frame.region,
+                    a,
+                    settings.pass_size(),
+                    settings.spp.max(1),
+                    grow,
+                )
+            }),
+            stats,
+            finished: None,
+            splat_scale: (frame.w as f64 * frame.h as f64 / frame.region.pixels() as f64) as f32,
+        }
+    }
+
+    /// Marks the window's pixels an interrupted first pass finished.
+    fn keep_finished(&mut self, frame: &Frame, outs: &[Option<TileOut>]) {
+        let window = &frame.window;
+        let mut mask = vec![false; window.pixels() as usize];
+        for (out, tile) in outs.iter().zip(&frame.tiles) {
+            if let Some(out) = out {
+                for k in 0..out.pixels_done {
+                    let (x, y) = tile.pixel(k);
+                    if (window.x0..window.x1).contains(&x) && (window.y0..window.y1).contains(&y) {
+                        let i = (y - window.y0) * window.width() + (x - window.x0);
+                        mask[i as usize] = true;
+                    }
+                }
+            }
+        }
+        self.stats.first_pass_pixels = mask.iter().filter(|&&m| m).count() as u64;
+        self.finished = Some(mask);
+    }
+
+    /// Adds a pass's tiles: their light tracing splats, sums, counts and
+    /// render passes, and each pixel's own samples for adaptive sampling.
+    fn add(&mut self, settings: &RenderSettings, outs: Vec<Option<TileOut>>) {
+        let splats: Vec<&[Splat]> = outs.iter().flatten().map(|o| &o.splats[..]).collect();
+        self.sums
+            .add_splats(&settings.filter, &splats, self.splat_scale);
+        for out in outs.into_iter().flatten() {
+            self.sums.add(&out.sums);
+            self.stats.trace += out.stats;
+            self.stats.time_split += out.split;
+            if let (Some(a), Some(o)) = (&mut self.aux, &out.aux) {
+                a.add(o);
+            }
+            self.stats.nan_samples += out.nan;
+            self.stats.negative_samples += out.negative;
+            if let (Some(c), Some(o)) = (&mut self.convergence, &out.own) {
+                c.add(o);
+            }
+        }
+    }
+
+    /// The adaptive round after a pass: which pixels go on. True when every
+    /// pixel is below the threshold, and the render is complete.
+    fn adaptive_round(&mut self) -> bool {
+        self.convergence.as_mut().is_some_and(|c| c.update() == 0)
+    }
+
+    /// The image of the completed passes, with the counts of samples
+    /// taken, and the object and material ids when asked for.
+    fn finish(
+        mut self,
+        world: &World,
+        settings: &RenderSettings,
+        frame: &Frame,
+        plan: &PassPlan,
+    ) -> RenderResult {
+        let window = &frame.window;
+        if self.finished.is_some() {
+            self.stats.spp = plan.indices(plan.first_pass).len() as u32;
+        } else if let Some(c) = &self.convergence {
+            self.stats.spp = c.most_samples(window);
+        }
+        let stats = &mut self.stats;
+        stats.adaptive = self
+            .convergence
+            .as_ref()
+            .map(|c| c.stats(window, stats.spp));
+        let samples = self.convergence.as_ref().map(|c| c.samples(window));
+        let mut result = finish(
+            self.sums,
+            self.aux,
+            self.finished.as_deref(),
+            self.stats,
+            settings,
+            samples,
+        );
+        let wants = |a: Aov| settings.aovs.contains(&a);
+        if let Some(aux) = result
+            .aux
+            .as_mut()
+            .filter(|_| wants(Aov::Object) || wants(Aov::Material))
+        {
+            let ids = ids::pixel_centres(world, window, frame.w, frame.h);
+            if wants(Aov::Object) {
+                aux.images.object = ids.objects;
+            }
+            if wants(Aov::Material) {
+                aux.images.material = ids.materials;
+            }
+        }
+        result
+    }
 }
 
 /// The image of the sums so far (black where `finished` says a pixel was not).
@@ -875,8 +1150,67 @@ struct Strip {
     bdpt: BdptBatch,
 }
 
+/// The pixels `[x0, x1) x [y0, y1)` of a strip.
+#[derive(Clone, Copy)]
+struct StripPixels {
+    x0: u32,
+    x1: u32,
+    y0: u32,
+    y1: u32,
+}
+
+impl StripPixels {
+    /// The pixels, rows top to bottom.
+    fn iter(self) -> impl Iterator<Item = (u32, u32)> {
+        (self.y0..self.y1).flat_map(move |y| (self.x0..self.x1).map(move |x| (x, y)))
+    }
+}
+
+/// Where the samples of a strip's camera come from: sample `g` of pixel
+/// `(x, y)` has its sampler, film position and camera ray.
+struct CameraSamples<'a> {
+    s: &'a RenderSettings,
+    camera: &'a crate::scene::camera::Camera,
+    w: u32,
+    inv: Vec2,
+    /// Samples per pixel of a pass.
+    spp: u32,
+}
+
+impl CameraSamples<'_> {
+    #[inline]
+    fn at(&self, x: u32, y: u32, g: u32) -> (PixelSampler, Vec2, sahara_kd::Ray, f32) {
+        let stream = hash2(self.s.seed, (y as u64) * self.w as u64 + x as u64);
+        let sampler = PixelSampler::new(
+            self.s.sampler,
+            SampleId {
+                stream,
+                pass: g / self.spp,
+                index: g % self.spp,
+                count: self.spp,
+            },
+        );
+        let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
+        let (ray, time) = self.camera.generate_ray(
+            pos * self.inv,
+            sampler.get_2d(dims::LENS),
+            sampler.get_1d(dims::TIME),
+        );
+        (sampler, pos, ray, time)
+    }
+}
+
+/// Where sample `g` of pixel `(x, y)` of a strip goes in its buffers.
+#[inline]
+fn slot(first: &[u32], samples: RoundSamples, p: StripPixels, x: u32, y: u32, g: u32) -> usize {
+    let start = samples.of(x, y).start;
+    (first[((y - p.y0) * (p.x1 - p.x0) + (x - p.x0)) as usize] + g - start) as usize
+}
+
 impl Strip {
-    /// Renders the round's `samples` of pixels `[x0, x1) x [y0, y1)`.
+    /// Renders the round's `samples` of pixels `[x0, x1) x [y0, y1)`: lays
+    /// out the strip's buffers, then traces the samples as the integrator
+    /// does (bidirectional, stepped in batches, or one at a time).
     #[allow(clippy::too_many_arguments)]
     fn render(
         &mut self,
@@ -890,69 +1224,18 @@ impl Strip {
         stats: &mut TraceStats,
     ) {
         let (w, h) = (s.width.max(1), s.height.max(1));
-        let camera = &world.scene.camera;
-        let inv = Vec2::new(1.0 / w as f32, 1.0 / h as f32);
-        let spp = s.pass_size();
-        // Where each pixel's samples start in the strip's buffers.
-        self.first.clear();
-        let mut n = 0usize;
-        for y in y0..y1 {
-            for x in x0..x1 {
-                self.first.push(n as u32);
-                n += samples.of(x, y).len();
-            }
-        }
-        self.pos.clear();
-        self.pos.resize(n, Vec2::ZERO);
-        self.radiance.clear();
-        self.radiance.resize(n, Vec3::ZERO);
-        self.aux.clear();
-        let aux = !s.aovs.is_empty();
-        if aux {
-            self.aux.resize(n, AuxSample::default());
-        }
-        // Sample `g` of pixel (x, y): its sampler, film position and
-        // camera ray.
-        let camera_sample = |x: u32, y: u32, g: u32| {
-            let stream = hash2(s.seed, (y as u64) * w as u64 + x as u64);
-            let sampler = PixelSampler::new(
-                s.sampler,
-                SampleId {
-                    stream,
-                    pass: g / spp,
-                    index: g % spp,
-                    count: spp,
-                },
-            );
-            let pos = Vec2::new(x as f32, y as f32) + sampler.get_2d(dims::FILM);
-            let (ray, time) = camera.generate_ray(
-                pos * inv,
-                sampler.get_2d(dims::LENS),
-                sampler.get_1d(dims::TIME),
-            );
-            (sampler, pos, ray, time)
-        };
-        let first = &self.first;
-        let slot_of = |x: u32, y: u32, g: u32| {
-            let start = samples.of(x, y).start;
-            (first[((y - y0) * (x1 - x0) + (x - x0)) as usize] + g - start) as usize
+        let pixels = StripPixels { x0, x1, y0, y1 };
+        self.lay_out(pixels, samples, !s.aovs.is_empty());
+        let cameras = CameraSamples {
+            s,
+            camera: &world.scene.camera,
+            w,
+            inv: Vec2::new(1.0 / w as f32, 1.0 / h as f32),
+            spp: s.pass_size(),
         };
         let film = Vec2::new(w as f32, h as f32);
         if let Some((max_depth, strategies)) = s.integrator.bidirectional() {
-            // The samples pixel by pixel, rows top to bottom.
-            self.cameras.clear();
-            self.slot.clear();
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    for g in samples.of(x, y) {
-                        let (sampler, pos, ray, time) = camera_sample(x, y, g);
-                        let k = slot_of(x, y, g);
-                        self.pos[k] = pos;
-                        self.slot.push(k as u32);
-                        self.cameras.push(CameraSample { ray, time, sampler });
-                    }
-                }
-            }
+            self.cameras_in_pixel_order(&cameras, pixels, samples);
             self.samples.clear();
             self.samples.resize(self.cameras.len(), Vec3::ZERO);
             self.bdpt.trace(
@@ -968,38 +1251,87 @@ impl Strip {
             for (&l, &k) in self.samples.iter().zip(&self.slot) {
                 self.radiance[k as usize] = l;
             }
-            return;
-        }
-        // A scene with media takes the volumetric path tracer, one path at
-        // a time.
-        if !s.integrator.is_stepped() || world.has_media() {
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    for g in samples.of(x, y) {
-                        let (sampler, pos, ray, time) = camera_sample(x, y, g);
-                        let mut ctx = Context {
-                            world,
-                            sampler,
-                            stats,
-                        };
-                        let k = slot_of(x, y, g);
-                        self.pos[k] = pos;
-                        self.radiance[k] =
-                            s.integrator
-                                .li_splats(&mut ctx, &ray, time, film, &mut self.splats);
-                    }
+        } else if s.integrator.is_stepped() && !world.has_media() {
+            // A scene with media takes the volumetric path tracer below,
+            // one path at a time.
+            self.trace_stepped(world, &cameras, pixels, samples, stats);
+        } else {
+            for (x, y) in pixels.iter() {
+                for g in samples.of(x, y) {
+                    let (sampler, pos, ray, time) = cameras.at(x, y, g);
+                    let mut ctx = Context {
+                        world,
+                        sampler,
+                        stats,
+                    };
+                    let k = slot(&self.first, samples, pixels, x, y, g);
+                    self.pos[k] = pos;
+                    self.radiance[k] =
+                        s.integrator
+                            .li_splats(&mut ctx, &ray, time, film, &mut self.splats);
                 }
             }
-            return;
         }
-        // The paths in camera-packet order: 4x4 pixel blocks, the pixels
-        // of a block in Morton order (2x2 blocks of 2x2), each pixel's
-        // samples together. A run of 16 paths is then 16 samples of one
-        // pixel, or the samples of a 2x2 block's pixels when a pixel takes
-        // 4: their camera rays, shadow rays and bounces start close
-        // together and share the tree's cells (figures in
-        // docs/performance.md, "What a packet of one pixel's samples would
-        // share"). The order changes no path's arithmetic.
+    }
+
+    /// Sizes the strip's buffers for the round's samples of `pixels`, and
+    /// notes where each pixel's samples start.
+    fn lay_out(&mut self, pixels: StripPixels, samples: RoundSamples, aux: bool) {
+        self.first.clear();
+        let mut n = 0usize;
+        for (x, y) in pixels.iter() {
+            self.first.push(n as u32);
+            n += samples.of(x, y).len();
+        }
+        self.pos.clear();
+        self.pos.resize(n, Vec2::ZERO);
+        self.radiance.clear();
+        self.radiance.resize(n, Vec3::ZERO);
+        self.aux.clear();
+        if aux {
+            self.aux.resize(n, AuxSample::default());
+        }
+    }
+
+    /// The bidirectional integrators' camera samples, pixel by pixel, rows
+    /// top to bottom, with the slot of each.
+    fn cameras_in_pixel_order(
+        &mut self,
+        cameras: &CameraSamples,
+        pixels: StripPixels,
+        samples: RoundSamples,
+    ) {
+        self.cameras.clear();
+        self.slot.clear();
+        for (x, y) in pixels.iter() {
+            for g in samples.of(x, y) {
+                let (sampler, pos, ray, time) = cameras.at(x, y, g);
+                let k = slot(&self.first, samples, pixels, x, y, g);
+                self.pos[k] = pos;
+                self.slot.push(k as u32);
+                self.cameras.push(CameraSample { ray, time, sampler });
+            }
+        }
+    }
+
+    /// Traces the stepped integrators' paths as batches, in camera-packet
+    /// order: 4x4 pixel blocks, the pixels of a block in Morton order (2x2
+    /// blocks of 2x2), each pixel's samples together. A run of 16 paths is
+    /// then 16 samples of one pixel, or the samples of a 2x2 block's pixels
+    /// when a pixel takes 4: their camera rays, shadow rays and bounces
+    /// start close together and share the tree's cells (figures in
+    /// docs/performance.md, "What a packet of one pixel's samples would
+    /// share"). The order changes no path's arithmetic.
+    fn trace_stepped(
+        &mut self,
+        world: &World,
+        cameras: &CameraSamples,
+        pixels: StripPixels,
+        samples: RoundSamples,
+        stats: &mut TraceStats,
+    ) {
+        let aux = !cameras.s.aovs.is_empty();
+        let StripPixels { x0, x1, y0, y1 } = pixels;
         self.paths.clear();
         self.slot.clear();
         for (bx, by) in (y0..y1)
@@ -1015,8 +1347,8 @@ impl Strip {
                     continue;
                 }
                 for g in samples.of(x, y) {
-                    let (sampler, pos, ray, time) = camera_sample(x, y, g);
-                    let k = slot_of(x, y, g);
+                    let (sampler, pos, ray, time) = cameras.at(x, y, g);
+                    let k = slot(&self.first, samples, pixels, x, y, g);
                     self.pos[k] = pos;
                     self.slot.push(k as u32);
                     self.paths
@@ -1025,7 +1357,7 @@ impl Strip {
             }
         }
         self.wavefront
-            .trace(&s.integrator, world, stats, &mut self.paths);
+            .trace(&cameras.s.integrator, world, stats, &mut self.paths);
         for (p, &k) in self.paths.iter().zip(&self.slot) {
             self.radiance[k as usize] = p.l;
         }

@@ -13,6 +13,10 @@ use crate::scene::Scene;
 /// emitting (17, 12, 4), seen from (278, 273, -800) looking +Z with a
 /// vertical field of view of 39.3 degrees. The red wall (x = 550) appears
 /// on the image's left, the green one (x = 0) on its right.
+///
+/// One piece: the scene's data (camera, materials, the measured quads of
+/// walls, light and blocks) in the order the Cornell Program publishes it,
+/// so that it reads against that table.
 pub fn cornell_box() -> Scene {
     let camera = Camera::look_at(
         Vec3::new(278.0, 273.0, -800.0),

@@ -49,14 +49,14 @@ fn in_pool(threads: usize, scene: &Scene, s: &RenderSettings) -> RenderResult {
         .num_threads(threads)
         .build()
         .unwrap();
-    pool.install(|| render(scene, s, &|_| {}))
+    pool.install(|| render(scene, s, &|_| {}).unwrap())
 }
 
 #[test]
 fn flat_pixels_stop_at_the_minimum_and_noisy_ones_reach_the_cap() {
     let scene = scene();
     let s = settings(0.002);
-    let r = render(&scene, &s, &|_| {});
+    let r = render(&scene, &s, &|_| {}).unwrap();
     let samples = r.samples.as_ref().expect("a sample count per pixel");
     assert_eq!(samples.len(), 32 * 32);
     let (mut flat, mut capped) = (0, 0);
@@ -123,7 +123,7 @@ fn windows_rendered_apart_add_up_to_the_whole_frame() {
         filter: Filter::from(FilterKind::Gaussian),
         ..settings(0.02)
     };
-    let whole = render(&scene, &s, &|_| {});
+    let whole = render(&scene, &s, &|_| {}).unwrap();
     let full = PixelWindow::full(32, 32);
     let mut merged = SumBuffer::new(0, 0, 32, 32);
     for i in 0..5 {
@@ -132,7 +132,7 @@ fn windows_rendered_apart_add_up_to_the_whole_frame() {
             window: Some(window),
             ..s.clone()
         };
-        let out = render(&scene, &part, &|_| {});
+        let out = render(&scene, &part, &|_| {}).unwrap();
         // The window's sample counts are the whole frame's there.
         let counts = out.samples.as_ref().unwrap();
         let mut k = 0;
@@ -161,8 +161,8 @@ fn a_threshold_no_pixel_reaches_renders_the_plain_image() {
         adaptive: None,
         ..adaptive.clone()
     };
-    let a = render(&scene, &adaptive, &|_| {});
-    let p = render(&scene, &plain, &|_| {});
+    let a = render(&scene, &adaptive, &|_| {}).unwrap();
+    let p = render(&scene, &plain, &|_| {}).unwrap();
     assert!(a.sums == p.sums, "the images differ");
     assert!(a.samples.unwrap().iter().all(|&n| n == 64));
     assert!(p.samples.is_none() && p.stats.adaptive.is_none());
@@ -175,7 +175,7 @@ fn pixels_that_stopped_are_as_clean_as_the_threshold_asks() {
     let scene = scene();
     let threshold = 0.05;
     let s = settings(threshold);
-    let r = render(&scene, &s, &|_| {});
+    let r = render(&scene, &s, &|_| {}).unwrap();
     let reference = render(
         &scene,
         &RenderSettings {
@@ -186,7 +186,8 @@ fn pixels_that_stopped_are_as_clean_as_the_threshold_asks() {
             ..s.clone()
         },
         &|_| {},
-    );
+    )
+    .unwrap();
     let samples = r.samples.unwrap();
     // The module's error measure, against the reference instead of the
     // other half: for a stopped pixel it should be about the threshold.

@@ -54,7 +54,8 @@ fn unhittable_triangles_are_skipped_and_counted() {
             ..Default::default()
         },
         &|_| {},
-    );
+    )
+    .unwrap();
     assert_eq!(r.stats.nan_samples, 0);
     let c = r.film.mean(6, 6, 10, 10);
     assert!(
@@ -83,7 +84,8 @@ fn an_unlit_scene_is_reported_and_renders_black() {
             ..Default::default()
         },
         &|_| {},
-    );
+    )
+    .unwrap();
     assert!(r.film.pixels.iter().all(|p| *p == Vec3::ZERO));
 }
 
@@ -112,7 +114,8 @@ fn a_camera_inside_a_closed_box_sees_its_walls() {
             ..Default::default()
         },
         &|_| {},
-    );
+    )
+    .unwrap();
     for p in &r.film.pixels {
         assert!((*p - Vec3::ONE).abs().max_element() < 1e-3, "{p}");
     }

@@ -184,7 +184,7 @@ fn bdpt_is_deterministic_across_thread_counts() {
             .num_threads(threads)
             .build()
             .unwrap();
-        let r = pool.install(|| render(&scene, &s, &|_| {}));
+        let r = pool.install(|| render(&scene, &s, &|_| {}).unwrap());
         r.film
             .pixels
             .iter()

@@ -26,7 +26,7 @@ pub fn settings(width: u32, height: u32, spp: u32, integrator: Integrator) -> Re
 
 /// Renders and checks the image is free of NaN and negative values.
 pub fn run(scene: &Scene, s: &RenderSettings) -> RenderResult {
-    let r = render(scene, s, &|_| {});
+    let r = render(scene, s, &|_| {}).unwrap();
     assert_eq!(r.stats.nan_samples, 0, "NaN samples");
     assert_eq!(r.stats.negative_samples, 0, "negative samples");
     for p in &r.film.pixels {

@@ -1,4 +1,4 @@
-//! Tests of `sahara-render`: the render loop, integrators, lighting, textures, cameras, split and adaptive renders.
+//! Tests of `sahara-render`: the render loop, integrators, lighting, textures, cameras, split and adaptive renders, what each integrator supports.
 //!
 //! One test binary for the crate's integration tests, each file a module:
 //! every test binary is compiled and linked (with LTO) on its own, so one
@@ -14,4 +14,5 @@ mod lighting;
 mod photons;
 mod render_loop;
 mod split_render;
+mod supports;
 mod textures;

@@ -71,7 +71,7 @@ fn bits(threads: usize, scene: &Scene, s: &RenderSettings) -> Vec<u32> {
         .num_threads(threads)
         .build()
         .unwrap();
-    let r = pool.install(|| render(scene, s, &|_| {}));
+    let r = pool.install(|| render(scene, s, &|_| {}).unwrap());
     r.film
         .pixels
         .iter()

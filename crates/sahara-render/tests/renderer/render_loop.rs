@@ -19,7 +19,7 @@ fn render_in_pool(threads: usize, scene: &Scene, s: &sahara_render::RenderSettin
         .num_threads(threads)
         .build()
         .unwrap();
-    let r = pool.install(|| render(scene, s, &|_| {}));
+    let r = pool.install(|| render(scene, s, &|_| {}).unwrap());
     r.film
         .pixels
         .iter()
@@ -225,7 +225,7 @@ fn passes_stop_on_cancel_and_time_limit() {
     let mut s = settings(16, 16, 1, Integrator::default());
     s.spp *= 1_000_000;
     s.time_limit = Some(Duration::from_millis(150));
-    let r = render(&scene, &s, &|_| {});
+    let r = render(&scene, &s, &|_| {}).unwrap();
     assert!(r.stats.stopped_early && r.stats.passes >= 1 && r.stats.passes < 1_000_000);
     assert_eq!(r.stats.spp, r.stats.passes);
     assert!(r.film.mean(0, 0, 16, 16).x > 0.0);
@@ -233,7 +233,7 @@ fn passes_stop_on_cancel_and_time_limit() {
     let cancel = Arc::new(AtomicBool::new(true));
     s.time_limit = None;
     s.cancel = Some(cancel);
-    let r = render(&scene, &s, &|_| {});
+    let r = render(&scene, &s, &|_| {}).unwrap();
     assert_eq!(r.stats.passes, 0);
     assert!(r.film.pixels.iter().all(|p| *p == Vec3::ZERO));
 
@@ -245,7 +245,8 @@ fn passes_stop_on_cancel_and_time_limit() {
     render(&scene, &s, &|p| {
         assert!(p.tiles_done <= p.tiles && p.pass < 3);
         count.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-    });
+    })
+    .unwrap();
     assert_eq!(count.into_inner(), 12);
 }
 
@@ -306,7 +307,7 @@ fn an_interrupted_first_pass_keeps_the_pixels_it_finished() {
         .num_threads(1)
         .build()
         .unwrap();
-    let full = pool.install(|| render(&scene, &s, &|_| {}));
+    let full = pool.install(|| render(&scene, &s, &|_| {}).unwrap());
     assert_eq!(full.stats.first_pass_pixels, 0);
 
     // Cancel as the second tile finishes: on one thread tiles run in order,
@@ -320,6 +321,7 @@ fn an_interrupted_first_pass_keeps_the_pixels_it_finished() {
                 cancel.store(true, std::sync::atomic::Ordering::SeqCst);
             }
         })
+        .unwrap()
     });
     assert!(r.stats.stopped_early);
     assert_eq!(r.stats.passes, 0);
@@ -350,7 +352,7 @@ fn previews_come_between_passes_and_leave_the_image_unchanged() {
     let scene = builtin::cornell_box();
     let mut s = settings(12, 12, 1, Integrator::default());
     s.spp *= 4;
-    let plain = render(&scene, &s, &|_| {});
+    let plain = render(&scene, &s, &|_| {}).unwrap();
     let mut seen = Vec::new();
     let watched = sahara_render::render_watched(
         &scene,
@@ -360,7 +362,8 @@ fn previews_come_between_passes_and_leave_the_image_unchanged() {
             every: Duration::ZERO,
             show: &mut |r| seen.push((r.stats.spp, r.film.mean(0, 0, 12, 12))),
         }),
-    );
+    )
+    .unwrap();
     // Passes 1 to 3; the image of pass 4 is the result itself.
     assert_eq!(
         seen.iter().map(|(spp, _)| *spp).collect::<Vec<_>>(),
@@ -392,7 +395,7 @@ fn the_built_in_cornell_light_is_a_white_diffuser_that_emits() {
 #[test]
 fn the_time_split_covers_the_path_tracer_only() {
     let scene = builtin::cornell_box();
-    let r = render(&scene, &settings(16, 16, 4, Integrator::default()), &|_| {});
+    let r = render(&scene, &settings(16, 16, 4, Integrator::default()), &|_| {}).unwrap();
     let split = r.stats.time_split;
     let shares = split.shares().expect("the path tracer measures its split");
     let (t, s, f, rest) = (shares.tracing, shares.shading, shares.film, shares.rest);
@@ -403,7 +406,7 @@ fn the_time_split_covers_the_path_tracer_only() {
         samples: 1,
         distance: 0.0,
     };
-    let r = render(&scene, &settings(16, 16, 4, ao), &|_| {});
+    let r = render(&scene, &settings(16, 16, 4, ao), &|_| {}).unwrap();
     assert_eq!(r.stats.time_split.shares(), None);
 }
 
@@ -532,7 +535,7 @@ fn aux_sums_do_not_depend_on_threads_and_leave_the_image_alone() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| render(&scene, s, &|_| {}))
+            .install(|| render(&scene, s, &|_| {}).unwrap())
     };
     let (one, two) = (in_pool(1, &s), in_pool(2, &s));
     assert_eq!(

@@ -84,7 +84,7 @@ proptest! {
             ..Default::default()
         };
         let total = settings.spp;
-        let whole = render(&scene, &settings, &|_| {});
+        let whole = render(&scene, &settings, &|_| {}).unwrap();
         // Sample ranges at random cut points (some empty).
         let mut bounds: Vec<u32> = cuts.iter().map(|c| (c * total as f64) as u32).collect();
         bounds.push(0);
@@ -101,7 +101,7 @@ proptest! {
                     tile_size: 4,
                     ..settings.clone()
                 };
-                let out = pool.install(|| render(&scene, &part, &|_| {}));
+                let out = pool.install(|| render(&scene, &part, &|_| {}).unwrap());
                 prop_assert_eq!(out.stats.spp, r[1] - r[0]);
                 prop_assert_eq!(out.sums.sums.len() as u64, window.pixels());
                 if !window.is_empty() {

@@ -1333,7 +1333,7 @@ fn render_passes_need_an_exr_and_a_path_tracer() {
     ]);
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("--aov needs the path or distribution integrator"),
+        stderr(&out).contains("--aov: the ao integrator cannot make render passes"),
         "{}",
         stderr(&out)
     );
@@ -1444,7 +1444,9 @@ fn a_scene_file_asks_for_adaptive_sampling_and_denoising() {
     );
     let (ok, err) = run(&["--samples", "0..8"]);
     assert!(
-        !ok && err.contains("the scene file's noise_threshold cannot be used with sample ranges"),
+        !ok && err.contains(
+            "the scene file's noise_threshold: adaptive sampling cannot be used with sample ranges"
+        ),
         "{err}"
     );
     write("min_spp = 8", "");
@@ -1563,7 +1565,7 @@ fn denoising_lowers_the_error_of_a_noisy_render() {
         noisy.to_str().unwrap(),
     ]);
     assert!(
-        stderr(&out).contains("--denoise needs the path or distribution integrator"),
+        stderr(&out).contains("--denoise: the normals integrator cannot be denoised"),
         "{}",
         stderr(&out)
     );
@@ -1770,5 +1772,82 @@ fn a_gltf_with_ktx2_textures_renders_with_them() {
         blue_light[2] > 10.0 * blue_light[0].max(blue_light[1]),
         "{blue_light:?}"
     );
+    let _ = fs::remove_dir_all(&dir);
+}
+
+/// What an integrator does not support (its declaration in the renderer)
+/// is refused by the renderer before anything renders, and printed in one
+/// line that names the option or scene-file key that asked for it.
+#[test]
+fn unsupported_settings_are_refused_in_one_line_naming_what_asked() {
+    const ADAPTIVE_SPHERE: &str = "[camera]\neye = [0, 1, 5]\ntarget = [0, 0, 0]\n\
+        [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\n\
+        [[light]]\ntype = \"point\"\nposition = [0, 4, 2]\nintensity = [20, 20, 20]\n\
+        [sampler]\nspp = 8\nnoise_threshold = 0.05\n[film]\nwidth = 16\nheight = 16\n";
+    let dir = temp_dir("unsupported");
+    let scene = dir.join("s.toml");
+    fs::write(&scene, ADAPTIVE_SPHERE).unwrap();
+    let exr = dir.join("x.exr");
+    let o = exr.to_str().unwrap();
+    for (args, says) in [
+        (
+            &[
+                "render",
+                "--integrator",
+                "sppm",
+                "--noise-threshold",
+                "0.05",
+                "-o",
+                o,
+            ][..],
+            "--noise-threshold: the sppm integrator cannot sample adaptively",
+        ),
+        (
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                "--integrator",
+                "bdpt",
+                "-o",
+                o,
+            ][..],
+            "the scene file's noise_threshold: the bdpt integrator cannot sample adaptively",
+        ),
+        (
+            &[
+                "render",
+                "--integrator",
+                "lightpath",
+                "--aov",
+                "albedo",
+                "-o",
+                o,
+            ][..],
+            "--aov: the lightpath integrator cannot make render passes",
+        ),
+        (
+            &[
+                "render",
+                "--integrator",
+                "sppm",
+                "--samples",
+                "0..4",
+                "-o",
+                o,
+            ][..],
+            "--samples: the sppm integrator cannot render a range of each pixel's samples",
+        ),
+    ] {
+        let out = sahara(args);
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{args:?} was rendered");
+        assert_eq!(
+            err.trim_end().lines().count(),
+            1,
+            "{args:?}: one line: {err}"
+        );
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert!(!exr.exists(), "{args:?}: an output was written");
+    }
     let _ = fs::remove_dir_all(&dir);
 }

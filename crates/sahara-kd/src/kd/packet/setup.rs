@@ -107,6 +107,10 @@ impl Packet {
 
     /// The rest of the set-up once the lanes hold the `n` rays (see
     /// [`Packet::setup`]); `neg` as [`Packet::gather`] returns it.
+    ///
+    /// One piece: the portable reference that `setup_full`'s
+    /// intrinsics are held to lane for lane; its steps stand in the same
+    /// order as those, so that the two read side by side.
     #[inline(always)]
     pub(super) fn setup_lanes(&mut self, n: usize, neg: [u32; 3], bounds: &Aabb) -> bool {
         debug_assert!((1..=PACKET).contains(&n));
@@ -338,7 +342,9 @@ mod avx2 {
         /// the portable one's, lane for lane, with the same rounding and the
         /// same NaN rules (ordered comparisons as Rust's `<`, `>`, `<=`, `>=`;
         /// `blendv` for `if`), so the lanes are bit-identical (tested against
-        /// it).
+        /// it). One piece for the same reason: split, its steps would pass
+        /// their vectors through memory at each call boundary, and they
+        /// read step for step against the portable set-up.
         #[target_feature(enable = "avx2")]
         fn setup_full(
             &mut self,
