@@ -27,6 +27,7 @@
 
 pub mod assembly;
 pub mod atomic;
+mod common;
 pub mod description;
 pub mod gltf_scene;
 pub mod image_in;

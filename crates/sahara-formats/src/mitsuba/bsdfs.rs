@@ -29,12 +29,11 @@ use sahara_render::{
     AlphaMode, Bsdf, Clearcoat, Distribution, Material, NormalMap, Texture, TextureMap,
 };
 
-use super::build::{key, Builder};
+use super::builder::{key, Builder};
 use super::properties::Object;
 use super::spectra::{conductor_rgb, Color, Usage};
 use super::xml::Node;
-use crate::pbrt::materials::blend;
-use crate::pbrt::textures::{with_opacity, Tint};
+use crate::common::tint::{blend, with_opacity, Tint};
 use crate::FormatError;
 
 /// Deepest chain of bsdfs nested in bsdfs.

@@ -16,7 +16,7 @@ use std::sync::Arc;
 use glam::{DMat3, DVec3, Vec2, Vec3};
 use sahara_render::{environment_direction, Environment, Light, Texture};
 
-use super::build::Builder;
+use super::builder::Builder;
 use super::properties::Object;
 use super::spectra::Usage;
 use super::xml::Node;

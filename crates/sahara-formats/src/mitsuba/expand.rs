@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use super::defaults::Defaults;
 use super::xml::{read_file, Node};
-use crate::pbrt::warnings::Warnings;
+use crate::common::warnings::Warnings;
 use crate::FormatError;
 
 /// Deepest chain of files including files.

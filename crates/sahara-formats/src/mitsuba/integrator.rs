@@ -17,7 +17,7 @@
 
 use sahara_render::Integrator;
 
-use super::build::Builder;
+use super::builder::Builder;
 use super::xml::Node;
 use crate::FormatError;
 

@@ -5,8 +5,9 @@
 //!   (`roxmltree`); [`expand`]: `<include>`, `<default>` and `$name`
 //!   ([`defaults`]), 0.x names; [`properties`]: an element as a typed
 //!   object ([`spectra`] for colours, [`transform`] for transforms).
-//! - The mapping to Sahara's [`SceneDescription`]: [`build`] (ids, the
-//!   walk), [`shapes`] (with [`serialized`] meshes), [`bsdfs`] (the one
+//! - The mapping to Sahara's [`SceneDescription`]: [`build`] (the walk)
+//!   over [`builder`] (ids, what is made once), [`shapes`] (with
+//!   [`serialized`] meshes), [`bsdfs`] (the one
 //!   material table), [`textures`], [`emitters`], [`sensor`] (camera,
 //!   film, filter, sampler) and [`integrator`].
 //! - Every error is one line, `file: line L: column C: what`; everything
@@ -18,6 +19,7 @@
 
 mod bsdfs;
 mod build;
+mod builder;
 mod defaults;
 mod emitters;
 mod expand;
@@ -39,7 +41,7 @@ use std::path::Path;
 
 use crate::assembly::{assemble, AssembledScene};
 use crate::description::SceneDescription;
-use crate::pbrt::warnings::Warnings;
+use crate::common::warnings::Warnings;
 use crate::FormatError;
 
 /// True if `path` names a Mitsuba scene file (`.xml`, any case).

@@ -18,8 +18,8 @@ use super::expand::Search;
 use super::spectra::{numbers, parse_rgb, parse_spectrum, parse_temperature, Color};
 use super::transform::parse_transform;
 use super::xml::Node;
-use crate::pbrt::lexer::Loc;
-use crate::pbrt::warnings::Warnings;
+use crate::common::position::Loc;
+use crate::common::warnings::Warnings;
 use crate::FormatError;
 
 /// Tags of nested objects.

@@ -23,7 +23,7 @@
 use glam::{DMat4, DVec3};
 use sahara_render::{Camera, Filter, Integrator, SamplerKind, ToneMap};
 
-use super::build::Builder;
+use super::builder::Builder;
 use super::properties::Object;
 use super::xml::Node;
 use crate::description::{FileCrop, FileSettings};

@@ -24,13 +24,13 @@
 use glam::{Affine3A, DMat3, DMat4, DVec3, Mat3, Vec2, Vec3};
 use sahara_render::{Mesh, SceneMesh, Shape};
 
-use super::build::{key, Builder};
+use super::builder::{key, Builder};
 use super::properties::Object;
 use super::serialized::parse_serialized;
 use super::xml::Node;
 use crate::description::{Geometry, Object as SceneObject, ObjectPlacement};
-use crate::pbrt::lexer::read_maybe_gz;
-use crate::pbrt::subdivision::smooth_normals;
+use crate::common::gzip::read_maybe_gz;
+use crate::common::normals::smooth_normals;
 use crate::FormatError;
 
 /// Rim segments of a tessellated cylinder.

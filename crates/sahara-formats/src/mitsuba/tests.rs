@@ -13,7 +13,7 @@ use sahara_render::{
 
 use super::{described, load_mitsuba, read_mitsuba_with, xml};
 use crate::description::{CameraRequest, FileCrop, Geometry, ObjectPlacement, SceneDescription};
-use crate::pbrt::warnings::Warnings;
+use crate::common::warnings::Warnings;
 use crate::scene_load::load_scene;
 use crate::FormatError;
 

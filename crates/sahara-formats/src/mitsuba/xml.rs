@@ -6,8 +6,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use crate::pbrt::lexer::{read_maybe_gz, Loc};
-use crate::pbrt::warnings::Warnings;
+use crate::common::gzip::read_maybe_gz;
+use crate::common::position::Loc;
+use crate::common::warnings::Warnings;
 use crate::FormatError;
 
 /// Largest number of XML nodes read from one file (roxmltree's own limit

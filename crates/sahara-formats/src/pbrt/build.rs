@@ -28,11 +28,12 @@ use sahara_render::{
 
 use super::declarations::{Declarations, Entity, MaterialRef, ShapeDecl, Xform};
 use super::lights::{add_light, area_emission};
-use super::materials::{blend, map_material, Mapped};
+use super::materials::{map_material, Mapped};
 use super::shapes::shape_geometry;
-use super::subdivision::smooth_normals;
-use super::textures::{with_opacity, Textures};
-use super::warnings::Warnings;
+use crate::common::normals::smooth_normals;
+use super::textures::Textures;
+use crate::common::tint::{blend, with_opacity};
+use crate::common::warnings::Warnings;
 use crate::description::{
     CameraRequest, FileCrop, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
 };
@@ -138,7 +139,7 @@ impl Materials<'_> {
         &mut self,
         scene: &mut SceneDescription,
         name: &str,
-        loc: &super::lexer::Loc,
+        loc: &crate::common::position::Loc,
         w: &mut Warnings,
         depth: usize,
     ) -> Result<Option<u32>, FormatError> {
@@ -299,7 +300,7 @@ fn camera(
             Entity {
                 kind: "perspective".into(),
                 params: Default::default(),
-                loc: super::lexer::Loc {
+                loc: crate::common::position::Loc {
                     file: "".into(),
                     line: 0,
                     col: 0,

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use glam::DMat4;
 
-use super::lexer::Loc;
+use crate::common::position::Loc;
 use super::params::ParamList;
 
 /// A directive's type name (`"perspective"`, `"trianglemesh"`, ...) with its parameters.

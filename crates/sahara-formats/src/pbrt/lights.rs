@@ -11,7 +11,7 @@
 //!
 //! A light's `rgb` value is its radiance or intensity in linear sRGB as
 //! written; a `blackbody` or other spectrum is normalised to luminance 1
-//! first (see [`super::spectrum`]). `power` rescales to the given radiant
+//! first (see [`crate::common::spectrum`]). `power` rescales to the given radiant
 //! power as pbrt-v4 does: `power / 4 pi` for a point light,
 //! `power / (2 pi (1 - (cos_start + cos_end) / 2))` for a spot light,
 //! `power / (pi area)` (halved when two-sided) for an area light.
@@ -23,9 +23,9 @@ use sahara_render::{Environment, Light, Texture};
 
 use super::declarations::{Entity, LightDecl};
 use super::envmap::to_lat_long;
-use super::spectrum::Use;
+use crate::common::spectrum::Use;
 use super::textures::rgb_of;
-use super::warnings::Warnings;
+use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
 use crate::image_in::load_rgb_f32;
 use crate::FormatError;

@@ -28,9 +28,10 @@ use sahara_render::{AlphaMode, Bsdf, Distribution, Material};
 
 use super::declarations::Entity;
 use super::params::SpectrumParam;
-use super::spectrum::{self, Use};
-use super::textures::{rgb_of, spectral_samples, Textures, Tint};
-use super::warnings::Warnings;
+use crate::common::spectrum::{self, Use};
+use super::textures::{rgb_of, spectral_samples, Textures};
+use crate::common::tint::Tint;
+use crate::common::warnings::Warnings;
 use crate::FormatError;
 
 /// pbrt's one microfacet distribution, Trowbridge-Reitz (GGX).
@@ -539,32 +540,6 @@ pub(crate) fn map_material(
         }
     };
     Ok(Mapped::Surface(m))
-}
-
-/// pbrt's `mix` of materials `a` and `b` with weight `t` of `b`, when
-/// Sahara can blend them exactly: the same material, or two diffuse
-/// colours without textures (a Lambertian BSDF is linear in its colour).
-pub(crate) fn blend(a: &Material, b: &Material, t: f32) -> Option<Material> {
-    if a == b {
-        return Some(a.clone());
-    }
-    match (a.bsdf, b.bsdf) {
-        (Bsdf::Diffuse { albedo: x }, Bsdf::Diffuse { albedo: y })
-            if a.textures.base_color.is_none()
-                && b.textures.base_color.is_none()
-                && Material {
-                    bsdf: a.bsdf,
-                    ..b.clone()
-                } == *a =>
-        {
-            let mut m = a.clone();
-            m.bsdf = Bsdf::Diffuse {
-                albedo: x.lerp(y, t),
-            };
-            Some(m)
-        }
-        _ => None,
-    }
 }
 
 #[cfg(test)]

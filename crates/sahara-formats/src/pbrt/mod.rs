@@ -11,7 +11,8 @@
 //! - The mapping to Sahara's [`SceneDescription`]: [`build`] (camera,
 //!   settings, shapes, objects and instances), [`shapes`] (with [`subdivision`]), [`materials`] (the
 //!   one material table), [`textures`], [`lights`] (with [`envmap`]),
-//!   [`spectrum`] (spectra to RGB).
+//!   with what the Mitsuba reader shares in [`crate::common`] (spectra
+//!   to RGB, tints and blends, warnings, positions).
 //! - Every error is one line, `file: line L: column C: what`; everything
 //!   Sahara approximates or leaves out is a warning, one per kind with a
 //!   count, naming the first place.
@@ -21,17 +22,15 @@
 
 mod build;
 mod declarations;
-pub(crate) mod envmap;
-pub(crate) mod lexer;
+mod envmap;
+mod lexer;
 mod lights;
-pub(crate) mod materials;
+mod materials;
 mod params;
 mod parser;
 mod shapes;
-pub(crate) mod spectrum;
-pub(crate) mod subdivision;
-pub(crate) mod textures;
-pub(crate) mod warnings;
+mod subdivision;
+mod textures;
 
 #[cfg(test)]
 mod tests;
@@ -39,6 +38,7 @@ mod tests;
 use std::path::Path;
 
 use crate::assembly::{assemble, AssembledScene};
+use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
 use crate::FormatError;
 
@@ -61,7 +61,7 @@ pub fn load_pbrt(path: &Path) -> Result<AssembledScene, FormatError> {
 /// Reads a pbrt file (and the files it includes, meshes and images) as
 /// a scene description.
 pub fn read_pbrt(path: &Path) -> Result<SceneDescription, FormatError> {
-    let mut w = warnings::Warnings::default();
+    let mut w = Warnings::default();
     let desc = parser::parse_file(path, &mut w)?;
     let folder = path.parent().unwrap_or(Path::new(""));
     let name = path.display().to_string();
@@ -71,13 +71,13 @@ pub fn read_pbrt(path: &Path) -> Result<SceneDescription, FormatError> {
 /// Parses and builds a pbrt file held in memory; `name` is used in
 /// messages and relative file names resolve against `folder`.
 pub fn parse_pbrt(text: &[u8], name: &str, folder: &Path) -> Result<AssembledScene, FormatError> {
-    let mut w = warnings::Warnings::default();
+    let mut w = Warnings::default();
     let desc = parser::parse_bytes(text.to_vec(), name, folder, &mut w)?;
     assembled(described(build::build(&desc, name, folder, &mut w)?, w))
 }
 
 /// The description with the reader's warnings, one line per kind.
-fn described(mut desc: SceneDescription, w: warnings::Warnings) -> SceneDescription {
+fn described(mut desc: SceneDescription, w: Warnings) -> SceneDescription {
     desc.warnings = w.into_lines();
     desc
 }

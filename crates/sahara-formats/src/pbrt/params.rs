@@ -7,7 +7,7 @@
 
 use std::cell::Cell;
 
-use super::lexer::Loc;
+use crate::common::position::Loc;
 use crate::FormatError;
 
 /// The values of one parameter.

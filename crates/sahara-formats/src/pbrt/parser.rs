@@ -17,9 +17,11 @@ use glam::{DMat4, DVec3};
 use super::declarations::{
     Declarations, Entity, InstanceDecl, LightDecl, MaterialRef, ShapeDecl, TextureDecl, Xform,
 };
-use super::lexer::{read_maybe_gz, Lexer, Loc, Token, TokenKind};
+use super::lexer::{Lexer, Token, TokenKind};
+use crate::common::gzip::read_maybe_gz;
+use crate::common::position::Loc;
 use super::params::{Param, ParamList, Values};
-use super::warnings::Warnings;
+use crate::common::warnings::Warnings;
 use crate::FormatError;
 
 /// Deepest `Include` nesting accepted (a file including itself is caught by this).

@@ -19,9 +19,10 @@ use sahara_render::Shape;
 use sahara_render::{Mesh, SceneMesh};
 
 use super::declarations::Entity;
-use super::lexer::read_maybe_gz;
-use super::subdivision::{loop_subdivide, smooth_normals};
-use super::warnings::Warnings;
+use crate::common::gzip::read_maybe_gz;
+use super::subdivision::loop_subdivide;
+use crate::common::normals::smooth_normals;
+use crate::common::warnings::Warnings;
 use crate::FormatError;
 use sahara_readers::fan::fan_triangulate;
 use sahara_readers::ply::parse_ply_with_attributes;

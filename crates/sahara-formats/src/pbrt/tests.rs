@@ -10,7 +10,7 @@ use sahara_render::{render, Placement, RenderSettings, Scene};
 
 use super::declarations::Declarations;
 use super::parser::parse_bytes;
-use super::warnings::Warnings;
+use crate::common::warnings::Warnings;
 use super::{load_pbrt, parse_pbrt};
 use crate::scene_load::load_scene;
 
