@@ -28,7 +28,8 @@ const GROUND_DWARFS: f32 = 4.0;
 const FLAT: f32 = 0.05;
 
 /// A camera that sees the scene (see [`auto_camera_framing`]).
-pub fn auto_camera(scene: &Scene, name: &str) -> Result<Camera, FormatError> {
+#[cfg(test)]
+fn auto_camera(scene: &Scene, name: &str) -> Result<Camera, FormatError> {
     auto_camera_framing(scene, name).map(|(c, _)| c)
 }
 

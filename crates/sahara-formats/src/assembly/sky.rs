@@ -20,8 +20,8 @@ use glam::Vec3;
 use sahara_render::luminance;
 use sahara_render::{Environment, Light, Scene, Texture};
 
+use crate::common::image::load_rgb_f32;
 use crate::description::Sky;
-use crate::image_in::load_rgb_f32;
 use crate::FormatError;
 
 /// Radiance of the default sky.

@@ -20,7 +20,7 @@ use super::builder::Builder;
 use super::properties::Object;
 use super::spectra::Usage;
 use super::xml::Node;
-use crate::image_in::load_rgb_f32;
+use crate::common::image::load_rgb_f32;
 use crate::FormatError;
 
 /// Mitsuba's lat-long coordinates of a direction in the map's own frame.

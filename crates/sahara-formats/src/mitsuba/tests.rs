@@ -11,11 +11,11 @@ use sahara_render::{
     RenderSettings, SamplerKind, Scene, Shape,
 };
 
-use super::{described, load_mitsuba, read_mitsuba_with, xml};
-use crate::description::{CameraRequest, FileCrop, Geometry, ObjectPlacement, SceneDescription};
+use super::{described, read_mitsuba_with, xml};
 use crate::common::warnings::Warnings;
-use crate::scene_load::load_scene;
+use crate::description::{CameraRequest, FileCrop, Geometry, ObjectPlacement, SceneDescription};
 use crate::FormatError;
+use crate::{load_mitsuba, load_scene};
 
 /// A fresh folder for a test's files.
 fn folder(name: &str) -> PathBuf {

@@ -23,7 +23,7 @@ use super::builder::{key, Builder};
 use super::properties::Object;
 use super::spectra::Usage;
 use super::xml::Node;
-use crate::image_in::load_texture;
+use crate::common::image::load_texture;
 use crate::common::tint::{Sampling, Tint};
 use crate::FormatError;
 

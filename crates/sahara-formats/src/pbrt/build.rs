@@ -30,8 +30,8 @@ use super::declarations::{Declarations, Entity, MaterialRef, ShapeDecl, Xform};
 use super::lights::{add_light, area_emission};
 use super::materials::{map_material, Mapped};
 use super::shapes::shape_geometry;
-use crate::common::normals::smooth_normals;
 use super::textures::Textures;
+use crate::common::mesh::smooth_normals;
 use crate::common::tint::{blend, with_opacity};
 use crate::common::warnings::Warnings;
 use crate::description::{

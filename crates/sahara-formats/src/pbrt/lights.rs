@@ -23,11 +23,11 @@ use sahara_render::{Environment, Light, Texture};
 
 use super::declarations::{Entity, LightDecl};
 use super::envmap::to_lat_long;
-use crate::common::spectrum::Use;
 use super::textures::rgb_of;
+use crate::common::image::load_rgb_f32;
+use crate::common::spectrum::Use;
 use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
-use crate::image_in::load_rgb_f32;
 use crate::FormatError;
 
 /// A spectrum parameter of a light as RGB (default white).

@@ -28,8 +28,8 @@ use sahara_render::{AlphaMode, Bsdf, Distribution, Material};
 
 use super::declarations::Entity;
 use super::params::SpectrumParam;
-use crate::common::spectrum::{self, Use};
 use super::textures::{rgb_of, spectral_samples, Textures};
+use crate::common::spectrum::{self, Use};
 use crate::common::tint::Tint;
 use crate::common::warnings::Warnings;
 use crate::FormatError;
@@ -560,7 +560,7 @@ mod tests {
     /// warnings.
     fn material_of(decl: &str) -> (Material, Vec<String>) {
         let text = format!("{decl}\nShape \"sphere\"\n");
-        let s = crate::pbrt::parse_pbrt(
+        let s = crate::parse_pbrt(
             text.as_bytes(),
             "m.pbrt",
             std::path::Path::new("/nonexistent"),

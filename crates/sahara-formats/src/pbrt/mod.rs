@@ -37,13 +37,12 @@ mod tests;
 
 use std::path::Path;
 
-use crate::assembly::{assemble, AssembledScene};
 use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
 use crate::FormatError;
 
 /// True if `path` names a pbrt file (`.pbrt` or `.pbrt.gz`, any case).
-pub fn is_pbrt_path(path: &Path) -> bool {
+pub(crate) fn is_pbrt_path(path: &Path) -> bool {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().to_ascii_lowercase())
@@ -51,16 +50,9 @@ pub fn is_pbrt_path(path: &Path) -> bool {
     name.ends_with(".pbrt") || name.ends_with(".pbrt.gz")
 }
 
-/// Reads a pbrt file (and the files it includes, meshes and images) and
-/// assembles its scene, checked (its settings are always there; the
-/// film's `cropwindow` or `pixelbounds` is in their `crop`).
-pub fn load_pbrt(path: &Path) -> Result<AssembledScene, FormatError> {
-    assembled(read_pbrt(path)?)
-}
-
 /// Reads a pbrt file (and the files it includes, meshes and images) as
 /// a scene description.
-pub fn read_pbrt(path: &Path) -> Result<SceneDescription, FormatError> {
+pub(crate) fn read_pbrt(path: &Path) -> Result<SceneDescription, FormatError> {
     let mut w = Warnings::default();
     let desc = parser::parse_file(path, &mut w)?;
     let folder = path.parent().unwrap_or(Path::new(""));
@@ -68,26 +60,20 @@ pub fn read_pbrt(path: &Path) -> Result<SceneDescription, FormatError> {
     Ok(described(build::build(&desc, &name, folder, &mut w)?, w))
 }
 
-/// Parses and builds a pbrt file held in memory; `name` is used in
+/// Parses and describes a pbrt file held in memory; `name` is used in
 /// messages and relative file names resolve against `folder`.
-pub fn parse_pbrt(text: &[u8], name: &str, folder: &Path) -> Result<AssembledScene, FormatError> {
+pub(crate) fn read_pbrt_text(
+    text: &[u8],
+    name: &str,
+    folder: &Path,
+) -> Result<SceneDescription, FormatError> {
     let mut w = Warnings::default();
     let desc = parser::parse_bytes(text.to_vec(), name, folder, &mut w)?;
-    assembled(described(build::build(&desc, name, folder, &mut w)?, w))
+    Ok(described(build::build(&desc, name, folder, &mut w)?, w))
 }
 
 /// The description with the reader's warnings, one line per kind.
 fn described(mut desc: SceneDescription, w: Warnings) -> SceneDescription {
     desc.warnings = w.into_lines();
     desc
-}
-
-/// The assembled scene, checked.
-fn assembled(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
-    let name = desc.name.clone();
-    let a = assemble(desc)?;
-    a.scene
-        .validate()
-        .map_err(|e| FormatError::in_file(&name, e))?;
-    Ok(a)
 }

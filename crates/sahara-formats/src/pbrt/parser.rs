@@ -18,9 +18,9 @@ use super::declarations::{
     Declarations, Entity, InstanceDecl, LightDecl, MaterialRef, ShapeDecl, TextureDecl, Xform,
 };
 use super::lexer::{Lexer, Token, TokenKind};
+use super::params::{Param, ParamList, Values};
 use crate::common::gzip::read_maybe_gz;
 use crate::common::position::Loc;
-use super::params::{Param, ParamList, Values};
 use crate::common::warnings::Warnings;
 use crate::FormatError;
 

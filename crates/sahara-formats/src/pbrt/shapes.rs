@@ -19,9 +19,9 @@ use sahara_render::Shape;
 use sahara_render::{Mesh, SceneMesh};
 
 use super::declarations::Entity;
-use crate::common::gzip::read_maybe_gz;
 use super::subdivision::loop_subdivide;
-use crate::common::normals::smooth_normals;
+use crate::common::gzip::read_maybe_gz;
+use crate::common::mesh::smooth_normals;
 use crate::common::warnings::Warnings;
 use crate::FormatError;
 use sahara_readers::fan::fan_triangulate;

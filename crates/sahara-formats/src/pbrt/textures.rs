@@ -20,17 +20,17 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Affine2, Mat2, Vec2, Vec3};
-use sahara_render::Wrap;
 use sahara_render::Texture;
+use sahara_render::Wrap;
 
 use super::declarations::{Entity, TextureDecl};
 use super::params::{FloatParam, SpectrumParam};
+use crate::common::image::load_image;
 use crate::common::spectrum::{self, Use};
 use crate::common::tint::{alpha_of, texel_count, with_alpha_of, Sampling, Tint};
 use crate::common::warnings::Warnings;
-use crate::image_in::load_image;
-use crate::srgb::linear_to_srgb8;
 use crate::FormatError;
+use sahara_render::linear_to_srgb8;
 
 /// Deepest chain of textures referring to textures.
 const MAX_TEXTURE_DEPTH: usize = 32;

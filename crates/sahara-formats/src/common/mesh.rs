@@ -1,7 +1,16 @@
-//! Smooth vertex normals of triangle meshes (pbrt's subdivided meshes,
-//! Mitsuba's `face_normals="false"` meshes without normals).
+//! Triangle meshes as the readers share them: a mesh file's plain
+//! triangles as the renderer's mesh, and smooth vertex normals (pbrt's
+//! subdivided meshes, Mitsuba's meshes without normals).
 
 use glam::Vec3;
+use sahara_readers::TriangleMesh;
+use sahara_render::Mesh;
+
+/// A mesh as read as the renderer's mesh (both vectors are moved, not copied).
+pub fn render_mesh(mesh: TriangleMesh) -> Mesh {
+    let TriangleMesh { positions, indices } = mesh;
+    Mesh { positions, indices }
+}
 
 /// Per-vertex normals: the area-weighted mean of the faces' (winding) normals.
 pub(crate) fn smooth_normals(positions: &[Vec3], tris: &[[u32; 3]]) -> Vec<Vec3> {

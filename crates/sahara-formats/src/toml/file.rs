@@ -1,4 +1,5 @@
-//! Scene files: TOML describing camera, materials, objects, lights and render settings.
+//! Scene files as read: TOML describing camera, materials, objects,
+//! lights and render settings, checked into a [`SceneFile`].
 //!
 //! The format is documented in `docs/scene-format.md` at the repository
 //! root; in short:
@@ -55,9 +56,6 @@
 //! out of range are errors; every error names the file, the line and column.
 //! Input file paths are resolved relative to the scene file's folder; the
 //! output relative to the working folder (unless absolute).
-
-mod raw;
-mod resolve;
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -408,5 +406,5 @@ pub fn load_scene_file(path: &Path) -> Result<SceneFile, FormatError> {
 
 /// Parses and checks scene TOML held in memory; `name` is used in errors, paths resolve against `folder`.
 pub fn parse_scene_file(text: &str, name: &str, folder: &Path) -> Result<SceneFile, FormatError> {
-    resolve::resolve(text, name, folder).map_err(sahara_readers::one_line)
+    super::resolve::resolve(text, name, folder).map_err(sahara_readers::one_line)
 }

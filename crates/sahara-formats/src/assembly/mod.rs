@@ -23,8 +23,8 @@
 //! - Moving emissive objects are seen but not sampled as lights; that is
 //!   a warning.
 
-pub mod camera;
-pub mod sky;
+pub(crate) mod camera;
+pub(crate) mod sky;
 
 use std::collections::HashSet;
 
@@ -35,13 +35,13 @@ use sahara_render::{Camera, Instance, Placement, Scene, Shape, Srt};
 use crate::description::{
     CameraRequest, FileSettings, Geometry, ObjectPlacement, SceneDescription,
 };
-use crate::gltf_scene::{gltf_camera, gltf_light};
-use crate::mesh_library::{file_key, MeshLibrary};
+use crate::gltf::{gltf_camera, gltf_light};
+use crate::mesh::library::{file_key, MeshLibrary};
 use crate::FormatError;
 use camera::has_finite_triangles;
 use sky::SkyUsed;
 
-pub use camera::{auto_camera, auto_camera_framing, AUTO_VFOV_DEG};
+use camera::{auto_camera_framing, AUTO_VFOV_DEG};
 
 /// A scene ready to render, with what assembling it decided.
 #[derive(Clone, Debug)]

@@ -12,10 +12,11 @@ use sahara_render::{
 };
 use toml::Spanned;
 
+use super::file::*;
 use super::raw::*;
-use super::*;
 use crate::description::Sky;
-use crate::image_out::ImageFormat;
+use crate::output::image::ImageFormat;
+use crate::FormatError;
 
 /// Largest film width or height.
 const MAX_FILM_SIDE: i64 = 65536;
