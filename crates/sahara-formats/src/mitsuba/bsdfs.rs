@@ -249,6 +249,10 @@ impl<'a> Builder<'a> {
     }
 
     /// The material of a bsdf element; `None` for no surface.
+    ///
+    /// One piece on purpose: it is Mitsuba's one bsdf table, an arm per kind, each mapping its
+    /// parameters onto Sahara's; it becomes one mapping per kind family when
+    /// materials and lights are kinds the renderer describes.
     fn bsdf(&mut self, node: &'a Node, depth: usize) -> Result<Option<Material>, FormatError> {
         if depth > MAX_NESTING {
             return Err(node.error("bsdfs nest too deep (a cycle of references?)"));

@@ -55,6 +55,10 @@ fn v3(p: [f64; 3]) -> DVec3 {
 }
 
 /// Adds the light `l` to `scene`.
+///
+/// One piece on purpose: it is pbrt's one light table, an arm per kind, each mapping its
+/// parameters onto Sahara's; it becomes one mapping per kind family when
+/// materials and lights are kinds the renderer describes.
 pub(crate) fn add_light(
     scene: &mut SceneDescription,
     l: &LightDecl,

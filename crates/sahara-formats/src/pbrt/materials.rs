@@ -298,6 +298,10 @@ fn layered(kd: &Tint, f0: Vec3, f90: f32, r: f32) -> Material {
 /// `e.kind` is the material type (for `MakeNamedMaterial`, the caller has
 /// put its `"string type"` there). Approximations are counted in `w`,
 /// one kind per material type.
+///
+/// One piece on purpose: it is pbrt's one material table, an arm per kind, each mapping its
+/// parameters onto Sahara's; it becomes one mapping per kind family when
+/// materials and lights are kinds the renderer describes.
 pub(crate) fn map_material(
     e: &Entity,
     tex: &mut Textures,

@@ -359,6 +359,12 @@ impl Parser<'_> {
         Ok(())
     }
 
+    /// Applies one directive at `loc` to the graphics state or the
+    /// declarations.
+    ///
+    /// One piece on purpose: it is the parser's one table of pbrt's
+    /// directives, an arm per directive, most of them a few lines; split
+    /// by directive, the graphics state would be passed to each.
     fn directive(&mut self, directive: &str, loc: Loc) -> Result<(), FormatError> {
         match directive {
             "Identity" => self.apply(|_| DMat4::IDENTITY),

@@ -261,6 +261,12 @@ impl<'a> Textures<'a> {
         }
     }
 
+    /// The texture `e` as a tint (`float`: a float texture), `depth`
+    /// textures deep.
+    ///
+    /// One piece on purpose: it is pbrt's one texture table, an arm per
+    /// texture type as the module's list has them, after the `uv`
+    /// mapping they share.
     fn convert(
         &mut self,
         e: &Entity,

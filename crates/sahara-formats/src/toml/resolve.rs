@@ -379,6 +379,10 @@ impl Ctx<'_> {
     }
 
     /// `[[material]]`.
+    ///
+    /// One piece on purpose: it is the scene file's one material table, an arm per kind, each mapping its
+    /// parameters onto Sahara's; it becomes one mapping per kind family when
+    /// materials and lights are kinds the renderer describes.
     fn material(&self, m: &RawMaterial) -> Result<MaterialSpec, FormatError> {
         let kind = *m.kind.get_ref();
         let what = format!("a {} material", type_name(&m.kind));
@@ -864,6 +868,10 @@ impl Ctx<'_> {
     }
 
     /// `[[light]]`.
+    ///
+    /// One piece on purpose: it is the scene file's one light table, an arm per kind, each mapping its
+    /// parameters onto Sahara's; it becomes one mapping per kind family when
+    /// materials and lights are kinds the renderer describes.
     fn light(
         &self,
         raw: &Spanned<RawLight>,
