@@ -13,13 +13,13 @@
 use std::path::Path;
 
 use sahara_readers::camera::read_sidecar;
+use sahara_readers::FormatError;
 use sahara_render::{builtin, Camera, Scene};
 
 use crate::assembly::{assemble, sky, AssembledScene, SceneNames};
 use crate::description::{FileSettings, SceneDescription, Sky};
 use crate::mesh::{read_mesh_scene, CameraChoice};
 use crate::toml::read_scene;
-use crate::FormatError;
 
 /// What may be asked of a scene besides its file.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -2,9 +2,8 @@
 //! the right.
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::{Camera, Scene};
-
-use crate::FormatError;
 
 /// Vertical field of view of the automatic camera, degrees.
 pub const AUTO_VFOV_DEG: f32 = 45.0;

@@ -38,11 +38,11 @@ use crate::description::{
 };
 use crate::gltf::{gltf_camera, gltf_light};
 use crate::mesh::library::{file_key, MeshLibrary};
-use crate::FormatError;
 use camera::has_finite_triangles;
 use sky::SkyUsed;
 
 use camera::{auto_camera_framing, AUTO_VFOV_DEG};
+use sahara_readers::FormatError;
 
 /// A scene ready to render, with what assembling it decided.
 #[derive(Clone, Debug)]

@@ -17,12 +17,12 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::luminance;
 use sahara_render::{Environment, Light, Scene, Texture};
 
 use crate::common::image::load_rgb_f32;
 use crate::description::Sky;
-use crate::FormatError;
 
 /// Radiance of the default sky.
 pub const DEFAULT_SKY: Vec3 = Vec3::new(0.55, 0.6, 0.7);

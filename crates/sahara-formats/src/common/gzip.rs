@@ -3,7 +3,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use crate::FormatError;
+use sahara_readers::FormatError;
 
 /// Largest file (after decompression) read, in bytes: a guard against a
 /// gzip bomb, far above any real scene file.

@@ -19,7 +19,7 @@ use sahara_readers::image_in::{decode_raw, load_raw, ImageFormat, Pixels, RawIma
 use sahara_render::Encoding;
 use sahara_render::Texture;
 
-use crate::FormatError;
+use sahara_readers::FormatError;
 use sahara_render::{srgb8_to_linear, srgb_to_linear};
 
 /// An image as linear float RGB: width, height, `width * height * 3` values row-major from the top left.

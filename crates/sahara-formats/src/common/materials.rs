@@ -8,10 +8,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::{Encoding, Texture};
 
 use crate::common::image::load_texture;
-use crate::FormatError;
 
 /// Where a texture's image came from, as the cache knows it.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]

@@ -3,7 +3,7 @@
 
 use std::sync::Arc;
 
-use crate::FormatError;
+use sahara_readers::FormatError;
 
 /// Where something is in a scene file.
 #[derive(Clone, Debug, PartialEq, Eq)]

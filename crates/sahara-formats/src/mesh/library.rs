@@ -17,8 +17,8 @@ use crate::common::materials::TextureCache;
 use crate::common::mesh::render_mesh;
 use crate::gltf::material::gltf_material;
 use crate::mesh::mtl::mtl_material;
-use crate::FormatError;
 use sahara_readers::gltf::{GltfCamera, GltfLight};
+use sahara_readers::FormatError;
 
 /// One scene mesh made from a file, and where the file puts it.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -23,8 +23,8 @@ use crate::common::mesh::render_mesh;
 
 use crate::description::Sky;
 use crate::description::{CameraRequest, Geometry, Object, ObjectPlacement, SceneDescription};
-use crate::FormatError;
 use sahara_readers::camera::{read_sidecar, sidecar_path};
+use sahara_readers::FormatError;
 
 /// Which camera a mesh file is seen by.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

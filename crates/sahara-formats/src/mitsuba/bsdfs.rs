@@ -25,6 +25,7 @@
 use glam::Vec3;
 use std::sync::Arc;
 
+use sahara_readers::FormatError;
 use sahara_render::{
     AlphaMode, Bsdf, Clearcoat, Distribution, Material, NormalMap, Texture, TextureMap,
 };
@@ -34,7 +35,6 @@ use super::properties::Object;
 use super::spectra::{conductor_rgb, Color, Usage};
 use super::xml::Node;
 use crate::common::tint::{blend, with_opacity, Tint};
-use crate::FormatError;
 
 /// Deepest chain of bsdfs nested in bsdfs.
 const MAX_NESTING: usize = 16;

@@ -13,12 +13,13 @@
 
 use std::collections::HashMap;
 
+use sahara_readers::FormatError;
+
 use super::builder::Builder;
 use super::expand::Search;
 use super::xml::Node;
 use crate::common::warnings::Warnings;
 use crate::description::{CameraRequest, SceneDescription};
-use crate::FormatError;
 
 /// The description of the expanded `<scene>` `root`, read from the file
 /// `name`, files looked for as `search` says.

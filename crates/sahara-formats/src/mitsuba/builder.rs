@@ -5,13 +5,14 @@
 use std::collections::HashMap;
 use std::path::PathBuf;
 
+use sahara_readers::FormatError;
+
 use super::expand::Search;
 use super::properties::{Child, Object};
 use super::xml::Node;
 use crate::common::tint::Tint;
 use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
-use crate::FormatError;
 
 /// What the walk over a scene builds, and what it has made so far.
 pub(crate) struct Builder<'a> {

@@ -15,12 +15,12 @@
 //! | `aov` | its nested integrator (warned: the image only) |
 //! | `hide_emitters` | not supported (warned) |
 
+use sahara_readers::FormatError;
 use sahara_render::Integrator;
 
 use super::builder::Builder;
 use super::properties::Object;
 use super::xml::Node;
-use crate::FormatError;
 
 /// Sahara's deepest path.
 const MAX_DEPTH: u32 = 1 << 16;

@@ -39,9 +39,10 @@ mod tests;
 
 use std::path::Path;
 
+use sahara_readers::FormatError;
+
 use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
-use crate::FormatError;
 
 /// True if `path` names a Mitsuba scene file (`.xml`, any case).
 pub(crate) fn is_mitsuba_path(path: &Path) -> bool {

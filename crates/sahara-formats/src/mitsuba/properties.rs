@@ -13,6 +13,7 @@ use std::cell::Cell;
 use std::path::PathBuf;
 
 use glam::{DMat4, DVec3};
+use sahara_readers::FormatError;
 
 use super::expand::Search;
 use super::spectra::{numbers, parse_rgb, parse_spectrum, parse_temperature, Color};
@@ -20,7 +21,6 @@ use super::transform::parse_transform;
 use super::xml::Node;
 use crate::common::position::Loc;
 use crate::common::warnings::Warnings;
-use crate::FormatError;
 
 /// Tags of nested objects.
 pub(crate) const OBJECT_TAGS: &[&str] = &[

@@ -11,9 +11,8 @@
 use std::io::Read;
 
 use glam::{Vec2, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{Mesh, SceneMesh};
-
-use crate::FormatError;
 
 const MAGIC: u16 = 0x041C;
 const HAS_NORMALS: u32 = 0x1;

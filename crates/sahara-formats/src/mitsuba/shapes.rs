@@ -22,6 +22,7 @@
 //!   serialized ones are kept, and every image texture reads them so.
 
 use glam::{Affine3A, DMat3, DMat4, DVec3, Mat3, Vec2, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{Mesh, SceneMesh, Shape};
 
 use super::builder::{key, Builder};
@@ -32,7 +33,6 @@ use crate::common::gzip::read_maybe_gz;
 use crate::common::mesh::render_mesh;
 use crate::common::mesh::smooth_normals;
 use crate::description::{Geometry, Object as SceneObject, ObjectPlacement};
-use crate::FormatError;
 
 /// Rim segments of a tessellated cylinder.
 const SEGMENTS: u32 = 128;

@@ -18,10 +18,10 @@
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
+use sahara_readers::FormatError;
 
 use super::xml::Node;
 use crate::common::spectrum;
-use crate::FormatError;
 
 /// A colour as the file gives it.
 #[derive(Clone, Debug, PartialEq)]

@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Affine3A, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{
     render, AlphaMode, Bsdf, Distribution, Environment, Filter, Integrator, Light, Material,
     RenderSettings, SamplerKind, Scene, Shape,
@@ -14,7 +15,6 @@ use sahara_render::{
 use super::{described, read_mitsuba_with, xml};
 use crate::common::warnings::Warnings;
 use crate::description::{CameraRequest, FileCrop, Geometry, ObjectPlacement, SceneDescription};
-use crate::FormatError;
 use crate::{load_mitsuba, load_scene};
 
 /// A fresh folder for a test's files.

@@ -17,6 +17,7 @@
 use std::sync::Arc;
 
 use glam::{Affine2, DMat4, Vec2, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{Encoding, Texture, Wrap};
 
 use super::builder::{key, Builder};
@@ -25,7 +26,6 @@ use super::spectra::Usage;
 use super::xml::Node;
 use crate::common::image::load_texture;
 use crate::common::tint::{Sampling, Tint};
-use crate::FormatError;
 
 /// Texels per check side of a baked checkerboard.
 const CHECK_TEXELS: u32 = 32;

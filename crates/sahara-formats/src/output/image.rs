@@ -16,7 +16,7 @@ use exr::prelude::{
 };
 
 use crate::output::atomic::write_atomically;
-use crate::FormatError;
+use sahara_readers::FormatError;
 use sahara_render::{linear_to_srgb8, srgb8_to_linear};
 
 /// The image file formats this module writes.

@@ -23,12 +23,12 @@ use exr::prelude::{
     AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
     WritableImage,
 };
+use sahara_readers::FormatError;
 use sahara_render::{
     Aov, Aux, AuxSums, IntegratorKind, Named, PixelSum, PixelWindow, SumBuffer, ToneMap,
 };
 
 use crate::output::atomic::write_atomically;
-use crate::FormatError;
 
 /// The value of `sahara:format` in a part file.
 const FORMAT: &str = "sahara render part 1";

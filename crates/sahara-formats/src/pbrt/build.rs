@@ -21,6 +21,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::{Affine3A, DMat3, DMat4, DVec3, Mat4, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::SceneMesh;
 use sahara_render::{
     AlphaMode, Camera, Filter, Integrator, Material, SamplerKind, Shape, Srt, TextureMap, ToneMap,
@@ -37,7 +38,6 @@ use crate::common::warnings::Warnings;
 use crate::description::{
     CameraRequest, FileCrop, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
 };
-use crate::FormatError;
 
 /// Deepest chain of `mix` materials followed.
 const MAX_MIX_DEPTH: usize = 16;

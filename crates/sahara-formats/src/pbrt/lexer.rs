@@ -4,8 +4,9 @@
 
 use std::sync::Arc;
 
+use sahara_readers::FormatError;
+
 use crate::common::position::Loc;
-use crate::FormatError;
 
 /// What a token is.
 #[derive(Clone, Debug, PartialEq)]

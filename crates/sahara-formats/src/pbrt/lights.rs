@@ -19,6 +19,7 @@
 use std::sync::Arc;
 
 use glam::{DMat3, DMat4, DVec3, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{Environment, Light, Texture};
 
 use super::declarations::{Entity, LightDecl};
@@ -28,7 +29,6 @@ use crate::common::image::load_rgb_f32;
 use crate::common::spectrum::Use;
 use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
-use crate::FormatError;
 
 /// A spectrum parameter of a light as RGB (default white).
 fn light_rgb(e: &Entity, name: &str, w: &mut Warnings) -> Result<Vec3, FormatError> {

@@ -24,6 +24,7 @@
 //! pbrt-v3's `opacity` (uber) becomes stochastic transparency.
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::{AlphaMode, Bsdf, Distribution, Material};
 
 use super::declarations::Entity;
@@ -32,7 +33,6 @@ use super::textures::{rgb_of, spectral_samples, Textures};
 use crate::common::spectrum::{self, Use};
 use crate::common::tint::Tint;
 use crate::common::warnings::Warnings;
-use crate::FormatError;
 
 /// pbrt's one microfacet distribution, Trowbridge-Reitz (GGX).
 const TROWBRIDGE_REITZ: Distribution = Distribution::Ggx;

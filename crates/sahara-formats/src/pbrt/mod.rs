@@ -37,9 +37,10 @@ mod tests;
 
 use std::path::Path;
 
+use sahara_readers::FormatError;
+
 use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
-use crate::FormatError;
 
 /// True if `path` names a pbrt file (`.pbrt` or `.pbrt.gz`, any case).
 pub(crate) fn is_pbrt_path(path: &Path) -> bool {

@@ -7,8 +7,9 @@
 
 use std::cell::Cell;
 
+use sahara_readers::FormatError;
+
 use crate::common::position::Loc;
-use crate::FormatError;
 
 /// The values of one parameter.
 #[derive(Clone, Debug, PartialEq)]

@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{DMat4, DVec3};
+use sahara_readers::FormatError;
 
 use super::declarations::{
     Declarations, Entity, InstanceDecl, LightDecl, MaterialRef, ShapeDecl, TextureDecl, Xform,
@@ -22,7 +23,6 @@ use super::params::{Param, ParamList, Values};
 use crate::common::gzip::read_maybe_gz;
 use crate::common::position::Loc;
 use crate::common::warnings::Warnings;
-use crate::FormatError;
 
 /// Deepest `Include` nesting accepted (a file including itself is caught by this).
 const MAX_INCLUDE_DEPTH: usize = 32;

@@ -23,9 +23,9 @@ use super::subdivision::loop_subdivide;
 use crate::common::gzip::read_maybe_gz;
 use crate::common::mesh::smooth_normals;
 use crate::common::warnings::Warnings;
-use crate::FormatError;
 use sahara_readers::fan::fan_triangulate;
 use sahara_readers::ply::parse_ply_with_attributes;
+use sahara_readers::FormatError;
 
 /// Largest number of triangles a shape may make (subdivision, tessellation).
 const MAX_TRIANGLES: u64 = 1 << 24;

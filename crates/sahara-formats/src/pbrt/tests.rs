@@ -13,7 +13,7 @@ use super::parser::parse_bytes;
 use crate::common::warnings::Warnings;
 use crate::{load_pbrt, load_scene, parse_pbrt};
 
-fn parse(text: &str) -> Result<(Declarations, Warnings), crate::FormatError> {
+fn parse(text: &str) -> Result<(Declarations, Warnings), sahara_readers::FormatError> {
     let mut w = Warnings::default();
     let d = parse_bytes(
         text.as_bytes().to_vec(),

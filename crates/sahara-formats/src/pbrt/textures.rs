@@ -29,7 +29,7 @@ use crate::common::image::load_image;
 use crate::common::spectrum::{self, Use};
 use crate::common::tint::{alpha_of, texel_count, with_alpha_of, Sampling, Tint};
 use crate::common::warnings::Warnings;
-use crate::FormatError;
+use sahara_readers::FormatError;
 use sahara_render::linear_to_srgb8;
 
 /// Deepest chain of textures referring to textures.

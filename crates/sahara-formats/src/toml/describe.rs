@@ -12,31 +12,23 @@
 //!   material's surface, or black); an environment is the description's.
 
 use std::collections::HashMap;
-use std::path::Path;
 use std::sync::Arc;
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::Encoding;
 use sahara_render::{Bsdf, Camera, Environment, Light, Material, Shape, Texture, TextureMap};
 
 use super::file::{
-    load_scene_file, CameraSpec, EnvironmentSpec, LightSpec, MaterialKind, MaterialSpec, SceneFile,
-    ShapeSpec,
+    CameraSpec, EnvironmentSpec, LightSpec, MaterialKind, MaterialSpec, SceneFile, ShapeSpec,
 };
 use crate::common::image::load_rgb_f32;
 use crate::common::materials::TextureCache;
 use crate::description::{
     CameraRequest, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
 };
-use crate::FormatError;
 
 use super::placement::placement;
-
-/// Reads a scene file as a description (meshes, textures and maps read
-/// relative to it).
-pub(crate) fn read_scene(path: &Path) -> Result<SceneDescription, FormatError> {
-    describe(&load_scene_file(path)?, &path.display().to_string())
-}
 
 /// The render settings of a parsed scene file.
 pub fn settings_of(file: &SceneFile) -> FileSettings {

@@ -5,6 +5,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::{defaults, Distribution};
 use sahara_render::{
     Adaptive, Filter, FilterKind, Integrator, IntegratorKind, Named, Parameter, SamplerKind, Shape,
@@ -16,7 +17,6 @@ use super::file::*;
 use super::raw::*;
 use crate::description::Sky;
 use crate::output::image::ImageFormat;
-use crate::FormatError;
 
 /// Largest film width or height.
 const MAX_FILM_SIDE: i64 = 65536;

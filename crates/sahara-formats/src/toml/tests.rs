@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 
 use super::file::*;
+use super::{load_scene_file, parse_scene_file};
 use glam::{Mat4, Quat, Vec3};
 use sahara_render::{Distribution, Filter, Integrator, SamplerKind, Shape, ToneMap};
 
