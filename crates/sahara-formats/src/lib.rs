@@ -83,7 +83,8 @@ pub use common::mesh::render_mesh;
 /// MTL materials as the renderer's.
 pub use mesh::mtl::{mtl_bsdf, mtl_material, phong_roughness, DEFAULT_GLASS_IOR};
 
-/// glTF cameras, lights and materials as the renderer's.
+/// glTF cameras and lights as the renderer's (light in watts from
+/// lumens at [`LUMENS_PER_WATT`]).
 pub use gltf::{gltf_camera, gltf_light, LUMENS_PER_WATT};
 
 /// glTF materials as the renderer's.

@@ -60,7 +60,7 @@ pub struct AssembledScene {
     pub sky: SkyUsed,
     /// With `auto` lighting, the measure that decided it: the scene's own
     /// lights' power as a share of the default sky and sun's
-    /// ([`sky::own_share`]; weak below [`sky::WEAK_FRACTION`]).
+    /// (weak below [`crate::WEAK_FRACTION`]).
     pub sky_share: Option<f32>,
     /// What the scene's objects and materials are called.
     pub names: SceneNames,

@@ -36,7 +36,7 @@ pub const DEFAULT_SUN: Vec3 = Vec3::splat(2.5);
 /// sky shed on the scene's bounding sphere.
 pub const WEAK_FRACTION: f32 = 0.05;
 
-/// What [`apply`] did.
+/// What lights a scene besides its own lights, as the sky rule decided.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum SkyUsed {
     /// The scene's own lights only.
