@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use libfuzzer_sys::fuzz_target;
-use sahara_formats::gltf_scene::{gltf_camera, gltf_light};
+use sahara_formats::{gltf_camera, gltf_light};
 use sahara_fuzz::{check_error, check_mesh};
 use sahara_readers::gltf::load_gltf;
 

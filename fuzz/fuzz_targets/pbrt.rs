@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
-use sahara_formats::pbrt::parse_pbrt;
+use sahara_formats::parse_pbrt;
 use sahara_fuzz::check_error;
 
 fuzz_target!(|data: &[u8]| {

@@ -1,4 +1,4 @@
-//! `parse_scene_file` on arbitrary UTF-8: no panic; a scene or a one-line
+//! `parse_scene` on arbitrary UTF-8: no panic; a scene or a one-line
 //! error naming the file. Paths resolve against a folder that does not exist,
 //! so file references are errors, never reads.
 #![no_main]
@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use libfuzzer_sys::fuzz_target;
-use sahara_formats::scene_file::parse_scene_file;
+use sahara_formats::parse_scene;
 use sahara_fuzz::check_error;
 
 fuzz_target!(|data: &[u8]| {
@@ -14,7 +14,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let folder = Path::new("/nonexistent-sahara-fuzz");
-    if let Err(e) = parse_scene_file(text, "fuzz.toml", folder) {
+    if let Err(e) = parse_scene(text, "fuzz.toml", folder) {
         check_error(&e, "fuzz.toml");
     }
 });

@@ -19,7 +19,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use sahara_formats::scene_load::load_scene;
+use sahara_formats::load_scene;
 use sahara_render::internals::{render_world, World};
 use sahara_render::{builtin, render, Integrator, RenderSettings};
 

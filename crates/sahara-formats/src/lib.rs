@@ -1,20 +1,31 @@
 //! `sahara-formats`: scenes for the renderer, and images out.
 //!
-//! - scenes, each read into a [`description::SceneDescription`]:
-//!   [`scene_file`] (TOML, documented in `docs/scene-format.md`) with
-//!   [`scene_load`] (its description), [`pbrt`] (pbrt-v4 scenes),
-//!   [`mitsuba`] (Mitsuba 3 XML scenes),
-//!   [`mesh_scene`] (a bare mesh file as a scene);
-//! - any of them by its extension: [`load`] (and [`load_builtin`], the
-//!   built-in Cornell box), read and assembled in one call;
-//! - to the renderer: [`assembly`] (a description as a
-//!   `sahara_render::Scene`: the sky rule, the automatic camera), using
-//!   [`mesh_library`] (each mesh file loaded once), [`material_map`]
-//!   (MTL / glTF materials) and [`gltf_scene`] (glTF cameras and lights);
-//! - images: [`image_out`] (PNG/EXR via [`atomic`] replacement), [`image_in`]
-//!   (textures and environment maps as linear colour);
-//! - render parts: [`part_file`] (a piece of a frame and its exact sums, as EXR);
-//! - every error is a [`FormatError`]: one line naming the file and the place.
+//! A file's way to the renderer is file → description → assembly → scene:
+//!
+//! - each reader turns its files into one scene description, the model
+//!   they all share: Sahara's TOML scene files (`docs/scene-format.md`),
+//!   pbrt-v4 (`docs/pbrt.md`), Mitsuba 3 XML (`docs/mitsuba.md`), and bare
+//!   mesh files (OBJ with MTL, PLY, glTF with its materials, cameras and
+//!   lights) as a scene;
+//! - the assembly turns a description into a [`sahara_render::Scene`]:
+//!   mesh files loaded once each, the sky rule ([`SkyUsed`]), the
+//!   automatic camera ([`AUTO_VFOV_DEG`]);
+//! - [`load`] reads any of them, choosing the reader by the file's
+//!   extension, and assembles it; [`load_builtin`] gives the built-in
+//!   Cornell box. The command line and the Python package load scenes
+//!   this way; the per-format loaders ([`load_scene`], [`load_pbrt`],
+//!   [`load_mitsuba`], [`load_mesh_scene`]) and their in-memory forms
+//!   ([`parse_scene`], [`parse_pbrt`], [`parse_mitsuba`]) are for tests,
+//!   fuzzing and callers that know their format.
+//!
+//! Out: images ([`write_image`]: PNG and EXR, [`write_exr_layers`] with
+//! render passes), render parts for the farm ([`write_part`],
+//! [`read_part`]), each file replaced atomically ([`write_atomically`]).
+//! In: textures and environment maps as linear colour ([`load_rgb_f32`],
+//! [`load_image`]).
+//!
+//! Every error is a [`FormatError`]: one line naming the file and the
+//! place.
 //!
 //! The mesh, image and camera-sidecar files themselves are read by
 //! `sahara-readers`, which returns plain data; this crate turns that data
@@ -25,46 +36,81 @@
 
 #![warn(missing_docs)]
 
-pub mod assembly;
-pub mod atomic;
-pub mod description;
-pub mod gltf_scene;
-pub mod image_in;
-pub mod image_out;
+mod assembly;
+mod common;
+mod description;
+mod gltf;
 mod load;
-pub mod material_map;
-pub mod mesh_library;
-pub mod mesh_scene;
-pub mod mitsuba;
-pub mod part_file;
-pub mod pbrt;
-pub mod scene_file;
-pub mod scene_load;
-pub mod srgb;
+mod mesh;
+mod mitsuba;
+mod output;
+mod pbrt;
+mod toml;
 
-use std::path::Path;
+// Loading scenes: any file by its extension, or one format.
 
-use sahara_readers::TriangleMesh;
-use sahara_render::Mesh;
+/// Any scene or mesh file by its extension, the built-in Cornell box, and
+/// the per-format loaders (file → description → assembled scene).
+pub use load::{
+    is_scene_file, load, load_builtin, load_mesh_scene, load_mesh_scene_with, load_mitsuba,
+    load_pbrt, load_scene, parse_mitsuba, parse_pbrt, parse_scene, LoadOptions, Loaded,
+};
 
-pub use load::{load, load_builtin, LoadOptions, Loaded};
+/// What assembling a description gave: the renderer's scene, the file's
+/// settings, the names of objects and materials, and what lit the scene.
+pub use assembly::{AssembledScene, SceneNames};
+
+/// The sky rule: what lights a scene besides its own lights, and the
+/// default sky and sun's colours and direction.
+pub use assembly::sky::{SkyUsed, DEFAULT_SKY, DEFAULT_SUN, DEFAULT_SUN_DIRECTION, WEAK_FRACTION};
+
+/// The vertical field of view of the automatic camera, degrees.
+pub use assembly::camera::AUTO_VFOV_DEG;
+
+/// What a scene file asks of a render (and its crop), and what lights it
+/// besides its own lights.
+pub use description::{FileCrop, FileSettings, Sky};
+
+// Mesh files.
+
+/// Mesh files as the renderer's meshes, and which camera a mesh file
+/// shown as a scene is seen by.
+pub use mesh::{load_mesh, load_mesh_with_warnings, CameraChoice};
+
+/// A mesh as read by `sahara-readers` as the renderer's mesh.
+pub use common::mesh::render_mesh;
+
+/// MTL materials as the renderer's.
+pub use mesh::mtl::{mtl_bsdf, mtl_material, phong_roughness, DEFAULT_GLASS_IOR};
+
+/// glTF cameras and lights as the renderer's (light in watts from
+/// lumens at [`LUMENS_PER_WATT`]).
+pub use gltf::{gltf_camera, gltf_light, LUMENS_PER_WATT};
+
+/// glTF materials as the renderer's.
+pub use gltf::material::{gltf_bsdf, gltf_material};
+
+/// Textures decoded once per image and encoding.
+pub use common::materials::TextureCache;
+
+// Images in and out, render parts.
+
+/// Images in as linear colour: environment maps and textures.
+pub use common::image::{
+    decode_image, decode_rgb_f32, decode_texture, load_image, load_rgb_f32, load_texture, Image,
+    RgbF32Image,
+};
+
+/// Images out: PNG and EXR, EXR with layers (render passes).
+pub use output::image::{
+    write_exr, write_exr_layers, write_image, write_png, ExrLayer, ImageFormat, Pixels,
+};
+
+/// Files replaced atomically, and the check that a path can be written.
+pub use output::atomic::{check_writable, write_atomically};
+
+/// Render parts: a piece of a frame and its exact sums, as EXR.
+pub use output::part::{read_part, read_part_info, write_part, PartInfo, PartSums};
+
+/// Every error of this crate: one line naming the file and the place.
 pub use sahara_readers::FormatError;
-
-/// A mesh as read as the renderer's mesh (both vectors are moved, not copied).
-pub fn render_mesh(mesh: TriangleMesh) -> Mesh {
-    let TriangleMesh { positions, indices } = mesh;
-    Mesh { positions, indices }
-}
-
-/// Loads a mesh file as the renderer's mesh: [`sahara_readers::load_mesh`]
-/// and [`render_mesh`].
-pub fn load_mesh(path: &Path) -> Result<Mesh, FormatError> {
-    sahara_readers::load_mesh(path).map(render_mesh)
-}
-
-/// Loads a mesh file as the renderer's mesh, with the problems that did not
-/// stop loading: [`sahara_readers::load_mesh_with_warnings`] and
-/// [`render_mesh`].
-pub fn load_mesh_with_warnings(path: &Path) -> Result<(Mesh, Vec<String>), FormatError> {
-    sahara_readers::load_mesh_with_warnings(path).map(|(mesh, w)| (render_mesh(mesh), w))
-}

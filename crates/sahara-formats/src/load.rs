@@ -3,17 +3,23 @@
 //! into a renderer scene with the settings its file asks for; and the
 //! built-in Cornell box. The command line and the Python package both load
 //! scenes through [`load`] and [`load_builtin`].
+//!
+//! Each reader gives a [`SceneDescription`]; this module is where a
+//! description meets [`assemble`], so no reader depends on the assembly:
+//! the per-format loaders ([`load_scene`], [`load_pbrt`], [`load_mitsuba`],
+//! [`load_mesh_scene`]) and their in-memory forms ([`parse_scene`],
+//! [`parse_pbrt`], [`parse_mitsuba`]) are here too.
 
 use std::path::Path;
 
 use sahara_readers::camera::read_sidecar;
+use sahara_readers::FormatError;
 use sahara_render::{builtin, Camera, Scene};
 
-use crate::assembly::{assemble, sky, SceneNames};
-use crate::description::{FileSettings, Sky};
-use crate::mesh_scene::{read_mesh_scene, CameraChoice};
-use crate::scene_load::read_scene;
-use crate::FormatError;
+use crate::assembly::{assemble, sky, AssembledScene, SceneNames};
+use crate::description::{FileSettings, SceneDescription, Sky};
+use crate::mesh::{read_mesh_scene, CameraChoice};
+use crate::toml::read_scene;
 
 /// What may be asked of a scene besides its file.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -191,6 +197,84 @@ pub fn load_builtin(options: &LoadOptions) -> Result<Loaded, FormatError> {
         warnings: Vec::new(),
         framing,
     })
+}
+
+/// True if `path` names a scene file (TOML, pbrt or Mitsuba) by its
+/// extension, rather than a mesh or anything else.
+pub fn is_scene_file(path: &Path) -> bool {
+    crate::pbrt::is_pbrt_path(path)
+        || crate::mitsuba::is_mitsuba_path(path)
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
+}
+
+/// Reads a scene file (TOML) and assembles its scene (meshes, textures
+/// and maps read relative to it); its settings are always there.
+pub fn load_scene(path: &Path) -> Result<AssembledScene, FormatError> {
+    assemble(read_scene(path)?)
+}
+
+/// Parses, checks and assembles scene TOML held in memory; `name` is used
+/// in messages and relative file names resolve against `folder`.
+pub fn parse_scene(text: &str, name: &str, folder: &Path) -> Result<AssembledScene, FormatError> {
+    assemble(crate::toml::read_scene_text(text, name, folder)?)
+}
+
+/// Reads a pbrt file (and the files it includes, meshes and images) and
+/// assembles its scene, checked (its settings are always there; the
+/// film's `cropwindow` or `pixelbounds` is in their `crop`).
+pub fn load_pbrt(path: &Path) -> Result<AssembledScene, FormatError> {
+    checked(crate::pbrt::read_pbrt(path)?)
+}
+
+/// Parses and builds a pbrt file held in memory; `name` is used in
+/// messages and relative file names resolve against `folder`.
+pub fn parse_pbrt(text: &[u8], name: &str, folder: &Path) -> Result<AssembledScene, FormatError> {
+    checked(crate::pbrt::read_pbrt_text(text, name, folder)?)
+}
+
+/// Reads a Mitsuba scene file and assembles its scene, checked.
+pub fn load_mitsuba(path: &Path) -> Result<AssembledScene, FormatError> {
+    checked(crate::mitsuba::read_mitsuba_with(path, &[])?)
+}
+
+/// Parses and builds a Mitsuba scene held in memory; `name` is used in
+/// messages and relative file names resolve against `folder`.
+pub fn parse_mitsuba(
+    text: &[u8],
+    name: &str,
+    folder: &Path,
+) -> Result<AssembledScene, FormatError> {
+    checked(crate::mitsuba::read_mitsuba_text(text, name, folder)?)
+}
+
+/// Loads a mesh file with its materials, lights, camera and (if its own
+/// lights are weak) the default sky and sun.
+pub fn load_mesh_scene(path: &Path) -> Result<AssembledScene, FormatError> {
+    load_mesh_scene_with(path, &CameraChoice::Auto, &Sky::Auto)
+}
+
+/// Loads a mesh file as [`load_mesh_scene`] does, seen by `camera` and
+/// lit as `sky` says.
+pub fn load_mesh_scene_with(
+    path: &Path,
+    camera: &CameraChoice,
+    sky: &Sky,
+) -> Result<AssembledScene, FormatError> {
+    let mut desc = read_mesh_scene(path, camera)?;
+    desc.sky = sky.clone();
+    assemble(desc)
+}
+
+/// The assembled scene, checked.
+fn checked(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
+    let name = desc.name.clone();
+    let a = assemble(desc)?;
+    a.scene
+        .validate()
+        .map_err(|e| FormatError::in_file(&name, e))?;
+    Ok(a)
 }
 
 /// The scene's name: the file name without its extension (`scene.pbrt.gz`

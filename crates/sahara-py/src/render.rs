@@ -12,8 +12,8 @@ use numpy::{PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray3, PyUntypedArray
 use pyo3::exceptions::{PyFileNotFoundError, PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use sahara_formats::description::FileSettings;
-use sahara_formats::image_out::{write_image, Pixels};
+use sahara_formats::FileSettings;
+use sahara_formats::{write_image, Pixels};
 use sahara_formats::{LoadOptions, Loaded};
 use sahara_kd::{BuildParams, Builder};
 use sahara_render::{

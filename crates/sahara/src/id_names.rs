@@ -14,9 +14,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, Context, Result};
-use sahara_formats::assembly::SceneNames;
-use sahara_formats::atomic::write_atomically;
+use sahara_formats::write_atomically;
 use sahara_formats::FormatError;
+use sahara_formats::SceneNames;
 use sahara_render::Aov;
 use serde_json::{Map, Value};
 

@@ -15,7 +15,7 @@ use std::ops::Range;
 use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
-use sahara_formats::part_file::{read_part, read_part_info, PartInfo};
+use sahara_formats::{read_part, read_part_info, PartInfo};
 use sahara_render::{
     cost_maps, Aov, Aux, AuxImages, AuxSums, Film, Integrator, Named, RenderResult, RenderSettings,
     RenderStats, SumBuffer,

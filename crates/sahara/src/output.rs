@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Context, Result};
-use sahara_formats::atomic::check_writable;
-use sahara_formats::image_out::{write_exr_layers, write_image, ExrLayer, ImageFormat, Pixels};
+use sahara_formats::check_writable;
+use sahara_formats::{write_exr_layers, write_image, ExrLayer, ImageFormat, Pixels};
 use sahara_render::{Aov, AuxImages, Integrator, Named, RenderResult, RenderSettings, ToneMap};
 
 /// Checks, before anything is loaded or rendered, that `path` names an

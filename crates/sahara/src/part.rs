@@ -5,7 +5,7 @@ use std::ops::Range;
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Result};
-use sahara_formats::part_file::{read_part_info, write_part, PartInfo, PartSums};
+use sahara_formats::{read_part_info, write_part, PartInfo, PartSums};
 use sahara_render::{crop, sample_range, tile, PixelWindow};
 use sahara_render::{Aov, Aux, AuxImages, RenderResult, RenderSettings, SumBuffer, ToneMap};
 

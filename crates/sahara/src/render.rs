@@ -107,12 +107,17 @@ fn check_args(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// The renderer's refusal of settings the integrator cannot honour
-/// ([`RenderSettings::check`]; `sahara_render::IntegratorKind::supports`
+/// The renderer's refusal of settings the integrator cannot honour in
+/// `scene` ([`RenderSettings::check_for`]; `sahara_render::IntegratorKind::supports`
 /// declares what each integrator supports), as one line naming the option
 /// or scene-file key that asked for it. `denoise`: the render is to be
 /// denoised.
-fn check_settings(args: &RenderArgs, settings: &RenderSettings, denoise: bool) -> Result<()> {
+fn check_settings(
+    args: &RenderArgs,
+    scene: &sahara_render::Scene,
+    settings: &RenderSettings,
+    denoise: bool,
+) -> Result<()> {
     let asked_by = |e: &SettingsError| -> &'static str {
         match e {
             SettingsError::Unsupported {
@@ -163,6 +168,14 @@ fn check_settings(args: &RenderArgs, settings: &RenderSettings, denoise: bool) -
                 feature: Feature::SampleRanges,
                 ..
             } => "--split samples",
+            SettingsError::Unsupported {
+                feature: Feature::Media,
+                ..
+            } if args.integrator.is_some() => "--integrator (the scene has participating media)",
+            SettingsError::Unsupported {
+                feature: Feature::Media,
+                ..
+            } => "the scene's integrator (the scene has participating media)",
         }
     };
     let named = |e: SettingsError| anyhow!("{}: {e}", asked_by(&e));
@@ -173,7 +186,7 @@ fn check_settings(args: &RenderArgs, settings: &RenderSettings, denoise: bool) -
             .require(Feature::Denoise)
             .map_err(named)?;
     }
-    settings.check().map_err(named)
+    settings.check_for(scene).map_err(named)
 }
 
 /// Render passes are layers of an EXR: refused for any other output.
@@ -280,7 +293,7 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         settings.window = Some(p.window);
         settings.samples = Some(p.samples.clone());
     }
-    check_settings(args, &settings, denoise)?;
+    check_settings(args, &scene, &settings, denoise)?;
     // A filter wider than a pixel shares each sample between neighbours:
     // their noise is then correlated, which the denoiser (trained on
     // independent pixels) takes for detail and keeps. Figures in

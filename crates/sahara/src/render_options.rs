@@ -6,7 +6,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{bail, Result};
-use sahara_formats::description::FileSettings;
+use sahara_formats::FileSettings;
 use sahara_kd::BuildParams;
 use sahara_render::UNLIMITED_SPP;
 use sahara_render::{Adaptive, Filter, Integrator, RenderSettings, ToneMap};

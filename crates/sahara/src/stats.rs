@@ -2,12 +2,12 @@
 //! the trees and instances its acceleration structure was built from.
 
 use std::fmt::Write;
-use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
 use sahara_bench::report::StatsReport;
 use sahara_bench::runner::{build_timed, Pools};
+use sahara_formats::is_scene_file;
 use sahara_render::internals::World;
 use serde::Serialize;
 
@@ -53,15 +53,6 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         print!("{}", human::stats_report(&report));
     }
     Ok(())
-}
-
-/// A scene file (TOML, pbrt or Mitsuba) rather than a mesh.
-fn is_scene_file(path: &Path) -> bool {
-    sahara_formats::pbrt::is_pbrt_path(path)
-        || sahara_formats::mitsuba::is_mitsuba_path(path)
-        || path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
 }
 
 /// What `sahara stats` says of a scene: how its acceleration structure

@@ -2,9 +2,8 @@
 //! the right.
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::{Camera, Scene};
-
-use crate::FormatError;
 
 /// Vertical field of view of the automatic camera, degrees.
 pub const AUTO_VFOV_DEG: f32 = 45.0;
@@ -28,7 +27,8 @@ const GROUND_DWARFS: f32 = 4.0;
 const FLAT: f32 = 0.05;
 
 /// A camera that sees the scene (see [`auto_camera_framing`]).
-pub fn auto_camera(scene: &Scene, name: &str) -> Result<Camera, FormatError> {
+#[cfg(test)]
+fn auto_camera(scene: &Scene, name: &str) -> Result<Camera, FormatError> {
     auto_camera_framing(scene, name).map(|(c, _)| c)
 }
 

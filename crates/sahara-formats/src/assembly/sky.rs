@@ -17,12 +17,12 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::luminance;
 use sahara_render::{Environment, Light, Scene, Texture};
 
+use crate::common::image::load_rgb_f32;
 use crate::description::Sky;
-use crate::image_in::load_rgb_f32;
-use crate::FormatError;
 
 /// Radiance of the default sky.
 pub const DEFAULT_SKY: Vec3 = Vec3::new(0.55, 0.6, 0.7);
@@ -36,7 +36,7 @@ pub const DEFAULT_SUN: Vec3 = Vec3::splat(2.5);
 /// sky shed on the scene's bounding sphere.
 pub const WEAK_FRACTION: f32 = 0.05;
 
-/// What [`apply`] did.
+/// What lights a scene besides its own lights, as the sky rule decided.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum SkyUsed {
     /// The scene's own lights only.

@@ -25,17 +25,16 @@
 use glam::Vec3;
 use std::sync::Arc;
 
+use sahara_readers::FormatError;
 use sahara_render::{
     AlphaMode, Bsdf, Clearcoat, Distribution, Material, NormalMap, Texture, TextureMap,
 };
 
-use super::build::{key, Builder};
+use super::builder::{key, Builder};
 use super::properties::Object;
 use super::spectra::{conductor_rgb, Color, Usage};
 use super::xml::Node;
-use crate::pbrt::materials::blend;
-use crate::pbrt::textures::{with_opacity, Tint};
-use crate::FormatError;
+use crate::common::tint::{blend, with_opacity, Tint};
 
 /// Deepest chain of bsdfs nested in bsdfs.
 const MAX_NESTING: usize = 16;
@@ -250,6 +249,10 @@ impl<'a> Builder<'a> {
     }
 
     /// The material of a bsdf element; `None` for no surface.
+    ///
+    /// One piece on purpose: it is Mitsuba's one bsdf table, an arm per kind, each mapping its
+    /// parameters onto Sahara's; it becomes one mapping per kind family when
+    /// materials and lights are kinds the renderer describes.
     fn bsdf(&mut self, node: &'a Node, depth: usize) -> Result<Option<Material>, FormatError> {
         if depth > MAX_NESTING {
             return Err(node.error("bsdfs nest too deep (a cycle of references?)"));

@@ -9,8 +9,9 @@
 
 use std::collections::HashMap;
 
+use sahara_readers::FormatError;
+
 use super::xml::Node;
-use crate::FormatError;
 
 /// The values of the scene's parameters.
 #[derive(Clone, Debug, Default)]

@@ -14,14 +14,14 @@
 use std::sync::Arc;
 
 use glam::{DMat3, DVec3, Vec2, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{environment_direction, Environment, Light, Texture};
 
-use super::build::Builder;
+use super::builder::Builder;
 use super::properties::Object;
 use super::spectra::Usage;
 use super::xml::Node;
-use crate::image_in::load_rgb_f32;
-use crate::FormatError;
+use crate::common::image::load_rgb_f32;
 
 /// Mitsuba's lat-long coordinates of a direction in the map's own frame.
 fn mitsuba_uv(d: DVec3) -> (f64, f64) {

@@ -5,10 +5,11 @@
 
 use std::path::{Path, PathBuf};
 
+use sahara_readers::FormatError;
+
 use super::defaults::Defaults;
 use super::xml::{read_file, Node};
-use crate::pbrt::warnings::Warnings;
-use crate::FormatError;
+use crate::common::warnings::Warnings;
 
 /// Deepest chain of files including files.
 const MAX_INCLUDE_DEPTH: usize = 16;

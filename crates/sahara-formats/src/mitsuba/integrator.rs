@@ -15,14 +15,86 @@
 //! | `aov` | its nested integrator (warned: the image only) |
 //! | `hide_emitters` | not supported (warned) |
 
+use sahara_readers::FormatError;
 use sahara_render::Integrator;
 
-use super::build::Builder;
+use super::builder::Builder;
+use super::properties::Object;
 use super::xml::Node;
-use crate::FormatError;
 
 /// Sahara's deepest path.
 const MAX_DEPTH: u32 = 1 << 16;
+
+/// Path tracing as `o` (a `path` integrator, or one rendered by Sahara's
+/// path tracer) asks for it: Mitsuba's `max_depth` counts the emitter
+/// seen, Sahara's bounces.
+fn path<'a>(b: &mut Builder<'a>, o: &Object<'a>) -> Result<Integrator, FormatError> {
+    let depth = o.int("max_depth", -1)?;
+    let rr = o.int("rr_depth", 5)?;
+    if o.bool("hide_emitters", false)? {
+        b.w.add(
+            format!(
+                "{}: 'hide_emitters' is not supported; emitters are seen",
+                o.what()
+            ),
+            &o.node.loc,
+        );
+    }
+    let max_depth = match depth {
+        d if d < 0 => MAX_DEPTH,
+        0 | 1 => {
+            b.w.add(
+                format!(
+                    "{}: max_depth {depth} ({}) is rendered with max_depth 2 (direct light)",
+                    o.what(),
+                    if depth == 0 {
+                        "nothing"
+                    } else {
+                        "emitters only"
+                    }
+                ),
+                &o.node.loc,
+            );
+            1
+        }
+        d => (d - 1).min(i64::from(MAX_DEPTH)) as u32,
+    };
+    if rr < 0 {
+        return Err(o.error("rr_depth must be >= 0"));
+    }
+    Ok(Integrator::Path {
+        max_depth,
+        rr_depth: rr.min(i64::from(MAX_DEPTH)) as u32,
+    })
+}
+
+/// Stochastic progressive photon mapping as `o` (an `sppm` or Mitsuba
+/// 0.6's `photonmapper`) asks for it.
+fn sppm<'a>(b: &mut Builder<'a>, o: &Object<'a>, node: &Node) -> Result<Integrator, FormatError> {
+    let radius = o.float("initial_radius", 0.0)?;
+    let photons = o.int("photon_count", 0)?;
+    for k in ["alpha", "granularity", "max_passes"] {
+        o.get(k);
+    }
+    if o.ty == "photonmapper" {
+        b.w.add(
+            "integrator 'photonmapper' is rendered by stochastic progressive photon mapping (sppm)",
+            &node.loc,
+        );
+    }
+    Ok(match path(b, o)? {
+        Integrator::Path { max_depth, .. } => Integrator::Sppm {
+            max_depth,
+            radius: if radius.is_finite() && radius > 0.0 {
+                radius as f32
+            } else {
+                0.0
+            },
+            photons: photons.clamp(0, i64::from(u32::MAX)) as u32,
+        },
+        other => other,
+    })
+}
 
 /// The integrator `node` asks for (Mitsuba's default without one: path
 /// tracing, unlimited depth, roulette from depth 5).
@@ -37,44 +109,6 @@ pub(crate) fn integrator<'a>(
         });
     };
     let o = b.object(node)?;
-    let path = |b: &mut Builder<'a>,
-                o: &super::properties::Object<'a>|
-     -> Result<Integrator, FormatError> {
-        let depth = o.int("max_depth", -1)?;
-        let rr = o.int("rr_depth", 5)?;
-        if o.bool("hide_emitters", false)? {
-            b.w.add(
-                format!(
-                    "{}: 'hide_emitters' is not supported; emitters are seen",
-                    o.what()
-                ),
-                &o.node.loc,
-            );
-        }
-        let max_depth =
-            match depth {
-                d if d < 0 => MAX_DEPTH,
-                0 | 1 => {
-                    b.w.add(
-                        format!(
-                        "{}: max_depth {depth} ({}) is rendered with max_depth 2 (direct light)",
-                        o.what(),
-                        if depth == 0 { "nothing" } else { "emitters only" }
-                    ),
-                        &o.node.loc,
-                    );
-                    1
-                }
-                d => (d - 1).min(i64::from(MAX_DEPTH)) as u32,
-            };
-        if rr < 0 {
-            return Err(o.error("rr_depth must be >= 0"));
-        }
-        Ok(Integrator::Path {
-            max_depth,
-            rr_depth: rr.min(i64::from(MAX_DEPTH)) as u32,
-        })
-    };
     let out = match o.ty {
         "path" => path(b, &o)?,
         // Mitsuba's particle tracer is light tracing.
@@ -97,31 +131,7 @@ pub(crate) fn integrator<'a>(
                 other => other,
             }
         }
-        "sppm" | "photonmapper" => {
-            let radius = o.float("initial_radius", 0.0)?;
-            let photons = o.int("photon_count", 0)?;
-            for k in ["alpha", "granularity", "max_passes"] {
-                o.get(k);
-            }
-            if o.ty == "photonmapper" {
-                b.w.add(
-                    "integrator 'photonmapper' is rendered by stochastic progressive photon mapping (sppm)",
-                    &node.loc,
-                );
-            }
-            match path(b, &o)? {
-                Integrator::Path { max_depth, .. } => Integrator::Sppm {
-                    max_depth,
-                    radius: if radius.is_finite() && radius > 0.0 {
-                        radius as f32
-                    } else {
-                        0.0
-                    },
-                    photons: photons.clamp(0, i64::from(u32::MAX)) as u32,
-                },
-                other => other,
-            }
-        }
+        "sppm" | "photonmapper" => sppm(b, &o, node)?,
         "volpath" | "volpathmis" | "prb" | "prb_basic" | "prbvolpath" => {
             b.w.add(
                 format!(

@@ -1,7 +1,7 @@
 //! Mitsuba's named conductors (`<string name="material" value="Cr"/>`)
 //! as per-channel `(eta, k)`.
 //!
-//! Each row is the fit ([`crate::pbrt::spectrum::fit_conductor`], the one
+//! Each row is the fit ([`crate::common::spectrum::fit_conductor`], the one
 //! the pbrt reader uses for measured metals) of the spectra Mitsuba 3
 //! ships for that name (`data/ior/<name>.eta.spd` and `.k.spd`, from the
 //! luxpop database and Palik's handbook), to 4 digits. The test
@@ -227,7 +227,7 @@ pub(crate) fn names() -> impl Iterator<Item = &'static str> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pbrt::spectrum::{fit_conductor, piecewise_linear};
+    use crate::common::spectrum::{fit_conductor, piecewise_linear};
     use std::path::Path;
 
     /// The `(wavelength, value)` pairs of an `.spd` file.

@@ -5,8 +5,9 @@
 //!   (`roxmltree`); [`expand`]: `<include>`, `<default>` and `$name`
 //!   ([`defaults`]), 0.x names; [`properties`]: an element as a typed
 //!   object ([`spectra`] for colours, [`transform`] for transforms).
-//! - The mapping to Sahara's [`SceneDescription`]: [`build`] (ids, the
-//!   walk), [`shapes`] (with [`serialized`] meshes), [`bsdfs`] (the one
+//! - The mapping to Sahara's [`SceneDescription`]: [`build`] (the walk)
+//!   over [`builder`] (ids, what is made once), [`shapes`] (with
+//!   [`serialized`] meshes), [`bsdfs`] (the one
 //!   material table), [`textures`], [`emitters`], [`sensor`] (camera,
 //!   film, filter, sampler) and [`integrator`].
 //! - Every error is one line, `file: line L: column C: what`; everything
@@ -18,6 +19,7 @@
 
 mod bsdfs;
 mod build;
+mod builder;
 mod defaults;
 mod emitters;
 mod expand;
@@ -37,26 +39,22 @@ mod tests;
 
 use std::path::Path;
 
-use crate::assembly::{assemble, AssembledScene};
+use sahara_readers::FormatError;
+
+use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
-use crate::pbrt::warnings::Warnings;
-use crate::FormatError;
 
 /// True if `path` names a Mitsuba scene file (`.xml`, any case).
-pub fn is_mitsuba_path(path: &Path) -> bool {
+pub(crate) fn is_mitsuba_path(path: &Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
 }
 
 /// Reads a Mitsuba scene file (and the files it includes, meshes and
-/// images) as a scene description.
-pub fn read_mitsuba(path: &Path) -> Result<SceneDescription, FormatError> {
-    read_mitsuba_with(path, &[])
-}
-
-/// [`read_mitsuba`] with scene parameters given as on Mitsuba's command
-/// line (`-D name=value`): they win over the file's `<default>`s.
-pub fn read_mitsuba_with(
+/// images) as a scene description, with scene parameters given as on
+/// Mitsuba's command line (`-D name=value`): they win over the file's
+/// `<default>`s.
+pub(crate) fn read_mitsuba_with(
     path: &Path,
     params: &[(String, String)],
 ) -> Result<SceneDescription, FormatError> {
@@ -67,21 +65,16 @@ pub fn read_mitsuba_with(
     described(root, &name, folder, params, w)
 }
 
-/// Reads a Mitsuba scene file and assembles its scene, checked.
-pub fn load_mitsuba(path: &Path) -> Result<AssembledScene, FormatError> {
-    assembled(read_mitsuba(path)?)
-}
-
-/// Parses and builds a Mitsuba scene held in memory; `name` is used in
+/// Parses and describes a Mitsuba scene held in memory; `name` is used in
 /// messages and relative file names resolve against `folder`.
-pub fn parse_mitsuba(
+pub(crate) fn read_mitsuba_text(
     text: &[u8],
     name: &str,
     folder: &Path,
-) -> Result<AssembledScene, FormatError> {
+) -> Result<SceneDescription, FormatError> {
     let mut w = Warnings::default();
     let root = xml::parse_text(text, name, folder, &mut w)?;
-    assembled(described(root, name, folder, &[], w)?)
+    described(root, name, folder, &[], w)
 }
 
 /// The description of the file whose root element is `root`.
@@ -96,14 +89,4 @@ fn described(
     let mut search = expand::Search::new(folder);
     let scene = expand::expand_scene(root, &mut d, &mut search, &mut w)?;
     build::build(&scene, name, search, w)
-}
-
-/// The assembled scene, checked.
-fn assembled(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
-    let name = desc.name.clone();
-    let a = assemble(desc)?;
-    a.scene
-        .validate()
-        .map_err(|e| FormatError::in_file(&name, e))?;
-    Ok(a)
 }

@@ -13,14 +13,14 @@ use std::cell::Cell;
 use std::path::PathBuf;
 
 use glam::{DMat4, DVec3};
+use sahara_readers::FormatError;
 
 use super::expand::Search;
 use super::spectra::{numbers, parse_rgb, parse_spectrum, parse_temperature, Color};
 use super::transform::parse_transform;
 use super::xml::Node;
-use crate::pbrt::lexer::Loc;
-use crate::pbrt::warnings::Warnings;
-use crate::FormatError;
+use crate::common::position::Loc;
+use crate::common::warnings::Warnings;
 
 /// Tags of nested objects.
 pub(crate) const OBJECT_TAGS: &[&str] = &[

@@ -21,13 +21,13 @@
 //! | `orthographic` and the other sensors | refused |
 
 use glam::{DMat4, DVec3};
+use sahara_readers::FormatError;
 use sahara_render::{Camera, Filter, Integrator, SamplerKind, ToneMap};
 
-use super::build::Builder;
+use super::builder::Builder;
 use super::properties::Object;
 use super::xml::Node;
 use crate::description::{FileCrop, FileSettings};
-use crate::FormatError;
 
 /// A 35 mm film's diagonal, in mm (what `focal_length` refers to).
 const FILM_DIAGONAL_MM: f64 = 43.266_615_300_557;

@@ -11,9 +11,8 @@
 use std::io::Read;
 
 use glam::{Vec2, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{Mesh, SceneMesh};
-
-use crate::FormatError;
 
 const MAGIC: u16 = 0x041C;
 const HAS_NORMALS: u32 = 0x1;
@@ -47,17 +46,19 @@ fn u64_at(b: &[u8], at: usize) -> Option<u64> {
     Some(u64::from_le_bytes(b.get(at..at + 8)?.try_into().ok()?))
 }
 
-/// Mesh number `index` of the serialized file `bytes`, called `name`.
-pub(crate) fn parse_serialized(
-    bytes: &[u8],
-    name: &str,
-    index: usize,
-) -> Result<SerializedMesh, FormatError> {
-    let bad = |offset: usize, what: &str| FormatError::AtByte {
+/// An error at byte `offset` of the file `name`.
+fn at_byte(name: &str, offset: usize, what: &str) -> FormatError {
+    FormatError::AtByte {
         path: name.to_owned(),
         offset: offset as u64,
         message: what.to_owned(),
-    };
+    }
+}
+
+/// The file `bytes`, called `name`: its version (3 or 4) and where mesh
+/// number `index` starts.
+fn mesh_start(bytes: &[u8], name: &str, index: usize) -> Result<(u16, usize), FormatError> {
+    let bad = |offset: usize, what: &str| at_byte(name, offset, what);
     if u16_at(bytes, 0) != Some(MAGIC) {
         return Err(bad(
             0,
@@ -105,6 +106,17 @@ pub(crate) fn parse_serialized(
                 )
             })?
     };
+    Ok((version, start))
+}
+
+/// Mesh number `index` of the serialized file `bytes`, called `name`.
+pub(crate) fn parse_serialized(
+    bytes: &[u8],
+    name: &str,
+    index: usize,
+) -> Result<SerializedMesh, FormatError> {
+    let bad = |offset: usize, what: &str| at_byte(name, offset, what);
+    let (version, start) = mesh_start(bytes, name, index)?;
     let mut z = flate2::read::ZlibDecoder::new(&bytes[start + 4..]);
     let mut read = |len: usize, what: &str| -> Result<Vec<u8>, FormatError> {
         let mut buf = Vec::new();

@@ -22,16 +22,17 @@
 //!   serialized ones are kept, and every image texture reads them so.
 
 use glam::{Affine3A, DMat3, DMat4, DVec3, Mat3, Vec2, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{Mesh, SceneMesh, Shape};
 
-use super::build::{key, Builder};
+use super::builder::{key, Builder};
 use super::properties::Object;
 use super::serialized::parse_serialized;
 use super::xml::Node;
+use crate::common::gzip::read_maybe_gz;
+use crate::common::mesh::render_mesh;
+use crate::common::mesh::smooth_normals;
 use crate::description::{Geometry, Object as SceneObject, ObjectPlacement};
-use crate::pbrt::lexer::read_maybe_gz;
-use crate::pbrt::subdivision::smooth_normals;
-use crate::FormatError;
 
 /// Rim segments of a tessellated cylinder.
 const SEGMENTS: u32 = 128;
@@ -383,7 +384,7 @@ impl<'a> Builder<'a> {
                     .map(|u| u.into_iter().map(|v| Vec2::new(v.x, 1.0 - v.y)).collect());
                 (
                     SceneMesh {
-                        mesh: crate::render_mesh(obj.mesh),
+                        mesh: render_mesh(obj.mesh),
                         normals: obj.normals,
                         uvs,
                         ..SceneMesh::default()
@@ -397,7 +398,7 @@ impl<'a> Builder<'a> {
                     sahara_readers::ply::parse_ply_with_attributes(&bytes, &name).map_err(at)?;
                 (
                     SceneMesh {
-                        mesh: crate::render_mesh(ply.mesh),
+                        mesh: render_mesh(ply.mesh),
                         normals: ply.normals,
                         uvs: ply.uvs,
                         ..SceneMesh::default()

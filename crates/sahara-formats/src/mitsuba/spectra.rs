@@ -1,6 +1,6 @@
 //! Mitsuba's colour values (`rgb`, `srgb`, `spectrum`, `blackbody`) and
 //! their linear sRGB, computed as Mitsuba's RGB variants compute them,
-//! with the spectral code of the pbrt reader ([`crate::pbrt::spectrum`]).
+//! with the spectral code shared with the pbrt reader ([`crate::common::spectrum`]).
 //!
 //! - `rgb` is linear sRGB as written; `srgb` (Mitsuba 0.x, also
 //!   `#rrggbb`) is decoded from sRGB.
@@ -11,17 +11,17 @@
 //!   relative to a perfect white's; as an emitter's radiance, its CIE XYZ
 //!   over the integral of `y` (Mitsuba's normalisation: a constant
 //!   spectrum of 1 is white 1); as a conductor's `eta` or `k`, the two
-//!   spectra fitted together ([`crate::pbrt::spectrum::fit_conductor`]).
+//!   spectra fitted together ([`crate::common::spectrum::fit_conductor`]).
 //! - A black body is normalised to luminance 1, as pbrt-v4 does (Mitsuba
 //!   gives it in absolute units): a warning.
 
 use std::path::Path;
 
 use glam::{DVec3, Vec3};
+use sahara_readers::FormatError;
 
 use super::xml::Node;
-use crate::pbrt::spectrum;
-use crate::FormatError;
+use crate::common::spectrum;
 
 /// A colour as the file gives it.
 #[derive(Clone, Debug, PartialEq)]

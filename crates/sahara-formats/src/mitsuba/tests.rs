@@ -6,16 +6,16 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Affine3A, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{
     render, AlphaMode, Bsdf, Distribution, Environment, Filter, Integrator, Light, Material,
     RenderSettings, SamplerKind, Scene, Shape,
 };
 
-use super::{described, load_mitsuba, read_mitsuba_with, xml};
+use super::{described, read_mitsuba_with, xml};
+use crate::common::warnings::Warnings;
 use crate::description::{CameraRequest, FileCrop, Geometry, ObjectPlacement, SceneDescription};
-use crate::pbrt::warnings::Warnings;
-use crate::scene_load::load_scene;
-use crate::FormatError;
+use crate::{load_mitsuba, load_scene};
 
 /// A fresh folder for a test's files.
 fn folder(name: &str) -> PathBuf {

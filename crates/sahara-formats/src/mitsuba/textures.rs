@@ -17,15 +17,15 @@
 use std::sync::Arc;
 
 use glam::{Affine2, DMat4, Vec2, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{Encoding, Texture, Wrap};
 
-use super::build::{key, Builder};
+use super::builder::{key, Builder};
 use super::properties::Object;
 use super::spectra::Usage;
 use super::xml::Node;
-use crate::image_in::load_texture;
-use crate::pbrt::textures::{Sampling, Tint};
-use crate::FormatError;
+use crate::common::image::load_texture;
+use crate::common::tint::{Sampling, Tint};
 
 /// Texels per check side of a baked checkerboard.
 const CHECK_TEXELS: u32 = 32;

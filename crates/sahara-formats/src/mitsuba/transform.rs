@@ -13,10 +13,10 @@
 //!   direction made orthogonal.
 
 use glam::{DMat3, DMat4, DVec3};
+use sahara_readers::FormatError;
 
 use super::spectra::numbers;
 use super::xml::Node;
-use crate::FormatError;
 
 /// Three numbers from `x`, `y`, `z` attributes (`missing` for absent
 /// ones) or from `value`.

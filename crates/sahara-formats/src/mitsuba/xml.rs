@@ -6,9 +6,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use crate::pbrt::lexer::{read_maybe_gz, Loc};
-use crate::pbrt::warnings::Warnings;
-use crate::FormatError;
+use sahara_readers::FormatError;
+
+use crate::common::gzip::read_maybe_gz;
+use crate::common::position::Loc;
+use crate::common::warnings::Warnings;
 
 /// Largest number of XML nodes read from one file (roxmltree's own limit
 /// is 2^32): a guard against a runaway file, far above real scenes.

@@ -18,9 +18,10 @@
 //!   transforms (`Scale -1 1 1`) mirror the image as in pbrt.
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use glam::{Affine3A, DMat3, DMat4, DVec3, Mat4, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::SceneMesh;
 use sahara_render::{
     AlphaMode, Camera, Filter, Integrator, Material, SamplerKind, Shape, Srt, TextureMap, ToneMap,
@@ -28,15 +29,15 @@ use sahara_render::{
 
 use super::declarations::{Declarations, Entity, MaterialRef, ShapeDecl, Xform};
 use super::lights::{add_light, area_emission};
-use super::materials::{blend, map_material, Mapped};
+use super::materials::{map_material, Mapped};
 use super::shapes::shape_geometry;
-use super::subdivision::smooth_normals;
-use super::textures::{with_opacity, Textures};
-use super::warnings::Warnings;
+use super::textures::Textures;
+use crate::common::mesh::smooth_normals;
+use crate::common::tint::{blend, with_opacity};
+use crate::common::warnings::Warnings;
 use crate::description::{
     CameraRequest, FileCrop, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
 };
-use crate::FormatError;
 
 /// Deepest chain of `mix` materials followed.
 const MAX_MIX_DEPTH: usize = 16;
@@ -138,7 +139,7 @@ impl Materials<'_> {
         &mut self,
         scene: &mut SceneDescription,
         name: &str,
-        loc: &super::lexer::Loc,
+        loc: &crate::common::position::Loc,
         w: &mut Warnings,
         depth: usize,
     ) -> Result<Option<u32>, FormatError> {
@@ -299,7 +300,7 @@ fn camera(
             Entity {
                 kind: "perspective".into(),
                 params: Default::default(),
-                loc: super::lexer::Loc {
+                loc: crate::common::position::Loc {
                     file: "".into(),
                     line: 0,
                     col: 0,
@@ -480,6 +481,38 @@ fn settings(
     folder: &Path,
     w: &mut Warnings,
 ) -> Result<FileSettings, FormatError> {
+    let film = film(desc, folder, w)?;
+    let (mut spp, sampler, seed) = sampler(desc, w)?;
+    let filter = pixel_filter(desc, w)?;
+    let integrator = integrator(desc, &mut spp, w)?;
+    Ok(FileSettings {
+        integrator,
+        sampler,
+        spp: spp as u32,
+        adaptive: None,
+        seed,
+        filter,
+        width: film.width as u32,
+        height: film.height as u32,
+        exposure: film.exposure,
+        tonemap: ToneMap::Clamp,
+        output: film.output,
+        crop: film.crop,
+        denoise: false,
+    })
+}
+
+/// What `Film` sets: the image size, the output file, the exposure and the crop.
+struct Film {
+    width: i64,
+    height: i64,
+    output: Option<PathBuf>,
+    exposure: f32,
+    crop: Option<FileCrop>,
+}
+
+/// The settings of `Film` (pbrt's defaults without one).
+fn film(desc: &Declarations, folder: &Path, w: &mut Warnings) -> Result<Film, FormatError> {
     let mut width = 1280i64;
     let mut height = 720i64;
     let mut output = None;
@@ -536,6 +569,17 @@ fn settings(
         }
         unknown_params(f, "film", w);
     }
+    Ok(Film {
+        width,
+        height,
+        output,
+        exposure,
+        crop,
+    })
+}
+
+/// The settings of `Sampler`: samples per pixel, the sampler and its seed.
+fn sampler(desc: &Declarations, w: &mut Warnings) -> Result<(i64, SamplerKind, u64), FormatError> {
     let mut spp = 16i64;
     let mut sampler = SamplerKind::Sobol;
     let mut seed = 0u64;
@@ -575,6 +619,11 @@ fn settings(
             |s| s.loc.error("pixel samples must be in 1..=16777216"),
         ));
     }
+    Ok((spp, sampler, seed))
+}
+
+/// The `PixelFilter` (pbrt's Gaussian without one).
+fn pixel_filter(desc: &Declarations, w: &mut Warnings) -> Result<Filter, FormatError> {
     let filter = match &desc.filter {
         None => Filter::Gaussian {
             radius: 1.5,
@@ -642,6 +691,16 @@ fn settings(
             out
         }
     };
+    Ok(filter)
+}
+
+/// The `Integrator` (pbrt's path tracer without one); SPPM's
+/// `iterations` replace `spp`.
+fn integrator(
+    desc: &Declarations,
+    spp: &mut i64,
+    w: &mut Warnings,
+) -> Result<Integrator, FormatError> {
     let integrator = match &desc.integrator {
         None => Integrator::Path {
             max_depth: 5,
@@ -689,13 +748,13 @@ fn settings(
                 "sppm" => {
                     // pbrt-v4's SPPM takes its iteration count from here,
                     // not from the sampler.
-                    let iterations = i.params.int("iterations", spp)?;
+                    let iterations = i.params.int("iterations", *spp)?;
                     if iterations < 1 {
                         return Err(i
                             .loc
                             .error("integrator 'sppm': iterations must be at least 1"));
                     }
-                    spp = iterations;
+                    *spp = iterations;
                     let radius = i.params.float("radius", 1.0)?;
                     if !(radius.is_finite() && radius > 0.0) {
                         return Err(i
@@ -748,21 +807,7 @@ fn settings(
             out
         }
     };
-    Ok(FileSettings {
-        integrator,
-        sampler,
-        spp: spp as u32,
-        adaptive: None,
-        seed,
-        filter,
-        width: width as u32,
-        height: height as u32,
-        exposure,
-        tonemap: ToneMap::Clamp,
-        output,
-        crop,
-        denoise: false,
-    })
+    Ok(integrator)
 }
 
 /// One shape's mesh in object space, oriented, or `None` if it is not rendered.

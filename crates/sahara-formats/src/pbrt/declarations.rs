@@ -7,8 +7,8 @@ use std::path::PathBuf;
 
 use glam::DMat4;
 
-use super::lexer::Loc;
 use super::params::ParamList;
+use crate::common::position::Loc;
 
 /// A directive's type name (`"perspective"`, `"trianglemesh"`, ...) with its parameters.
 #[derive(Clone, Debug)]

@@ -2,44 +2,11 @@
 //! `false`), quoted strings and brackets, each with its 1-based line and
 //! column; `#` starts a comment that runs to the end of the line.
 
-use std::io::Read;
-use std::path::Path;
 use std::sync::Arc;
 
-use crate::FormatError;
+use sahara_readers::FormatError;
 
-/// Largest file (after decompression) read, in bytes: a guard against a
-/// gzip bomb, far above any real scene file.
-pub(crate) const MAX_FILE_BYTES: u64 = 1 << 32;
-
-/// Where something is in a scene file.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub(crate) struct Loc {
-    /// The file as shown in messages.
-    pub(crate) file: Arc<str>,
-    /// 1-based line.
-    pub(crate) line: u32,
-    /// 1-based column (in characters).
-    pub(crate) col: u32,
-}
-
-impl Loc {
-    /// An error here: `file: line L: column C: message`, the form every
-    /// Sahara scene error has.
-    pub(crate) fn error(&self, message: impl std::fmt::Display) -> FormatError {
-        let message = message.to_string().replace(['\n', '\r'], " ");
-        FormatError::at_line(
-            &self.file,
-            self.line as usize,
-            format!("column {}: {message}", self.col),
-        )
-    }
-
-    /// `file:line:column`, for warnings.
-    pub(crate) fn short(&self) -> String {
-        format!("{}:{}:{}", self.file, self.line, self.col)
-    }
-}
+use crate::common::position::Loc;
 
 /// What a token is.
 #[derive(Clone, Debug, PartialEq)]
@@ -70,32 +37,6 @@ pub(crate) struct Lexer {
     line: u32,
     col: u32,
     file: Arc<str>,
-}
-
-/// Reads a file, decompressing it if it is gzip (recognised by its first
-/// two bytes, whatever its name).
-pub(crate) fn read_maybe_gz(path: &Path) -> Result<Vec<u8>, FormatError> {
-    let bytes = std::fs::read(path).map_err(|e| FormatError::io(path, e))?;
-    if !bytes.starts_with(&[0x1f, 0x8b]) {
-        return Ok(bytes);
-    }
-    let mut out = Vec::new();
-    flate2::read::MultiGzDecoder::new(&bytes[..])
-        .take(MAX_FILE_BYTES + 1)
-        .read_to_end(&mut out)
-        .map_err(|e| {
-            FormatError::in_file(
-                &path.display().to_string(),
-                format!("cannot decompress: {e}"),
-            )
-        })?;
-    if out.len() as u64 > MAX_FILE_BYTES {
-        return Err(FormatError::in_file(
-            &path.display().to_string(),
-            format!("decompresses to more than {MAX_FILE_BYTES} bytes"),
-        ));
-    }
-    Ok(out)
 }
 
 impl Lexer {

@@ -11,7 +11,7 @@
 //!
 //! A light's `rgb` value is its radiance or intensity in linear sRGB as
 //! written; a `blackbody` or other spectrum is normalised to luminance 1
-//! first (see [`super::spectrum`]). `power` rescales to the given radiant
+//! first (see [`crate::common::spectrum`]). `power` rescales to the given radiant
 //! power as pbrt-v4 does: `power / 4 pi` for a point light,
 //! `power / (2 pi (1 - (cos_start + cos_end) / 2))` for a spot light,
 //! `power / (pi area)` (halved when two-sided) for an area light.
@@ -19,16 +19,16 @@
 use std::sync::Arc;
 
 use glam::{DMat3, DMat4, DVec3, Vec3};
+use sahara_readers::FormatError;
 use sahara_render::{Environment, Light, Texture};
 
 use super::declarations::{Entity, LightDecl};
 use super::envmap::to_lat_long;
-use super::spectrum::Use;
 use super::textures::rgb_of;
-use super::warnings::Warnings;
+use crate::common::image::load_rgb_f32;
+use crate::common::spectrum::Use;
+use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
-use crate::image_in::load_rgb_f32;
-use crate::FormatError;
 
 /// A spectrum parameter of a light as RGB (default white).
 fn light_rgb(e: &Entity, name: &str, w: &mut Warnings) -> Result<Vec3, FormatError> {
@@ -55,6 +55,10 @@ fn v3(p: [f64; 3]) -> DVec3 {
 }
 
 /// Adds the light `l` to `scene`.
+///
+/// One piece on purpose: it is pbrt's one light table, an arm per kind, each mapping its
+/// parameters onto Sahara's; it becomes one mapping per kind family when
+/// materials and lights are kinds the renderer describes.
 pub(crate) fn add_light(
     scene: &mut SceneDescription,
     l: &LightDecl,

@@ -24,14 +24,15 @@
 //! pbrt-v3's `opacity` (uber) becomes stochastic transparency.
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::{AlphaMode, Bsdf, Distribution, Material};
 
 use super::declarations::Entity;
 use super::params::SpectrumParam;
-use super::spectrum::{self, Use};
-use super::textures::{rgb_of, spectral_samples, Textures, Tint};
-use super::warnings::Warnings;
-use crate::FormatError;
+use super::textures::{rgb_of, spectral_samples, Textures};
+use crate::common::spectrum::{self, Use};
+use crate::common::tint::Tint;
+use crate::common::warnings::Warnings;
 
 /// pbrt's one microfacet distribution, Trowbridge-Reitz (GGX).
 const TROWBRIDGE_REITZ: Distribution = Distribution::Ggx;
@@ -297,6 +298,10 @@ fn layered(kd: &Tint, f0: Vec3, f90: f32, r: f32) -> Material {
 /// `e.kind` is the material type (for `MakeNamedMaterial`, the caller has
 /// put its `"string type"` there). Approximations are counted in `w`,
 /// one kind per material type.
+///
+/// One piece on purpose: it is pbrt's one material table, an arm per kind, each mapping its
+/// parameters onto Sahara's; it becomes one mapping per kind family when
+/// materials and lights are kinds the renderer describes.
 pub(crate) fn map_material(
     e: &Entity,
     tex: &mut Textures,
@@ -541,32 +546,6 @@ pub(crate) fn map_material(
     Ok(Mapped::Surface(m))
 }
 
-/// pbrt's `mix` of materials `a` and `b` with weight `t` of `b`, when
-/// Sahara can blend them exactly: the same material, or two diffuse
-/// colours without textures (a Lambertian BSDF is linear in its colour).
-pub(crate) fn blend(a: &Material, b: &Material, t: f32) -> Option<Material> {
-    if a == b {
-        return Some(a.clone());
-    }
-    match (a.bsdf, b.bsdf) {
-        (Bsdf::Diffuse { albedo: x }, Bsdf::Diffuse { albedo: y })
-            if a.textures.base_color.is_none()
-                && b.textures.base_color.is_none()
-                && Material {
-                    bsdf: a.bsdf,
-                    ..b.clone()
-                } == *a =>
-        {
-            let mut m = a.clone();
-            m.bsdf = Bsdf::Diffuse {
-                albedo: x.lerp(y, t),
-            };
-            Some(m)
-        }
-        _ => None,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -585,7 +564,7 @@ mod tests {
     /// warnings.
     fn material_of(decl: &str) -> (Material, Vec<String>) {
         let text = format!("{decl}\nShape \"sphere\"\n");
-        let s = crate::pbrt::parse_pbrt(
+        let s = crate::parse_pbrt(
             text.as_bytes(),
             "m.pbrt",
             std::path::Path::new("/nonexistent"),

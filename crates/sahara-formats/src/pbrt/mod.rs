@@ -11,7 +11,8 @@
 //! - The mapping to Sahara's [`SceneDescription`]: [`build`] (camera,
 //!   settings, shapes, objects and instances), [`shapes`] (with [`subdivision`]), [`materials`] (the
 //!   one material table), [`textures`], [`lights`] (with [`envmap`]),
-//!   [`spectrum`] (spectra to RGB).
+//!   with what the Mitsuba reader shares in [`crate::common`] (spectra
+//!   to RGB, tints and blends, warnings, positions).
 //! - Every error is one line, `file: line L: column C: what`; everything
 //!   Sahara approximates or leaves out is a warning, one per kind with a
 //!   count, naming the first place.
@@ -21,29 +22,28 @@
 
 mod build;
 mod declarations;
-pub(crate) mod envmap;
-pub(crate) mod lexer;
+mod envmap;
+mod lexer;
 mod lights;
-pub(crate) mod materials;
+mod materials;
 mod params;
 mod parser;
 mod shapes;
-pub(crate) mod spectrum;
-pub(crate) mod subdivision;
-pub(crate) mod textures;
-pub(crate) mod warnings;
+mod subdivision;
+mod textures;
 
 #[cfg(test)]
 mod tests;
 
 use std::path::Path;
 
-use crate::assembly::{assemble, AssembledScene};
+use sahara_readers::FormatError;
+
+use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
-use crate::FormatError;
 
 /// True if `path` names a pbrt file (`.pbrt` or `.pbrt.gz`, any case).
-pub fn is_pbrt_path(path: &Path) -> bool {
+pub(crate) fn is_pbrt_path(path: &Path) -> bool {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().to_ascii_lowercase())
@@ -51,43 +51,30 @@ pub fn is_pbrt_path(path: &Path) -> bool {
     name.ends_with(".pbrt") || name.ends_with(".pbrt.gz")
 }
 
-/// Reads a pbrt file (and the files it includes, meshes and images) and
-/// assembles its scene, checked (its settings are always there; the
-/// film's `cropwindow` or `pixelbounds` is in their `crop`).
-pub fn load_pbrt(path: &Path) -> Result<AssembledScene, FormatError> {
-    assembled(read_pbrt(path)?)
-}
-
 /// Reads a pbrt file (and the files it includes, meshes and images) as
 /// a scene description.
-pub fn read_pbrt(path: &Path) -> Result<SceneDescription, FormatError> {
-    let mut w = warnings::Warnings::default();
+pub(crate) fn read_pbrt(path: &Path) -> Result<SceneDescription, FormatError> {
+    let mut w = Warnings::default();
     let desc = parser::parse_file(path, &mut w)?;
     let folder = path.parent().unwrap_or(Path::new(""));
     let name = path.display().to_string();
     Ok(described(build::build(&desc, &name, folder, &mut w)?, w))
 }
 
-/// Parses and builds a pbrt file held in memory; `name` is used in
+/// Parses and describes a pbrt file held in memory; `name` is used in
 /// messages and relative file names resolve against `folder`.
-pub fn parse_pbrt(text: &[u8], name: &str, folder: &Path) -> Result<AssembledScene, FormatError> {
-    let mut w = warnings::Warnings::default();
+pub(crate) fn read_pbrt_text(
+    text: &[u8],
+    name: &str,
+    folder: &Path,
+) -> Result<SceneDescription, FormatError> {
+    let mut w = Warnings::default();
     let desc = parser::parse_bytes(text.to_vec(), name, folder, &mut w)?;
-    assembled(described(build::build(&desc, name, folder, &mut w)?, w))
+    Ok(described(build::build(&desc, name, folder, &mut w)?, w))
 }
 
 /// The description with the reader's warnings, one line per kind.
-fn described(mut desc: SceneDescription, w: warnings::Warnings) -> SceneDescription {
+fn described(mut desc: SceneDescription, w: Warnings) -> SceneDescription {
     desc.warnings = w.into_lines();
     desc
-}
-
-/// The assembled scene, checked.
-fn assembled(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
-    let name = desc.name.clone();
-    let a = assemble(desc)?;
-    a.scene
-        .validate()
-        .map_err(|e| FormatError::in_file(&name, e))?;
-    Ok(a)
 }

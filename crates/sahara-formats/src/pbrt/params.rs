@@ -7,8 +7,9 @@
 
 use std::cell::Cell;
 
-use super::lexer::Loc;
-use crate::FormatError;
+use sahara_readers::FormatError;
+
+use crate::common::position::Loc;
 
 /// The values of one parameter.
 #[derive(Clone, Debug, PartialEq)]

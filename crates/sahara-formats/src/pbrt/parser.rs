@@ -13,14 +13,16 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{DMat4, DVec3};
+use sahara_readers::FormatError;
 
 use super::declarations::{
     Declarations, Entity, InstanceDecl, LightDecl, MaterialRef, ShapeDecl, TextureDecl, Xform,
 };
-use super::lexer::{read_maybe_gz, Lexer, Loc, Token, TokenKind};
+use super::lexer::{Lexer, Token, TokenKind};
 use super::params::{Param, ParamList, Values};
-use super::warnings::Warnings;
-use crate::FormatError;
+use crate::common::gzip::read_maybe_gz;
+use crate::common::position::Loc;
+use crate::common::warnings::Warnings;
 
 /// Deepest `Include` nesting accepted (a file including itself is caught by this).
 const MAX_INCLUDE_DEPTH: usize = 32;
@@ -357,6 +359,12 @@ impl Parser<'_> {
         Ok(())
     }
 
+    /// Applies one directive at `loc` to the graphics state or the
+    /// declarations.
+    ///
+    /// One piece on purpose: it is the parser's one table of pbrt's
+    /// directives, an arm per directive, most of them a few lines; split
+    /// by directive, the graphics state would be passed to each.
     fn directive(&mut self, directive: &str, loc: Loc) -> Result<(), FormatError> {
         match directive {
             "Identity" => self.apply(|_| DMat4::IDENTITY),

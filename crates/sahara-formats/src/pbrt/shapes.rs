@@ -19,12 +19,13 @@ use sahara_render::Shape;
 use sahara_render::{Mesh, SceneMesh};
 
 use super::declarations::Entity;
-use super::lexer::read_maybe_gz;
-use super::subdivision::{loop_subdivide, smooth_normals};
-use super::warnings::Warnings;
-use crate::FormatError;
+use super::subdivision::loop_subdivide;
+use crate::common::gzip::read_maybe_gz;
+use crate::common::mesh::smooth_normals;
+use crate::common::warnings::Warnings;
 use sahara_readers::fan::fan_triangulate;
 use sahara_readers::ply::parse_ply_with_attributes;
+use sahara_readers::FormatError;
 
 /// Largest number of triangles a shape may make (subdivision, tessellation).
 const MAX_TRIANGLES: u64 = 1 << 24;
@@ -212,141 +213,13 @@ pub(crate) fn shape_geometry(
                 .map_err(|err| e.loc.error(err))?;
             scene_mesh(ply.mesh.positions, ply.mesh.indices, ply.normals, ply.uvs)
         }
-        "heightfield" => {
-            let nu = e.params.int("nu", 0)?;
-            let nv = e.params.int("nv", 0)?;
-            let z = e.params.floats("Pz")?.unwrap_or(&[]);
-            if nu < 2 || nv < 2 || (nu as u64).saturating_mul(nv as u64) != z.len() as u64 {
-                return Err(e.loc.error(format!(
-                    "heightfield: nu = {nu}, nv = {nv} need nu, nv >= 2 and nu * nv values of Pz (found {})",
-                    z.len()
-                )));
-            }
-            let (nu, nv) = (nu as u32, nv as u32);
-            grid(nu - 1, nv - 1, |u, v| {
-                let (i, j) = (
-                    (u * (nu - 1) as f32).round() as usize,
-                    (v * (nv - 1) as f32).round() as usize,
-                );
-                Vec3::new(u, v, z[j * nu as usize + i] as f32)
-            })
-        }
-        "sphere" => {
-            let r = e.params.float("radius", 1.0)?;
-            let zmin = e.params.float("zmin", -r)?.clamp(-r, r);
-            let zmax = e.params.float("zmax", r)?.clamp(-r, r);
-            let phimax = e
-                .params
-                .float("phimax", 360.0)?
-                .clamp(0.0, 360.0)
-                .to_radians();
-            if r <= 0.0 || zmin >= zmax || phimax <= 0.0 {
-                w.add(
-                    "degenerate sphere (radius, zmin / zmax or phimax) skipped",
-                    &e.loc,
-                );
-                return Ok(None);
-            }
-            let (t0, t1) = ((zmin / r).acos(), (zmax / r).acos());
-            let full = zmin <= -r && zmax >= r && phimax >= 2.0 * std::f64::consts::PI;
-            let (r, t0, t1, phimax) = (r as f32, t0 as f32, t1 as f32, phimax as f32);
-            let bands = ((t0 - t1) / std::f32::consts::PI * (SEGMENTS / 2) as f32)
-                .ceil()
-                .max(1.0) as u32;
-            let segs = (phimax / (2.0 * std::f32::consts::PI) * SEGMENTS as f32)
-                .ceil()
-                .max(1.0) as u32;
-            let mut g = grid(segs, bands, |u, v| {
-                let phi = u * phimax;
-                let theta = t0 + (t1 - t0) * v;
-                Vec3::new(
-                    r * theta.sin() * phi.cos(),
-                    r * theta.sin() * phi.sin(),
-                    r * theta.cos(),
-                )
-            });
-            g.normals = Some(
-                g.mesh
-                    .positions
-                    .iter()
-                    .map(|p| p.normalize_or_zero())
-                    .collect(),
-            );
-            return Ok(Some(Geometry {
-                mesh: g,
-                exact: full.then_some(Shape::Sphere {
-                    center: Vec3::ZERO,
-                    radius: r,
-                }),
-            }));
-        }
-        "disk" => {
-            let h = e.params.float("height", 0.0)? as f32;
-            let r = e.params.float("radius", 1.0)? as f32;
-            let ri = e.params.float("innerradius", 0.0)?.max(0.0) as f32;
-            let phimax = e
-                .params
-                .float("phimax", 360.0)?
-                .clamp(0.0, 360.0)
-                .to_radians() as f32;
-            if r <= 0.0 || ri >= r || phimax <= 0.0 {
-                w.add(
-                    "degenerate disk (radius, innerradius or phimax) skipped",
-                    &e.loc,
-                );
-                return Ok(None);
-            }
-            let full = ri == 0.0 && phimax >= 2.0 * std::f32::consts::PI - 1e-6;
-            let segs = (phimax / (2.0 * std::f32::consts::PI) * SEGMENTS as f32)
-                .ceil()
-                .max(1.0) as u32;
-            let mut g = grid(segs, 1, |u, v| {
-                let phi = u * phimax;
-                let rr = r + (ri - r) * v;
-                Vec3::new(rr * phi.cos(), rr * phi.sin(), h)
-            });
-            g.normals = Some(vec![Vec3::Z; g.mesh.positions.len()]);
-            return Ok(Some(Geometry {
-                mesh: g,
-                exact: full.then_some(Shape::Disc {
-                    center: Vec3::new(0.0, 0.0, h),
-                    normal: Vec3::Z,
-                    radius: r,
-                }),
-            }));
-        }
-        "cylinder" => {
-            let r = e.params.float("radius", 1.0)? as f32;
-            let zmin = e.params.float("zmin", -1.0)? as f32;
-            let zmax = e.params.float("zmax", 1.0)? as f32;
-            let phimax = e
-                .params
-                .float("phimax", 360.0)?
-                .clamp(0.0, 360.0)
-                .to_radians() as f32;
-            if r <= 0.0 || zmin == zmax || phimax <= 0.0 {
-                w.add(
-                    "degenerate cylinder (radius, zmin = zmax or phimax) skipped",
-                    &e.loc,
-                );
-                return Ok(None);
-            }
-            let segs = (phimax / (2.0 * std::f32::consts::PI) * SEGMENTS as f32)
-                .ceil()
-                .max(1.0) as u32;
-            let mut g = grid(segs, 1, |u, v| {
-                let phi = u * phimax;
-                Vec3::new(r * phi.cos(), r * phi.sin(), zmin + (zmax - zmin) * v)
-            });
-            g.normals = Some(
-                g.mesh
-                    .positions
-                    .iter()
-                    .map(|p| Vec3::new(p.x, p.y, 0.0).normalize_or_zero())
-                    .collect(),
-            );
-            g
-        }
+        "heightfield" => heightfield(e)?,
+        "sphere" => return sphere(e, w),
+        "disk" => return disk(e, w),
+        "cylinder" => match cylinder(e, w)? {
+            Some(g) => g,
+            None => return Ok(None),
+        },
         "curve" | "nurbs" | "cone" | "paraboloid" | "hyperboloid" => {
             w.add(
                 format!("shape '{}' is not supported; skipped", e.kind),
@@ -358,6 +231,150 @@ pub(crate) fn shape_geometry(
         other => return Err(e.loc.error(format!("unknown shape type '{other}'"))),
     };
     Ok(Some(Geometry { mesh, exact: None }))
+}
+
+/// A `heightfield`: a grid of `nu` x `nv` heights `Pz` over the unit square.
+fn heightfield(e: &Entity) -> Result<SceneMesh, FormatError> {
+    let nu = e.params.int("nu", 0)?;
+    let nv = e.params.int("nv", 0)?;
+    let z = e.params.floats("Pz")?.unwrap_or(&[]);
+    if nu < 2 || nv < 2 || (nu as u64).saturating_mul(nv as u64) != z.len() as u64 {
+        return Err(e.loc.error(format!(
+            "heightfield: nu = {nu}, nv = {nv} need nu, nv >= 2 and nu * nv values of Pz (found {})",
+            z.len()
+        )));
+    }
+    let (nu, nv) = (nu as u32, nv as u32);
+    Ok(grid(nu - 1, nv - 1, |u, v| {
+        let (i, j) = (
+            (u * (nu - 1) as f32).round() as usize,
+            (v * (nv - 1) as f32).round() as usize,
+        );
+        Vec3::new(u, v, z[j * nu as usize + i] as f32)
+    }))
+}
+
+/// A `sphere` (part of one, between `zmin` and `zmax`, up to `phimax`), exact when whole.
+fn sphere(e: &Entity, w: &mut Warnings) -> Result<Option<Geometry>, FormatError> {
+    let r = e.params.float("radius", 1.0)?;
+    let zmin = e.params.float("zmin", -r)?.clamp(-r, r);
+    let zmax = e.params.float("zmax", r)?.clamp(-r, r);
+    let phimax = e
+        .params
+        .float("phimax", 360.0)?
+        .clamp(0.0, 360.0)
+        .to_radians();
+    if r <= 0.0 || zmin >= zmax || phimax <= 0.0 {
+        w.add(
+            "degenerate sphere (radius, zmin / zmax or phimax) skipped",
+            &e.loc,
+        );
+        return Ok(None);
+    }
+    let (t0, t1) = ((zmin / r).acos(), (zmax / r).acos());
+    let full = zmin <= -r && zmax >= r && phimax >= 2.0 * std::f64::consts::PI;
+    let (r, t0, t1, phimax) = (r as f32, t0 as f32, t1 as f32, phimax as f32);
+    let bands = ((t0 - t1) / std::f32::consts::PI * (SEGMENTS / 2) as f32)
+        .ceil()
+        .max(1.0) as u32;
+    let segs = (phimax / (2.0 * std::f32::consts::PI) * SEGMENTS as f32)
+        .ceil()
+        .max(1.0) as u32;
+    let mut g = grid(segs, bands, |u, v| {
+        let phi = u * phimax;
+        let theta = t0 + (t1 - t0) * v;
+        Vec3::new(
+            r * theta.sin() * phi.cos(),
+            r * theta.sin() * phi.sin(),
+            r * theta.cos(),
+        )
+    });
+    g.normals = Some(
+        g.mesh
+            .positions
+            .iter()
+            .map(|p| p.normalize_or_zero())
+            .collect(),
+    );
+    Ok(Some(Geometry {
+        mesh: g,
+        exact: full.then_some(Shape::Sphere {
+            center: Vec3::ZERO,
+            radius: r,
+        }),
+    }))
+}
+
+/// A `disk` (an annulus with `innerradius`, up to `phimax`), exact when whole.
+fn disk(e: &Entity, w: &mut Warnings) -> Result<Option<Geometry>, FormatError> {
+    let h = e.params.float("height", 0.0)? as f32;
+    let r = e.params.float("radius", 1.0)? as f32;
+    let ri = e.params.float("innerradius", 0.0)?.max(0.0) as f32;
+    let phimax = e
+        .params
+        .float("phimax", 360.0)?
+        .clamp(0.0, 360.0)
+        .to_radians() as f32;
+    if r <= 0.0 || ri >= r || phimax <= 0.0 {
+        w.add(
+            "degenerate disk (radius, innerradius or phimax) skipped",
+            &e.loc,
+        );
+        return Ok(None);
+    }
+    let full = ri == 0.0 && phimax >= 2.0 * std::f32::consts::PI - 1e-6;
+    let segs = (phimax / (2.0 * std::f32::consts::PI) * SEGMENTS as f32)
+        .ceil()
+        .max(1.0) as u32;
+    let mut g = grid(segs, 1, |u, v| {
+        let phi = u * phimax;
+        let rr = r + (ri - r) * v;
+        Vec3::new(rr * phi.cos(), rr * phi.sin(), h)
+    });
+    g.normals = Some(vec![Vec3::Z; g.mesh.positions.len()]);
+    Ok(Some(Geometry {
+        mesh: g,
+        exact: full.then_some(Shape::Disc {
+            center: Vec3::new(0.0, 0.0, h),
+            normal: Vec3::Z,
+            radius: r,
+        }),
+    }))
+}
+
+/// A `cylinder` (between `zmin` and `zmax`, up to `phimax`), or `None`
+/// (with a warning) if it is degenerate.
+fn cylinder(e: &Entity, w: &mut Warnings) -> Result<Option<SceneMesh>, FormatError> {
+    let r = e.params.float("radius", 1.0)? as f32;
+    let zmin = e.params.float("zmin", -1.0)? as f32;
+    let zmax = e.params.float("zmax", 1.0)? as f32;
+    let phimax = e
+        .params
+        .float("phimax", 360.0)?
+        .clamp(0.0, 360.0)
+        .to_radians() as f32;
+    if r <= 0.0 || zmin == zmax || phimax <= 0.0 {
+        w.add(
+            "degenerate cylinder (radius, zmin = zmax or phimax) skipped",
+            &e.loc,
+        );
+        return Ok(None);
+    }
+    let segs = (phimax / (2.0 * std::f32::consts::PI) * SEGMENTS as f32)
+        .ceil()
+        .max(1.0) as u32;
+    let mut g = grid(segs, 1, |u, v| {
+        let phi = u * phimax;
+        Vec3::new(r * phi.cos(), r * phi.sin(), zmin + (zmax - zmin) * v)
+    });
+    g.normals = Some(
+        g.mesh
+            .positions
+            .iter()
+            .map(|p| Vec3::new(p.x, p.y, 0.0).normalize_or_zero())
+            .collect(),
+    );
+    Ok(Some(g))
 }
 
 /// A `nu` x `nv` grid of quads over `f(u, v)`, `u, v` in [0, 1], two

@@ -10,11 +10,10 @@ use sahara_render::{render, Placement, RenderSettings, Scene};
 
 use super::declarations::Declarations;
 use super::parser::parse_bytes;
-use super::warnings::Warnings;
-use super::{load_pbrt, parse_pbrt};
-use crate::scene_load::load_scene;
+use crate::common::warnings::Warnings;
+use crate::{load_pbrt, load_scene, parse_pbrt};
 
-fn parse(text: &str) -> Result<(Declarations, Warnings), crate::FormatError> {
+fn parse(text: &str) -> Result<(Declarations, Warnings), sahara_readers::FormatError> {
     let mut w = Warnings::default();
     let d = parse_bytes(
         text.as_bytes().to_vec(),
@@ -486,7 +485,7 @@ fn an_octahedral_environment_map_becomes_a_lat_long_map_through_the_light_transf
     // A 2x2 equal-area map: the quadrant u > 1/2, v < 1/2 (directions with
     // x > 0, y < 0 in light space) red, the rest black.
     let texels: Vec<f32> = [[0.0; 3], [1.0, 0.0, 0.0], [0.0; 3], [0.0; 3]].concat();
-    crate::image_out::write_exr(&dir.join("sky.exr"), 2, 2, &texels, &[]).unwrap();
+    crate::output::image::write_exr(&dir.join("sky.exr"), 2, 2, &texels, &[]).unwrap();
     // Rotate 90 about z: light +x is world +y, light -y is world +x.
     std::fs::write(
         dir.join("s.pbrt"),
@@ -541,7 +540,7 @@ fn tga_and_pfm_imagemaps_load_and_textures_combine_texel_by_texel() {
         &[[0.0, 0.0, 1.0], [4.0, 4.0, 4.0]],
     );
     let quad = "Shape \"bilinearmesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 0] \"point2 uv\" [0 0 1 0 0 1 1 1]";
-    let srgb = crate::srgb::srgb8_to_linear;
+    let srgb = sahara_render::srgb8_to_linear;
     let (m, w) = shape_material(
         &dir,
         &format!("Texture \"a\" \"spectrum\" \"imagemap\" \"string filename\" \"a.tga\"\n\
@@ -586,7 +585,7 @@ fn imagemaps_keep_their_wrap_mode_and_uv_scale_and_offset() {
     assert_eq!(uv, glam::Vec2::new(2.25, 3.5));
     // Past the right edge, clamping reads the last texel (grey), where
     // repeating would read the first (red).
-    let grey = crate::srgb::srgb8_to_linear(128);
+    let grey = sahara_render::srgb8_to_linear(128);
     let point = sahara_render::UvFootprint::POINT;
     let far = glam::Vec2::new(0.9, 0.5);
     let tint = m.at(&[far, far], &point).bsdf.tint;

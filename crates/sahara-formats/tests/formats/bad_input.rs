@@ -22,8 +22,8 @@ use std::cell::Cell;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use sahara_formats::image_in::decode_rgb_f32;
-use sahara_formats::scene_file::parse_scene_file;
+use sahara_formats::decode_rgb_f32;
+use sahara_formats::parse_scene;
 use sahara_formats::{render_mesh, FormatError};
 use sahara_readers::gltf::load_gltf;
 use sahara_readers::obj::parse_obj;
@@ -487,20 +487,20 @@ fn scene_file_bad_numbers_name_line_and_column() {
     ] {
         let text = format!("{head}{rest}");
         assert_error(
-            parse_scene_file(&text, "bad.toml", Path::new("/nonexistent")),
+            parse_scene(&text, "bad.toml", Path::new("/nonexistent")),
             &format!("bad.toml: {prefix}"),
             &[needle],
         );
     }
     let text = "[camera]\neye = [1, 2, 3]\ntarget = [1, 2, 3]\n[film]\nwidth = 8\nheight = 4\n";
     assert_error(
-        parse_scene_file(text, "bad.toml", Path::new("/nonexistent")),
+        parse_scene(text, "bad.toml", Path::new("/nonexistent")),
         "bad.toml: line 3: column 10:",
         &["eye and target are the same point"],
     );
     // An empty file has no position to name: the message says what is missing.
     assert_error(
-        parse_scene_file("", "empty.toml", Path::new("/nonexistent")),
+        parse_scene("", "empty.toml", Path::new("/nonexistent")),
         "empty.toml: ",
         &["no [camera] table"],
     );
@@ -645,7 +645,7 @@ fn fuzz_crash_inputs_load_or_fail_cleanly() {
                     let text = String::from_utf8_lossy(&bytes);
                     let folder = Path::new("/nonexistent");
                     (
-                        parse_scene_file(&text, "fuzz.in", folder).err(),
+                        parse_scene(&text, "fuzz.in", folder).err(),
                         "fuzz.in".to_owned(),
                     )
                 }
@@ -683,7 +683,7 @@ fn scene_file_errors_quoting_line_breaks_stay_one_line() {
     let text = "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 8\nheight = 4\n\
                 [integrator]\nname = \"\"\"path\nmax_depth = 3\n\"\"\"\n";
     let m = assert_error(
-        parse_scene_file(text, "bad.toml", Path::new("/nonexistent")),
+        parse_scene(text, "bad.toml", Path::new("/nonexistent")),
         "bad.toml: line 8: column 8:",
         &["unknown integrator", "path\\nmax_depth = 3\\n"],
     );
@@ -692,7 +692,7 @@ fn scene_file_errors_quoting_line_breaks_stay_one_line() {
     let text = "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\n[film]\nwidth = 8\nheight = 4\n\
                 [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"a\\nb\\r\\nc\"\n";
     assert_error(
-        parse_scene_file(text, "bad.toml", Path::new("/nonexistent")),
+        parse_scene(text, "bad.toml", Path::new("/nonexistent")),
         "bad.toml: line 11:",
         &[],
     );

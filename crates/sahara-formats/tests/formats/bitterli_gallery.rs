@@ -28,10 +28,10 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use sahara_formats::assembly::AssembledScene;
-use sahara_formats::image_in::load_rgb_f32;
-use sahara_formats::mitsuba::load_mitsuba;
-use sahara_formats::pbrt::load_pbrt;
+use sahara_formats::load_mitsuba;
+use sahara_formats::load_pbrt;
+use sahara_formats::load_rgb_f32;
+use sahara_formats::AssembledScene;
 use sahara_render::defaults::PASS_SPP;
 use sahara_render::{render, RenderSettings};
 

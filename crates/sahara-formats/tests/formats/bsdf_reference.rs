@@ -26,10 +26,10 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use sahara_formats::description::FileSettings;
-use sahara_formats::image_in::load_rgb_f32;
-use sahara_formats::pbrt::load_pbrt;
-use sahara_formats::scene_load::load_scene;
+use sahara_formats::load_pbrt;
+use sahara_formats::load_rgb_f32;
+use sahara_formats::load_scene;
+use sahara_formats::FileSettings;
 use sahara_render::{render, RenderSettings, Scene};
 
 use crate::blocks::block_errors;

@@ -5,11 +5,11 @@
 //! is said; non-finite vertices.
 
 use glam::{Affine2, Mat4, Vec2, Vec3, Vec4};
-use sahara_formats::assembly::sky::SkyUsed;
-use sahara_formats::description::Sky;
-use sahara_formats::gltf_scene::{gltf_camera, gltf_light, LUMENS_PER_WATT};
-use sahara_formats::material_map::{gltf_material, TextureCache};
-use sahara_formats::mesh_scene::{load_mesh_scene, load_mesh_scene_with, CameraChoice};
+use sahara_formats::Sky;
+use sahara_formats::SkyUsed;
+use sahara_formats::{gltf_camera, gltf_light, LUMENS_PER_WATT};
+use sahara_formats::{gltf_material, TextureCache};
+use sahara_formats::{load_mesh_scene, load_mesh_scene_with, CameraChoice};
 use sahara_readers::gltf::{load_gltf, GltfLightKind, GltfWrap};
 use sahara_render::{Bsdf, Light};
 use sahara_render::{Channel, Wrap};
@@ -407,7 +407,7 @@ fn ktx2_data(name: &str) -> std::path::PathBuf {
 fn a_texture_stored_only_as_ktx2_is_read_through_khr_texture_basisu() {
     // A square whose one texture is a UASTC KTX2 image named only by the
     // extension (no PNG fallback), as files exported for the web are.
-    let s = sahara_formats::mesh_scene::load_mesh_scene(&ktx2_data("quad_basisu.gltf")).unwrap();
+    let s = sahara_formats::load_mesh_scene(&ktx2_data("quad_basisu.gltf")).unwrap();
     assert!(
         s.warnings
             .iter()

@@ -2,8 +2,8 @@
 
 use std::fs;
 
-use sahara_formats::image_in::{decode_rgb_f32, load_image, load_rgb_f32};
-use sahara_formats::image_out::{write_exr, write_png};
+use sahara_formats::{decode_rgb_f32, load_image, load_rgb_f32};
+use sahara_formats::{write_exr, write_png};
 
 use crate::common::TempDir;
 

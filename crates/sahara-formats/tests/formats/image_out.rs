@@ -3,9 +3,9 @@
 use std::fs;
 use std::path::Path;
 
-use sahara_formats::atomic::{check_writable, write_atomically};
-use sahara_formats::image_out::{write_exr, write_image, write_png, ImageFormat, Pixels};
 use sahara_formats::FormatError;
+use sahara_formats::{check_writable, write_atomically};
+use sahara_formats::{write_exr, write_image, write_png, ImageFormat, Pixels};
 
 use crate::common::TempDir;
 
@@ -144,7 +144,7 @@ fn the_same_exr_is_written_byte_for_byte_every_time() {
             v => panic!("{key}: {v:?}"),
         }
     }
-    let (w, h, back) = sahara_formats::image_in::load_rgb_f32(&first).unwrap();
+    let (w, h, back) = sahara_formats::load_rgb_f32(&first).unwrap();
     assert_eq!((w, h), (4, 3));
     assert_eq!(back, rgb);
 }
@@ -165,7 +165,7 @@ fn write_image_picks_the_format_by_extension_in_any_case() {
     // 8-bit input to an EXR is sRGB-decoded: code 255 is 1.0 exactly.
     let path = dir.0.join("d.exr");
     write_image(&path, 1, 1, Pixels::Rgb8(&[255, 0, 255]), &[]).unwrap();
-    let (_, _, back) = sahara_formats::image_in::load_rgb_f32(&path).unwrap();
+    let (_, _, back) = sahara_formats::load_rgb_f32(&path).unwrap();
     assert_eq!(back, vec![1.0, 0.0, 1.0]);
 
     assert_eq!(

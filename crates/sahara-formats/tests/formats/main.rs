@@ -15,6 +15,5 @@ mod gltf_extensions;
 mod image_in;
 mod image_out;
 mod mitsuba_kit;
-mod scene_file;
 mod scene_load;
 mod scenes;

@@ -24,9 +24,8 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use sahara_formats::assembly::{assemble, AssembledScene};
-use sahara_formats::image_in::load_rgb_f32;
-use sahara_formats::mitsuba::read_mitsuba_with;
+use sahara_formats::load_rgb_f32;
+use sahara_formats::{LoadOptions, Loaded};
 use sahara_render::{render, RenderSettings};
 
 use crate::blocks::block_errors;
@@ -71,15 +70,17 @@ fn folder() -> PathBuf {
 }
 
 /// The scene of the XML file `path`, its meshes read from `scenes`.
-fn load(path: &Path, scenes: &Path) -> AssembledScene {
-    let params = [("scenes".to_owned(), scenes.display().to_string())];
-    let desc = read_mitsuba_with(path, &params).unwrap();
-    assemble(desc).unwrap()
+fn load(path: &Path, scenes: &Path) -> Loaded {
+    let options = LoadOptions {
+        defines: vec![("scenes".to_owned(), scenes.display().to_string())],
+        ..LoadOptions::default()
+    };
+    sahara_formats::load(path, &options).unwrap()
 }
 
 /// Sahara's image of `a` at `spp` (the file's size, filter, sampler and
 /// integrator).
-fn render_image(a: &AssembledScene, spp: u32) -> Vec<Vec3> {
+fn render_image(a: &Loaded, spp: u32) -> Vec<Vec3> {
     let s = a.settings.as_ref().unwrap();
     let mut scene = a.scene.clone();
     scene.camera.aspect = s.width as f32 / s.height as f32;

@@ -2,9 +2,9 @@
 //! meshes, shapes, lights, motion and errors.
 
 use glam::{Affine3A, Vec3};
-use sahara_formats::material_map::{gltf_bsdf, mtl_bsdf, phong_roughness};
-use sahara_formats::mesh_scene::load_mesh_scene;
-use sahara_formats::scene_load::load_scene;
+use sahara_formats::load_mesh_scene;
+use sahara_formats::load_scene;
+use sahara_formats::{gltf_bsdf, mtl_bsdf, phong_roughness};
 use sahara_readers::gltf::GltfMaterial;
 use sahara_readers::mtl::MtlMaterial;
 use sahara_render::{AlphaMode, Bsdf, Distribution, Integrator, Light, Placement, Shape};
@@ -500,7 +500,7 @@ fn the_scene_files_sky_key_adds_what_it_names() {
     assert_eq!(
         s.environment,
         Some(sahara_render::Environment::Constant(
-            sahara_formats::assembly::sky::DEFAULT_SKY
+            sahara_formats::DEFAULT_SKY
         ))
     );
     let s = scene("sky = \"default\"").unwrap().scene;

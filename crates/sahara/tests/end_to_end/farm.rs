@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 use crate::common::{denoiser_missing, sahara, temp_dir};
-use sahara_formats::part_file::{read_part, write_part};
+use sahara_formats::{read_part, write_part};
 
 /// The frame of every test: small, a few passes (the last one shorter), a
 /// filter wider than a pixel.

@@ -6,7 +6,7 @@ use std::fs;
 use std::path::Path;
 use std::process::Output;
 
-use sahara_formats::image_in::load_rgb_f32;
+use sahara_formats::load_rgb_f32;
 
 use crate::common::{sahara, temp_dir};
 

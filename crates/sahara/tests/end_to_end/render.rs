@@ -5,7 +5,7 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use sahara_formats::image_in::load_rgb_f32;
+use sahara_formats::load_rgb_f32;
 
 use crate::common::{denoiser_missing, sahara, temp_dir};
 

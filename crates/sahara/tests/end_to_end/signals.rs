@@ -88,7 +88,7 @@ fn sigterm_writes_the_completed_passes_marked_partial() {
     assert_eq!(exr_text(&out, "sahara:partial").as_deref(), Some("true"));
     let spp: u32 = exr_text(&out, "sahara:spp").unwrap().parse().unwrap();
     assert!(spp >= 1, "{spp}");
-    let (w, h, rgb) = sahara_formats::image_in::load_rgb_f32(&out).unwrap();
+    let (w, h, rgb) = sahara_formats::load_rgb_f32(&out).unwrap();
     assert_eq!((w, h), (24, 16));
     assert!(rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
     assert!(rgb.iter().any(|v| *v > 0.0), "the Cornell box is lit");
@@ -169,7 +169,7 @@ fn sigint_in_the_first_pass_keeps_the_finished_pixels_marked_partial() {
         finished > 0 && finished < 48 * 32,
         "{finished} pixels: {log}"
     );
-    let (w, h, rgb) = sahara_formats::image_in::load_rgb_f32(&out).unwrap();
+    let (w, h, rgb) = sahara_formats::load_rgb_f32(&out).unwrap();
     assert_eq!((w, h), (48, 32));
     assert!(rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
     // The finished pixels are lit; the unfinished ones are black.

@@ -12,15 +12,15 @@
 //! renderer's scene.
 //!
 //! Every reader fills the same fields: TOML scene files
-//! ([`crate::scene_load`]), pbrt ([`crate::pbrt`]) and bare mesh files
-//! ([`crate::mesh_scene`]); a Mitsuba reader would map its shapes
-//! (`rectangle`, `cube`, `sphere`, `disk` as [`Geometry::Shape`]; `obj`,
-//! `ply` as [`Geometry::File`]; `serialized` as [`Geometry::Mesh`]), its
-//! bsdfs as [`SceneDescription::materials`], its emitters (area: an
-//! object with an emissive material; point and spot as
-//! [`SceneDescription::lights`]; `envmap` and `constant` as
-//! [`SceneDescription::environment`]), its sensor as
-//! [`CameraRequest::Given`] and its integrator and sampler as
+//! ([`crate::toml`]), pbrt ([`crate::pbrt`]), Mitsuba ([`crate::mitsuba`])
+//! and bare mesh files ([`crate::mesh`]). The Mitsuba reader, for one,
+//! maps its shapes (`rectangle`, `cube`, `sphere`, `disk` as
+//! [`Geometry::Shape`]; `obj`, `ply` and `serialized`, read as it reads
+//! the scene, as [`Geometry::Mesh`]), its bsdfs as
+//! [`SceneDescription::materials`], its emitters (area: an object with an
+//! emissive material; point and spot as [`SceneDescription::lights`];
+//! `envmap` and `constant` as [`SceneDescription::environment`]), its
+//! sensor as [`CameraRequest::Given`] and its integrator and sampler as
 //! [`FileSettings`].
 
 mod settings;
@@ -125,7 +125,7 @@ pub enum CameraRequest {
     /// (glTF cameras).
     Named(String),
     /// The first camera the scene's mesh files bring, else one framing
-    /// the scene's bounds ([`crate::assembly::auto_camera`]).
+    /// the scene's bounds (`crate::assembly::camera`).
     Automatic,
 }
 

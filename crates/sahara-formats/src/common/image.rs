@@ -1,7 +1,7 @@
 //! Images in, as the renderer wants them: linear colour, or material
 //! textures. The files are read by [`sahara_readers::image_in`], which gives
 //! their stored values; here those become linear with the renderer's sRGB
-//! transfer function ([`crate::srgb`]).
+//! transfer function (`sahara_render::srgb_to_linear`).
 //!
 //! - [`decode_texture`]: a material's texture. 8-bit PNG and JPEG stay
 //!   8-bit, their colour channels read as sRGB or as plain values as the
@@ -19,8 +19,8 @@ use sahara_readers::image_in::{decode_raw, load_raw, ImageFormat, Pixels, RawIma
 use sahara_render::Encoding;
 use sahara_render::Texture;
 
-use crate::srgb::{srgb8_to_linear, srgb_to_linear};
-use crate::FormatError;
+use sahara_readers::FormatError;
+use sahara_render::{srgb8_to_linear, srgb_to_linear};
 
 /// An image as linear float RGB: width, height, `width * height * 3` values row-major from the top left.
 pub type RgbF32Image = (u32, u32, Vec<f32>);

@@ -2,7 +2,7 @@
 //!
 //! Pixels are row-major from the top-left corner, three interleaved channels
 //! (R, G, B) per pixel. Every writer goes through
-//! [`crate::atomic::write_atomically`]: a failed write
+//! [`crate::output::atomic::write_atomically`]: a failed write
 //! leaves an existing file as it was. Metadata (`key`, `value`) pairs become
 //! text attributes: PNG `tEXt` chunks (`iTXt` for non-ASCII values) and EXR
 //! header string attributes.
@@ -15,9 +15,9 @@ use exr::prelude::{
     Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2 as ExrVec2, WritableImage,
 };
 
-use crate::atomic::write_atomically;
-use crate::srgb::{linear_to_srgb8, srgb8_to_linear};
-use crate::FormatError;
+use crate::output::atomic::write_atomically;
+use sahara_readers::FormatError;
+use sahara_render::{linear_to_srgb8, srgb8_to_linear};
 
 /// The image file formats this module writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

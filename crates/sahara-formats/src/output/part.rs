@@ -23,12 +23,12 @@ use exr::prelude::{
     AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
     WritableImage,
 };
+use sahara_readers::FormatError;
 use sahara_render::{
     Aov, Aux, AuxSums, IntegratorKind, Named, PixelSum, PixelWindow, SumBuffer, ToneMap,
 };
 
-use crate::atomic::write_atomically;
-use crate::FormatError;
+use crate::output::atomic::write_atomically;
 
 /// The value of `sahara:format` in a part file.
 const FORMAT: &str = "sahara render part 1";
@@ -459,7 +459,7 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &PartSums) -> Result<(), F
         .to_buffered(&mut bytes)
         .map_err(|e| FormatError::in_file(&name, format!("cannot encode EXR: {e}")))?;
     let mut bytes = bytes.into_inner();
-    crate::image_out::sort_exr_header(&mut bytes)
+    crate::output::image::sort_exr_header(&mut bytes)
         .map_err(|e| FormatError::in_file(&name, format!("cannot encode EXR: {e}")))?;
     write_atomically(path, |out: &mut BufWriter<std::fs::File>| {
         out.write_all(&bytes)

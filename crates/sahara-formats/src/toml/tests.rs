@@ -2,11 +2,12 @@
 
 use std::path::{Path, PathBuf};
 
+use super::file::*;
+use super::{load_scene_file, parse_scene_file};
 use glam::{Mat4, Quat, Vec3};
-use sahara_formats::scene_file::*;
 use sahara_render::{Distribution, Filter, Integrator, SamplerKind, Shape, ToneMap};
 
-use crate::common::TempDir;
+use super::test_helpers::TempDir;
 
 /// A folder with a mesh, a texture and an environment map for scenes to name.
 fn assets() -> TempDir {

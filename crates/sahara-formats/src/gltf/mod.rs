@@ -1,6 +1,8 @@
-//! A glTF file's cameras and lights as the renderer's (the file is read by
-//! [`sahara_readers::gltf`]; its meshes and materials are assembled by
-//! [`crate::mesh_library`] and [`crate::material_map`]).
+//! A glTF file's cameras, lights and materials as the renderer's (the file
+//! is read by [`sahara_readers::gltf`]; its meshes are loaded by
+//! [`crate::mesh::library`], its materials mapped by [`material`]).
+
+pub(crate) mod material;
 
 use glam::{Mat4, Vec3};
 use sahara_readers::gltf::{GltfCamera, GltfLight, GltfLightKind};

@@ -5,6 +5,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::{defaults, Distribution};
 use sahara_render::{
     Adaptive, Filter, FilterKind, Integrator, IntegratorKind, Named, Parameter, SamplerKind, Shape,
@@ -12,10 +13,10 @@ use sahara_render::{
 };
 use toml::Spanned;
 
+use super::file::*;
 use super::raw::*;
-use super::*;
 use crate::description::Sky;
-use crate::image_out::ImageFormat;
+use crate::output::image::ImageFormat;
 
 /// Largest film width or height.
 const MAX_FILM_SIDE: i64 = 65536;
@@ -378,6 +379,10 @@ impl Ctx<'_> {
     }
 
     /// `[[material]]`.
+    ///
+    /// One piece on purpose: it is the scene file's one material table, an arm per kind, each mapping its
+    /// parameters onto Sahara's; it becomes one mapping per kind family when
+    /// materials and lights are kinds the renderer describes.
     fn material(&self, m: &RawMaterial) -> Result<MaterialSpec, FormatError> {
         let kind = *m.kind.get_ref();
         let what = format!("a {} material", type_name(&m.kind));
@@ -863,6 +868,10 @@ impl Ctx<'_> {
     }
 
     /// `[[light]]`.
+    ///
+    /// One piece on purpose: it is the scene file's one light table, an arm per kind, each mapping its
+    /// parameters onto Sahara's; it becomes one mapping per kind family when
+    /// materials and lights are kinds the renderer describes.
     fn light(
         &self,
         raw: &Spanned<RawLight>,

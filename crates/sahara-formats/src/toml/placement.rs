@@ -3,8 +3,8 @@
 use glam::{Affine3A, Mat4, Quat};
 use sahara_render::Srt;
 
+use super::file::{Placement as PlacementSpec, TransformSpec};
 use crate::description::ObjectPlacement;
-use crate::scene_file::{Placement as PlacementSpec, TransformSpec};
 
 /// The scale-rotation-translation of a transform.
 pub fn srt(t: &TransformSpec) -> Srt {

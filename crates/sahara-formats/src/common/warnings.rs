@@ -3,7 +3,7 @@
 
 use std::collections::HashMap;
 
-use super::lexer::Loc;
+use super::position::Loc;
 
 /// Warnings gathered while loading, by kind, in the order first seen.
 #[derive(Debug, Default)]

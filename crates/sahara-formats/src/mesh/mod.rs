@@ -7,19 +7,24 @@
 //! bounds from above and to the side. The sky follows [`crate::assembly::sky`]
 //! (`auto` unless told otherwise: the default sky and sun when the file's
 //! own lights are weak).
+//!
+//! The mesh files themselves are read by `sahara-readers` as plain data;
+//! [`library`] loads each file a description names once, with its own
+//! materials ([`mtl`] for OBJ, [`crate::gltf`] for glTF).
+
+pub(crate) mod library;
+pub(crate) mod mtl;
 
 use std::path::{Path, PathBuf};
 
-use sahara_render::Camera;
+use sahara_render::{Camera, Mesh};
 
-use crate::assembly::{assemble, AssembledScene};
+use crate::common::mesh::render_mesh;
+
 use crate::description::Sky;
 use crate::description::{CameraRequest, Geometry, Object, ObjectPlacement, SceneDescription};
-use crate::FormatError;
 use sahara_readers::camera::{read_sidecar, sidecar_path};
-
-pub use crate::assembly::sky::{DEFAULT_SKY, DEFAULT_SUN, DEFAULT_SUN_DIRECTION};
-pub use crate::assembly::AUTO_VFOV_DEG;
+use sahara_readers::FormatError;
 
 /// Which camera a mesh file is seen by.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -47,27 +52,9 @@ impl CameraChoice {
     }
 }
 
-/// Loads a mesh file with its materials, lights, camera and (if its own
-/// lights are weak) the default sky and sun.
-pub fn load_mesh_scene(path: &Path) -> Result<AssembledScene, FormatError> {
-    load_mesh_scene_with(path, &CameraChoice::Auto, &Sky::Auto)
-}
-
-/// Loads a mesh file as [`load_mesh_scene`] does, seen by `camera` and
-/// lit as `sky` says.
-pub fn load_mesh_scene_with(
-    path: &Path,
-    camera: &CameraChoice,
-    sky: &Sky,
-) -> Result<AssembledScene, FormatError> {
-    let mut desc = read_mesh_scene(path, camera)?;
-    desc.sky = sky.clone();
-    assemble(desc)
-}
-
 /// The description of a mesh file as a scene: the file in world space
 /// with its own materials, seen by `camera`, lit by the `auto` sky.
-pub fn read_mesh_scene(
+pub(crate) fn read_mesh_scene(
     path: &Path,
     camera: &CameraChoice,
 ) -> Result<SceneDescription, FormatError> {
@@ -94,4 +81,17 @@ pub fn read_mesh_scene(
         name: None,
     });
     Ok(desc)
+}
+
+/// Loads a mesh file as the renderer's mesh: [`sahara_readers::load_mesh`]
+/// and [`render_mesh`].
+pub fn load_mesh(path: &Path) -> Result<Mesh, FormatError> {
+    sahara_readers::load_mesh(path).map(render_mesh)
+}
+
+/// Loads a mesh file as the renderer's mesh, with the problems that did not
+/// stop loading: [`sahara_readers::load_mesh_with_warnings`] and
+/// [`render_mesh`].
+pub fn load_mesh_with_warnings(path: &Path) -> Result<(Mesh, Vec<String>), FormatError> {
+    sahara_readers::load_mesh_with_warnings(path).map(|(mesh, w)| (render_mesh(mesh), w))
 }

@@ -11,7 +11,7 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::FormatError;
+use sahara_readers::FormatError;
 
 /// Writes `path` atomically: `fill` writes the contents into a temporary file,
 /// which is flushed, fsynced and renamed over `path`.

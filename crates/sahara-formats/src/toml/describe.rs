@@ -1,6 +1,5 @@
 //! Scene files as descriptions: a [`SceneFile`] becomes a
-//! [`SceneDescription`] (assembled by [`crate::assembly`] into a
-//! renderer scene with the file's render settings).
+//! [`SceneDescription`] (with the file's render settings).
 //!
 //! - `[[object]]`s are objects in file order: a mesh file (its own
 //!   materials unless the object names one; a PLY or a built-in shape
@@ -12,57 +11,24 @@
 //!   light is a shape in world space whose material emits (its named
 //!   material's surface, or black); an environment is the description's.
 
-mod placement;
-
 use std::collections::HashMap;
-use std::path::Path;
 use std::sync::Arc;
 
 use glam::Vec3;
+use sahara_readers::FormatError;
 use sahara_render::Encoding;
 use sahara_render::{Bsdf, Camera, Environment, Light, Material, Shape, Texture, TextureMap};
 
-use crate::assembly::{assemble, AssembledScene};
-use crate::description::Sky;
+use super::file::{
+    CameraSpec, EnvironmentSpec, LightSpec, MaterialKind, MaterialSpec, SceneFile, ShapeSpec,
+};
+use crate::common::image::load_rgb_f32;
+use crate::common::materials::TextureCache;
 use crate::description::{
     CameraRequest, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
 };
-use crate::image_in::load_rgb_f32;
-use crate::material_map::TextureCache;
-use crate::scene_file::{
-    load_scene_file, CameraSpec, EnvironmentSpec, LightSpec, MaterialKind, MaterialSpec, SceneFile,
-    ShapeSpec,
-};
-use crate::FormatError;
 
-pub use placement::{placement, srt};
-
-/// Reads a scene file and assembles its scene (meshes, textures and maps
-/// read relative to it); its settings are always there.
-pub fn load_scene(path: &Path) -> Result<AssembledScene, FormatError> {
-    load_scene_with_sky(path, None)
-}
-
-/// Reads a scene file as [`load_scene`] does, lit by `sky` instead of the
-/// file's `sky` key if given.
-pub fn load_scene_with_sky(path: &Path, sky: Option<&Sky>) -> Result<AssembledScene, FormatError> {
-    let mut desc = read_scene(path)?;
-    if let Some(sky) = sky {
-        desc.sky = sky.clone();
-    }
-    assemble(desc)
-}
-
-/// Reads a scene file as a description (meshes, textures and maps read
-/// relative to it).
-pub fn read_scene(path: &Path) -> Result<SceneDescription, FormatError> {
-    describe(&load_scene_file(path)?, &path.display().to_string())
-}
-
-/// Builds the scene of a parsed scene file; `name` (the scene file) is used in messages.
-pub fn build_scene(file: &SceneFile, name: &str) -> Result<AssembledScene, FormatError> {
-    assemble(describe(file, name)?)
-}
+use super::placement::placement;
 
 /// The render settings of a parsed scene file.
 pub fn settings_of(file: &SceneFile) -> FileSettings {

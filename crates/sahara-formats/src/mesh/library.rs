@@ -2,7 +2,7 @@
 //!
 //! A file becomes one or more scene meshes ([`MeshPart`]s: one for OBJ and
 //! PLY, one per glTF mesh with a transform per glTF node using it) plus, when
-//! asked for, its own materials converted by [`crate::material_map`] and
+//! asked for, its own materials converted by [`crate::mesh::mtl`] and [`crate::gltf::material`] and
 //! appended to the scene's materials, with the meshes' per-triangle
 //! material ids pointing at them. Objects then only add instances, so many
 //! copies of a mesh cost one mesh's memory (and one kd-tree).
@@ -13,9 +13,12 @@ use std::path::{Path, PathBuf};
 use glam::{Mat4, Vec2};
 use sahara_render::{Scene, SceneMesh};
 
-use crate::material_map::{gltf_material, mtl_material, TextureCache};
-use crate::FormatError;
+use crate::common::materials::TextureCache;
+use crate::common::mesh::render_mesh;
+use crate::gltf::material::gltf_material;
+use crate::mesh::mtl::mtl_material;
 use sahara_readers::gltf::{GltfCamera, GltfLight};
+use sahara_readers::FormatError;
 
 /// One scene mesh made from a file, and where the file puts it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -113,7 +116,7 @@ impl MeshLibrary {
         let loaded = match ext.as_str() {
             "obj" => self.load_obj(scene, path, own_materials)?,
             "ply" => {
-                let mesh = crate::render_mesh(sahara_readers::ply::load_ply(path)?);
+                let mesh = render_mesh(sahara_readers::ply::load_ply(path)?);
                 let mesh = scene.add_mesh(mesh);
                 LoadedFile {
                     parts: vec![MeshPart {
@@ -151,7 +154,7 @@ impl MeshLibrary {
         let obj = sahara_readers::obj::load_obj_with_materials(path)?;
         self.warnings.extend(obj.warnings);
         let mut mesh = SceneMesh {
-            mesh: crate::render_mesh(obj.mesh),
+            mesh: render_mesh(obj.mesh),
             normals: obj.normals,
             uvs: obj.uvs,
             ..SceneMesh::default()
@@ -221,7 +224,7 @@ impl MeshLibrary {
             .into_iter()
             .map(|m| {
                 scene.add_mesh(SceneMesh {
-                    mesh: crate::render_mesh(m.mesh),
+                    mesh: render_mesh(m.mesh),
                     normals: m.normals,
                     uvs: flip(m.uvs),
                     uvs1: flip(m.uvs1),

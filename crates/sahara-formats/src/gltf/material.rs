@@ -1,24 +1,7 @@
-//! File materials (MTL, glTF) as renderer [`Material`]s, and their textures.
+//! glTF materials as renderer [`Material`]s, with their textures.
 //!
 //! The renderer has one BSDF per material, so a file material becomes the
 //! BSDF its parameters say it mostly is:
-//!
-//! **MTL** (first rule that applies):
-//!
-//! 1. `illum` 4, 6 or 7, or `d` < 1: smooth glass (`Dielectric`) with
-//!    `ior = Ni` (1.5 when `Ni` <= 1, the MTL default of 1 meaning "not given").
-//! 2. `illum` 3 or 5: a mirror tinted by `Ks` (white when `Ks` is black).
-//! 3. `illum` >= 2 with `Ks` brighter than `Kd` (largest component): a
-//!    glossy conductor of colour `Ks` whose GGX width is the Beckmann width
-//!    matching Phong exponent `Ns` (Walter et al. 2007):
-//!    `alpha = sqrt(2 / (Ns + 2))`, so perceptual `roughness = sqrt(alpha)`
-//!    (the renderer squares it).
-//! 4. Otherwise Lambertian with albedo `Kd` (`illum` 0 and 1 have no
-//!    specular term; a `Ks` weaker than `Kd` is dropped).
-//!
-//! `Ke` > 0 adds front-face emission of radiance `Ke` to any of these;
-//! `map_Kd` multiplies the diffuse or conductor colour (sRGB images are
-//! linearised). Colours are clamped to [0, 1].
 //!
 //! **glTF**: the metallic-roughness BSDF (`Bsdf::MetallicRoughness`) with
 //! the material's base colour, metallic and roughness factors, its
@@ -45,78 +28,21 @@
 //! texture is linear.
 //!
 //! A texture that cannot be read is a warning and the material goes
-//! without it. Each image is decoded once per encoding ([`TextureCache`]).
+//! without it. Each image is decoded once per encoding
+//! ([`TextureCache`]).
 
-use std::collections::HashMap;
-use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use glam::{Affine2, Vec2, Vec3};
+use glam::{Affine2, Vec2};
+use sahara_readers::gltf::{GltfAlphaMode, GltfImage, GltfMaterial, GltfTexture, GltfWrap};
 use sahara_render::{AlphaMode, Bsdf, Distribution, Material, Texture};
 use sahara_render::{Channel, Encoding, ScalarMap, TextureMap, Wrap};
 use sahara_render::{Clearcoat, NormalMap, OcclusionMap};
 
-use crate::image_in::{decode_texture, load_texture};
-use sahara_readers::gltf::{GltfAlphaMode, GltfImage, GltfMaterial, GltfTexture, GltfWrap};
-use sahara_readers::mtl::MtlMaterial;
-
-/// IOR used for MTL glass that gives none (`Ni` <= 1).
-pub const DEFAULT_GLASS_IOR: f32 = 1.5;
-
-/// Where a texture's image came from, as the cache knows it.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
-enum Source {
-    /// A file.
-    File(PathBuf),
-    /// Image `index` embedded in the glTF file `file`.
-    Embedded(String, usize),
-}
-
-/// Decoded textures by image and encoding, so that an image used by many
-/// materials is read once.
-#[derive(Debug, Default)]
-pub struct TextureCache {
-    images: HashMap<(Source, Encoding), Option<Arc<Texture>>>,
-}
+use crate::common::image::decode_texture;
+use crate::common::materials::{emission, unit, Source, TextureCache};
 
 impl TextureCache {
-    /// An empty cache.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// The texture in `path` read as `encoding`, decoded on first use;
-    /// `None` (and a warning) if it cannot be read.
-    pub fn file(
-        &mut self,
-        path: &Path,
-        encoding: Encoding,
-        warnings: &mut Vec<String>,
-    ) -> Option<Arc<Texture>> {
-        self.get(Source::File(path.to_path_buf()), encoding, warnings, || {
-            load_texture(path, encoding)
-        })
-    }
-
-    fn get(
-        &mut self,
-        source: Source,
-        encoding: Encoding,
-        warnings: &mut Vec<String>,
-        decode: impl FnOnce() -> Result<Texture, crate::FormatError>,
-    ) -> Option<Arc<Texture>> {
-        self.images
-            .entry((source, encoding))
-            .or_insert_with(|| match decode() {
-                Ok(t) => Some(Arc::new(t)),
-                Err(e) => {
-                    warnings.push(format!("{e}; the material goes without this texture"));
-                    None
-                }
-            })
-            .clone()
-    }
-
     /// The image of a glTF texture of the file `name`, read as `encoding`.
     fn gltf(
         &mut self,
@@ -141,16 +67,6 @@ impl TextureCache {
             ),
         }
     }
-
-    /// Number of distinct images decoded (or tried), per encoding.
-    pub fn len(&self) -> usize {
-        self.images.len()
-    }
-
-    /// True if no texture was asked for.
-    pub fn is_empty(&self) -> bool {
-        self.images.is_empty()
-    }
 }
 
 /// A glTF `alphaMode` as the renderer's.
@@ -169,68 +85,6 @@ fn wrap(w: GltfWrap) -> Wrap {
         GltfWrap::Clamp => Wrap::Clamp,
         GltfWrap::MirroredRepeat => Wrap::MirroredRepeat,
     }
-}
-
-/// Clamps every component to [0, 1] (NaN becomes 0).
-fn unit(c: [f32; 3]) -> Vec3 {
-    Vec3::from_array(c.map(|x| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) }))
-}
-
-/// GGX perceptual roughness matching the Phong exponent `ns`: `sqrt(sqrt(2 / (ns + 2)))`.
-pub fn phong_roughness(ns: f32) -> f32 {
-    let ns = if ns.is_finite() { ns.max(0.0) } else { 0.0 };
-    (2.0 / (ns + 2.0)).sqrt().sqrt().clamp(0.0, 1.0)
-}
-
-/// The BSDF an MTL material stands for (rules in the module documentation).
-pub fn mtl_bsdf(m: &MtlMaterial) -> Bsdf {
-    let (kd, ks) = (unit(m.kd), unit(m.ks));
-    if matches!(m.illum, 4 | 6 | 7) || m.d < 1.0 {
-        let ior = if m.ni > 1.0 && m.ni.is_finite() {
-            m.ni
-        } else {
-            DEFAULT_GLASS_IOR
-        };
-        Bsdf::Dielectric { ior }
-    } else if matches!(m.illum, 3 | 5) {
-        let color = if ks.max_element() > 0.0 {
-            ks
-        } else {
-            Vec3::ONE
-        };
-        Bsdf::Mirror { color }
-    } else if m.illum >= 2 && ks.max_element() > kd.max_element() {
-        Bsdf::Conductor {
-            color: ks,
-            roughness: phong_roughness(m.ns),
-            distribution: Distribution::Ggx,
-        }
-    } else {
-        Bsdf::Diffuse { albedo: kd }
-    }
-}
-
-/// An MTL material as a renderer material (texture from `textures`; problems go to `warnings`).
-pub fn mtl_material(
-    m: &MtlMaterial,
-    textures: &mut TextureCache,
-    warnings: &mut Vec<String>,
-) -> Material {
-    let bsdf = mtl_bsdf(m);
-    let mut out = Material::new(bsdf).with_emission(emission(m.ke));
-    if let Some(path) = &m.map_kd {
-        if matches!(bsdf, Bsdf::Diffuse { .. } | Bsdf::Conductor { .. }) {
-            out.textures.base_color = textures
-                .file(path, Encoding::Srgb, warnings)
-                .map(TextureMap::new);
-        }
-    }
-    out
-}
-
-/// Non-negative finite emission.
-fn emission(c: [f32; 3]) -> Vec3 {
-    Vec3::from_array(c.map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 }))
 }
 
 /// The BSDF a glTF material stands for (rules in the module documentation).

@@ -1,4 +1,5 @@
-//! Scene files: TOML describing camera, materials, objects, lights and render settings.
+//! Scene files as read: TOML describing camera, materials, objects,
+//! lights and render settings, checked into a [`SceneFile`].
 //!
 //! The format is documented in `docs/scene-format.md` at the repository
 //! root; in short:
@@ -56,16 +57,10 @@
 //! Input file paths are resolved relative to the scene file's folder; the
 //! output relative to the working folder (unless absolute).
 
-mod raw;
-mod resolve;
-
-use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use glam::{Mat4, Quat, Vec3};
 use sahara_render::{Distribution, Filter, Integrator, SamplerKind, Shape, ToneMap};
-
-use crate::FormatError;
 
 /// A parsed and checked scene file.
 #[derive(Clone, Debug, PartialEq)]
@@ -397,16 +392,4 @@ pub struct FilmSpec {
     pub output: Option<PathBuf>,
     /// Denoise the image (default false).
     pub denoise: bool,
-}
-
-/// Reads and checks a scene file; paths in it are resolved relative to its folder.
-pub fn load_scene_file(path: &Path) -> Result<SceneFile, FormatError> {
-    let text = fs::read_to_string(path).map_err(|e| FormatError::io(path, e))?;
-    let folder = path.parent().unwrap_or(Path::new(""));
-    parse_scene_file(&text, &path.display().to_string(), folder)
-}
-
-/// Parses and checks scene TOML held in memory; `name` is used in errors, paths resolve against `folder`.
-pub fn parse_scene_file(text: &str, name: &str, folder: &Path) -> Result<SceneFile, FormatError> {
-    resolve::resolve(text, name, folder).map_err(sahara_readers::one_line)
 }

@@ -23,25 +23,26 @@
 //! - Moving emissive objects are seen but not sampled as lights; that is
 //!   a warning.
 
-pub mod camera;
-pub mod sky;
+pub(crate) mod camera;
+pub(crate) mod sky;
 
-use std::collections::HashSet;
+use std::collections::{BTreeMap, HashSet};
+use std::path::PathBuf;
 
 use glam::{Affine3A, Mat4, Vec3};
 use sahara_readers::gltf::GltfCamera;
 use sahara_render::{Camera, Instance, Placement, Scene, Shape, Srt};
 
 use crate::description::{
-    CameraRequest, FileSettings, Geometry, ObjectPlacement, SceneDescription,
+    CameraRequest, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
 };
-use crate::gltf_scene::{gltf_camera, gltf_light};
-use crate::mesh_library::{file_key, MeshLibrary};
-use crate::FormatError;
+use crate::gltf::{gltf_camera, gltf_light};
+use crate::mesh::library::{file_key, MeshLibrary};
 use camera::has_finite_triangles;
 use sky::SkyUsed;
 
-pub use camera::{auto_camera, auto_camera_framing, AUTO_VFOV_DEG};
+use camera::{auto_camera_framing, AUTO_VFOV_DEG};
+use sahara_readers::FormatError;
 
 /// A scene ready to render, with what assembling it decided.
 #[derive(Clone, Debug)]
@@ -59,7 +60,7 @@ pub struct AssembledScene {
     pub sky: SkyUsed,
     /// With `auto` lighting, the measure that decided it: the scene's own
     /// lights' power as a share of the default sky and sun's
-    /// ([`sky::own_share`]; weak below [`sky::WEAK_FRACTION`]).
+    /// (weak below [`crate::WEAK_FRACTION`]).
     pub sky_share: Option<f32>,
     /// What the scene's objects and materials are called.
     pub names: SceneNames,
@@ -113,16 +114,7 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
     let mut inline = desc.meshes.into_iter().map(Some).collect::<Vec<_>>();
     let mut library = MeshLibrary::new();
     let mut cameras: Vec<GltfCamera> = Vec::new();
-    // Files some object shows with their own materials.
-    let own: HashSet<_> = desc
-        .objects
-        .iter()
-        .filter(|o| o.material.is_none())
-        .filter_map(|o| match &o.geometry {
-            Geometry::File(path) => Some(file_key(path)),
-            _ => None,
-        })
-        .collect();
+    let own = shown_with_own_materials(&desc.objects);
     let mut moving_emitters = 0;
     for (k, o) in desc.objects.iter().enumerate() {
         let emits = match &o.geometry {
@@ -190,27 +182,7 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
         if o.placement.is_moving() && emits {
             moving_emitters += 1;
         }
-        // Name the instances the object added.
-        let label = o.name.clone().unwrap_or_else(|| match &o.geometry {
-            Geometry::File(path) => path.file_name().map_or_else(
-                || path.display().to_string(),
-                |f| f.to_string_lossy().into_owned(),
-            ),
-            Geometry::Shape(s) => format!("{} {}", s.kind(), k + 1),
-            Geometry::Mesh(_) => format!("mesh {}", k + 1),
-        });
-        let added = scene.instances.len() - object_names.len();
-        let parts = match &o.geometry {
-            Geometry::File(path) => library.part_names(path),
-            _ => Vec::new(),
-        };
-        for j in 0..added {
-            object_names.push(match (added, parts.get(j).cloned().flatten()) {
-                (_, Some(part)) => format!("{label}/{part}"),
-                (1, None) => label.clone(),
-                (_, None) => format!("{label}/{j}"),
-            });
-        }
+        name_instances(&mut object_names, &scene, &library, o, k);
     }
     warnings.append(&mut library.warnings);
     if moving_emitters > 0 {
@@ -225,20 +197,82 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
         scene.environment = Some(env);
     }
     scene.generate_tangents();
-    let (camera, camera_source) = match desc.camera {
+    let (camera, camera_source) =
+        choose_camera(desc.camera, &cameras, &scene, &name, &mut warnings)?;
+    scene.camera = camera;
+    let (sky, sky_share) = sky::apply(&mut scene, &desc.sky)
+        .map_err(|e| FormatError::in_file(&name, format!("sky: {e}")))?;
+    // What the sky added (its ground) is named after it.
+    object_names.resize(scene.instances.len(), "sky ground".into());
+    let names = SceneNames {
+        objects: object_names,
+        materials: material_names(&scene, &desc.material_names, &library.material_names),
+    };
+    Ok(AssembledScene {
+        scene,
+        settings: desc.settings,
+        camera_source,
+        sky,
+        sky_share,
+        names,
+        warnings,
+    })
+}
+
+/// The mesh files some object shows with their own materials.
+fn shown_with_own_materials(objects: &[Object]) -> HashSet<PathBuf> {
+    objects
+        .iter()
+        .filter(|o| o.material.is_none())
+        .filter_map(|o| match &o.geometry {
+            Geometry::File(path) => Some(file_key(path)),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The name of each of `scene`'s materials: the description's name for
+/// it, else its mesh file's, else its number.
+fn material_names(
+    scene: &Scene,
+    described: &BTreeMap<u32, String>,
+    files: &BTreeMap<u32, String>,
+) -> Vec<String> {
+    (0..scene.materials.len() as u32)
+        .map(|id| {
+            described
+                .get(&id)
+                .or(files.get(&id))
+                .cloned()
+                .unwrap_or_else(|| format!("material {}", id + 1))
+        })
+        .collect()
+}
+
+/// The camera the description asks for, and where it came from: the given
+/// one, a named camera of its mesh files (`cameras`), or the files' first
+/// camera, else the automatic one framing `scene`.
+fn choose_camera(
+    request: CameraRequest,
+    cameras: &[GltfCamera],
+    scene: &Scene,
+    name: &str,
+    warnings: &mut Vec<String>,
+) -> Result<(Camera, String), FormatError> {
+    Ok(match request {
         CameraRequest::Given { camera, source } => (camera, source),
         CameraRequest::Named(want) => match cameras
             .iter()
             .find(|c| c.name.as_deref() == Some(want.as_str()))
         {
-            Some(c) => (gltf_camera(c), camera_name(&name, c)),
+            Some(c) => (gltf_camera(c), camera_name(name, c)),
             None => {
                 let names: Vec<String> = cameras
                     .iter()
                     .map(|c| format!("'{}'", c.name.as_deref().unwrap_or("(unnamed)")))
                     .collect();
                 return Err(FormatError::in_file(
-                    &name,
+                    name,
                     if names.is_empty() {
                         format!("no camera named '{want}': the file has no cameras (and no file {want} exists)")
                     } else {
@@ -251,8 +285,8 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
             }
         },
         CameraRequest::Automatic => match cameras.first() {
-            Some(c) => (gltf_camera(c), camera_name(&name, c)),
-            None if !has_finite_triangles(&scene) => {
+            Some(c) => (gltf_camera(c), camera_name(name, c)),
+            None if !has_finite_triangles(scene) => {
                 warnings.push(format!(
                     "{name}: every triangle has a NaN or infinite corner: nothing to frame; \
                      the camera looks at the origin from +Z"
@@ -268,36 +302,41 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
                     "auto (nothing to frame)".into(),
                 )
             }
-            None => auto_camera_framing(&scene, &name)?,
+            None => auto_camera_framing(scene, name)?,
         },
-    };
-    scene.camera = camera;
-    let (sky, sky_share) = sky::apply(&mut scene, &desc.sky)
-        .map_err(|e| FormatError::in_file(&name, format!("sky: {e}")))?;
-    // What the sky added (its ground) is named after it.
-    object_names.resize(scene.instances.len(), "sky ground".into());
-    let materials = (0..scene.materials.len() as u32)
-        .map(|id| {
-            desc.material_names
-                .get(&id)
-                .or(library.material_names.get(&id))
-                .cloned()
-                .unwrap_or_else(|| format!("material {}", id + 1))
-        })
-        .collect();
-    let names = SceneNames {
-        objects: object_names,
-        materials,
-    };
-    Ok(AssembledScene {
-        scene,
-        settings: desc.settings,
-        camera_source,
-        sky,
-        sky_share,
-        names,
-        warnings,
     })
+}
+
+/// Names the instances object `k` (`o`) added to `scene`: its own name or
+/// what it is, with a glTF file's part names or numbers when it added more
+/// than one.
+fn name_instances(
+    object_names: &mut Vec<String>,
+    scene: &Scene,
+    library: &MeshLibrary,
+    o: &Object,
+    k: usize,
+) {
+    let label = o.name.clone().unwrap_or_else(|| match &o.geometry {
+        Geometry::File(path) => path.file_name().map_or_else(
+            || path.display().to_string(),
+            |f| f.to_string_lossy().into_owned(),
+        ),
+        Geometry::Shape(s) => format!("{} {}", s.kind(), k + 1),
+        Geometry::Mesh(_) => format!("mesh {}", k + 1),
+    });
+    let added = scene.instances.len() - object_names.len();
+    let parts = match &o.geometry {
+        Geometry::File(path) => library.part_names(path),
+        _ => Vec::new(),
+    };
+    for j in 0..added {
+        object_names.push(match (added, parts.get(j).cloned().flatten()) {
+            (_, Some(part)) => format!("{label}/{part}"),
+            (1, None) => label.clone(),
+            (_, None) => format!("{label}/{j}"),
+        });
+    }
 }
 
 /// What the log calls a glTF camera of the file `name`.

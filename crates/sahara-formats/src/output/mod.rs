@@ -1,0 +1,7 @@
+//! Files out: images ([`image`]: PNG and EXR, with layers), render parts
+//! for the farm ([`part`]: a piece of a frame and its exact sums, as EXR),
+//! each written atomically ([`atomic`]: a failed write leaves the old file).
+
+pub(crate) mod atomic;
+pub(crate) mod image;
+pub(crate) mod part;
