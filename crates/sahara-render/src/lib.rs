@@ -14,7 +14,8 @@
 //!
 //! The crate's parts, each importing only those before it in this list:
 //! `math` (hashing, piecewise distributions, warps) and `names` (the name
-//! tables of settings); `texture`; `material`, `light` and `sampler`;
+//! tables of settings); `texture`; `material`, `light`, `medium` and
+//! `sampler`;
 //! `scene` (camera, meshes, shapes, instances); `film` (the image,
 //! reconstruction filters, exact sums, pixel windows) and `accel` (the
 //! instances' kd-trees); `world` (the scene prepared for tracing);
@@ -31,6 +32,7 @@ mod integrator;
 mod light;
 mod material;
 mod math;
+mod medium;
 mod names;
 mod render;
 mod sampler;
@@ -54,6 +56,7 @@ pub use material::{
     fresnel, metals, AlphaMode, Bsdf, Clearcoat, Distribution, Material, MaterialTextures,
     NormalMap, OcclusionMap,
 };
+pub use medium::{DensityGrid, GridMedium, HenyeyGreenstein, Homogeneous, Medium, MediumInterface};
 pub use texture::footprint::UvFootprint;
 pub use texture::{
     linear_to_srgb8, srgb8_to_linear, srgb_to_linear, Channel, Encoding, ScalarMap, Texture,

@@ -11,6 +11,8 @@ use crate::light::{AreaLight, EnvLight, LightSample, LightSource};
 use crate::material::Material;
 use crate::math::piecewise::Distribution1D;
 use crate::math::warp::Frame;
+use crate::medium::{Medium, MediumInterface};
+use crate::scene::mesh::SceneMesh;
 use crate::scene::shape::Shape;
 use crate::scene::Scene;
 use crate::texture::footprint::{CameraSpread, UvFootprint};
@@ -126,6 +128,11 @@ pub struct World<'a> {
     pub center: Vec3,
     /// Radius of the scene's bounding sphere.
     pub radius: f32,
+    /// The media on the two sides of each instance's surface (empty when
+    /// the scene has no media).
+    interfaces: Vec<Option<MediumInterface>>,
+    /// Whether light travels through media ([`Scene::has_media`]).
+    has_media: bool,
 }
 
 impl<'a> World<'a> {
@@ -160,7 +167,39 @@ impl<'a> World<'a> {
             spread: None,
             center,
             radius,
+            interfaces: if scene.has_media() {
+                let mut v = vec![None; scene.instances.len()];
+                for &(i, m) in &scene.medium_interfaces {
+                    if let Some(slot) = v.get_mut(i as usize) {
+                        *slot = Some(m);
+                    }
+                }
+                v
+            } else {
+                Vec::new()
+            },
+            has_media: scene.has_media(),
         }
+    }
+
+    /// True if light travels through media in this scene (see
+    /// [`Scene::has_media`]).
+    #[inline]
+    pub fn has_media(&self) -> bool {
+        self.has_media
+    }
+
+    /// The media on the two sides of `instance`'s surface, if it bounds
+    /// any.
+    #[inline]
+    pub fn medium_interface(&self, instance: u32) -> Option<&MediumInterface> {
+        self.interfaces.get(instance as usize)?.as_ref()
+    }
+
+    /// Medium `i` of the scene.
+    #[inline]
+    pub fn medium(&self, i: u32) -> &Medium {
+        &self.scene.media[i as usize]
     }
 
     /// Sets the footprint of texture lookups from the film: `height`
@@ -305,9 +344,63 @@ impl<'a> World<'a> {
         buf.raw.resize(rays.len(), None);
         self.accel
             .closest_batch(rays, &buf.s, &mut buf.raw, &mut buf.accel);
-        for ((o, h), &s) in out.iter_mut().zip(&buf.raw).zip(&buf.s) {
+        // The hits' triangles lie anywhere in the meshes: their indices,
+        // then their vertices, are asked of the cache a few hits ahead
+        // of the one whose shading data is computed, so that the loads
+        // overlap instead of each hit waiting for its own.
+        let raw = &buf.raw;
+        let ahead = |k: usize| raw.get(k).copied().flatten();
+        for k in 0..raw.len().min(2 * PREFETCH_AHEAD) {
+            if let Some(h) = ahead(k) {
+                self.prefetch_indices(&h);
+            }
+        }
+        for (k, ((o, h), &s)) in out.iter_mut().zip(raw).zip(&buf.s).enumerate() {
+            if let Some(h) = ahead(k + 2 * PREFETCH_AHEAD) {
+                self.prefetch_indices(&h);
+            }
+            if let Some(h) = ahead(k + PREFETCH_AHEAD) {
+                self.prefetch_vertices(&h);
+            }
             *o = h.map(|h| self.surface(&h, s));
         }
+    }
+
+    /// Asks the cache for the indices (and material id) of `h`'s triangle.
+    #[inline(always)]
+    fn prefetch_indices(&self, h: &RawHit) {
+        let mesh = self.mesh_of(h);
+        prefetch(mesh.mesh.indices.as_ptr().wrapping_add(h.tri as usize));
+        if let Some(ids) = &mesh.material_ids {
+            prefetch(ids.as_ptr().wrapping_add(h.tri as usize));
+        }
+    }
+
+    /// Asks the cache for the vertices of `h`'s triangle: positions, and
+    /// normals and texture coordinates where the mesh has them.
+    #[inline(always)]
+    fn prefetch_vertices(&self, h: &RawHit) {
+        let mesh = self.mesh_of(h);
+        let Some(idx) = mesh.mesh.indices.get(h.tri as usize) else {
+            return;
+        };
+        for &i in idx {
+            let i = i as usize;
+            prefetch(mesh.mesh.positions.as_ptr().wrapping_add(i));
+            if let Some(n) = &mesh.normals {
+                prefetch(n.as_ptr().wrapping_add(i));
+            }
+            if let Some(t) = &mesh.uvs {
+                prefetch(t.as_ptr().wrapping_add(i));
+            }
+        }
+    }
+
+    /// The mesh of `h`'s instance.
+    #[inline(always)]
+    fn mesh_of(&self, h: &RawHit) -> &SceneMesh {
+        let inst = &self.scene.instances[h.instance as usize];
+        &self.scene.meshes[inst.mesh as usize]
     }
 
     /// [`World::visible`] of many queries, into `out[i]`, in one batch
@@ -751,4 +844,21 @@ pub(crate) fn pass_through_draw(ray: &Ray, hit: &SurfaceHit, k: u32) -> f32 {
     let c = (d[1] as u64) << 32 | d[2] as u64;
     let e = (hit.instance as u64) << 32 | hit.tri as u64;
     crate::math::hash::unit_f32(crate::math::hash::hash3(a ^ e, b, c.wrapping_add(k as u64)))
+}
+
+/// Hits ahead of the one being shaded whose vertices are asked of the
+/// cache (their indices twice as far ahead).
+const PREFETCH_AHEAD: usize = 8;
+
+/// Asks the cache for the line holding `p` (a hint: it neither faults nor
+/// reads).
+#[inline(always)]
+fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch neither faults nor reads.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(p.cast())
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
 }

@@ -9,6 +9,7 @@ mod path;
 mod queries;
 pub(crate) mod sppm;
 mod state;
+pub(crate) mod volpath;
 pub(crate) mod wavefront;
 
 use glam::{Vec2, Vec3};
@@ -465,6 +466,10 @@ impl Integrator {
                 ctx.stats.camera_rays -= 1;
                 sppm::camera_path(ctx, *ray, time, max_depth).0
             }
+            Integrator::Path {
+                max_depth,
+                rr_depth,
+            } if ctx.world.has_media() => volpath::li(ctx, ray, time, max_depth, rr_depth),
             Integrator::Path { .. } | Integrator::Distribution { .. } => {
                 let world = ctx.world;
                 let mut st = PathState::new(*ray, time, ctx.sampler);

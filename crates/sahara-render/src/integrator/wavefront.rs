@@ -50,8 +50,8 @@ impl Wavefront {
     /// Traces every path of `paths` to its end with `integrator` (one of
     /// the stepped ones), leaving each sample's radiance in its `l`.
     /// Consecutive runs of [`PACKET16`] paths start with one camera packet
-    /// (order them as 4x4 pixel blocks, rows 0-1 then 2-3, each block's
-    /// rays at the same sample index).
+    /// (order them so that a run's rays leave close together: one pixel's
+    /// samples, or a small block of pixels).
     pub fn trace(
         &mut self,
         integrator: &Integrator,

@@ -970,7 +970,9 @@ impl Strip {
             }
             return;
         }
-        if !s.integrator.is_stepped() {
+        // A scene with media takes the volumetric path tracer, one path at
+        // a time.
+        if !s.integrator.is_stepped() || world.has_media() {
             for y in y0..y1 {
                 for x in x0..x1 {
                     for g in samples.of(x, y) {
@@ -990,36 +992,35 @@ impl Strip {
             }
             return;
         }
-        // The paths in camera-packet order: 4x4 pixel blocks, each block's
-        // samples index by index (the `i`-th sample of each of its pixels
-        // that takes that many).
+        // The paths in camera-packet order: 4x4 pixel blocks, the pixels
+        // of a block in Morton order (2x2 blocks of 2x2), each pixel's
+        // samples together. A run of 16 paths is then 16 samples of one
+        // pixel, or the samples of a 2x2 block's pixels when a pixel takes
+        // 4: their camera rays, shadow rays and bounces start close
+        // together and share the tree's cells (figures in
+        // docs/performance.md, "What a packet of one pixel's samples would
+        // share"). The order changes no path's arithmetic.
         self.paths.clear();
         self.slot.clear();
         for (bx, by) in (y0..y1)
             .step_by(4)
             .flat_map(|by| (x0..x1).step_by(4).map(move |bx| (bx, by)))
         {
-            let (ys, xs) = (by..(by + 4).min(y1), bx..(bx + 4).min(x1));
-            let most = ys
-                .clone()
-                .flat_map(|y| xs.clone().map(move |x| samples.of(x, y).len()))
-                .max()
-                .unwrap_or(0) as u32;
-            for i in 0..most {
-                for y in ys.clone() {
-                    for x in xs.clone() {
-                        let r = samples.of(x, y);
-                        let g = r.start + i;
-                        if g >= r.end {
-                            continue;
-                        }
-                        let (sampler, pos, ray, time) = camera_sample(x, y, g);
-                        let k = slot_of(x, y, g);
-                        self.pos[k] = pos;
-                        self.slot.push(k as u32);
-                        self.paths
-                            .push(PathState::new(ray, time, sampler).with_aux(aux));
-                    }
+            for m in 0..16u32 {
+                // De-interleave the Morton index's bits.
+                let dx = (m & 1) | (m >> 1 & 2);
+                let dy = (m >> 1 & 1) | (m >> 2 & 2);
+                let (x, y) = (bx + dx, by + dy);
+                if x >= x1 || y >= y1 {
+                    continue;
+                }
+                for g in samples.of(x, y) {
+                    let (sampler, pos, ray, time) = camera_sample(x, y, g);
+                    let k = slot_of(x, y, g);
+                    self.pos[k] = pos;
+                    self.slot.push(k as u32);
+                    self.paths
+                        .push(PathState::new(ray, time, sampler).with_aux(aux));
                 }
             }
         }

@@ -14,6 +14,7 @@ use sahara_kd::Aabb;
 
 use crate::light::{Environment, Light};
 use crate::material::Material;
+use crate::medium::{Medium, MediumInterface};
 use crate::scene::camera::Camera;
 use crate::scene::instance::{Instance, Placement};
 use crate::scene::mesh::SceneMesh;
@@ -51,6 +52,14 @@ pub struct Scene {
     pub environment: Option<Environment>,
     /// Instances that are built-in shapes.
     pub shapes: Vec<ShapeInstance>,
+    /// Participating media, indexed by [`MediumInterface`]s and
+    /// `camera_medium`.
+    pub media: Vec<Medium>,
+    /// The medium the camera sits in (none: vacuum).
+    pub camera_medium: Option<u32>,
+    /// The media on the two sides of instances' surfaces, by instance
+    /// (an instance named twice takes the last).
+    pub medium_interfaces: Vec<(u32, MediumInterface)>,
 }
 
 impl Scene {
@@ -64,7 +73,33 @@ impl Scene {
             lights: Vec::new(),
             environment: None,
             shapes: Vec::new(),
+            media: Vec::new(),
+            camera_medium: None,
+            medium_interfaces: Vec::new(),
         }
+    }
+
+    /// Adds a medium; returns its index.
+    pub fn add_medium(&mut self, m: Medium) -> u32 {
+        self.media.push(m);
+        self.media.len() as u32 - 1
+    }
+
+    /// Puts the media of `interface` on the two sides of `instance`'s
+    /// surface.
+    pub fn set_medium_interface(&mut self, instance: u32, interface: MediumInterface) {
+        self.medium_interfaces.push((instance, interface));
+    }
+
+    /// True if any light travels through a medium: the camera sits in
+    /// one, or a surface bounds one.
+    pub fn has_media(&self) -> bool {
+        !self.media.is_empty()
+            && (self.camera_medium.is_some()
+                || self
+                    .medium_interfaces
+                    .iter()
+                    .any(|(_, m)| m.inside.is_some() || m.outside.is_some() || m.index_matched))
     }
 
     /// Adds a material; returns its id.
