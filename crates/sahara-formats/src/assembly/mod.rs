@@ -22,6 +22,8 @@
 //!   light the scene only if its own lights are weak.
 //! - Moving emissive objects are seen but not sampled as lights; that is
 //!   a warning.
+//! - An object's media (inside and outside its surface) go on every
+//!   instance it adds.
 
 pub(crate) mod camera;
 pub(crate) mod sky;
@@ -116,7 +118,10 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
     let mut cameras: Vec<GltfCamera> = Vec::new();
     let own = shown_with_own_materials(&desc.objects);
     let mut moving_emitters = 0;
+    // Each object's media go on every instance it adds.
+    let interfaces: BTreeMap<u32, _> = desc.medium_interfaces.iter().copied().collect();
     for (k, o) in desc.objects.iter().enumerate() {
+        let first_instance = scene.instances.len() as u32;
         let emits = match &o.geometry {
             Geometry::File(path) => {
                 let first = library.file_count();
@@ -182,8 +187,15 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
         if o.placement.is_moving() && emits {
             moving_emitters += 1;
         }
+        if let Some(&mi) = interfaces.get(&(k as u32)) {
+            for i in first_instance..scene.instances.len() as u32 {
+                scene.set_medium_interface(i, mi);
+            }
+        }
         name_instances(&mut object_names, &scene, &library, o, k);
     }
+    scene.media = desc.media;
+    scene.camera_medium = desc.camera_medium;
     warnings.append(&mut library.warnings);
     if moving_emitters > 0 {
         warnings.push(format!(

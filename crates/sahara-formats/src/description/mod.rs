@@ -29,7 +29,9 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use glam::Affine3A;
-use sahara_render::{Camera, Environment, Light, Material, SceneMesh, Shape, Srt};
+use sahara_render::{
+    Camera, Environment, Light, Material, Medium, MediumInterface, SceneMesh, Shape, Srt,
+};
 
 pub use settings::{FileCrop, FileSettings};
 
@@ -65,6 +67,14 @@ pub struct SceneDescription {
     /// How the file asks to be rendered (`None`: a file that does not
     /// say, as a bare mesh).
     pub settings: Option<FileSettings>,
+    /// Participating media, referred to by index by `camera_medium` and
+    /// `medium_interfaces`.
+    pub media: Vec<Medium>,
+    /// The medium the camera sits in.
+    pub camera_medium: Option<u32>,
+    /// The media on the two sides of objects' surfaces: the object's
+    /// index into [`SceneDescription::objects`], and the media.
+    pub medium_interfaces: Vec<(u32, MediumInterface)>,
     /// Problems found while reading that did not stop it, one line each,
     /// naming the file.
     pub warnings: Vec<String>,
@@ -85,6 +95,9 @@ impl SceneDescription {
             environment: None,
             sky: Sky::None,
             settings: None,
+            media: Vec::new(),
+            camera_medium: None,
+            medium_interfaces: Vec::new(),
             warnings: Vec::new(),
         }
     }

@@ -75,6 +75,10 @@ pub fn describe(file: &SceneFile, name: &str) -> Result<SceneDescription, Format
             ShapeSpec::Mesh { path } => Geometry::File(path.clone()),
             ShapeSpec::Builtin(shape) => Geometry::Shape(*shape),
         };
+        if let Some(mi) = o.interface {
+            desc.medium_interfaces
+                .push((desc.objects.len() as u32, mi));
+        }
         desc.objects.push(Object {
             geometry,
             placement: placement(&o.placement),
@@ -82,6 +86,8 @@ pub fn describe(file: &SceneFile, name: &str) -> Result<SceneDescription, Format
             name: o.name.clone(),
         });
     }
+    desc.media = file.media.iter().map(|m| m.medium.clone()).collect();
+    desc.camera_medium = file.camera_medium;
     for l in &file.lights {
         add_light(&mut desc, l, &named, name)?;
     }

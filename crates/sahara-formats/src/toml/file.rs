@@ -60,7 +60,9 @@
 use std::path::PathBuf;
 
 use glam::{Mat4, Quat, Vec3};
-use sahara_render::{Distribution, Filter, Integrator, SamplerKind, Shape, ToneMap};
+use sahara_render::{
+    Distribution, Filter, Integrator, Medium, MediumInterface, SamplerKind, Shape, ToneMap,
+};
 
 /// A parsed and checked scene file.
 #[derive(Clone, Debug, PartialEq)]
@@ -70,6 +72,11 @@ pub struct SceneFile {
     pub sky: crate::description::Sky,
     /// The camera.
     pub camera: CameraSpec,
+    /// The medium the camera sits in (`[camera] medium`), by index into
+    /// `media`.
+    pub camera_medium: Option<u32>,
+    /// Named media, in file order.
+    pub media: Vec<MediumSpec>,
     /// Named materials, in file order.
     pub materials: Vec<MaterialSpec>,
     /// Objects, in file order.
@@ -241,6 +248,18 @@ pub struct ObjectSpec {
     pub placement: Placement,
     /// Its name, for the `object` render pass's list of names.
     pub name: Option<String>,
+    /// The media inside and outside its surface (indices into
+    /// [`SceneFile::media`]), if it bounds any.
+    pub interface: Option<MediumInterface>,
+}
+
+/// `[[medium]]`: a named participating medium.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MediumSpec {
+    /// The name objects and the camera use to refer to it (unique).
+    pub name: String,
+    /// The medium (a grid's density read from its file).
+    pub medium: Medium,
 }
 
 /// Geometry: a mesh file or a built-in shape.

@@ -29,6 +29,8 @@ pub(super) struct RawScene {
     pub object: Vec<Spanned<RawObject>>,
     #[serde(default)]
     pub light: Vec<Spanned<RawLight>>,
+    #[serde(default)]
+    pub medium: Vec<Spanned<RawMedium>>,
     pub integrator: Option<Spanned<RawNamedTable>>,
     pub sampler: Option<Spanned<RawSampler>>,
     pub filter: Option<Spanned<RawNamedTable>>,
@@ -47,6 +49,31 @@ pub(super) struct RawCamera {
     pub focus_distance: Opt<f32>,
     pub shutter_open: Opt<f32>,
     pub shutter_close: Opt<f32>,
+    pub medium: Opt<String>,
+}
+
+/// Medium kinds (`type` of a `[[medium]]`).
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub(super) enum MediumType {
+    Homogeneous,
+    Grid,
+}
+
+/// `[[medium]]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RawMedium {
+    pub name: Spanned<String>,
+    #[serde(rename = "type")]
+    pub kind: Spanned<MediumType>,
+    pub sigma_a: Opt<V3>,
+    pub sigma_s: Opt<V3>,
+    pub scale: Opt<f32>,
+    pub g: Opt<f32>,
+    pub file: Opt<String>,
+    pub min: Opt<V3>,
+    pub max: Opt<V3>,
 }
 
 /// Material kinds (`type` of a `[[material]]`).
@@ -167,6 +194,8 @@ pub(super) struct RawObject {
     pub min: Opt<V3>,
     pub max: Opt<V3>,
     pub material: Opt<String>,
+    pub medium_inside: Opt<String>,
+    pub medium_outside: Opt<String>,
     pub transform: Opt<RawTransform>,
     pub motion: Opt<RawMotion>,
 }

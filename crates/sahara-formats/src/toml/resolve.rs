@@ -1,6 +1,6 @@
 //! From the raw TOML shape to checked [`SceneFile`] values, with positioned errors.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -17,6 +17,8 @@ use super::file::*;
 use super::raw::*;
 use crate::description::Sky;
 use crate::output::image::ImageFormat;
+
+mod media;
 
 /// Largest film width or height.
 const MAX_FILM_SIDE: i64 = 65536;
@@ -59,11 +61,29 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
             ));
         }
     }
+    let media = raw
+        .medium
+        .iter()
+        .map(|m| ctx.medium(m))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut medium_index = HashMap::new();
+    for (i, (m, raw_m)) in media.iter().zip(&raw.medium).enumerate() {
+        if medium_index.insert(m.name.clone(), i as u32).is_some() {
+            return Err(ctx.at(
+                raw_m.get_ref().name.span(),
+                format!("a medium named '{}' is already defined", m.name),
+            ));
+        }
+    }
     let objects = raw
         .object
         .iter()
-        .map(|o| ctx.object(o, &seen))
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|o| {
+            let mut spec = ctx.object(o, &seen)?;
+            spec.interface = ctx.object_media(o.get_ref(), &medium_index)?;
+            Ok(spec)
+        })
+        .collect::<Result<Vec<_>, FormatError>>()?;
     let lights = raw
         .light
         .iter()
@@ -83,6 +103,8 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
             .as_ref()
             .map_or(Sky::None, |s| Sky::parse(s.get_ref(), folder)),
         camera: ctx.camera(camera)?,
+        camera_medium: ctx.medium_named(&camera.get_ref().medium, &medium_index)?,
+        media,
         materials,
         objects,
         lights,
@@ -108,12 +130,13 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
 }
 
 /// The top-level keys of a scene file (those of `RawScene`).
-const SCENE_KEYS: [&str; 9] = [
+const SCENE_KEYS: [&str; 10] = [
     "sky",
     "camera",
     "material",
     "object",
     "light",
+    "medium",
     "integrator",
     "sampler",
     "filter",
@@ -722,6 +745,7 @@ impl Ctx<'_> {
             material: o.material.as_ref().map(|m| m.get_ref().clone()),
             placement,
             name: o.name.as_ref().map(|n| n.get_ref().clone()),
+            interface: None,
         })
     }
 

@@ -276,6 +276,7 @@ fn a_complete_scene_parses_into_the_expected_values() {
             material: None,
             placement: Placement::Static(TransformSpec::IDENTITY),
             name: None,
+            interface: None,
         }
     );
     assert_eq!(
@@ -851,4 +852,90 @@ fn alpha_keys_parse_and_apply_to_reflectors_only() {
         e.contains("line 10:") && e.contains("between 0 and 1"),
         "{e}"
     );
+}
+
+#[test]
+fn media_parse_and_bind_to_objects_and_the_camera() {
+    let dir = assets();
+    let grid = sahara_readers::vol::VolGrid {
+        size: [2, 2, 2],
+        channels: 1,
+        bounds_min: [-1.0; 3],
+        bounds_max: [1.0; 3],
+        values: vec![0.5; 8],
+    };
+    std::fs::write(dir.0.join("blob.vol"), sahara_readers::vol::vol_bytes(&grid)).unwrap();
+    let path = dir.write(
+        "media.toml",
+        &with_head(
+            "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nsigma_s = [0.5, 0.5, 0.5]\nsigma_a = [0.1, 0.2, 0.3]\nscale = 2\ng = 0.4\n\
+             [[medium]]\nname = \"cloud\"\ntype = \"grid\"\nfile = \"blob.vol\"\nsigma_s = [1, 1, 1]\n\
+             [[material]]\nname = \"glass\"\ntype = \"dielectric\"\n\
+             [[object]]\ntype = \"box\"\nmin = [-2, -2, -2]\nmax = [2, 2, 2]\nmedium_inside = \"fog\"\n\
+             [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\"\nmedium_inside = \"cloud\"\nmedium_outside = \"fog\"\n",
+        )
+        .replace("[film]", "[film]\n")
+        .replacen("target = [0, 0, 0]\n", "target = [0, 0, 0]\nmedium = \"fog\"\n", 1),
+    );
+    let s = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.media.len(), 2);
+    assert_eq!(s.camera_medium, Some(0));
+    match &s.media[0].medium {
+        sahara_render::Medium::Homogeneous(h) => {
+            assert_eq!(h.sigma_s, Vec3::splat(1.0));
+            assert_eq!(h.sigma_a, Vec3::new(0.2, 0.4, 0.6));
+            assert_eq!(h.phase.g, 0.4);
+        }
+        m => panic!("{m:?}"),
+    }
+    assert!(matches!(s.media[1].medium, sahara_render::Medium::Grid(_)));
+    let fog_box = s.objects[0].interface.unwrap();
+    assert_eq!((fog_box.inside, fog_box.outside), (Some(0), None));
+    assert!(fog_box.index_matched, "a box without a material only bounds its medium");
+    let ball = s.objects[1].interface.unwrap();
+    assert_eq!((ball.inside, ball.outside), (Some(1), Some(0)));
+    assert!(!ball.index_matched);
+}
+
+#[test]
+fn bad_media_are_errors_at_the_value() {
+    let m = error_of(&with_head(
+        "[[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmedium_inside = \"fog\"\n",
+    ));
+    assert!(m.contains("line 11:") && m.contains("no [[medium]] is named 'fog'"), "{m}");
+    let m = error_of(&with_head(
+        "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nsigma_s = [1, -1, 1]\n",
+    ));
+    assert!(m.contains("line 10:") && m.contains("must not be negative"), "{m}");
+    let m = error_of(&with_head(
+        "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\ng = 1\n",
+    ));
+    assert!(m.contains("line 10:") && m.contains("`g` is 1"), "{m}");
+    let m = error_of(&with_head(
+        "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\n[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\n",
+    ));
+    assert!(m.contains("line 11:") && m.contains("already defined"), "{m}");
+    let m = error_of(&with_head(
+        "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nfile = \"x.vol\"\n",
+    ));
+    assert!(m.contains("`file` does not apply to a homogeneous medium"), "{m}");
+    let m = error_of(&with_head("[[medium]]\nname = \"cloud\"\ntype = \"grid\"\n"));
+    assert!(m.contains("a grid medium needs the key `file`"), "{m}");
+    // A grid file whose header promises more values than it holds.
+    let dir = assets();
+    let mut bytes = sahara_readers::vol::vol_bytes(&sahara_readers::vol::VolGrid {
+        size: [2, 2, 2],
+        channels: 1,
+        bounds_min: [0.0; 3],
+        bounds_max: [1.0; 3],
+        values: vec![1.0; 8],
+    });
+    bytes.truncate(bytes.len() - 4);
+    std::fs::write(dir.0.join("short.vol"), bytes).unwrap();
+    let path = dir.write(
+        "bad.toml",
+        &with_head("[[medium]]\nname = \"cloud\"\ntype = \"grid\"\nfile = \"short.vol\"\n"),
+    );
+    let m = load_scene_file(&path).unwrap_err().to_string();
+    assert!(m.contains("short.vol: byte 48:") && m.contains("needs 80 bytes"), "{m}");
 }

@@ -1,0 +1,132 @@
+//! `[[medium]]` tables, and the keys of objects and the camera that name
+//! media.
+
+use std::collections::HashMap;
+
+use glam::{Affine3A, Quat, Vec3};
+use sahara_render::{DensityGrid, GridMedium, HenyeyGreenstein, Medium, MediumInterface};
+use toml::Spanned;
+
+use super::{span, Ctx};
+use crate::toml::file::MediumSpec;
+use crate::toml::raw::{MediumType, Opt, RawMedium, RawObject};
+use crate::FormatError;
+
+impl Ctx<'_> {
+    /// `[[medium]]`: a homogeneous medium, or a density grid read from a
+    /// `.vol` file over a box (the file's own unless `min` and `max` say).
+    pub(super) fn medium(&self, raw: &Spanned<RawMedium>) -> Result<MediumSpec, FormatError> {
+        let m = raw.get_ref();
+        let what = format!("a {} medium", type_name(*m.kind.get_ref()));
+        let present = [
+            ("sigma_a", span(&m.sigma_a)),
+            ("sigma_s", span(&m.sigma_s)),
+            ("scale", span(&m.scale)),
+            ("g", span(&m.g)),
+            ("file", span(&m.file)),
+            ("min", span(&m.min)),
+            ("max", span(&m.max)),
+        ];
+        let coefficient = |value: &Opt<[f32; 3]>, key: &str| -> Result<Vec3, FormatError> {
+            match value {
+                Some(v) => self.power(v, key),
+                None => Ok(Vec3::ZERO),
+            }
+        };
+        let scale = self.number(&m.scale, "scale", 1.0, |s| s >= 0.0, "at least 0")?;
+        let sigma_a = coefficient(&m.sigma_a, "sigma_a")? * scale;
+        let sigma_s = coefficient(&m.sigma_s, "sigma_s")? * scale;
+        let g = self.number(&m.g, "g", 0.0, |g| g > -1.0 && g < 1.0, "between -1 and 1 (exclusive)")?;
+        let phase = HenyeyGreenstein::new(g);
+        let medium = match m.kind.get_ref() {
+            MediumType::Homogeneous => {
+                self.only(&present, &["sigma_a", "sigma_s", "scale", "g"], &what)?;
+                Medium::Homogeneous(sahara_render::Homogeneous {
+                    sigma_a,
+                    sigma_s,
+                    phase,
+                })
+            }
+            MediumType::Grid => {
+                self.only(
+                    &present,
+                    &["sigma_a", "sigma_s", "scale", "g", "file", "min", "max"],
+                    &what,
+                )?;
+                let file = self.required(&m.file, "file", &raw.span(), &what)?;
+                let path = self.file(file, "density grid")?;
+                let grid = sahara_readers::vol::read_vol(&path)?;
+                if grid.channels != 1 {
+                    return Err(self.at(
+                        file.span(),
+                        format!(
+                            "'{}' holds {} channels; a density grid holds 1",
+                            file.get_ref(),
+                            grid.channels
+                        ),
+                    ));
+                }
+                let lo = self.vec_or(&m.min, "min", Vec3::from_array(grid.bounds_min))?;
+                let hi = self.vec_or(&m.max, "max", Vec3::from_array(grid.bounds_max))?;
+                if (hi - lo).min_element() <= 0.0 {
+                    return Err(self.at(
+                        span(&m.max).or(span(&m.min)).unwrap_or(file.span()),
+                        format!("the grid's box {lo} to {hi} must be above its min on every axis"),
+                    ));
+                }
+                let density = DensityGrid::new(grid.size, grid.values)
+                    .map_err(|e| FormatError::in_file(&path.display().to_string(), e))?;
+                let to_world = Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo);
+                Medium::Grid(Box::new(GridMedium::new(
+                    density, sigma_a, sigma_s, phase, to_world,
+                )))
+            }
+        };
+        Ok(MediumSpec {
+            name: m.name.get_ref().clone(),
+            medium,
+        })
+    }
+
+    /// The index of the medium a key names (`None` if the key is absent).
+    pub(super) fn medium_named(
+        &self,
+        value: &Opt<String>,
+        media: &HashMap<String, u32>,
+    ) -> Result<Option<u32>, FormatError> {
+        let Some(v) = value else {
+            return Ok(None);
+        };
+        media
+            .get(v.get_ref())
+            .copied()
+            .map(Some)
+            .ok_or_else(|| self.at(v.span(), format!("no [[medium]] is named '{}'", v.get_ref())))
+    }
+
+    /// The media an object bounds: `medium_inside` and `medium_outside`;
+    /// an object with either and no material only bounds them (light
+    /// passes its surface unbent).
+    pub(super) fn object_media(
+        &self,
+        o: &RawObject,
+        media: &HashMap<String, u32>,
+    ) -> Result<Option<MediumInterface>, FormatError> {
+        if o.medium_inside.is_none() && o.medium_outside.is_none() {
+            return Ok(None);
+        }
+        Ok(Some(MediumInterface {
+            inside: self.medium_named(&o.medium_inside, media)?,
+            outside: self.medium_named(&o.medium_outside, media)?,
+            index_matched: o.material.is_none(),
+        }))
+    }
+}
+
+/// The name a `type` is written with.
+fn type_name(t: MediumType) -> &'static str {
+    match t {
+        MediumType::Homogeneous => "homogeneous",
+        MediumType::Grid => "grid",
+    }
+}
