@@ -60,7 +60,10 @@ pub fn parse_vol(bytes: &[u8], name: &str) -> Result<VolGrid, FormatError> {
         ));
     }
     if &bytes[0..3] != b"VOL" {
-        return Err(at(0, "not a .vol grid (it does not start with `VOL`)".into()));
+        return Err(at(
+            0,
+            "not a .vol grid (it does not start with `VOL`)".into(),
+        ));
     }
     if bytes[3] != 3 {
         return Err(at(

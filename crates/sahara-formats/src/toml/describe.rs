@@ -76,8 +76,7 @@ pub fn describe(file: &SceneFile, name: &str) -> Result<SceneDescription, Format
             ShapeSpec::Builtin(shape) => Geometry::Shape(*shape),
         };
         if let Some(mi) = o.interface {
-            desc.medium_interfaces
-                .push((desc.objects.len() as u32, mi));
+            desc.medium_interfaces.push((desc.objects.len() as u32, mi));
         }
         desc.objects.push(Object {
             geometry,

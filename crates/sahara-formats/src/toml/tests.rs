@@ -864,7 +864,11 @@ fn media_parse_and_bind_to_objects_and_the_camera() {
         bounds_max: [1.0; 3],
         values: vec![0.5; 8],
     };
-    std::fs::write(dir.0.join("blob.vol"), sahara_readers::vol::vol_bytes(&grid)).unwrap();
+    std::fs::write(
+        dir.0.join("blob.vol"),
+        sahara_readers::vol::vol_bytes(&grid),
+    )
+    .unwrap();
     let path = dir.write(
         "media.toml",
         &with_head(
@@ -891,7 +895,10 @@ fn media_parse_and_bind_to_objects_and_the_camera() {
     assert!(matches!(s.media[1].medium, sahara_render::Medium::Grid(_)));
     let fog_box = s.objects[0].interface.unwrap();
     assert_eq!((fog_box.inside, fog_box.outside), (Some(0), None));
-    assert!(fog_box.index_matched, "a box without a material only bounds its medium");
+    assert!(
+        fog_box.index_matched,
+        "a box without a material only bounds its medium"
+    );
     let ball = s.objects[1].interface.unwrap();
     assert_eq!((ball.inside, ball.outside), (Some(1), Some(0)));
     assert!(!ball.index_matched);
@@ -902,11 +909,17 @@ fn bad_media_are_errors_at_the_value() {
     let m = error_of(&with_head(
         "[[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmedium_inside = \"fog\"\n",
     ));
-    assert!(m.contains("line 11:") && m.contains("no [[medium]] is named 'fog'"), "{m}");
+    assert!(
+        m.contains("line 11:") && m.contains("no [[medium]] is named 'fog'"),
+        "{m}"
+    );
     let m = error_of(&with_head(
         "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nsigma_s = [1, -1, 1]\n",
     ));
-    assert!(m.contains("line 10:") && m.contains("must not be negative"), "{m}");
+    assert!(
+        m.contains("line 10:") && m.contains("must not be negative"),
+        "{m}"
+    );
     let m = error_of(&with_head(
         "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\ng = 1\n",
     ));
@@ -914,12 +927,20 @@ fn bad_media_are_errors_at_the_value() {
     let m = error_of(&with_head(
         "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\n[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\n",
     ));
-    assert!(m.contains("line 11:") && m.contains("already defined"), "{m}");
+    assert!(
+        m.contains("line 11:") && m.contains("already defined"),
+        "{m}"
+    );
     let m = error_of(&with_head(
         "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nfile = \"x.vol\"\n",
     ));
-    assert!(m.contains("`file` does not apply to a homogeneous medium"), "{m}");
-    let m = error_of(&with_head("[[medium]]\nname = \"cloud\"\ntype = \"grid\"\n"));
+    assert!(
+        m.contains("`file` does not apply to a homogeneous medium"),
+        "{m}"
+    );
+    let m = error_of(&with_head(
+        "[[medium]]\nname = \"cloud\"\ntype = \"grid\"\n",
+    ));
     assert!(m.contains("a grid medium needs the key `file`"), "{m}");
     // A grid file whose header promises more values than it holds.
     let dir = assets();
@@ -937,5 +958,8 @@ fn bad_media_are_errors_at_the_value() {
         &with_head("[[medium]]\nname = \"cloud\"\ntype = \"grid\"\nfile = \"short.vol\"\n"),
     );
     let m = load_scene_file(&path).unwrap_err().to_string();
-    assert!(m.contains("short.vol: byte 48:") && m.contains("needs 80 bytes"), "{m}");
+    assert!(
+        m.contains("short.vol: byte 48:") && m.contains("needs 80 bytes"),
+        "{m}"
+    );
 }

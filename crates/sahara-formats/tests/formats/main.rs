@@ -14,6 +14,7 @@ mod gltf_data;
 mod gltf_extensions;
 mod image_in;
 mod image_out;
+mod media_reference;
 mod mitsuba_kit;
 mod scene_load;
 mod scenes;

@@ -36,7 +36,13 @@ impl Ctx<'_> {
         let scale = self.number(&m.scale, "scale", 1.0, |s| s >= 0.0, "at least 0")?;
         let sigma_a = coefficient(&m.sigma_a, "sigma_a")? * scale;
         let sigma_s = coefficient(&m.sigma_s, "sigma_s")? * scale;
-        let g = self.number(&m.g, "g", 0.0, |g| g > -1.0 && g < 1.0, "between -1 and 1 (exclusive)")?;
+        let g = self.number(
+            &m.g,
+            "g",
+            0.0,
+            |g| g > -1.0 && g < 1.0,
+            "between -1 and 1 (exclusive)",
+        )?;
         let phase = HenyeyGreenstein::new(g);
         let medium = match m.kind.get_ref() {
             MediumType::Homogeneous => {
@@ -76,7 +82,8 @@ impl Ctx<'_> {
                 }
                 let density = DensityGrid::new(grid.size, grid.values)
                     .map_err(|e| FormatError::in_file(&path.display().to_string(), e))?;
-                let to_world = Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo);
+                let to_world =
+                    Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo);
                 Medium::Grid(Box::new(GridMedium::new(
                     density, sigma_a, sigma_s, phase, to_world,
                 )))
@@ -97,11 +104,12 @@ impl Ctx<'_> {
         let Some(v) = value else {
             return Ok(None);
         };
-        media
-            .get(v.get_ref())
-            .copied()
-            .map(Some)
-            .ok_or_else(|| self.at(v.span(), format!("no [[medium]] is named '{}'", v.get_ref())))
+        media.get(v.get_ref()).copied().map(Some).ok_or_else(|| {
+            self.at(
+                v.span(),
+                format!("no [[medium]] is named '{}'", v.get_ref()),
+            )
+        })
     }
 
     /// The media an object bounds: `medium_inside` and `medium_outside`;
