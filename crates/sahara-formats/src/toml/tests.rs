@@ -871,7 +871,7 @@ fn media_parse_and_bind_to_objects_and_the_camera() {
     .unwrap();
     let path = dir.write(
         "media.toml",
-        &with_head(
+        with_head(
             "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nsigma_s = [0.5, 0.5, 0.5]\nsigma_a = [0.1, 0.2, 0.3]\nscale = 2\ng = 0.4\n\
              [[medium]]\nname = \"cloud\"\ntype = \"grid\"\nfile = \"blob.vol\"\nsigma_s = [1, 1, 1]\n\
              [[material]]\nname = \"glass\"\ntype = \"dielectric\"\n\
@@ -955,7 +955,7 @@ fn bad_media_are_errors_at_the_value() {
     std::fs::write(dir.0.join("short.vol"), bytes).unwrap();
     let path = dir.write(
         "bad.toml",
-        &with_head("[[medium]]\nname = \"cloud\"\ntype = \"grid\"\nfile = \"short.vol\"\n"),
+        with_head("[[medium]]\nname = \"cloud\"\ntype = \"grid\"\nfile = \"short.vol\"\n"),
     );
     let m = load_scene_file(&path).unwrap_err().to_string();
     assert!(

@@ -312,6 +312,20 @@ mod tests {
     use crate::scene::shape::Shape;
     use crate::scene::Scene;
 
+    /// Fills the inside of `instance`'s closed surface with `medium`, the
+    /// surface only bounding it.
+    fn fill(scene: &mut Scene, instance: u32, medium: Medium) {
+        let m = scene.add_medium(medium);
+        scene.set_medium_interface(
+            instance,
+            MediumInterface {
+                inside: Some(m),
+                outside: None,
+                index_matched: true,
+            },
+        );
+    }
+
     /// The mean pixel of a `size`² render of `scene` at `spp`, path traced
     /// to `max_depth` without Russian roulette, box filtered.
     fn mean(scene: &Scene, size: u32, spp: u32, max_depth: u32) -> Vec3 {
@@ -362,14 +376,10 @@ mod tests {
             glass,
         );
         let sigma_a = Vec3::new(0.5, 1.0, 2.0);
-        let m = scene.add_medium(Medium::homogeneous(sigma_a, Vec3::ZERO, 0.0));
-        scene.set_medium_interface(
+        fill(
+            &mut scene,
             slab,
-            MediumInterface {
-                inside: Some(m),
-                outside: None,
-                index_matched: true,
-            },
+            Medium::homogeneous(sigma_a, Vec3::ZERO, 0.0),
         );
         let got = mean(&scene, 32, 64, 4);
         let want = Vec3::new((-1.0f32).exp(), (-2.0f32).exp(), (-4.0f32).exp());
@@ -428,15 +438,7 @@ mod tests {
                 },
                 mat,
             );
-            let m = scene.add_medium(medium);
-            scene.set_medium_interface(
-                ball,
-                MediumInterface {
-                    inside: Some(m),
-                    outside: None,
-                    index_matched: true,
-                },
-            );
+            fill(&mut scene, ball, medium);
             let got = mean(&scene, 24, 32, 256);
             assert!(
                 (got - Vec3::ONE).abs().max_element() < 0.006,
@@ -474,15 +476,7 @@ mod tests {
             mat,
         );
         let (sigma_a, sigma_s) = (Vec3::new(0.5, 0.2, 0.0), Vec3::new(0.3, 1.0, 2.5));
-        let m = scene.add_medium(Medium::homogeneous(sigma_a, sigma_s, 0.0));
-        scene.set_medium_interface(
-            slab,
-            MediumInterface {
-                inside: Some(m),
-                outside: None,
-                index_matched: true,
-            },
-        );
+        fill(&mut scene, slab, Medium::homogeneous(sigma_a, sigma_s, 0.0));
         let got = mean(&scene, 24, 64, 1);
         let sigma_t = sigma_a + sigma_s;
         let want = sigma_s * e * (Vec3::ONE - (-2.0 * sigma_t * h).exp())

@@ -30,6 +30,16 @@ const MAJORANT_CELLS: u32 = 16;
 /// counts the walk as ended: absorbed, or blocked).
 const MAX_STEPS: u32 = 100_000;
 
+/// How a tracking walk ended ([`GridMedium::track`]).
+enum Tracked {
+    /// It reached the segment's end.
+    Through,
+    /// The collision at this distance ended it.
+    Stopped(f32),
+    /// It gave up at this distance after [`MAX_STEPS`] collisions.
+    GaveUp(f32),
+}
+
 /// A density on a regular grid over the unit cube, its values at the
 /// cells' centres (pbrt's convention): value `(x, y, z)` sits at
 /// `((x + 1/2) / nx, (y + 1/2) / ny, (z + 1/2) / nz)`, x varying fastest.
@@ -266,17 +276,20 @@ impl GridMedium {
         self.density.lookup(self.to_medium.transform_point3(p))
     }
 
-    /// Delta tracking along `origin + t dir` over `[0, t_max]`, drawing
-    /// from `draw`.
-    pub(crate) fn free_flight(
+    /// Tentative collisions along `origin + t dir` over `[0, t_max]`:
+    /// distances drawn from `draw` at each majorant cell's rate, and
+    /// `collide(t, majorant, draw)` at each (drawing what it needs from the
+    /// same run), which returns false to end the walk there. How the walk ended: through the segment, stopped by
+    /// `collide` at `t`, or given up at `t` after [`MAX_STEPS`].
+    fn track(
         &self,
         origin: Vec3,
         dir: Vec3,
         t_max: f32,
         draw: &mut dyn FnMut() -> f32,
-    ) -> FreeFlight {
-        let mut weight = Vec3::ONE;
-        let mut found = None;
+        mut collide: impl FnMut(f32, f32, &mut dyn FnMut() -> f32) -> bool,
+    ) -> Tracked {
+        let mut ended = Tracked::Through;
         let mut steps = 0;
         self.walk(origin, dir, t_max, |t0, t1, m| {
             if m <= 0.0 {
@@ -290,39 +303,63 @@ impl GridMedium {
                 }
                 steps += 1;
                 if steps > MAX_STEPS {
-                    weight = Vec3::ZERO;
-                    found = Some(t);
+                    ended = Tracked::GaveUp(t);
                     return false;
                 }
-                let rho = self.density_at(origin + dir * t);
-                let sigma_s = self.sigma_s * rho;
-                let sigma_n = Vec3::splat(m) - (self.sigma_a + self.sigma_s) * rho;
-                let (ps, pn) = (sigma_s.element_sum(), sigma_n.max(Vec3::ZERO).element_sum());
-                if ps + pn <= 0.0 {
-                    // Absorbed for certain.
-                    weight = Vec3::ZERO;
-                    found = Some(t);
+                if !collide(t, m, &mut *draw) {
+                    ended = Tracked::Stopped(t);
                     return false;
                 }
-                let p_scatter = ps / (ps + pn);
-                if draw() < p_scatter {
-                    weight *= sigma_s / (m * p_scatter);
-                    found = Some(t);
-                    return false;
-                }
-                weight *= sigma_n / (m * (1.0 - p_scatter));
             }
         });
-        match found {
-            Some(t) => FreeFlight {
+        ended
+    }
+
+    /// Delta tracking along `origin + t dir` over `[0, t_max]`, drawing
+    /// from `draw`.
+    pub(crate) fn free_flight(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        draw: &mut dyn FnMut() -> f32,
+    ) -> FreeFlight {
+        let mut weight = Vec3::ONE;
+        // Each tentative collision is real (the path scatters) or null,
+        // chosen by the channels' average coefficients.
+        let ended = self.track(origin, dir, t_max, draw, |t, m, draw| {
+            let rho = self.density_at(origin + dir * t);
+            let sigma_s = self.sigma_s * rho;
+            let sigma_n = Vec3::splat(m) - (self.sigma_a + self.sigma_s) * rho;
+            let (ps, pn) = (sigma_s.element_sum(), sigma_n.max(Vec3::ZERO).element_sum());
+            if ps + pn <= 0.0 {
+                // Absorbed for certain.
+                weight = Vec3::ZERO;
+                return false;
+            }
+            let p_scatter = ps / (ps + pn);
+            if draw() < p_scatter {
+                weight *= sigma_s / (m * p_scatter);
+                return false;
+            }
+            weight *= sigma_n / (m * (1.0 - p_scatter));
+            true
+        });
+        match ended {
+            Tracked::Through => FreeFlight {
+                t: t_max,
+                scattered: false,
+                weight,
+            },
+            Tracked::Stopped(t) => FreeFlight {
                 t,
                 scattered: weight != Vec3::ZERO,
                 weight,
             },
-            None => FreeFlight {
-                t: t_max,
+            Tracked::GaveUp(t) => FreeFlight {
+                t,
                 scattered: false,
-                weight,
+                weight: Vec3::ZERO,
             },
         }
     }
@@ -337,31 +374,15 @@ impl GridMedium {
         draw: &mut dyn FnMut() -> f32,
     ) -> Vec3 {
         let mut tr = Vec3::ONE;
-        let mut steps = 0;
         let sigma_t = self.sigma_a + self.sigma_s;
-        self.walk(origin, dir, d, |t0, t1, m| {
-            if m <= 0.0 {
-                return true;
-            }
-            let mut t = t0;
-            loop {
-                t -= (1.0 - draw()).ln() / m;
-                if t >= t1 {
-                    return true;
-                }
-                steps += 1;
-                if steps > MAX_STEPS {
-                    tr = Vec3::ZERO;
-                    return false;
-                }
-                tr *= Vec3::ONE - sigma_t * (self.density_at(origin + dir * t) / m);
-                if tr.max_element() <= 0.0 {
-                    tr = Vec3::ZERO;
-                    return false;
-                }
-            }
+        let ended = self.track(origin, dir, d, draw, |t, m, _| {
+            tr *= Vec3::ONE - sigma_t * (self.density_at(origin + dir * t) / m);
+            tr.max_element() > 0.0
         });
-        tr
+        match ended {
+            Tracked::Through => tr,
+            Tracked::Stopped(_) | Tracked::GaveUp(_) => Vec3::ZERO,
+        }
     }
 
     /// The transmittance along the segment by numerical integration of
