@@ -99,20 +99,26 @@ pub(crate) fn step(
     st.prev_p = hit.p;
     st.ray = next;
     st.depth += 1;
-    // Russian roulette: continue with probability max(beta), so paths
-    // carrying little keep a bounded weight.
-    if st.depth >= rr_depth {
-        let q = st.beta.max_element().min(1.0);
+    roulette(ctx, &mut st.beta, st.depth, rr_depth)
+}
+
+/// Russian roulette after `depth` bounces: the path goes on with
+/// probability max(beta) (at least 5 %) from bounce `rr_depth` on, so
+/// paths carrying little keep a bounded weight, its throughput divided by
+/// that probability; false if it ends (or carries nothing).
+pub(crate) fn roulette(ctx: &mut Context, beta: &mut Vec3, depth: u32, rr_depth: u32) -> bool {
+    if depth >= rr_depth {
+        let q = beta.max_element().min(1.0);
         if q <= 0.0 {
             return false;
         }
         if q < 1.0 {
             let q = q.max(0.05);
-            if ctx.sampler.get_1d(dims::bounce(st.depth, dims::ROULETTE)) >= q {
+            if ctx.sampler.get_1d(dims::bounce(depth, dims::ROULETTE)) >= q {
                 return false;
             }
-            st.beta /= q;
+            *beta /= q;
         }
     }
-    st.beta != Vec3::ZERO
+    *beta != Vec3::ZERO
 }

@@ -20,6 +20,7 @@
 use glam::Vec3;
 use sahara_kd::Ray;
 
+use super::path::roulette;
 use super::{light_contribution, through_hole, Context, Shading};
 use crate::math::warp::power_heuristic;
 use crate::medium::Medium;
@@ -277,26 +278,6 @@ pub(crate) fn transmittance(
         }
     }
     Vec3::ZERO
-}
-
-/// Russian roulette after `depth` bounces: the path goes on with
-/// probability max(beta) (at least 5 %) from bounce `rr_depth` on, its
-/// throughput divided by that probability; false if it ends.
-fn roulette(ctx: &mut Context, beta: &mut Vec3, depth: u32, rr_depth: u32) -> bool {
-    if depth >= rr_depth {
-        let q = beta.max_element().min(1.0);
-        if q <= 0.0 {
-            return false;
-        }
-        if q < 1.0 {
-            let q = q.max(0.05);
-            if ctx.sampler.get_1d(dims::bounce(depth, dims::ROULETTE)) >= q {
-                return false;
-            }
-            *beta /= q;
-        }
-    }
-    *beta != Vec3::ZERO
 }
 
 #[cfg(test)]
