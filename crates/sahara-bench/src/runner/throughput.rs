@@ -46,7 +46,7 @@ pub fn mrays_per_sec(rays: usize, secs: f64) -> f64 {
 }
 
 /// CPU time consumed by the calling thread, in seconds.
-pub(crate) fn thread_cpu_seconds() -> f64 {
+pub fn thread_cpu_seconds() -> f64 {
     let mut ts = libc::timespec {
         tv_sec: 0,
         tv_nsec: 0,
