@@ -420,7 +420,14 @@ impl Integrator {
     /// left out here (see [`Integrator::li_splats`]); so is the photons'
     /// part of SPPM's.
     pub fn li(&self, ctx: &mut Context, ray: &Ray, time: f32) -> Vec3 {
-        self.li_splats(ctx, ray, time, Vec2::ONE, &mut Vec::new())
+        self.li_splats(
+            ctx,
+            ray,
+            time,
+            Vec2::ONE,
+            &mut Vec::new(),
+            &mut AuxSample::default(),
+        )
     }
 
     /// True for the integrators whose samples also add light elsewhere on
@@ -432,7 +439,9 @@ impl Integrator {
 
     /// [`Integrator::li`], with the light tracing contributions of the
     /// bidirectional integrators pushed to `splats` (`film`: the image's
-    /// size in pixels).
+    /// size in pixels), and what the denoiser is told recorded in `aux` by
+    /// the volumetric path tracer (the other integrators that come here
+    /// record none; the stepped ones record theirs in the render loop).
     pub(crate) fn li_splats(
         &self,
         ctx: &mut Context,
@@ -440,6 +449,7 @@ impl Integrator {
         time: f32,
         film: Vec2,
         splats: &mut Vec<bdpt::Splat>,
+        aux: &mut AuxSample,
     ) -> Vec3 {
         ctx.stats.camera_rays += 1;
         match *self {
@@ -471,7 +481,7 @@ impl Integrator {
             Integrator::Path {
                 max_depth,
                 rr_depth,
-            } if ctx.world.has_media() => volpath::li(ctx, ray, time, max_depth, rr_depth),
+            } if ctx.world.has_media() => volpath::li(ctx, ray, time, max_depth, rr_depth, aux),
             Integrator::Path { .. } | Integrator::Distribution { .. } => {
                 let world = ctx.world;
                 let mut st = PathState::new(*ray, time, ctx.sampler);

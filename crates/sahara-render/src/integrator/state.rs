@@ -101,6 +101,24 @@ impl AuxSample {
         }
     }
 
+    /// Records a scattering in a participating medium of single-scattering
+    /// albedo `albedo` at `p`, at `distance` from the camera if it is the
+    /// path's first event: a medium has no surface, so its normal is zero
+    /// (the denoiser's sign for "no surface here").
+    #[inline]
+    pub fn medium(&mut self, albedo: Vec3, p: Vec3, distance: Option<f32>) {
+        if !self.open {
+            return;
+        }
+        if let Some(d) = distance {
+            self.depth = d;
+            self.position = p;
+        }
+        self.albedo = albedo.clamp(Vec3::ZERO, Vec3::ONE);
+        self.normal = Vec3::ZERO;
+        self.open = false;
+    }
+
     /// Records an escape into the environment of radiance `le`.
     #[inline]
     pub fn escape(&mut self, le: Vec3) {

@@ -21,7 +21,7 @@ use glam::Vec3;
 use sahara_kd::Ray;
 
 use super::path::roulette;
-use super::{light_contribution, through_hole, Context, Shading};
+use super::{light_contribution, through_hole, AuxSample, Context, Shading};
 use crate::math::warp::power_heuristic;
 use crate::medium::Medium;
 use crate::sampler::{dims, PixelSampler};
@@ -51,8 +51,20 @@ const MAX_CROSSINGS: u32 = 256;
 
 /// Radiance along a camera ray at `time` through the scene's media;
 /// `max_depth` counts scattering events at surfaces and in media alike.
-pub(crate) fn li(ctx: &mut Context, ray: &Ray, time: f32, max_depth: u32, rr_depth: u32) -> Vec3 {
+/// What the denoiser is told goes to `aux` (if open): the first surface
+/// that is not a perfect mirror or smooth glass, or the first scattering
+/// in a medium before it, whichever comes first; index-matched boundaries
+/// are not surfaces to it.
+pub(crate) fn li(
+    ctx: &mut Context,
+    ray: &Ray,
+    time: f32,
+    max_depth: u32,
+    rr_depth: u32,
+    aux: &mut AuxSample,
+) -> Vec3 {
     let world = ctx.world;
+    let camera = ray.origin;
     let mut l = Vec3::ZERO;
     let mut beta = Vec3::ONE;
     let mut ray = *ray;
@@ -82,6 +94,7 @@ pub(crate) fn li(ctx: &mut Context, ray: &Ray, time: f32, max_depth: u32, rr_dep
                     break;
                 }
                 let p = ray.origin + ray.dir * flight.t;
+                aux.medium(m.albedo(p), p, (depth == 0).then(|| (p - camera).length()));
                 l += beta * medium_light(ctx, m, p, ray.dir, medium, time, depth);
                 let (wi, pdf) = m.phase().sample(
                     ray.dir,
@@ -100,12 +113,14 @@ pub(crate) fn li(ctx: &mut Context, ray: &Ray, time: f32, max_depth: u32, rr_dep
         }
         let Some(hit) = hit else {
             if world.has_environment() {
+                let le = world.env_radiance(ray.dir);
+                aux.escape(le);
                 let w = if prev_delta {
                     1.0
                 } else {
                     power_heuristic(prev_pdf, world.env_pdf(ray.dir))
                 };
-                l += beta * world.env_radiance(ray.dir) * w;
+                l += beta * le * w;
             }
             break;
         };
@@ -125,6 +140,14 @@ pub(crate) fn li(ctx: &mut Context, ray: &Ray, time: f32, max_depth: u32, rr_dep
             continue;
         }
         let sh = Shading::new(world, &hit, ray.dir);
+        if depth == 0 && aux.open && crossings + holes > 0 {
+            // The camera ray went on past boundaries and holes: its first
+            // hit's distance is from the camera, not from the last of them.
+            aux.surface(&sh, &hit, ray.dir, 0);
+            aux.depth = (hit.p - camera).length();
+        } else {
+            aux.surface(&sh, &hit, ray.dir, depth);
+        }
         if sh.emitted != Vec3::ZERO {
             let w = if prev_delta {
                 1.0
@@ -325,6 +348,84 @@ mod tests {
         let r = render(scene, &settings, &|_| {}).unwrap();
         assert_eq!(r.stats.nan_samples, 0);
         r.film.pixels.iter().copied().sum::<Vec3>() / r.film.pixels.len() as f32
+    }
+
+    /// The render passes of a scene with media: a diffuse wall seen
+    /// through a box of medium (an index-matched boundary, 1 to 6 in
+    /// front of the camera). Through an empty medium, the passes are the
+    /// wall's, as without the box (the distance from the camera, not from
+    /// the boundary); through a dense one, every first event is a
+    /// scattering in it: the medium's albedo σs / σt, a zero normal, a
+    /// distance within the box.
+    #[test]
+    fn render_passes_record_the_first_surface_or_the_first_scattering() {
+        use crate::render::{Aov, AuxImages};
+        let passes = |medium: Option<Medium>| -> AuxImages {
+            let cam = Camera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 20.0, 1.0);
+            let mut scene = Scene::new(cam);
+            scene.add_light(crate::light::Light::Directional {
+                direction: -Vec3::Z,
+                irradiance: Vec3::ONE,
+            });
+            let wall = scene.add_material(Material::diffuse(Vec3::new(0.2, 0.4, 0.6)));
+            scene.add_shape(
+                Shape::Quad {
+                    corner: Vec3::new(-20.0, -20.0, -2.0),
+                    edge_u: Vec3::new(40.0, 0.0, 0.0),
+                    edge_v: Vec3::new(0.0, 40.0, 0.0),
+                },
+                wall,
+            );
+            if let Some(medium) = medium {
+                let bound = scene.add_material(Material::diffuse(Vec3::ONE));
+                let b = scene.add_shape(
+                    Shape::Box {
+                        min: Vec3::new(-20.0, -20.0, -1.0),
+                        max: Vec3::new(20.0, 20.0, 4.0),
+                    },
+                    bound,
+                );
+                fill(&mut scene, b, medium);
+            }
+            let settings = RenderSettings {
+                width: 8,
+                height: 8,
+                spp: 4,
+                aovs: vec![Aov::Albedo, Aov::Normal, Aov::Depth],
+                ..RenderSettings::default()
+            };
+            render(&scene, &settings, &|_| {})
+                .unwrap()
+                .aux
+                .unwrap()
+                .images
+        };
+        let bare = passes(None);
+        let clear = passes(Some(Medium::homogeneous(Vec3::ZERO, Vec3::ZERO, 0.0)));
+        assert_eq!(clear.albedo, bare.albedo);
+        assert_eq!(clear.normal, bare.normal);
+        for (a, b) in clear.depth.iter().zip(&bare.depth) {
+            assert!(
+                (a - b).abs() < 1e-5 * b,
+                "depth {a} through the box, {b} without"
+            );
+        }
+        let sigma_s = Vec3::new(25.0, 50.0, 50.0);
+        let sigma_a = Vec3::new(25.0, 0.0, 0.0);
+        let dense = passes(Some(Medium::homogeneous(sigma_a, sigma_s, 0.0)));
+        for k in 0..dense.albedo.len() {
+            let a = dense.albedo[k];
+            assert!(
+                (a - Vec3::new(0.5, 1.0, 1.0)).abs().max_element() < 1e-6,
+                "{a}"
+            );
+            assert_eq!(dense.normal[k], Vec3::ZERO);
+            assert!(
+                dense.depth[k] > 1.0 && dense.depth[k] < 1.5,
+                "{}",
+                dense.depth[k]
+            );
+        }
     }
 
     /// An absorbing slab of thickness 2 between the camera and an emitter

@@ -121,6 +121,19 @@ impl Medium {
         }
     }
 
+    /// The single-scattering albedo at world point `p`: the fraction of
+    /// the light a collision takes that it scatters, σs / (σa + σs), per
+    /// channel (0 where the medium neither absorbs nor scatters).
+    pub fn albedo(&self, p: Vec3) -> Vec3 {
+        let _ = p; // the same everywhere in today's media: a density scales σa and σs alike
+        let (sigma_a, sigma_s) = match self {
+            Medium::Homogeneous(h) => (h.sigma_a, h.sigma_s),
+            Medium::Grid(m) => (m.sigma_a, m.sigma_s),
+        };
+        let sigma_t = sigma_a + sigma_s;
+        Vec3::select(sigma_t.cmpgt(Vec3::ZERO), sigma_s / sigma_t, Vec3::ZERO)
+    }
+
     /// The phase function.
     #[inline]
     pub fn phase(&self) -> HenyeyGreenstein {

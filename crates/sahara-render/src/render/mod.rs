@@ -157,21 +157,11 @@ impl RenderSettings {
     }
 
     /// [`RenderSettings::check`], and refuses what the integrator cannot
-    /// honour in this scene: participating media (and render passes
-    /// through them, which the volumetric path tracer does not record).
+    /// honour in this scene: participating media.
     pub fn check_for(&self, scene: &Scene) -> Result<(), SettingsError> {
         self.check()?;
         if scene.has_media() {
-            let kind = self.integrator.kind();
-            kind.require(Feature::Media)?;
-            if !self.aovs.is_empty() {
-                return Err(SettingsError::Unsupported {
-                    integrator: kind,
-                    feature: Feature::Aovs,
-                    why: "the volumetric path tracer, which renders scenes with media, does not \
-                          record what each sample first sees",
-                });
-            }
+            self.integrator.kind().require(Feature::Media)?;
         }
         Ok(())
     }
@@ -1225,7 +1215,8 @@ impl Strip {
     ) {
         let (w, h) = (s.width.max(1), s.height.max(1));
         let pixels = StripPixels { x0, x1, y0, y1 };
-        self.lay_out(pixels, samples, !s.aovs.is_empty());
+        let aux_on = !s.aovs.is_empty();
+        self.lay_out(pixels, samples, aux_on);
         let cameras = CameraSamples {
             s,
             camera: &world.scene.camera,
@@ -1266,9 +1257,21 @@ impl Strip {
                     };
                     let k = slot(&self.first, samples, pixels, x, y, g);
                     self.pos[k] = pos;
-                    self.radiance[k] =
-                        s.integrator
-                            .li_splats(&mut ctx, &ray, time, film, &mut self.splats);
+                    let mut aux = AuxSample {
+                        open: aux_on,
+                        ..AuxSample::default()
+                    };
+                    self.radiance[k] = s.integrator.li_splats(
+                        &mut ctx,
+                        &ray,
+                        time,
+                        film,
+                        &mut self.splats,
+                        &mut aux,
+                    );
+                    if aux_on {
+                        self.aux[k] = aux;
+                    }
                 }
             }
         }

@@ -171,7 +171,7 @@ fn sppm_shows_previews_between_iterations() {
 }
 
 /// A scene with a participating medium renders with the path tracer only
-/// (as the volumetric path tracer), and without render passes; the other
+/// (as the volumetric path tracer, render passes included); the other
 /// integrators refuse it rather than render it as if in vacuum.
 #[test]
 fn media_are_refused_by_the_integrators_that_cannot_trace_them() {
@@ -204,6 +204,5 @@ fn media_are_refused_by_the_integrators_that_cannot_trace_them() {
         aovs: vec![Aov::Albedo],
         ..path
     };
-    let e = render(&scene, &passes, &|_| {}).expect_err("render passes through media");
-    assert!(e.to_string().contains("does not record"), "{e}");
+    assert!(render(&scene, &passes, &|_| {}).is_ok());
 }

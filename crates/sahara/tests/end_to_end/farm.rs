@@ -644,3 +644,51 @@ fn a_denoised_frame_is_denoised_once_merged() {
     );
     fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A scene with participating media (the volumetric path tracer, one path
+/// at a time) splits by tiles and by samples, and its render passes with
+/// it, into parts that merge to the whole frame byte for byte; the whole
+/// frame is the same on one thread as on two.
+#[test]
+fn media_split_and_merge_byte_for_byte() {
+    let dir = temp_dir("farm-media");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/fog_cornell.toml");
+    let scene = scene.to_str().unwrap();
+    let with_scene = |pieces: Vec<Vec<String>>| -> Vec<Vec<String>> {
+        pieces
+            .into_iter()
+            .map(|mut p| {
+                p.extend([scene.to_string(), "--aov".into(), "albedo,normal".into()]);
+                p
+            })
+            .collect()
+    };
+    let whole = dir.join("whole.exr");
+    render(&[scene, "--aov", "albedo,normal"], &whole);
+    let one = dir.join("one-thread.exr");
+    let o = one.to_str().unwrap();
+    let r = sahara(
+        &[
+            &["render"],
+            FRAME,
+            &[scene, "--aov", "albedo,normal", "--threads", "1", "-o", o],
+        ]
+        .concat(),
+    );
+    assert!(r.status.success(), "{}", stderr(&r));
+    assert!(
+        fs::read(&one).unwrap() == fs::read(&whole).unwrap(),
+        "one thread and two render different frames"
+    );
+    for (tag, how) in [("tiles", "tiles"), ("samples", "samples")] {
+        let files = parts(&dir, tag, &with_scene(split(3, how)));
+        let out = dir.join(format!("merged-{tag}.exr"));
+        let m = merge(&files, &out, &[]);
+        assert!(m.status.success(), "{tag}: {}", stderr(&m));
+        assert!(
+            fs::read(&out).unwrap() == fs::read(&whole).unwrap(),
+            "{tag}: the merged frame differs from the whole one"
+        );
+    }
+    fs::remove_dir_all(&dir).unwrap();
+}
