@@ -147,7 +147,7 @@ def rectangle(T, corner, u, v):
     return T(m.tolist())
 
 
-def mitsuba_scene(mi, name, case, out, spp, seed):
+def mitsuba_scene(mi, name, case, out, spp, seed, size=SIZE):
     eye, target, vfov = case["camera"]
     rgb = lambda c: {"type": "rgb", "value": [float(x) for x in c]}
     T = mi.ScalarTransform4f
@@ -158,7 +158,7 @@ def mitsuba_scene(mi, name, case, out, spp, seed):
             "type": "perspective", "fov_axis": "y", "fov": vfov, "near_clip": 1e-3,
             "to_world": T().look_at(origin=eye, target=target, up=(0, 1, 0)),
             "sampler": {"type": "independent", "sample_count": spp, "seed": seed},
-            "film": {"type": "hdrfilm", "width": SIZE, "height": SIZE, "pixel_format": "rgb",
+            "film": {"type": "hdrfilm", "width": size, "height": size, "pixel_format": "rgb",
                      "rfilter": {"type": "box"}},
         },
     }

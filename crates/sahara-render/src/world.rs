@@ -7,7 +7,7 @@ use sahara_kd::{BuildParams, Counters, NoCounters, Ray};
 
 use crate::accel::{Accel, BatchBuffers, RawHit};
 use crate::light::area::{EmissionTextures, Emitter};
-use crate::light::{AreaLight, EnvLight, LightSample, LightSource};
+use crate::light::{AreaLight, EnvLight, Light, LightSample, LightSource};
 use crate::material::Material;
 use crate::math::piecewise::Distribution1D;
 use crate::math::warp::Frame;
@@ -114,7 +114,11 @@ pub struct World<'a> {
     pub accel: Accel,
     /// Every sampled light.
     pub lights: Vec<LightSource>,
+    /// How light tracing picks the light a path starts from: by power.
     select: Distribution1D,
+    /// How next-event estimation picks the light it samples
+    /// ([`next_event_choice`]).
+    nee: Distribution1D,
     instance_light: Vec<Option<u32>>,
     env: Option<u32>,
     default_material: Material,
@@ -154,12 +158,15 @@ impl<'a> World<'a> {
             .collect();
         let accel = Accel::build(&scene.meshes, &scene.instances, params, &ignorable);
         let (center, radius) = bounding_sphere(&accel);
-        let select = Distribution1D::new(lights.iter().map(|l| l.power(radius)).collect());
+        let powers: Vec<f32> = lights.iter().map(|l| l.power(radius)).collect();
+        let nee = Distribution1D::new(next_event_choice(&lights, &powers));
+        let select = Distribution1D::new(powers);
         Self {
             scene,
             accel,
             lights,
             select,
+            nee,
             instance_light,
             env,
             default_material: Scene::default_material(),
@@ -577,13 +584,14 @@ impl<'a> World<'a> {
         !self.lights.is_empty()
     }
 
-    /// One light chosen by power (`u_pick`), sampled from `p` (`u`), with
-    /// the probability of the choice.
+    /// One light chosen for next-event estimation (`u_pick`,
+    /// [`next_event_choice`]), sampled from `p` (`u`), with the
+    /// probability of the choice.
     pub fn sample_light(&self, p: Vec3, u_pick: f32, u: Vec2) -> Option<(LightSample, f32)> {
         if self.lights.is_empty() {
             return None;
         }
-        let (i, pmf) = self.select.sample_discrete(u_pick);
+        let (i, pmf) = self.nee.sample_discrete(u_pick);
         if pmf <= 0.0 {
             return None;
         }
@@ -611,7 +619,7 @@ impl<'a> World<'a> {
         self.env
     }
 
-    /// Probability that [`World::sample_light`] picks light `i`.
+    /// Probability that [`World::pick_light`] picks light `i`.
     pub fn light_pmf(&self, i: usize) -> f32 {
         self.select.pmf(i)
     }
@@ -624,7 +632,7 @@ impl<'a> World<'a> {
             return 0.0;
         };
         match &self.lights[l as usize] {
-            LightSource::Area(a) => self.select.pmf(l as usize) * a.pdf(p_ref, hit.p, hit.ng, wi),
+            LightSource::Area(a) => self.nee.pmf(l as usize) * a.pdf(p_ref, hit.p, hit.ng, wi),
             _ => 0.0,
         }
     }
@@ -645,7 +653,7 @@ impl<'a> World<'a> {
     pub fn env_pdf(&self, w: Vec3) -> f32 {
         match self.env {
             Some(i) => match &self.lights[i as usize] {
-                LightSource::Environment(e) => self.select.pmf(i as usize) * e.pdf(w),
+                LightSource::Environment(e) => self.nee.pmf(i as usize) * e.pdf(w),
                 _ => 0.0,
             },
             None => 0.0,
@@ -660,6 +668,38 @@ impl<'a> World<'a> {
 
 /// Relative shortening of shadow rays towards points on lights.
 pub const SHADOW_EPS: f32 = 1.0 / 4096.0;
+
+/// The weights by which next-event estimation picks a light: by power
+/// within each of two families, the lights infinitely far away (the
+/// environment, directional lights) and the lights in the scene, with
+/// half the choices to each family when the scene has both. Power alone
+/// would rate an environment by the disc of the whole scene it lights, and
+/// a dim sky around a room would take nearly every choice from the lamp
+/// that lights the room (pbrt-v4's light samplers split the same way).
+fn next_event_choice(lights: &[LightSource], powers: &[f32]) -> Vec<f32> {
+    let infinite = |l: &LightSource| {
+        matches!(
+            l,
+            LightSource::Environment(_) | LightSource::Explicit(Light::Directional { .. })
+        )
+    };
+    let (mut far, mut near) = (0.0f64, 0.0f64);
+    for (l, &p) in lights.iter().zip(powers) {
+        if infinite(l) {
+            far += p as f64;
+        } else {
+            near += p as f64;
+        }
+    }
+    if far <= 0.0 || near <= 0.0 {
+        return powers.to_vec();
+    }
+    lights
+        .iter()
+        .zip(powers)
+        .map(|(l, &p)| (p as f64 / if infinite(l) { far } else { near }) as f32)
+        .collect()
+}
 
 /// The centre and radius of a sphere around the scene's geometry (the unit
 /// sphere when there is none).
