@@ -25,7 +25,7 @@ use super::{light_contribution, through_hole, AuxSample, Context, Shading};
 use crate::math::warp::power_heuristic;
 use crate::medium::Medium;
 use crate::sampler::{dims, PixelSampler};
-use crate::world::{pass_through_draw, ShadowQuery, World, MAX_PASS_THROUGHS};
+use crate::world::{pass_through_draw, ShadowQuery, SurfaceHit, World, MAX_PASS_THROUGHS};
 
 /// The `light` fields of [`dims::extra`] whose dimensions sample distances
 /// in media along a path's rays, and estimate transmittance along its
@@ -152,14 +152,7 @@ pub(crate) fn li(
             let w = if prev_delta {
                 1.0
             } else {
-                let lp = world.light_pdf(prev_p, &hit, ray.dir);
-                // Emitters that light sampling never picks are found by
-                // scattering alone: weight 1.
-                if lp > 0.0 {
-                    power_heuristic(prev_pdf, lp)
-                } else {
-                    1.0
-                }
+                emitter_weight(world, prev_pdf, prev_p, &hit, ray.dir)
             };
             l += beta * sh.emitted * w;
         }
@@ -170,25 +163,8 @@ pub(crate) fn li(
             break;
         }
         let leaving = |dir: Vec3| interface.map_or(medium, |mi| mi.medium_along(hit.ng, dir));
-        // Next-event estimation: one light, chosen by power.
         if !sh.bsdf.is_delta() {
-            let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
-            let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
-            if let Some((ls, pmf)) = world.sample_light(hit.p, u_pick, u) {
-                if let Some((c, bsdf_pdf, shadow)) = light_contribution(ctx, &hit, &sh, &ls, time) {
-                    let mut draw = draws(ctx.sampler, depth, SHADOW_MEDIUM_DIMS);
-                    let tr = transmittance(world, &shadow, leaving(ls.wi), &mut draw);
-                    if tr != Vec3::ZERO {
-                        let light_pdf = pmf * ls.pdf;
-                        let w = if ls.delta {
-                            1.0
-                        } else {
-                            power_heuristic(light_pdf, bsdf_pdf)
-                        };
-                        l += beta * c * tr * (w / light_pdf);
-                    }
-                }
-            }
+            l += surface_light(ctx, &hit, &sh, beta, time, depth, &leaving);
         }
         let Some((s, next)) = sh.sample_bounce(ctx, &hit, depth) else {
             break;
@@ -205,6 +181,57 @@ pub(crate) fn li(
         }
     }
     l
+}
+
+/// The power heuristic's weight of an emitter that a path found at `hit`
+/// along `dir` by scattering at `prev_p` with density `prev_pdf`, against
+/// light sampling from there.
+fn emitter_weight(world: &World, prev_pdf: f32, prev_p: Vec3, hit: &SurfaceHit, dir: Vec3) -> f32 {
+    let lp = world.light_pdf(prev_p, hit, dir);
+    // Emitters that light sampling never picks are found by scattering
+    // alone: weight 1.
+    if lp > 0.0 {
+        power_heuristic(prev_pdf, lp)
+    } else {
+        1.0
+    }
+}
+
+/// Next-event estimation at a surface: light from one light reflected
+/// by the surface `sh` of `hit` at bounce `depth`, through the media
+/// (`leaving(wi)`: the medium a ray towards `wi` starts in), weighted
+/// against BSDF sampling by the power heuristic, times the path's
+/// throughput `beta`.
+fn surface_light(
+    ctx: &mut Context,
+    hit: &SurfaceHit,
+    sh: &Shading,
+    beta: Vec3,
+    time: f32,
+    depth: u32,
+    leaving: &dyn Fn(Vec3) -> Option<u32>,
+) -> Vec3 {
+    let world = ctx.world;
+    let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
+    let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
+    let Some((ls, pmf)) = world.sample_light(hit.p, u_pick, u) else {
+        return Vec3::ZERO;
+    };
+    let Some((c, bsdf_pdf, shadow)) = light_contribution(ctx, hit, sh, &ls, time) else {
+        return Vec3::ZERO;
+    };
+    let mut draw = draws(ctx.sampler, depth, SHADOW_MEDIUM_DIMS);
+    let tr = transmittance(world, &shadow, leaving(ls.wi), &mut draw);
+    if tr == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    let light_pdf = pmf * ls.pdf;
+    let w = if ls.delta {
+        1.0
+    } else {
+        power_heuristic(light_pdf, bsdf_pdf)
+    };
+    beta * c * tr * (w / light_pdf)
 }
 
 /// Light arriving at `p` in medium `m` (index `medium`) from one light
