@@ -121,6 +121,14 @@ pub struct GltfMaterial {
     /// Thickness of the volume the surface bounds (`KHR_materials_volume`;
     /// 0, a thin wall, without it).
     pub thickness: f32,
+    /// The colour white light becomes after crossing
+    /// `attenuation_distance` inside the volume (`KHR_materials_volume`;
+    /// white without it).
+    pub attenuation_color: [f32; 3],
+    /// The distance over which light inside the volume becomes
+    /// `attenuation_color` (`KHR_materials_volume`; infinite, no
+    /// attenuation, without it).
+    pub attenuation_distance: f32,
     /// How the base colour's alpha cuts the surface (`alphaMode`, with
     /// `alphaCutoff` for `MASK`).
     pub alpha_mode: GltfAlphaMode,
@@ -147,6 +155,8 @@ impl GltfMaterial {
             specular_color: [1.0; 3],
             transmission: 0.0,
             thickness: 0.0,
+            attenuation_color: [1.0; 3],
+            attenuation_distance: f32::INFINITY,
             alpha_mode: GltfAlphaMode::Opaque,
         }
     }
@@ -831,6 +841,12 @@ impl Loader<'_> {
                 .transmission()
                 .map_or(0.0, |t| t.transmission_factor()),
             thickness: material.volume().map_or(0.0, |v| v.thickness_factor()),
+            attenuation_color: material
+                .volume()
+                .map_or([1.0; 3], |v| v.attenuation_color()),
+            attenuation_distance: material
+                .volume()
+                .map_or(f32::INFINITY, |v| v.attenuation_distance()),
             alpha_mode: match material.alpha_mode() {
                 ::gltf::material::AlphaMode::Opaque => GltfAlphaMode::Opaque,
                 ::gltf::material::AlphaMode::Mask => GltfAlphaMode::Mask {

@@ -102,7 +102,7 @@ impl AssembledScene {
 }
 
 /// Assembles the scene `desc` describes.
-pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
+pub fn assemble(mut desc: SceneDescription) -> Result<AssembledScene, FormatError> {
     let name = desc.name.clone();
     let mut warnings = desc.warnings;
     let placeholder = Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, AUTO_VFOV_DEG, 1.0);
@@ -120,6 +120,11 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
     let mut moving_emitters = 0;
     // Each object's media go on every instance it adds.
     let interfaces: BTreeMap<u32, _> = desc.medium_interfaces.iter().copied().collect();
+    // The file's media come first (the objects' interfaces name them by
+    // index); a mesh file's glass volumes are added after them.
+    scene.media = std::mem::take(&mut desc.media);
+    // Instances whose glTF material fills them with a medium.
+    let mut filled: HashSet<u32> = HashSet::new();
     for (k, o) in desc.objects.iter().enumerate() {
         let first_instance = scene.instances.len() as u32;
         let emits = match &o.geometry {
@@ -138,11 +143,18 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
                     cameras.extend(f.cameras.iter().cloned());
                 }
                 for part in &f.parts {
-                    scene.add_instance(Instance {
+                    let instance = scene.add_instance(Instance {
                         mesh: part.mesh,
                         placement: placed(&o.placement, part.transform),
                         material: o.material.or(f.material),
                     });
+                    if o.material.is_none() && !f.volumes.is_empty() {
+                        let outside = interfaces.get(&(k as u32)).and_then(|mi| mi.outside);
+                        if let Some(mi) = volume_interface(&scene, part.mesh, &f.volumes, outside) {
+                            scene.set_medium_interface(instance, mi);
+                            filled.insert(instance);
+                        }
+                    }
                 }
                 // The file's lights, where the object puts the file
                 // (where it starts, if it moves).
@@ -189,12 +201,13 @@ pub fn assemble(desc: SceneDescription) -> Result<AssembledScene, FormatError> {
         }
         if let Some(&mi) = interfaces.get(&(k as u32)) {
             for i in first_instance..scene.instances.len() as u32 {
-                scene.set_medium_interface(i, mi);
+                if !filled.contains(&i) {
+                    scene.set_medium_interface(i, mi);
+                }
             }
         }
         name_instances(&mut object_names, &scene, &library, o, k);
     }
-    scene.media = desc.media;
     scene.camera_medium = desc.camera_medium;
     warnings.append(&mut library.warnings);
     if moving_emitters > 0 {
@@ -468,4 +481,26 @@ fn add_placed_shape(
         placement,
         material: Some(material),
     })
+}
+
+/// The media on the sides of an instance of `mesh` whose triangles all
+/// wear one material with a volume (glTF `KHR_materials_volume`
+/// attenuation): its medium inside, `outside` (the object's own outside
+/// medium, if it names one) around it.
+fn volume_interface(
+    scene: &Scene,
+    mesh: u32,
+    volumes: &std::collections::HashMap<u32, u32>,
+    outside: Option<u32>,
+) -> Option<sahara_render::MediumInterface> {
+    let ids = scene.meshes[mesh as usize].material_ids.as_ref()?;
+    let first = *ids.first()?;
+    let inside = *volumes.get(&first)?;
+    ids.iter()
+        .all(|&m| m == first)
+        .then_some(sahara_render::MediumInterface {
+            inside: Some(inside),
+            outside,
+            index_matched: false,
+        })
 }

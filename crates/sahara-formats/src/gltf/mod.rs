@@ -1,8 +1,10 @@
 //! A glTF file's cameras, lights and materials as the renderer's (the file
 //! is read by [`sahara_readers::gltf`]; its meshes are loaded by
-//! [`crate::mesh::library`], its materials mapped by [`material`]).
+//! [`crate::mesh::library`], its materials mapped by [`material`], the
+//! media inside its glass by [`volume`]).
 
 pub(crate) mod material;
+pub(crate) mod volume;
 
 use glam::{Mat4, Vec3};
 use sahara_readers::gltf::{GltfCamera, GltfLight, GltfLightKind};

@@ -16,6 +16,7 @@ use sahara_render::{Scene, SceneMesh};
 use crate::common::materials::TextureCache;
 use crate::common::mesh::render_mesh;
 use crate::gltf::material::gltf_material;
+use crate::gltf::volume::volume_medium;
 use crate::mesh::mtl::mtl_material;
 use sahara_readers::gltf::{GltfCamera, GltfLight};
 use sahara_readers::FormatError;
@@ -48,6 +49,10 @@ pub struct LoadedFile {
     /// The file's lights (glTF `KHR_lights_punctual`), placed in the
     /// file's space.
     pub lights: Vec<GltfLight>,
+    /// The media inside the file's materials (glTF `KHR_materials_volume`
+    /// attenuation): the scene's material index to the medium's in
+    /// [`Scene::media`].
+    pub volumes: HashMap<u32, u32>,
 }
 
 /// Every mesh file loaded so far, by canonical path.
@@ -128,6 +133,7 @@ impl MeshLibrary {
                     emissive: false,
                     cameras: Vec::new(),
                     lights: Vec::new(),
+                    volumes: HashMap::new(),
                 }
             }
             "gltf" | "glb" => self.load_gltf(scene, path, own_materials)?,
@@ -184,6 +190,7 @@ impl MeshLibrary {
             emissive,
             cameras: Vec::new(),
             lights: Vec::new(),
+            volumes: HashMap::new(),
         })
     }
 
@@ -198,12 +205,16 @@ impl MeshLibrary {
         let name = path.display().to_string();
         self.warnings.extend(g.warnings);
         let mut emissive = false;
+        let mut volumes = HashMap::new();
         let first = scene.materials.len() as u32;
         let material = if own_materials {
             for gm in &g.materials {
                 let m = gltf_material(gm, &name, &mut self.textures, &mut self.warnings);
                 emissive |= m.is_emissive();
                 let id = scene.add_material(m);
+                if let Some(medium) = volume_medium(gm) {
+                    volumes.insert(id, scene.add_medium(medium));
+                }
                 if let Some(n) = &gm.name {
                     self.material_names.insert(id, n.clone());
                 }
@@ -258,6 +269,7 @@ impl MeshLibrary {
             emissive,
             cameras: g.cameras,
             lights: g.lights,
+            volumes,
         })
     }
 }

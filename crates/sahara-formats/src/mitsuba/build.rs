@@ -52,10 +52,10 @@ pub(crate) fn build(
             "bsdf" | "texture" => {
                 node.need("type")?;
             }
-            "medium" | "phase" | "volume" => b.w.add(
-                "participating media are not supported; ignored",
-                &node.loc,
-            ),
+            // Made when used (a shape or the sensor refers to them).
+            "medium" | "phase" | "volume" => {
+                node.need("type")?;
+            }
             // Defined for a sensor to refer to.
             "film" | "sampler" | "rfilter" if node.attr("id").is_some() => {}
             "film" | "sampler" | "rfilter" => b.w.add(

@@ -40,6 +40,8 @@ pub(crate) struct Builder<'a> {
     pub(crate) bump_maps: Vec<std::sync::Arc<sahara_render::Texture>>,
     /// Textures read so far (by element address).
     pub(crate) textures: HashMap<usize, Tint>,
+    /// The index of each medium element (by address), once made.
+    pub(crate) media: HashMap<usize, u32>,
 }
 
 /// The address of an element: its identity for the caches.
@@ -91,6 +93,7 @@ impl<'a> Builder<'a> {
             groups: HashMap::new(),
             textures: HashMap::new(),
             bump_maps: Vec::new(),
+            media: HashMap::new(),
         })
     }
 

@@ -10,7 +10,8 @@
 //! |---|---|
 //! | `path` (`max_depth`, `rr_depth`) | path tracer |
 //! | `direct` | path tracer of depth 1: direct light with MIS |
-//! | `volpath`, `volpathmis`, `prb`, `prb_basic`, `prbvolpath`, `ptracer` | path tracer (warned; no media) |
+//! | `volpath`, `volpathmis` | path tracer (the volumetric one in a scene with media) |
+//! | `prb`, `prb_basic`, `prbvolpath`, `ptracer` | path tracer (warned) |
 //! | `depth` | depth |
 //! | `aov` | its nested integrator (warned: the image only) |
 //! | `hide_emitters` | not supported (warned) |
@@ -132,12 +133,14 @@ pub(crate) fn integrator<'a>(
             }
         }
         "sppm" | "photonmapper" => sppm(b, &o, node)?,
-        "volpath" | "volpathmis" | "prb" | "prb_basic" | "prbvolpath" => {
+        "volpath" | "volpathmis" => {
+            o.get("samples_per_pass");
+            o.get("timeout");
+            path(b, &o)?
+        }
+        "prb" | "prb_basic" | "prbvolpath" => {
             b.w.add(
-                format!(
-                    "integrator '{}' is rendered by Sahara's path tracer (no media)",
-                    o.ty
-                ),
+                format!("integrator '{}' is rendered by Sahara's path tracer", o.ty),
                 &node.loc,
             );
             for k in ["samples_per_pass", "timeout"] {

@@ -24,6 +24,7 @@ mod defaults;
 mod emitters;
 mod expand;
 mod integrator;
+mod media;
 mod metals;
 mod properties;
 mod sensor;

@@ -384,6 +384,7 @@ pub(crate) fn sensor<'a>(
         }
     }
     o.get("srf");
+    b.sensor_medium(&o)?;
     o.warn_unused(&mut b.w);
     Ok((Some(c), settings(&f, s)))
 }

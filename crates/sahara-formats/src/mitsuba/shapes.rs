@@ -159,16 +159,22 @@ impl<'a> Builder<'a> {
             _ => {}
         }
         let (material, emitter) = self.shape_material(&o, true)?;
-        let Some(material) = material else {
-            o.mark_all_used();
-            return Ok(());
+        let media = self.shape_media(&o)?;
+        // A shape bounding media without a surface of its own: no material.
+        let material = match (material, media) {
+            (_, Some(mi)) if mi.index_matched && emitter.is_none() => None,
+            (Some(m), _) => Some(m),
+            (None, _) => {
+                o.mark_all_used();
+                return Ok(());
+            }
         };
         let Some(geom) = self.geometry(&o)? else {
             return Ok(());
         };
-        let material = match emitter {
-            Some(e) => self.area_light(material, e)?,
-            None => material,
+        let material = match (emitter, material) {
+            (Some(e), Some(m)) => Some(self.area_light(m, e)?),
+            (_, m) => m,
         };
         o.warn_unused(&mut self.w);
         let (geometry, placement) = match geom {
@@ -180,9 +186,14 @@ impl<'a> Builder<'a> {
         self.scene.objects.push(SceneObject {
             geometry,
             placement,
-            material: Some(material),
+            material,
             name: o.node.attr("id").map(str::to_owned),
         });
+        if let Some(mut mi) = media {
+            mi.index_matched &= material.is_none();
+            let k = self.scene.objects.len() as u32 - 1;
+            self.scene.medium_interfaces.push((k, mi));
+        }
         Ok(())
     }
 
@@ -220,8 +231,10 @@ impl<'a> Builder<'a> {
                         .error(format!("{} has more than one emitter", o.what())))
                 }
                 "emitter" => emitter = Some(node),
+                // Read by `shape_media` (a shape directly in the scene).
+                "medium" if may_emit => {}
                 "medium" => self.w.add(
-                    "participating media are not supported; ignored",
+                    "media on shapes inside a shapegroup are not supported; ignored",
                     &e.child.node().loc,
                 ),
                 _ => continue,

@@ -879,7 +879,7 @@ fn approximations_are_warned_once_per_kind_with_a_count() {
     let d = describe(
         "<shape type=\"sphere\"><bsdf type=\"diffuse\"><float name=\"roughness\" value=\"0.5\"/></bsdf></shape>\n\
          <shape type=\"sphere\"><bsdf type=\"diffuse\"><float name=\"roughness\" value=\"0.5\"/></bsdf></shape>\n\
-         <integrator type=\"volpath\"/>\n\
+         <integrator type=\"prbvolpath\"/>\n\
          <shape type=\"bsplinecurve\"><string name=\"filename\" value=\"c.txt\"/></shape>",
     );
     assert_eq!(
@@ -887,7 +887,7 @@ fn approximations_are_warned_once_per_kind_with_a_count() {
         vec![
             "t.xml:2:43: bsdf 'diffuse': unknown parameter 'roughness', ignored (2 times; the first here)",
             "t.xml:5:1: shape 'bsplinecurve' is not supported; skipped",
-            "t.xml:4:1: integrator 'volpath' is rendered by Sahara's path tracer (no media)",
+            "t.xml:4:1: integrator 'prbvolpath' is rendered by Sahara's path tracer",
         ]
     );
 }
@@ -1048,5 +1048,219 @@ fn a_mitsuba_cornell_box_renders_the_same_bytes_as_its_toml_twin() {
         "the reference image is black"
     );
     assert!(a == b, "the images differ");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The bytes of a Mitsuba `.vol` file of `channels` channels.
+fn vol_bytes(size: [u32; 3], channels: u32, values: &[f32]) -> Vec<u8> {
+    let mut b = b"VOL\x03".to_vec();
+    for v in [1, size[0], size[1], size[2], channels] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in [0.0f32, 0.0, 0.0, 1.0, 1.0, 1.0].iter().chain(values) {
+        b.extend(v.to_le_bytes());
+    }
+    b
+}
+
+const MEDIA_XML: &str = r#"<scene version="3.0.0">
+  <integrator type="volpath"><integer name="max_depth" value="6"/></integrator>
+  <medium type="homogeneous" id="fog">
+    <rgb name="sigma_t" value="0.25 0.5 1"/><float name="albedo" value="0.5"/>
+    <phase type="hg"><float name="g" value="0.25"/></phase>
+  </medium>
+  <sensor type="perspective">
+    <float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0, 0, 0" target="0, 0, 1" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="24"/></film>
+    <ref id="fog"/>
+  </sensor>
+  <emitter type="point"><point name="position" x="1" y="2" z="0"/><rgb name="intensity" value="5 5 5"/></emitter>
+  <shape type="sphere"><float name="radius" value="20"/><bsdf type="null"/><ref name="interior" id="fog"/></shape>
+  <shape type="sphere"><point name="center" x="0" y="1" z="4"/><float name="radius" value="1.8"/>
+    <medium type="heterogeneous" name="interior">
+      <volume type="gridvolume" name="sigma_t"><string name="filename" value="smoke.vol"/>
+        <transform name="to_world"><scale value="2"/><translate x="-1" y="0" z="3"/></transform></volume>
+      <float name="scale" value="4"/><rgb name="albedo" value="0.75 0.75 0.75"/>
+    </medium>
+    <ref name="exterior" id="fog"/>
+  </shape>
+  <shape type="sphere"><point name="center" x="0" y="-1.5" z="5"/>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0.5 0.5 0.5"/></bsdf></shape>
+  <shape type="sphere"><point name="center" x="1.25" y="-0.5" z="4"/><float name="radius" value="0.5"/>
+    <bsdf type="dielectric"><float name="int_ior" value="1.4"/><float name="ext_ior" value="1"/></bsdf>
+    <medium type="homogeneous" name="interior"><float name="sigma_t" value="2"/><float name="albedo" value="0.5"/></medium>
+    <ref name="exterior" id="fog"/>
+  </shape>
+</scene>
+"#;
+
+const MEDIA_TOML: &str = r#"
+[camera]
+eye = [0, 0, 0]
+target = [0, 0, 1]
+vfov = 40
+medium = "fog"
+
+[[medium]]
+name = "fog"
+type = "homogeneous"
+sigma_a = [0.125, 0.25, 0.5]
+sigma_s = [0.125, 0.25, 0.5]
+g = 0.25
+
+[[medium]]
+name = "smoke"
+type = "grid"
+file = "smoke.vol"
+min = [-1, 0, 3]
+max = [1, 2, 5]
+sigma_a = [1, 1, 1]
+sigma_s = [3, 3, 3]
+
+[[medium]]
+name = "wax"
+type = "homogeneous"
+sigma_a = [1, 1, 1]
+sigma_s = [1, 1, 1]
+
+[[material]]
+name = "grey"
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+
+[[material]]
+name = "boundary"
+type = "dielectric"
+ior = 1.4
+
+[[object]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 20
+medium_inside = "fog"
+
+[[object]]
+type = "sphere"
+center = [0, 1, 4]
+radius = 1.8
+medium_inside = "smoke"
+medium_outside = "fog"
+
+[[object]]
+type = "sphere"
+center = [0, -1.5, 5]
+radius = 1
+material = "grey"
+
+[[object]]
+type = "sphere"
+center = [1.25, -0.5, 4]
+radius = 0.5
+material = "boundary"
+medium_inside = "wax"
+medium_outside = "fog"
+
+[[light]]
+type = "point"
+position = [1, 2, 0]
+intensity = [5, 5, 5]
+
+[integrator]
+name = "path"
+max_depth = 5
+
+[film]
+width = 24
+height = 24
+"#;
+
+#[test]
+fn mitsuba_and_toml_media_make_the_same_scene_and_image() {
+    let dir = folder("media");
+    std::fs::write(dir.join("m.xml"), MEDIA_XML).unwrap();
+    std::fs::write(dir.join("m.toml"), MEDIA_TOML).unwrap();
+    std::fs::write(
+        dir.join("smoke.vol"),
+        vol_bytes([2, 1, 2], 1, &[0.0, 1.0, 2.0, 0.5]),
+    )
+    .unwrap();
+    let m = load_mitsuba(&dir.join("m.xml")).unwrap();
+    let t = load_scene(&dir.join("m.toml")).unwrap();
+    assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+    assert_eq!(m.scene.camera_medium, Some(0));
+    assert_eq!(m.scene.camera_medium, t.scene.camera_medium);
+    assert_eq!(m.scene.media.len(), 3);
+    for (i, (a, b)) in m.scene.media.iter().zip(&t.scene.media).enumerate() {
+        match (a, b) {
+            (sahara_render::Medium::Grid(a), sahara_render::Medium::Grid(b)) => {
+                assert_eq!(a.density, b.density);
+                assert_eq!(
+                    (a.sigma_a, a.sigma_s, a.phase),
+                    (b.sigma_a, b.sigma_s, b.phase)
+                );
+                assert!(a.to_medium.abs_diff_eq(b.to_medium, 1e-6), "{a:?} {b:?}");
+            }
+            (a, b) => assert_eq!(a, b, "medium {i}"),
+        }
+    }
+    assert_eq!(m.scene.medium_interfaces, t.scene.medium_interfaces);
+    assert_eq!(m.scene.medium_interfaces.len(), 3);
+    let (a, b) = (image(&m.scene, 4), image(&t.scene, 4));
+    assert!(b.iter().any(|v| v.max_element() > 0.0), "black");
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (*x - *y).abs().max_element())
+        .fold(0.0, f32::max);
+    assert!(worst < 1e-3, "the images differ by up to {worst}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_media_are_errors_naming_the_line() {
+    let dir = folder("bad-media");
+    std::fs::write(
+        dir.join("rgb.vol"),
+        vol_bytes([1, 1, 1], 3, &[1.0, 1.0, 1.0]),
+    )
+    .unwrap();
+    std::fs::write(dir.join("short.vol"), &vol_bytes([2, 2, 2], 1, &[1.0])[..]).unwrap();
+    let e = |body: &str| match describe_in(body, &dir) {
+        Ok(_) => panic!("expected an error for {body:?}"),
+        Err(e) => e.to_string(),
+    };
+    let shape = |medium: &str| format!("<shape type=\"sphere\">\n{medium}\n</shape>");
+    let m = e(&shape("<medium type=\"homogeneous\" name=\"interior\"><float name=\"albedo\" value=\"1.5\"/></medium>"));
+    assert!(
+        m.contains("t.xml") && m.contains("line 3") && m.contains("'albedo'"),
+        "{m}"
+    );
+    let m = e(&shape("<medium type=\"homogeneous\" name=\"interior\"><float name=\"sigma_t\" value=\"-1\"/></medium>"));
+    assert!(
+        m.contains("line 3") && m.contains("must be finite and not negative"),
+        "{m}"
+    );
+    let m = e(&shape("<medium type=\"homogeneous\" name=\"inside\"/>"));
+    assert!(
+        m.contains("line 3") && m.contains("'interior' or 'exterior'"),
+        "{m}"
+    );
+    let m = e(&shape("<medium type=\"clouds\" name=\"interior\"/>"));
+    assert!(m.contains("medium type 'clouds' is not supported"), "{m}");
+    let m = e(&shape("<ref name=\"interior\" id=\"nothing\"/>"));
+    assert!(m.contains("no object has the id \"nothing\""), "{m}");
+    let grid = |file: &str, name: &str| {
+        shape(&format!("<medium type=\"heterogeneous\" name=\"interior\"><volume type=\"gridvolume\" name=\"{name}\"><string name=\"filename\" value=\"{file}\"/></volume></medium>"))
+    };
+    let m = e(&grid("rgb.vol", "sigma_t"));
+    assert!(m.contains("holds 3 channels"), "{m}");
+    let m = e(&grid("short.vol", "sigma_t"));
+    assert!(m.contains("short.vol"), "{m}");
+    let m = e(&grid("rgb.vol", "albedo"));
+    assert!(
+        m.contains("albedo given by a grid is not supported") || m.contains("holds 3 channels"),
+        "{m}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }

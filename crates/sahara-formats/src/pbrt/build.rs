@@ -24,12 +24,14 @@ use glam::{Affine3A, DMat3, DMat4, DVec3, Mat4, Vec3};
 use sahara_readers::FormatError;
 use sahara_render::SceneMesh;
 use sahara_render::{
-    AlphaMode, Camera, Filter, Integrator, Material, SamplerKind, Shape, Srt, TextureMap, ToneMap,
+    AlphaMode, Camera, Filter, Integrator, Material, MediumInterface, SamplerKind, Shape, Srt,
+    TextureMap, ToneMap,
 };
 
 use super::declarations::{Declarations, Entity, MaterialRef, ShapeDecl, Xform};
 use super::lights::{add_light, area_emission};
 use super::materials::{map_material, Mapped};
+use super::media::{add_media, interface};
 use super::shapes::shape_geometry;
 use super::textures::Textures;
 use crate::common::mesh::smooth_normals;
@@ -43,7 +45,7 @@ use crate::description::{
 const MAX_MIX_DEPTH: usize = 16;
 
 /// Reports the parameters of `e` nothing asked for.
-fn unknown_params(e: &Entity, what: &str, w: &mut Warnings) {
+pub(super) fn unknown_params(e: &Entity, what: &str, w: &mut Warnings) {
     for p in e.params.unused() {
         w.add(
             format!(
@@ -64,6 +66,8 @@ struct Materials<'a> {
     default: Option<u32>,
     /// Materials cut by a shape's `alpha`: (material, alpha) to the cut one.
     cut: HashMap<(u32, String), u32>,
+    /// `subsurface` materials (their boundaries) to the media inside them.
+    subsurface: HashMap<u32, u32>,
 }
 
 impl Materials<'_> {
@@ -176,6 +180,14 @@ impl Materials<'_> {
         w: &mut Warnings,
         depth: usize,
     ) -> Result<Option<u32>, FormatError> {
+        if e.kind == "subsurface" {
+            let (boundary, medium) = super::media::subsurface(e, w)?;
+            unknown_params(e, "material", w);
+            let id = scene.add_material(boundary);
+            scene.media.push(medium);
+            self.subsurface.insert(id, scene.media.len() as u32 - 1);
+            return Ok(Some(id));
+        }
         let mapped = map_material(e, &mut self.textures, w)?;
         unknown_params(e, "material", w);
         match mapped {
@@ -864,31 +876,80 @@ pub(crate) fn build(
         named: HashMap::new(),
         default: None,
         cut: HashMap::new(),
+        subsurface: HashMap::new(),
     };
     for (what, loc) in &desc.ignored {
         w.add(format!("{what} is not supported; ignored"), loc);
     }
+    let media = add_media(&desc.media, &mut scene, w)?;
+    if let Some(d) = &desc.camera_medium {
+        scene.camera_medium = interface(&media, d)?.1;
+    }
     let times = desc.transform_times;
     for s in &desc.shapes {
         let m = s.xform.m[0];
-        let Some(material) = materials.resolve(&mut scene, &s.material, w)? else {
-            w.add(
-                "shapes with an 'interface' material (no surface) are not rendered",
-                &s.entity.loc,
-            );
-            shape_geometry(&s.entity, w)?;
-            continue;
+        // pbrt's media on the shape's sides; equal sides are no boundary.
+        let sides = match &s.media {
+            Some(d) => Some(interface(&media, d)?),
+            None => None,
         };
-        let Some(material) = materials.cut(&mut scene, material, &s.entity, w)? else {
-            shape_geometry(&s.entity, w)?;
-            continue;
+        let transition = sides.filter(|(inside, outside)| inside != outside);
+        let (material, medium_interface) = match materials.resolve(&mut scene, &s.material, w)? {
+            None => match transition {
+                // No surface between two media: an index-matched boundary.
+                Some((inside, outside)) => (
+                    None,
+                    Some(MediumInterface {
+                        inside,
+                        outside,
+                        index_matched: true,
+                    }),
+                ),
+                None => {
+                    w.add(
+                        "shapes with an 'interface' material (no surface) and no media \
+                             to bound are not rendered",
+                        &s.entity.loc,
+                    );
+                    shape_geometry(&s.entity, w)?;
+                    continue;
+                }
+            },
+            Some(material) => {
+                let inner = materials.subsurface.get(&material).copied();
+                let Some(material) = materials.cut(&mut scene, material, &s.entity, w)? else {
+                    shape_geometry(&s.entity, w)?;
+                    continue;
+                };
+                let mi = match inner {
+                    Some(inner) => Some(MediumInterface {
+                        inside: Some(inner),
+                        outside: sides.and_then(|(_, outside)| outside),
+                        index_matched: false,
+                    }),
+                    None => transition.map(|(inside, outside)| MediumInterface {
+                        inside,
+                        outside,
+                        index_matched: false,
+                    }),
+                };
+                (Some(material), mi)
+            }
         };
         let Some((mesh, exact)) = oriented_geometry(s, &m, w)? else {
             continue;
         };
-        let material = match &s.area_light {
-            None => material,
-            Some(a) => {
+        let material = match (&s.area_light, material) {
+            (None, material) => material,
+            (Some(a), None) => {
+                w.add(
+                    "area lights on shapes with an 'interface' material do not emit",
+                    &a.loc,
+                );
+                a.params.mark_all_used();
+                None
+            }
+            (Some(a), Some(material)) => {
                 let em = area_emission(a, w)?;
                 unknown_params(a, "area light", w);
                 let mut radiance = em.radiance;
@@ -903,7 +964,7 @@ pub(crate) fn build(
                     .clone()
                     .with_emission(radiance);
                 mat.two_sided_emission = em.two_sided;
-                scene.add_material(mat)
+                Some(scene.add_material(mat))
             }
         };
         let placement = placement(&s.xform, times, shutter);
@@ -915,9 +976,13 @@ pub(crate) fn build(
         scene.objects.push(Object {
             geometry,
             placement,
-            material: Some(material),
+            material,
             name: None,
         });
+        if let Some(mi) = medium_interface {
+            let k = scene.objects.len() as u32 - 1;
+            scene.medium_interfaces.push((k, mi));
+        }
     }
     let mut objects: HashMap<&str, Option<u32>> = HashMap::new();
     for inst in &desc.instances {
@@ -972,6 +1037,13 @@ fn object_mesh(
         if s.xform.is_animated() {
             w.add(
                 "moving shapes inside an object definition use their start transform",
+                &s.entity.loc,
+            );
+        }
+        if s.media.is_some() {
+            w.add(
+                "media on shapes inside an object definition are not supported; \
+                 the shapes bound no media",
                 &s.entity.loc,
             );
         }

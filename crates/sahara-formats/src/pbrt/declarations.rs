@@ -61,6 +61,31 @@ pub(crate) struct ShapeDecl {
     pub(crate) material: MaterialRef,
     /// The `AreaLightSource` in effect, if any.
     pub(crate) area_light: Option<Entity>,
+    /// The `MediumInterface` in effect, if any.
+    pub(crate) media: Option<MediaDecl>,
+}
+
+/// A `MediumInterface`: the media named inside and outside the surfaces
+/// declared after it (`""`: vacuum).
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct MediaDecl {
+    /// The medium behind the surface (against its normal).
+    pub(crate) inside: String,
+    /// The medium in front of the surface.
+    pub(crate) outside: String,
+    /// Where the directive is.
+    pub(crate) loc: Loc,
+}
+
+/// A `MakeNamedMedium`.
+#[derive(Clone, Debug)]
+pub(crate) struct MediumDecl {
+    /// The name it is given.
+    pub(crate) name: String,
+    /// Its parameters (the type is `"string type"`).
+    pub(crate) entity: Entity,
+    /// Medium to world: the transform in effect where it is declared.
+    pub(crate) xform: Xform,
 }
 
 /// An `ObjectInstance`.
@@ -103,8 +128,7 @@ pub(crate) struct Declarations {
     pub(crate) filter: Option<Entity>,
     /// `Integrator`.
     pub(crate) integrator: Option<Entity>,
-    /// `Accelerator`, `ColorSpace`, `Option`, `MakeNamedMedium`,
-    /// `MediumInterface` and other directives that change nothing Sahara
+    /// `Accelerator`, `ColorSpace`, `Option` and other directives that change nothing Sahara
     /// renders, as (directive, where), for one warning each.
     pub(crate) ignored: Vec<(String, Loc)>,
     /// `Material` directives, in order.
@@ -122,6 +146,12 @@ pub(crate) struct Declarations {
     pub(crate) instances: Vec<InstanceDecl>,
     /// `LightSource`s.
     pub(crate) lights: Vec<LightDecl>,
+    /// `MakeNamedMedium`s, in order (a later one of the same name
+    /// replaces an earlier one).
+    pub(crate) media: Vec<MediumDecl>,
+    /// The `MediumInterface` in effect at `Camera` (its outside medium
+    /// holds the camera).
+    pub(crate) camera_medium: Option<MediaDecl>,
     /// `TransformTimes` (default 0 and 1).
     pub(crate) transform_times: (f64, f64),
 }

@@ -26,6 +26,8 @@ mod envmap;
 mod lexer;
 mod lights;
 mod materials;
+mod measured_media;
+mod media;
 mod params;
 mod parser;
 mod shapes;

@@ -16,7 +16,8 @@ use glam::{DMat4, DVec3};
 use sahara_readers::FormatError;
 
 use super::declarations::{
-    Declarations, Entity, InstanceDecl, LightDecl, MaterialRef, ShapeDecl, TextureDecl, Xform,
+    Declarations, Entity, InstanceDecl, LightDecl, MaterialRef, MediaDecl, MediumDecl, ShapeDecl,
+    TextureDecl, Xform,
 };
 use super::lexer::{Lexer, Token, TokenKind};
 use super::params::{Param, ParamList, Values};
@@ -45,6 +46,8 @@ struct State {
     reverse: bool,
     material: MaterialRef,
     area_light: Option<Entity>,
+    /// The `MediumInterface` in effect, if one was given.
+    media: Option<MediaDecl>,
     /// `Attribute` defaults by target (`shape`, `light`, `material`, `medium`, `texture`).
     attributes: HashMap<String, Vec<Param>>,
 }
@@ -93,6 +96,7 @@ pub(crate) fn parse_bytes(
             reverse: false,
             material: MaterialRef::Default,
             area_light: None,
+            media: None,
             attributes: HashMap::new(),
         },
         stack: Vec::new(),
@@ -509,6 +513,9 @@ impl Parser<'_> {
                 };
                 self.named_coordinates.insert("camera".into(), inv);
                 self.out.camera = Some((e, ctm));
+                // The camera sits in the medium outside the surfaces
+                // declared with it.
+                self.out.camera_medium = self.state.media.clone();
             }
             "Film" | "Sampler" | "PixelFilter" | "Integrator" => {
                 let kind = self.string(&loc, "a type")?;
@@ -521,7 +528,16 @@ impl Parser<'_> {
                 };
                 *slot = Some(e);
             }
-            "Accelerator" | "MakeNamedMedium" => {
+            "MakeNamedMedium" => {
+                let name = self.string(&loc, "a medium name")?;
+                let entity = self.entity(String::new(), loc, "medium")?;
+                self.out.media.push(MediumDecl {
+                    name,
+                    entity,
+                    xform: self.state.ctm,
+                });
+            }
+            "Accelerator" => {
                 self.string(&loc, "a name")?;
                 self.params()?;
                 self.out.ignored.push((directive.to_owned(), loc));
@@ -539,17 +555,20 @@ impl Parser<'_> {
                 self.out.ignored.push(("Option".into(), loc));
             }
             "MediumInterface" => {
-                self.string(&loc, "a medium name")?;
-                if let Some(Token {
-                    kind: TokenKind::Str(_),
-                    ..
-                }) = self.peek()?
-                {
-                    self.next()?;
-                }
-                self.out
-                    .ignored
-                    .push(("MediumInterface (participating media)".into(), loc));
+                let inside = self.string(&loc, "a medium name")?;
+                // One name: the same medium on both sides.
+                let outside = match self.peek()? {
+                    Some(Token {
+                        kind: TokenKind::Str(_),
+                        ..
+                    }) => self.string(&loc, "a medium name")?,
+                    _ => inside.clone(),
+                };
+                self.state.media = Some(MediaDecl {
+                    inside,
+                    outside,
+                    loc,
+                });
             }
             "Material" => {
                 let kind = self.string(&loc, "a material type")?;
@@ -606,6 +625,7 @@ impl Parser<'_> {
                     reverse: self.state.reverse,
                     material: self.state.material.clone(),
                     area_light: self.state.area_light.clone(),
+                    media: self.state.media.clone(),
                 };
                 match &mut self.object {
                     Some((_, shapes, _)) => shapes.push(decl),

@@ -758,3 +758,166 @@ fn bidirectional_integrators_map_onto_bdpt_and_light_tracing() {
     let (_, w) = integrator("Integrator \"bdpt\" \"bool visualizestrategies\" true");
     assert!(w.iter().any(|w| w.contains("visualizestrategies")), "{w:?}");
 }
+
+/// The bytes of a Mitsuba `.vol` file of one channel.
+fn vol_bytes(size: [u32; 3], lo: [f32; 3], hi: [f32; 3], values: &[f32]) -> Vec<u8> {
+    let mut b = b"VOL\x03".to_vec();
+    for v in [1, size[0], size[1], size[2], 1] {
+        b.extend(v.to_le_bytes());
+    }
+    for v in lo.iter().chain(&hi).chain(values) {
+        b.extend(v.to_le_bytes());
+    }
+    b
+}
+
+#[test]
+fn pbrt_and_toml_media_make_the_same_scene_and_image() {
+    let pbrt = "Scale -1 1 1\nLookAt 0 0 0  0 0 1  0 1 0\nMediumInterface \"\" \"fog\"\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n\
+                MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.02 0.03 0.04] \"rgb sigma_s\" [0.1 0.1 0.1] \"float scale\" 2 \"float g\" 0.3\n\
+                AttributeBegin Translate 0 1 4 Scale 2 2 2\n\
+                MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"integer ny\" 1 \"integer nz\" 2 \"float density\" [0 1 2 0.5] \
+                \"point3 p0\" [-0.5 -0.5 -0.5] \"point3 p1\" [0.5 0.5 0.5] \"rgb sigma_s\" [3 3 3] \"rgb sigma_a\" [0.5 0.5 0.5]\nAttributeEnd\n\
+                LightSource \"point\" \"rgb I\" [5 5 5] \"point3 from\" [1 2 0]\n\
+                AttributeBegin MediumInterface \"fog\" \"\" Material \"interface\" Shape \"sphere\" \"float radius\" 20 AttributeEnd\n\
+                AttributeBegin MediumInterface \"smoke\" \"fog\" Material \"interface\" Translate 0 1 4 Shape \"sphere\" \"float radius\" 1.8 AttributeEnd\n\
+                AttributeBegin MediumInterface \"fog\" Material \"diffuse\" Translate 0 -1.5 5 Shape \"sphere\" AttributeEnd\n\
+                AttributeBegin MediumInterface \"\" \"fog\" Material \"subsurface\" \"string name\" \"Skin1\" \"float scale\" 0.5 \"float eta\" 1.4\n\
+                Translate 1.25 -0.5 4 Shape \"sphere\" \"float radius\" 0.5 AttributeEnd\n";
+    let toml = "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, 1]\nvfov = 40\nmedium = \"fog\"\n\
+                [[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nsigma_a = [0.04, 0.06, 0.08]\nsigma_s = [0.2, 0.2, 0.2]\ng = 0.3\n\
+                [[medium]]\nname = \"smoke\"\ntype = \"grid\"\nfile = \"smoke.vol\"\nmin = [-1, 0, 3]\nmax = [1, 2, 5]\nsigma_s = [3, 3, 3]\nsigma_a = [0.5, 0.5, 0.5]\n\
+                [[medium]]\nname = \"skin\"\ntype = \"homogeneous\"\nsigma_a = [0.016, 0.085, 0.24]\nsigma_s = [0.37, 0.44, 0.505]\n\
+                [[material]]\nname = \"grey\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\
+                [[material]]\nname = \"boundary\"\ntype = \"dielectric\"\nior = 1.4\n\
+                [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 20\nmedium_inside = \"fog\"\n\
+                [[object]]\ntype = \"sphere\"\ncenter = [0, 1, 4]\nradius = 1.8\nmedium_inside = \"smoke\"\nmedium_outside = \"fog\"\n\
+                [[object]]\ntype = \"sphere\"\ncenter = [0, -1.5, 5]\nradius = 1\nmaterial = \"grey\"\n\
+                [[object]]\ntype = \"sphere\"\ncenter = [1.25, -0.5, 4]\nradius = 0.5\nmaterial = \"boundary\"\nmedium_inside = \"skin\"\nmedium_outside = \"fog\"\n\
+                [[light]]\ntype = \"point\"\nposition = [1, 2, 0]\nintensity = [5, 5, 5]\n\
+                [film]\nwidth = 24\nheight = 24\n";
+    let dir = folder("media");
+    std::fs::write(dir.join("s.pbrt"), pbrt).unwrap();
+    std::fs::write(dir.join("s.toml"), toml).unwrap();
+    std::fs::write(
+        dir.join("smoke.vol"),
+        vol_bytes([2, 1, 2], [0.0; 3], [1.0; 3], &[0.0, 1.0, 2.0, 0.5]),
+    )
+    .unwrap();
+    let p = load_pbrt(&dir.join("s.pbrt")).unwrap();
+    let t = load_scene(&dir.join("s.toml")).unwrap();
+    assert!(p.warnings.is_empty(), "{:#?}", p.warnings);
+    assert_eq!(p.scene.camera_medium, Some(0));
+    assert_eq!(p.scene.camera_medium, t.scene.camera_medium);
+    assert_eq!(p.scene.media.len(), 3);
+    for (i, (a, b)) in p.scene.media.iter().zip(&t.scene.media).enumerate() {
+        match (a, b) {
+            (sahara_render::Medium::Grid(a), sahara_render::Medium::Grid(b)) => {
+                assert_eq!(a.density, b.density);
+                assert_eq!(
+                    (a.sigma_a, a.sigma_s, a.phase),
+                    (b.sigma_a, b.sigma_s, b.phase)
+                );
+                assert!(a.to_medium.abs_diff_eq(b.to_medium, 1e-6), "{a:?} {b:?}");
+            }
+            (a, b) => assert_eq!(a, b, "medium {i}"),
+        }
+    }
+    // The sphere with the same medium on both sides bounds nothing.
+    assert_eq!(p.scene.medium_interfaces, t.scene.medium_interfaces);
+    assert_eq!(p.scene.medium_interfaces.len(), 3);
+    let (a, b) = (image(&p.scene, 4), image(&t.scene, 4));
+    assert!(b.iter().any(|v| v.max_element() > 0.0), "black");
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (*x - *y).abs().max_element())
+        .fold(0.0, f32::max);
+    assert!(worst < 1e-3, "the images differ by up to {worst}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_media_are_errors_naming_the_line() {
+    let medium = |params: &str| {
+        format!("WorldBegin\nMakeNamedMedium \"m\" {params}\nMediumInterface \"m\" \"\"\nMaterial \"interface\"\nShape \"sphere\"")
+    };
+    let e = err("WorldBegin\nMediumInterface \"nothing\" \"\"\nShape \"sphere\"");
+    assert!(
+        e.contains("t.pbrt: line 2") && e.contains("no MakeNamedMedium defines \"nothing\""),
+        "{e}"
+    );
+    let e = err(&medium(
+        "\"string type\" \"homogeneous\" \"rgb sigma_a\" [-1 0 0]",
+    ));
+    assert!(e.contains("line 2") && e.contains("absorption"), "{e}");
+    let e = err(&medium("\"string type\" \"uniformgrid\" \"integer nx\" 2 \"integer ny\" 2 \"float density\" [1 1 1]"));
+    assert!(
+        e.contains("line 2") && e.contains("needs 4 density values but 3"),
+        "{e}"
+    );
+    let e = err(&medium(
+        "\"string type\" \"homogeneous\" \"string preset\" \"Jam\"",
+    ));
+    assert!(e.contains("no measured medium is named \"Jam\""), "{e}");
+    for kind in ["rgbgrid", "cloud", "nanovdb"] {
+        let e = err(&medium(&format!("\"string type\" \"{kind}\"")));
+        assert!(
+            e.contains("line 2") && e.contains(&format!("'{kind}'")) && e.contains("not supported"),
+            "{e}"
+        );
+    }
+    let e = err(&medium("\"float scale\" 2"));
+    assert!(e.contains("has no \"string type\""), "{e}");
+    let e = err(
+        "WorldBegin\nMaterial \"subsurface\" \"rgb reflectance\" [0.5 0.5 0.5]\nShape \"sphere\"",
+    );
+    assert!(
+        e.contains("line 2") && e.contains("\"reflectance\" form"),
+        "{e}"
+    );
+    let e = err("WorldBegin\nMaterial \"subsurface\" \"float g\" 1\nShape \"sphere\"");
+    assert!(e.contains("line 2") && e.contains("asymmetry"), "{e}");
+}
+
+#[test]
+fn media_follow_the_graphics_state_and_presets_and_emission_warn() {
+    let text = "MediumInterface \"a\"\nCamera \"perspective\"\nWorldBegin\n\
+                MakeNamedMedium \"a\" \"string type\" \"homogeneous\" \"string preset\" \"Ketchup\" \"float scale\" 10 \"rgb Le\" [1 1 1]\n\
+                MakeNamedMedium \"b\" \"string type\" \"homogeneous\"\n\
+                AttributeBegin MediumInterface \"b\" \"a\" Shape \"sphere\" AttributeEnd\n\
+                Shape \"sphere\"\n\
+                AttributeBegin Material \"interface\" Shape \"sphere\" AttributeEnd\n";
+    let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent")).unwrap();
+    // The camera's one-name interface: inside and outside "a".
+    assert_eq!(s.scene.camera_medium, Some(0));
+    let sahara_render::Medium::Homogeneous(a) = &s.scene.media[0] else {
+        panic!()
+    };
+    assert!((a.sigma_s - Vec3::new(1.8, 0.7, 0.3)).abs().max_element() < 1e-6);
+    assert!((a.sigma_a - Vec3::new(0.61, 9.7, 14.5)).abs().max_element() < 1e-5);
+    assert_eq!(
+        s.scene.media[1],
+        sahara_render::Medium::homogeneous(Vec3::ONE, Vec3::ONE, 0.0)
+    );
+    // Only the first sphere bounds media; AttributeEnd restored none; the
+    // interface sphere without media is not rendered.
+    assert_eq!(s.scene.medium_interfaces.len(), 1);
+    assert_eq!(s.scene.medium_interfaces[0].1.inside, Some(1));
+    assert_eq!(s.scene.medium_interfaces[0].1.outside, Some(0));
+    assert!(!s.scene.medium_interfaces[0].1.index_matched);
+    assert!(
+        s.warnings
+            .iter()
+            .any(|l| l.contains("medium 'homogeneous': emission ('Le') is not rendered")),
+        "{:#?}",
+        s.warnings
+    );
+    assert!(
+        s.warnings
+            .iter()
+            .any(|l| l.contains("'interface' material (no surface) and no media")),
+        "{:#?}",
+        s.warnings
+    );
+}

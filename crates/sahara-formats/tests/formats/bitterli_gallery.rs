@@ -105,11 +105,15 @@ const CASES: [Case; 8] = [
         block_p50: (0.0136, 0.0038),
         block_p90: (0.0649, 0.0096),
     },
-    // volumetric-caustic: the box is full of a scattering medium, which
-    // Sahara does not render: the image is the box without it (as Mitsuba 3
-    // renders that, block for block), and its mean is carried by rare paths
-    // from the tiny light through the glass sphere, hence the wide bounds on
-    // the ratio; the blocks hold the scene.
+    // volumetric-caustic: the box is filled with the file's medium (sigma_s
+    // 1, albedo 1) around a glass sphere and a 5 x 4 mm light. Sahara's image
+    // is brighter than Tungsten's and Mitsuba 3's volpath renders the same
+    // scene darker than Tungsten's (0.92, 0.95, 1.00, block median 0.22):
+    // with single scattering alone (no sphere) Sahara's image centre is the
+    // numerically integrated answer and Mitsuba's 11 % below it, and the
+    // gap widens with more bounces, so the bounds hold Sahara's image as
+    // it is. The mean rests on rare paths from the tiny
+    // light through the sphere, hence the wide bounds on the ratio.
     Case {
         name: "volumetric-caustic",
         scene: "volumetric-caustic",
@@ -119,10 +123,10 @@ const CASES: [Case; 8] = [
         height: 128,
         spp: 64,
         mask: None,
-        ratio: [1.2655, 1.1738, 1.0133],
-        ratio_tol: [2.1511, 2.2253, 2.3415],
-        block_p50: (0.4970, 0.0087),
-        block_p90: (1.5511, 0.0931),
+        ratio: [1.3841, 1.3686, 1.3243],
+        ratio_tol: [1.6249, 1.6820, 1.7724],
+        block_p50: (0.2992, 0.0333),
+        block_p90: (0.5619, 0.0810),
     },
     // veach-mis: the pbrt-v4 file is not the scene Tungsten rendered: its
     // plates lack Tungsten's albedo of 0.3, are GGX where Tungsten's are

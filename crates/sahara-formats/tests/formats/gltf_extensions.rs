@@ -436,3 +436,70 @@ fn a_texture_stored_only_as_ktx2_is_read_through_khr_texture_basisu() {
         );
     }
 }
+
+#[test]
+fn khr_materials_volume_attenuation_fills_solid_glass_with_an_absorbing_medium() {
+    // A closed tetrahedron (mesh 0) in solid glass attenuating to
+    // (0.5, 0.25, 1) over 2 units, and the same tetrahedron (mesh 1) in
+    // thin-walled glass (no thickness): only the first bounds a medium.
+    let mut bin = f32s(&[0., 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1.]);
+    bin.extend(
+        [0u16, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]
+            .iter()
+            .flat_map(|x| x.to_le_bytes()),
+    );
+    let glass = |volume: &str| {
+        format!(
+            r#"{{"pbrMetallicRoughness": {{"metallicFactor": 0, "roughnessFactor": 0}},
+               "extensions": {{"KHR_materials_transmission": {{"transmissionFactor": 1}}{volume}}}}}"#
+        )
+    };
+    let json = format!(
+        r#"{{"asset": {{"version": "2.0"}},
+  "extensionsUsed": ["KHR_materials_transmission", "KHR_materials_volume"],
+  "buffers": [{{"byteLength": {}, "uri": "data:application/octet-stream;base64,{}"}}],
+  "bufferViews": [{{"buffer": 0, "byteLength": 48}}, {{"buffer": 0, "byteOffset": 48, "byteLength": 24}}],
+  "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 1]}},
+                {{"bufferView": 1, "componentType": 5123, "count": 12, "type": "SCALAR"}}],
+  "materials": [{}, {}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1, "material": 0}}]}},
+             {{"primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1, "material": 1}}]}}],
+  "nodes": [{{"mesh": 0}}, {{"mesh": 1, "translation": [3, 0, 0]}}], "scenes": [{{"nodes": [0, 1]}}]}}"#,
+        bin.len(),
+        base64(&bin),
+        glass(
+            r#", "KHR_materials_volume": {"thicknessFactor": 0.5, "attenuationColor": [0.5, 0.25, 1], "attenuationDistance": 2}"#
+        ),
+        glass(
+            r#", "KHR_materials_volume": {"attenuationColor": [0.5, 0.25, 1], "attenuationDistance": 2}"#
+        ),
+    );
+    let dir = TempDir::new("gltf-volume");
+    let path = dir.write("volume.gltf", json);
+    let s = load_mesh_scene(&path).unwrap();
+    assert!(
+        s.warnings
+            .iter()
+            .all(|w| !w.contains("KHR_materials_volume")),
+        "{:?}",
+        s.warnings
+    );
+    assert_eq!(s.scene.media.len(), 1);
+    let sahara_render::Medium::Homogeneous(h) = &s.scene.media[0] else {
+        panic!("{:?}", s.scene.media)
+    };
+    // Crossing the attenuation distance keeps the attenuation colour.
+    let kept = (-h.sigma_a * 2.0).exp();
+    assert!(
+        (kept - Vec3::new(0.5, 0.25, 1.0)).abs().max_element() < 1e-6,
+        "{kept}"
+    );
+    assert_eq!(h.sigma_s, Vec3::ZERO);
+    assert_eq!(s.scene.medium_interfaces.len(), 1);
+    let (instance, mi) = s.scene.medium_interfaces[0];
+    assert_eq!(s.scene.instances[instance as usize].mesh, 0);
+    assert_eq!(
+        (mi.inside, mi.outside, mi.index_matched),
+        (Some(0), None, false)
+    );
+}

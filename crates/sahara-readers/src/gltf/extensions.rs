@@ -12,8 +12,9 @@ use serde_json::Value;
 
 use crate::error::FormatError;
 
-/// Extensions Sahara reads (in part, for `KHR_materials_volume`: its
-/// thickness decides between a thin wall and a solid).
+/// Extensions Sahara reads (`KHR_materials_volume` in part: its
+/// thickness decides between a thin wall and a solid, and its attenuation
+/// fills a solid with an absorbing medium).
 pub const SUPPORTED: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_materials_clearcoat",

@@ -1,0 +1,325 @@
+//! pbrt's participating media: `MakeNamedMedium` (homogeneous media and
+//! density grids), the media a `MediumInterface` puts on either side of
+//! the shapes after it and around the camera, and the `subsurface`
+//! material (a dielectric boundary around a homogeneous medium).
+//!
+//! Coefficients are per unit length of the scene, as in pbrt (the
+//! measured presets per millimetre, so a scene in metres scales them
+//! with `"float scale"`).
+
+use std::collections::HashMap;
+
+use glam::{Affine3A, DMat4, DVec3, Vec3};
+use sahara_readers::FormatError;
+use sahara_render::{DensityGrid, GridMedium, HenyeyGreenstein, Material, Medium};
+
+use super::declarations::{Entity, MediaDecl, MediumDecl};
+use super::measured_media::{measured, names};
+use super::params::SpectrumParam;
+use super::textures::rgb_of;
+use crate::common::spectrum::Use;
+use crate::common::warnings::Warnings;
+use crate::description::SceneDescription;
+
+/// Default `sigma_a` and `sigma_s` of the `subsurface` material (per mm):
+/// pbrt's, whole milk's coefficients.
+const SUBSURFACE_SIGMA_A: [f32; 3] = [0.0011, 0.0024, 0.014];
+const SUBSURFACE_SIGMA_S: [f32; 3] = [2.55, 3.21, 3.77];
+
+/// The file's named media, added to the scene: each name to its index
+/// in [`SceneDescription::media`] (a later definition of a name replaces
+/// an earlier one, with a warning).
+pub(crate) fn add_media(
+    decls: &[MediumDecl],
+    scene: &mut SceneDescription,
+    w: &mut Warnings,
+) -> Result<HashMap<String, u32>, FormatError> {
+    let mut index = HashMap::new();
+    for d in decls {
+        let m = named_medium(d, w)?;
+        scene.media.push(m);
+        let i = scene.media.len() as u32 - 1;
+        if index.insert(d.name.clone(), i).is_some() {
+            w.add(
+                format!(
+                    "medium \"{}\" defined again; the last definition is used",
+                    d.name
+                ),
+                &d.entity.loc,
+            );
+        }
+    }
+    Ok(index)
+}
+
+/// The media a `MediumInterface` names, inside and outside (`None`:
+/// vacuum); an error naming the directive for a name no
+/// `MakeNamedMedium` defines.
+pub(crate) fn interface(
+    media: &HashMap<String, u32>,
+    d: &MediaDecl,
+) -> Result<(Option<u32>, Option<u32>), FormatError> {
+    let look = |name: &str| -> Result<Option<u32>, FormatError> {
+        if name.is_empty() {
+            return Ok(None);
+        }
+        media.get(name).copied().map(Some).ok_or_else(|| {
+            d.loc.error(format!(
+                "MediumInterface: no MakeNamedMedium defines \"{name}\""
+            ))
+        })
+    };
+    Ok((look(&d.inside)?, look(&d.outside)?))
+}
+
+/// One `MakeNamedMedium` as a medium.
+fn named_medium(d: &MediumDecl, w: &mut Warnings) -> Result<Medium, FormatError> {
+    let e = &d.entity;
+    let what = format!("MakeNamedMedium \"{}\"", d.name);
+    let Some(kind) = e.params.string("type")? else {
+        return Err(e.loc.error(format!("{what} has no \"string type\"")));
+    };
+    let medium = match kind {
+        "homogeneous" => {
+            let c = coefficients(e, &what, w)?;
+            emission(e, kind, w)?;
+            Medium::homogeneous(c.sigma_a, c.sigma_s, c.g)
+        }
+        "uniformgrid" => {
+            let c = coefficients(e, &what, w)?;
+            emission(e, kind, w)?;
+            for k in [
+                "Lescale",
+                "temperature",
+                "temperaturescale",
+                "temperaturecutoff",
+            ] {
+                if e.params.get(k).is_some() {
+                    w.add(
+                        format!("medium '{kind}': emission ('{k}') is not rendered"),
+                        &e.loc,
+                    );
+                }
+            }
+            let grid = density_grid(e, &what)?;
+            let to_world = grid_to_world(e, &d.xform.m[0])?;
+            Medium::Grid(Box::new(GridMedium::new(
+                grid,
+                c.sigma_a,
+                c.sigma_s,
+                HenyeyGreenstein::new(c.g),
+                to_world,
+            )))
+        }
+        "rgbgrid" => {
+            return Err(e.loc.error(format!(
+                "{what}: type 'rgbgrid' (coefficients per voxel) is not supported; \
+                 use 'uniformgrid' (a density times one sigma_a and sigma_s)"
+            )))
+        }
+        "cloud" => {
+            return Err(e.loc.error(format!(
+                "{what}: type 'cloud' (pbrt's procedural noise cloud) is not supported; \
+                 bake it into a 'uniformgrid'"
+            )))
+        }
+        "nanovdb" => {
+            return Err(e.loc.error(format!(
+                "{what}: type 'nanovdb' is not supported (no NanoVDB reader); \
+                 convert the grid to a 'uniformgrid' or a Mitsuba .vol file"
+            )))
+        }
+        other => {
+            return Err(e
+                .loc
+                .error(format!("{what}: unknown medium type '{other}'")))
+        }
+    };
+    if let Some(problem) = medium.problem() {
+        return Err(e.loc.error(format!("{what}: {problem}")));
+    }
+    super::build::unknown_params(e, "medium", w);
+    Ok(medium)
+}
+
+/// A medium's coefficients (scale applied) and phase asymmetry.
+struct Coefficients {
+    sigma_a: Vec3,
+    sigma_s: Vec3,
+    g: f32,
+}
+
+/// `sigma_a`, `sigma_s` (default 1 each) or a `preset`, times `scale`,
+/// and `g`.
+fn coefficients(e: &Entity, what: &str, w: &mut Warnings) -> Result<Coefficients, FormatError> {
+    let (sigma_a, sigma_s) = match e.params.string("preset")? {
+        Some(name) => {
+            let (s, a) = preset(e, name, what)?;
+            e.params.get("sigma_a");
+            e.params.get("sigma_s");
+            (a, s)
+        }
+        None => (
+            spectrum(e, "sigma_a", Vec3::ONE, w)?,
+            spectrum(e, "sigma_s", Vec3::ONE, w)?,
+        ),
+    };
+    let scale = e.params.float("scale", 1.0)? as f32;
+    if !(scale.is_finite() && scale >= 0.0) {
+        return Err(e.loc.error(format!(
+            "{what}: scale {scale} must be finite and not negative"
+        )));
+    }
+    let g = e.params.float("g", 0.0)? as f32;
+    Ok(Coefficients {
+        sigma_a: sigma_a * scale,
+        sigma_s: sigma_s * scale,
+        g,
+    })
+}
+
+/// A measured medium's (scattering, absorption), or an error naming it.
+fn preset(e: &Entity, name: &str, what: &str) -> Result<(Vec3, Vec3), FormatError> {
+    match measured(name) {
+        Some((s, a)) => Ok((Vec3::from_array(s), Vec3::from_array(a))),
+        None => Err(e.loc.error(format!(
+            "{what}: no measured medium is named \"{name}\" (known: {})",
+            names().collect::<Vec<_>>().join(", ")
+        ))),
+    }
+}
+
+/// A spectrum parameter as RGB (an unbounded quantity), or `default`.
+fn spectrum(e: &Entity, name: &str, default: Vec3, w: &mut Warnings) -> Result<Vec3, FormatError> {
+    match e.params.spectrum(name, false)? {
+        Some(p) => rgb_of(&p, Use::Unbounded, &e.folders, w),
+        None => Ok(default),
+    }
+}
+
+/// Warns once if the medium emits (`Le` other than zero): Sahara's media
+/// do not.
+fn emission(e: &Entity, kind: &str, w: &mut Warnings) -> Result<(), FormatError> {
+    let le = match e.params.spectrum("Le", false)? {
+        Some(SpectrumParam::Rgb(c)) => c.iter().any(|&v| v != 0.0),
+        Some(_) => true,
+        None => false,
+    };
+    let scale = e.params.float("Lescale", 1.0)?;
+    if le && scale != 0.0 {
+        w.add(
+            format!("medium '{kind}': emission ('Le') is not rendered"),
+            &e.loc,
+        );
+    }
+    Ok(())
+}
+
+/// A `uniformgrid`'s density: `nx` x `ny` x `nz` values, x fastest; the
+/// sizes checked against the values given.
+fn density_grid(e: &Entity, what: &str) -> Result<DensityGrid, FormatError> {
+    let size = ["nx", "ny", "nz"].map(|k| e.params.int(k, 1));
+    let mut n = [0u32; 3];
+    for (i, s) in size.into_iter().enumerate() {
+        let s = s?;
+        n[i] = u32::try_from(s).ok().filter(|&v| v > 0).ok_or_else(|| {
+            e.loc.error(format!(
+                "{what}: grid size {} = {s} must be a positive integer",
+                ["nx", "ny", "nz"][i]
+            ))
+        })?;
+    }
+    let Some(values) = e.params.floats("density")? else {
+        return Err(e
+            .loc
+            .error(format!("{what}: a 'uniformgrid' needs \"float density\"")));
+    };
+    let want = n.iter().map(|&v| u64::from(v)).product::<u64>();
+    if want != values.len() as u64 {
+        return Err(e.loc.error(format!(
+            "{what}: grid size {}x{}x{} needs {want} density values but {} are given",
+            n[0],
+            n[1],
+            n[2],
+            values.len()
+        )));
+    }
+    DensityGrid::new(n, values.iter().map(|&v| v as f32).collect())
+        .map_err(|m| e.loc.error(format!("{what}: {m}")))
+}
+
+/// The grid's box `p0` to `p1` (default the unit cube) in the medium's
+/// space, placed by `ctm`: the unit cube to world.
+fn grid_to_world(e: &Entity, ctm: &DMat4) -> Result<Affine3A, FormatError> {
+    let p0 = DVec3::from_array(e.params.triple("p0", [0.0; 3])?);
+    let p1 = DVec3::from_array(e.params.triple("p1", [1.0; 3])?);
+    if (p1 - p0).min_element() <= 0.0 {
+        return Err(e.loc.error(format!(
+            "medium grid bounds p0 {p0} to p1 {p1}: p1 must be above p0 on every axis"
+        )));
+    }
+    let m = *ctm * DMat4::from_translation(p0) * DMat4::from_scale(p1 - p0);
+    Ok(Affine3A::from_mat4(m.as_mat4()))
+}
+
+/// The `subsurface` material: its boundary (a dielectric of `eta`,
+/// default 1.33, smooth or rough) and the homogeneous medium inside,
+/// from a measured medium's `name`, or `sigma_a` and `sigma_s` (default
+/// whole milk's, per mm), times `scale`, with asymmetry `g`. The
+/// `reflectance` form (coefficients found from a colour and a mean free
+/// path) is refused.
+pub(crate) fn subsurface(e: &Entity, w: &mut Warnings) -> Result<(Material, Medium), FormatError> {
+    let what = "material 'subsurface'";
+    if e.params.has("reflectance") {
+        return Err(e.loc.error(format!(
+            "{what}: the \"reflectance\" form (coefficients from a colour and \"mfp\") is not \
+             supported; give \"string name\" or \"sigma_a\" and \"sigma_s\""
+        )));
+    }
+    let (sigma_s, sigma_a) = match e.params.string("name")? {
+        Some(name) => preset(e, name, what)?,
+        None => (
+            spectrum(e, "sigma_s", Vec3::from_array(SUBSURFACE_SIGMA_S), w)?,
+            spectrum(e, "sigma_a", Vec3::from_array(SUBSURFACE_SIGMA_A), w)?,
+        ),
+    };
+    let scale = e.params.float("scale", 1.0)? as f32;
+    let g = e.params.float("g", 0.0)? as f32;
+    let medium = Medium::homogeneous(sigma_a * scale, sigma_s * scale, g);
+    if let Some(problem) = medium.problem() {
+        return Err(e.loc.error(format!("{what}: {problem}")));
+    }
+    let eta = e.params.float("eta", 1.33)? as f32;
+    if !(eta.is_finite() && eta > 0.0) {
+        return Err(e.loc.error(format!("{what}: eta {eta} must be positive")));
+    }
+    let remap = e.params.bool("remaproughness", true)?;
+    let r = match e.params.float_opt("roughness")? {
+        Some(r) => r,
+        None => {
+            let u = e.params.float("uroughness", 0.0)?;
+            let v = e.params.float("vroughness", u)?;
+            if u != v {
+                w.add(
+                    format!("{what}: anisotropic roughness is rendered isotropic (the mean)"),
+                    &e.loc,
+                );
+            }
+            0.5 * (u + v)
+        }
+    };
+    // pbrt-v4 remaps roughness to alpha = sqrt(r); Sahara's roughness is sqrt(alpha).
+    let alpha = if remap { r.max(0.0).sqrt() } else { r };
+    let roughness = alpha.clamp(0.0, 1.0).sqrt() as f32;
+    let boundary = if roughness <= 1e-3 {
+        Material::glass(eta)
+    } else {
+        Material::rough_glass(eta, roughness)
+    };
+    for k in ["mfp", "displacement", "normalmap"] {
+        if e.params.get(k).is_some() {
+            w.add(format!("{what}: '{k}' is ignored"), &e.loc);
+        }
+    }
+    Ok((boundary, medium))
+}
