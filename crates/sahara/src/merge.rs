@@ -36,39 +36,8 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         let info = read_part_info(path).map_err(|e| anyhow!("{e}"))?;
         parts.push((path.clone(), info));
     }
-    let (first_path, first) = &parts[0];
-    for (path, info) in &parts[1..] {
-        let same = info.digest == first.digest
-            && (info.width, info.height, info.spp, info.seed)
-                == (first.width, first.height, first.spp, first.seed)
-            && info.integrator == first.integrator;
-        if !same {
-            bail!(
-                "{}: a part of another frame than {} (digest {} vs {}): another scene or other settings",
-                path.display(),
-                first_path.display(),
-                short(&info.digest),
-                short(&first.digest)
-            );
-        }
-        let same_passes = (&info.passes, &info.aovs, info.denoise, info.sample_counts)
-            == (
-                &first.passes,
-                &first.aovs,
-                first.denoise,
-                first.sample_counts,
-            );
-        if !same_passes {
-            bail!(
-                "{}: rendered with other render passes than {} ({} vs {}): render every part \
-                 with the same --aov and --denoise",
-                path.display(),
-                first_path.display(),
-                passes_said(info),
-                passes_said(first)
-            );
-        }
-    }
+    check_one_frame(&parts)?;
+    let first = &parts[0].1;
     let denoise = args.denoise || first.denoise;
     let guides = [Aov::Albedo, Aov::Normal];
     if denoise && !guides.iter().all(|a| first.passes.contains(a)) {
@@ -103,12 +72,125 @@ pub fn run(args: &MergeArgs) -> Result<()> {
             info.window
         );
     }
+    let merged = add_up(&parts)?;
+    let mut result = merged.result(first, spp);
+    let noisy = match &denoiser {
+        Some(d) => crate::denoise::apply(d, &mut result, first.noisy_guides)?,
+        None => None,
+    };
+    let settings = RenderSettings {
+        width: first.width,
+        height: first.height,
+        seed: first.seed,
+        integrator: Integrator::from(first.integrator),
+        ..Default::default()
+    };
+    let out = Output {
+        path: args.output.clone(),
+        settings: &settings,
+        exposure: first.exposure,
+        tonemap: first.tonemap,
+        aovs: &first.aovs,
+        noisy: noisy.as_deref(),
+    };
+    out.write(&result, !partial.is_empty(), true)?;
+    if !first.names.is_empty() {
+        crate::id_names::write_beside(&args.output, &first.names)?;
+    }
+    eprintln!(
+        "wrote {}{}: {} parts, {}x{}, {} spp",
+        if partial.is_empty() { "" } else { "PARTIAL " },
+        args.output.display(),
+        parts.len(),
+        first.width,
+        first.height,
+        spp
+    );
+    Ok(())
+}
 
+/// Refuses parts of other frames than the first part's (another scene,
+/// other settings) and parts with other render passes.
+fn check_one_frame(parts: &[(PathBuf, PartInfo)]) -> Result<()> {
+    let (first_path, first) = &parts[0];
+    for (path, info) in &parts[1..] {
+        let same = info.digest == first.digest
+            && (info.width, info.height, info.spp, info.seed)
+                == (first.width, first.height, first.spp, first.seed)
+            && info.integrator == first.integrator;
+        if !same {
+            bail!(
+                "{}: a part of another frame than {} (digest {} vs {}): another scene or other settings",
+                path.display(),
+                first_path.display(),
+                short(&info.digest),
+                short(&first.digest)
+            );
+        }
+        let same_passes = (&info.passes, &info.aovs, info.denoise, info.sample_counts)
+            == (
+                &first.passes,
+                &first.aovs,
+                first.denoise,
+                first.sample_counts,
+            );
+        if !same_passes {
+            bail!(
+                "{}: rendered with other render passes than {} ({} vs {}): render every part \
+                 with the same --aov and --denoise",
+                path.display(),
+                first_path.display(),
+                passes_said(info),
+                passes_said(first)
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The frame's pixels as the parts add up to them.
+struct Merged {
+    film: Film,
+    passes: FramePasses,
+    /// The samples each pixel took, when the parts count them.
+    samples: Option<Vec<u32>>,
+}
+
+impl Merged {
+    /// The frame as a render's result of `spp` samples.
+    fn result(self, first: &PartInfo, spp: u32) -> RenderResult {
+        let mut film = self.film;
+        let integrator = Integrator::from(first.integrator);
+        let cost = matches!(integrator, Integrator::Cost).then(|| cost_maps(&mut film, None));
+        RenderResult {
+            film,
+            sums: SumBuffer::new(0, 0, 0, 0),
+            stats: RenderStats {
+                passes: 1,
+                spp,
+                ..Default::default()
+            },
+            cost,
+            aux: (!first.passes.is_empty()).then(|| Aux {
+                images: self.passes.images,
+                sums: AuxSums::default(),
+            }),
+            samples: self.samples,
+        }
+    }
+}
+
+/// Adds the parts up group by group (parts whose windows overlap), one
+/// group's sums in memory at a time.
+fn add_up(parts: &[(PathBuf, PartInfo)]) -> Result<Merged> {
+    let first = &parts[0].1;
     let (w, h) = (first.width, first.height);
-    let mut film = Film::new(w, h);
-    let mut passes = FramePasses::new(&first.passes, w, h);
-    let mut samples = first.sample_counts.then(|| vec![0u32; (w * h) as usize]);
-    for group in groups(&parts) {
+    let mut merged = Merged {
+        film: Film::new(w, h),
+        passes: FramePasses::new(&first.passes, w, h),
+        samples: first.sample_counts.then(|| vec![0u32; (w * h) as usize]),
+    };
+    for group in groups(parts) {
         let bounds = group
             .iter()
             .map(|&k| parts[k].1.window)
@@ -128,100 +210,63 @@ pub fn run(args: &MergeArgs) -> Result<()> {
             bounds.height(),
         );
         for &k in &group {
-            let (path, info) = &parts[k];
-            if info.samples_done.is_empty() {
-                continue;
-            }
-            let (again, part) = read_part(path).map_err(|e| anyhow!("{e}"))?;
-            if again != *info {
-                bail!("{}: the file changed while being merged", path.display());
-            }
-            sums.add(&part.beauty);
-            aux.add(&Aux {
-                images: AuxImages::default(),
-                sums: part.passes,
-            });
-            let win = info.window;
-            if let (Some(frame), Some(n)) = (&mut samples, &part.samples) {
-                for (k, (x, y)) in rows(&win).enumerate() {
-                    frame[(y * w + x) as usize] += n[k];
-                }
-            }
-            // Ids depend on the pixel alone: every part of a pixel has them.
-            let f = &mut passes.images;
-            for (frame, ids) in [
-                (&mut f.object, &part.object),
-                (&mut f.material, &part.material),
-            ] {
-                if let Some(ids) = ids {
-                    for (k, (x, y)) in rows(&win).enumerate() {
-                        frame[(y * w + x) as usize] = ids[k];
-                    }
-                }
-            }
+            add_part(&parts[k], w, &mut sums, &mut aux, &mut merged)?;
         }
         let aux = Aux::from_sums(aux.sums);
         for &k in &group {
             let win = parts[k].1.window;
             for (x, y) in rows(&win) {
                 let value = sums.get(x, y).expect("inside the group").value();
-                film.pixels[(y * w + x) as usize] = value;
+                merged.film.pixels[(y * w + x) as usize] = value;
                 let at = (y - bounds.y0) * bounds.width() + (x - bounds.x0);
-                passes.set((y * w + x) as usize, &aux.images, at as usize);
+                merged
+                    .passes
+                    .set((y * w + x) as usize, &aux.images, at as usize);
             }
         }
     }
+    Ok(merged)
+}
 
-    let integrator = Integrator::from(first.integrator);
-    let cost = matches!(integrator, Integrator::Cost).then(|| cost_maps(&mut film, None));
-    let tonemap = first.tonemap;
-    let settings = RenderSettings {
-        width: w,
-        height: h,
-        seed: first.seed,
-        integrator,
-        ..Default::default()
-    };
-    let mut result = RenderResult {
-        film,
-        sums: SumBuffer::new(0, 0, 0, 0),
-        stats: RenderStats {
-            passes: 1,
-            spp,
-            ..Default::default()
-        },
-        cost,
-        aux: (!first.passes.is_empty()).then(|| Aux {
-            images: passes.images,
-            sums: AuxSums::default(),
-        }),
-        samples,
-    };
-    let noisy = match &denoiser {
-        Some(d) => crate::denoise::apply(d, &mut result, first.noisy_guides)?,
-        None => None,
-    };
-    let out = Output {
-        path: args.output.clone(),
-        settings: &settings,
-        exposure: first.exposure,
-        tonemap,
-        aovs: &first.aovs,
-        noisy: noisy.as_deref(),
-    };
-    out.write(&result, !partial.is_empty(), true)?;
-    if !first.names.is_empty() {
-        crate::id_names::write_beside(&args.output, &first.names)?;
+/// Reads one part and adds it to its group's `sums` and `aux`, its sample
+/// counts and ids to the frame's (`w` pixels wide).
+fn add_part(
+    (path, info): &(PathBuf, PartInfo),
+    w: u32,
+    sums: &mut SumBuffer,
+    aux: &mut Aux,
+    merged: &mut Merged,
+) -> Result<()> {
+    if info.samples_done.is_empty() {
+        return Ok(());
     }
-    eprintln!(
-        "wrote {}{}: {} parts, {}x{}, {} spp",
-        if partial.is_empty() { "" } else { "PARTIAL " },
-        args.output.display(),
-        parts.len(),
-        w,
-        h,
-        spp
-    );
+    let (again, part) = read_part(path).map_err(|e| anyhow!("{e}"))?;
+    if again != *info {
+        bail!("{}: the file changed while being merged", path.display());
+    }
+    sums.add(&part.beauty);
+    aux.add(&Aux {
+        images: AuxImages::default(),
+        sums: part.passes,
+    });
+    let win = info.window;
+    if let (Some(frame), Some(n)) = (&mut merged.samples, &part.samples) {
+        for (k, (x, y)) in rows(&win).enumerate() {
+            frame[(y * w + x) as usize] += n[k];
+        }
+    }
+    // Ids depend on the pixel alone: every part of a pixel has them.
+    let f = &mut merged.passes.images;
+    for (frame, ids) in [
+        (&mut f.object, &part.object),
+        (&mut f.material, &part.material),
+    ] {
+        if let Some(ids) = ids {
+            for (k, (x, y)) in rows(&win).enumerate() {
+                frame[(y * w + x) as usize] = ids[k];
+            }
+        }
+    }
     Ok(())
 }
 
