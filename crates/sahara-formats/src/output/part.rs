@@ -211,18 +211,8 @@ impl PartInfo {
 
     /// Parses the attributes of the file `name`.
     fn parse(name: &str, get: &dyn Fn(&str) -> Option<String>) -> Result<PartInfo, FormatError> {
-        let need = |key: &str| {
-            get(key).ok_or_else(|| {
-                FormatError::in_file(
-                    name,
-                    format!("not a Sahara render part: the header has no {key} attribute"),
-                )
-            })
-        };
-        let bad = |key: &str, v: &str| {
-            FormatError::in_file(name, format!("the header's {key} = {v:?} is not valid"))
-        };
-        let format = need("sahara:format")?;
+        let h = Header { name, get };
+        let format = h.need("sahara:format")?;
         if format != FORMAT {
             return Err(FormatError::in_file(
                 name,
@@ -231,81 +221,34 @@ impl PartInfo {
                 ),
             ));
         }
-        let number = |key: &str| -> Result<u32, FormatError> {
-            let v = need(key)?;
-            v.parse().map_err(|_| bad(key, &v))
-        };
-        let frame = need("sahara:frame")?;
-        let (width, height) = frame
-            .split_once('x')
-            .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
-            .filter(|&(w, h)| (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h))
-            .ok_or_else(|| bad("sahara:frame", &frame))?;
-        let spp = number("sahara:spp")?;
-        let win = need("sahara:window")?;
-        let v: Vec<u32> = win.split(',').filter_map(|p| p.parse().ok()).collect();
-        let window = match v[..] {
-            [x0, x1, y0, y1] if x0 <= x1 && x1 <= width && y0 <= y1 && y1 <= height => {
-                PixelWindow { x0, x1, y0, y1 }
-            }
-            _ => return Err(bad("sahara:window", &win)),
-        };
-        let parse_range = |key: &str| -> Result<Range<u32>, FormatError> {
-            let v = need(key)?;
-            v.split_once("..")
-                .and_then(|(a, b)| Some(a.parse::<u32>().ok()?..b.parse::<u32>().ok()?))
-                .filter(|r| r.start <= r.end && r.end <= spp)
-                .ok_or_else(|| bad(key, &v))
-        };
-        let samples = parse_range("sahara:samples")?;
-        let samples_done = parse_range("sahara:samples_done")?;
+        let (width, height) = h.frame()?;
+        let spp: u32 = h.parsed("sahara:spp")?;
+        let window = h.window(width, height)?;
+        let samples = h.range("sahara:samples", spp)?;
+        let samples_done = h.range("sahara:samples_done", spp)?;
         if samples_done.start != samples.start || samples_done.end > samples.end {
-            return Err(bad("sahara:samples_done", &range(&samples_done)));
+            return Err(h.bad("sahara:samples_done", &range(&samples_done)));
         }
-        // Parts of a render without passes may leave these out.
-        let flag = |key: &str| match get(key).as_deref() {
-            None => Ok(false),
-            Some("true") => Ok(true),
-            Some("false") => Ok(false),
-            Some(v) => Err(bad(key, v)),
-        };
-        let complete = match need("sahara:complete")?.as_str() {
+        let complete = match h.need("sahara:complete")?.as_str() {
             "true" => true,
             "false" => false,
-            v => return Err(bad("sahara:complete", v)),
+            v => return Err(h.bad("sahara:complete", v)),
         };
-        let passes = |key: &str| -> Result<Vec<Aov>, FormatError> {
-            let v = get(key).unwrap_or_default();
-            let mut list = v
-                .split(',')
-                .filter(|p| !p.is_empty())
-                .map(Aov::from_name)
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|_| bad(key, &v))?;
-            list.sort();
-            list.dedup();
-            Ok(list)
-        };
-        let held = passes("sahara:passes")?;
-        let aovs = passes("sahara:aovs")?;
-        let denoise = flag("sahara:denoise")?;
-        let noisy_guides = flag("sahara:noisy_guides")?;
-        let sample_counts = flag("sahara:sample_counts")?;
+        let held = h.passes("sahara:passes")?;
+        let aovs = h.passes("sahara:aovs")?;
+        let denoise = h.flag("sahara:denoise")?;
         if let Some(a) = aovs.iter().find(|a| !held.contains(a)) {
-            return Err(bad("sahara:aovs", a.name()));
+            return Err(h.bad("sahara:aovs", a.name()));
         }
         if denoise && !(held.contains(&Aov::Albedo) && held.contains(&Aov::Normal)) {
-            return Err(bad("sahara:passes", &pass_list(&held)));
+            return Err(h.bad("sahara:passes", &pass_list(&held)));
         }
         if complete && samples_done != samples {
-            return Err(bad("sahara:samples_done", &range(&samples_done)));
+            return Err(h.bad("sahara:samples_done", &range(&samples_done)));
         }
-        let integrator = need("sahara:integrator")?;
-        let tonemap = need("sahara:tonemap")?;
-        let seed = need("sahara:seed")?;
-        let exposure = need("sahara:exposure")?;
+        let exposure = h.need("sahara:exposure")?;
         Ok(PartInfo {
-            digest: need("sahara:digest")?,
+            digest: h.need("sahara:digest")?,
             width,
             height,
             spp,
@@ -314,26 +257,109 @@ impl PartInfo {
             samples_done,
             complete,
             part: get("sahara:part").unwrap_or_default(),
-            integrator: integrator
-                .parse()
-                .map_err(|_| bad("sahara:integrator", &integrator))?,
-            seed: seed.parse().map_err(|_| bad("sahara:seed", &seed))?,
+            integrator: h.parsed("sahara:integrator")?,
+            seed: h.parsed("sahara:seed")?,
             exposure: exposure
                 .parse()
                 .ok()
                 .filter(|e: &f32| e.is_finite())
-                .ok_or_else(|| bad("sahara:exposure", &exposure))?,
-            tonemap: tonemap
-                .parse()
-                .map_err(|_| bad("sahara:tonemap", &tonemap))?,
+                .ok_or_else(|| h.bad("sahara:exposure", &exposure))?,
+            tonemap: h.parsed("sahara:tonemap")?,
             passes: held,
             aovs,
             denoise,
-            noisy_guides,
-            sample_counts,
+            noisy_guides: h.flag("sahara:noisy_guides")?,
+            sample_counts: h.flag("sahara:sample_counts")?,
             names: get("sahara:names").unwrap_or_default(),
             stats: Vec::new(),
         })
+    }
+}
+
+/// A part file's header attributes, read with errors that name the file.
+struct Header<'a> {
+    name: &'a str,
+    get: &'a dyn Fn(&str) -> Option<String>,
+}
+
+impl Header<'_> {
+    /// Attribute `key`, which must be there.
+    fn need(&self, key: &str) -> Result<String, FormatError> {
+        (self.get)(key).ok_or_else(|| {
+            FormatError::in_file(
+                self.name,
+                format!("not a Sahara render part: the header has no {key} attribute"),
+            )
+        })
+    }
+
+    /// The error of attribute `key`'s value `v`.
+    fn bad(&self, key: &str, v: &str) -> FormatError {
+        FormatError::in_file(
+            self.name,
+            format!("the header's {key} = {v:?} is not valid"),
+        )
+    }
+
+    /// Attribute `key` parsed as a `T`.
+    fn parsed<T: std::str::FromStr>(&self, key: &str) -> Result<T, FormatError> {
+        let v = self.need(key)?;
+        v.parse().map_err(|_| self.bad(key, &v))
+    }
+
+    /// The frame's size, `WxH`, each side in `1..=MAX_SIDE`.
+    fn frame(&self) -> Result<(u32, u32), FormatError> {
+        let frame = self.need("sahara:frame")?;
+        frame
+            .split_once('x')
+            .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
+            .filter(|&(w, h)| (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h))
+            .ok_or_else(|| self.bad("sahara:frame", &frame))
+    }
+
+    /// The part's pixels, `x0,x1,y0,y1` inside a `width` x `height` frame.
+    fn window(&self, width: u32, height: u32) -> Result<PixelWindow, FormatError> {
+        let win = self.need("sahara:window")?;
+        let v: Vec<u32> = win.split(',').filter_map(|p| p.parse().ok()).collect();
+        match v[..] {
+            [x0, x1, y0, y1] if x0 <= x1 && x1 <= width && y0 <= y1 && y1 <= height => {
+                Ok(PixelWindow { x0, x1, y0, y1 })
+            }
+            _ => Err(self.bad("sahara:window", &win)),
+        }
+    }
+
+    /// A range of samples `a..b` within `0..spp`.
+    fn range(&self, key: &str, spp: u32) -> Result<Range<u32>, FormatError> {
+        let v = self.need(key)?;
+        v.split_once("..")
+            .and_then(|(a, b)| Some(a.parse::<u32>().ok()?..b.parse::<u32>().ok()?))
+            .filter(|r| r.start <= r.end && r.end <= spp)
+            .ok_or_else(|| self.bad(key, &v))
+    }
+
+    /// A flag; parts of a render without passes may leave it out (false).
+    fn flag(&self, key: &str) -> Result<bool, FormatError> {
+        match (self.get)(key).as_deref() {
+            None => Ok(false),
+            Some("true") => Ok(true),
+            Some("false") => Ok(false),
+            Some(v) => Err(self.bad(key, v)),
+        }
+    }
+
+    /// A list of render passes, sorted, each once (empty if left out).
+    fn passes(&self, key: &str) -> Result<Vec<Aov>, FormatError> {
+        let v = (self.get)(key).unwrap_or_default();
+        let mut list = v
+            .split(',')
+            .filter(|p| !p.is_empty())
+            .map(Aov::from_name)
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|_| self.bad(key, &v))?;
+        list.sort();
+        list.dedup();
+        Ok(list)
     }
 }
 
