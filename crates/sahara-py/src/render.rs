@@ -17,9 +17,9 @@ use sahara_formats::{write_image, Pixels};
 use sahara_formats::{LoadOptions, Loaded};
 use sahara_kd::{BuildParams, Builder};
 use sahara_render::{
-    defaults, render_watched, Aov, Feature, Film, Filter, FilterKind, Integrator, IntegratorKind,
-    Named, PixelSum, Progress, RenderResult, RenderSettings, SamplerKind, Scene as RenderScene,
-    SettingsError, ToneMap,
+    defaults, render_watched, Aov, AuxImages, Feature, Film, Filter, FilterKind, Integrator,
+    IntegratorKind, Named, PixelSum, Progress, RenderResult, RenderSettings, SamplerKind,
+    Scene as RenderScene, SettingsError, ToneMap,
 };
 
 use crate::pool::pool;
@@ -208,23 +208,7 @@ pub fn render<'py>(
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray3<f32>>, Bound<'py, PyDict>)> {
     let file = scene.settings.as_ref();
-    for (what, v) in [
-        ("spp", spp),
-        ("width", width),
-        ("height", height),
-        ("pass_spp", pass_spp),
-    ] {
-        if v == Some(0) || v.is_some_and(|v| v > 65536 && what != "spp") {
-            return Err(PyValueError::new_err(format!(
-                "{what} must be {}",
-                if what == "spp" {
-                    "at least 1"
-                } else {
-                    "1..=65536"
-                }
-            )));
-        }
-    }
+    check_sizes(spp, width, height, pass_spp)?;
     let integrator = Integrator::chosen(
         integrator
             .as_deref()
@@ -313,19 +297,7 @@ pub fn render<'py>(
         };
         PyValueError::new_err(format!("{asked}: {e}"))
     })?;
-    // The film's sums, its image and the passes are allocated in the
-    // render's threads, where a failed allocation aborts the process: the
-    // memory is asked for here first, so that a size beyond the machine
-    // is a MemoryError.
-    let pixels = width as usize * height as usize;
-    let per_pixel = std::mem::size_of::<PixelSum>() + 16 * (2 + settings.aovs.len());
-    let bytes = pixels.saturating_mul(per_pixel);
-    if Vec::<u8>::new().try_reserve_exact(bytes).is_err() {
-        return Err(PyMemoryError::new_err(format!(
-            "a {width}x{height} render needs about {:.1} GB, more than this machine gives",
-            bytes as f64 / 1e9
-        )));
-    }
+    check_memory(width, height, settings.aovs.len())?;
     let denoiser = if denoise {
         Some(
             sahara_denoise::Denoiser::load()
@@ -347,50 +319,111 @@ pub fn render<'py>(
     let image = PyArray3::<f32>::zeros(py, [h, w, 3], false);
     // SAFETY: made here, held by no one else.
     unsafe { image.as_slice_mut()? }.copy_from_slice(&result.film.to_rgb_f32());
+    let out = match &result.aux {
+        Some(aux) => pass_arrays(py, &aux.images, &asked, w, h)?,
+        None => PyDict::new(py),
+    };
+    Ok((image, out))
+}
+
+/// Refuses a zero size or sample count, and sides beyond 65536.
+fn check_sizes(
+    spp: Option<u32>,
+    width: Option<u32>,
+    height: Option<u32>,
+    pass_spp: Option<u32>,
+) -> PyResult<()> {
+    for (what, v) in [
+        ("spp", spp),
+        ("width", width),
+        ("height", height),
+        ("pass_spp", pass_spp),
+    ] {
+        if v == Some(0) || v.is_some_and(|v| v > 65536 && what != "spp") {
+            return Err(PyValueError::new_err(format!(
+                "{what} must be {}",
+                if what == "spp" {
+                    "at least 1"
+                } else {
+                    "1..=65536"
+                }
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A MemoryError for a render beyond the machine. The film's sums, its
+/// image and the passes are allocated in the render's threads, where a
+/// failed allocation aborts the process: the memory is asked for here
+/// first.
+fn check_memory(width: u32, height: u32, passes: usize) -> PyResult<()> {
+    let pixels = width as usize * height as usize;
+    let per_pixel = std::mem::size_of::<PixelSum>() + 16 * (2 + passes);
+    let bytes = pixels.saturating_mul(per_pixel);
+    if Vec::<u8>::new().try_reserve_exact(bytes).is_err() {
+        return Err(PyMemoryError::new_err(format!(
+            "a {width}x{height} render needs about {:.1} GB, more than this machine gives",
+            bytes as f64 / 1e9
+        )));
+    }
+    Ok(())
+}
+
+/// The render passes `asked` for as numpy arrays of `h` x `w` pixels, by
+/// name.
+fn pass_arrays<'py>(
+    py: Python<'py>,
+    im: &AuxImages,
+    asked: &[Aov],
+    w: usize,
+    h: usize,
+) -> PyResult<Bound<'py, PyDict>> {
     let out = PyDict::new(py);
-    if let Some(aux) = &result.aux {
-        let im = &aux.images;
-        let v3 = |v: &[Vec3]| -> PyResult<Bound<'py, PyArray3<f32>>> {
-            let a = PyArray3::<f32>::zeros(py, [h, w, 3], false);
-            let s = unsafe { a.as_slice_mut()? };
-            for (o, p) in s.chunks_exact_mut(3).zip(v) {
-                o.copy_from_slice(&p.to_array());
+    let v3 = |v: &[Vec3]| -> PyResult<Bound<'py, PyArray3<f32>>> {
+        let a = PyArray3::<f32>::zeros(py, [h, w, 3], false);
+        // SAFETY: made here, held by no one else.
+        let s = unsafe { a.as_slice_mut()? };
+        for (o, p) in s.chunks_exact_mut(3).zip(v) {
+            o.copy_from_slice(&p.to_array());
+        }
+        Ok(a)
+    };
+    for aov in asked {
+        match aov {
+            Aov::Albedo => out.set_item("albedo", v3(&im.albedo)?)?,
+            Aov::Normal => out.set_item("normal", v3(&im.normal)?)?,
+            Aov::Position => out.set_item("position", v3(&im.position)?)?,
+            Aov::Variance => out.set_item("variance", v3(&im.variance)?)?,
+            Aov::Depth => {
+                let a = PyArray2::<f32>::zeros(py, [h, w], false);
+                // SAFETY: made here, held by no one else.
+                unsafe { a.as_slice_mut()? }.copy_from_slice(&im.depth);
+                out.set_item("depth", a)?
             }
-            Ok(a)
-        };
-        for aov in &asked {
-            match aov {
-                Aov::Albedo => out.set_item("albedo", v3(&im.albedo)?)?,
-                Aov::Normal => out.set_item("normal", v3(&im.normal)?)?,
-                Aov::Position => out.set_item("position", v3(&im.position)?)?,
-                Aov::Variance => out.set_item("variance", v3(&im.variance)?)?,
-                Aov::Depth => {
-                    let a = PyArray2::<f32>::zeros(py, [h, w], false);
-                    unsafe { a.as_slice_mut()? }.copy_from_slice(&im.depth);
-                    out.set_item("depth", a)?
+            Aov::Uv => {
+                let a = PyArray3::<f32>::zeros(py, [h, w, 2], false);
+                // SAFETY: made here, held by no one else.
+                let s = unsafe { a.as_slice_mut()? };
+                for (o, p) in s.chunks_exact_mut(2).zip(&im.uv) {
+                    o.copy_from_slice(&p.to_array());
                 }
-                Aov::Uv => {
-                    let a = PyArray3::<f32>::zeros(py, [h, w, 2], false);
-                    let s = unsafe { a.as_slice_mut()? };
-                    for (o, p) in s.chunks_exact_mut(2).zip(&im.uv) {
-                        o.copy_from_slice(&p.to_array());
-                    }
-                    out.set_item("uv", a)?
-                }
-                Aov::Object | Aov::Material => {
-                    let ids = if *aov == Aov::Object {
-                        &im.object
-                    } else {
-                        &im.material
-                    };
-                    let a = PyArray2::<u32>::zeros(py, [h, w], false);
-                    unsafe { a.as_slice_mut()? }.copy_from_slice(ids);
-                    out.set_item(aov.name(), a)?
-                }
+                out.set_item("uv", a)?
+            }
+            Aov::Object | Aov::Material => {
+                let ids = if *aov == Aov::Object {
+                    &im.object
+                } else {
+                    &im.material
+                };
+                let a = PyArray2::<u32>::zeros(py, [h, w], false);
+                // SAFETY: made here, held by no one else.
+                unsafe { a.as_slice_mut()? }.copy_from_slice(ids);
+                out.set_item(aov.name(), a)?
             }
         }
     }
-    Ok((image, out))
+    Ok(out)
 }
 
 /// Runs the render on its own thread (in the pool of `threads`), while

@@ -55,6 +55,11 @@ const MAX_CROSSINGS: u32 = 256;
 /// that is not a perfect mirror or smooth glass, or the first scattering
 /// in a medium before it, whichever comes first; index-matched boundaries
 /// are not surfaces to it.
+///
+/// One loop on purpose: the path's state (ray, medium, throughput, the
+/// last scattering for MIS, boundaries crossed) passes from event to
+/// event (a scattering in a medium, a boundary, a hole, a surface), and
+/// each event's work is in the functions below.
 pub(crate) fn li(
     ctx: &mut Context,
     ray: &Ray,
