@@ -77,9 +77,6 @@ pub use description::{FileCrop, FileSettings, Sky};
 /// shown as a scene is seen by.
 pub use mesh::{load_mesh, load_mesh_with_warnings, CameraChoice};
 
-/// A mesh as read by `sahara-readers` as the renderer's mesh.
-pub use common::mesh::render_mesh;
-
 /// MTL materials as the renderer's.
 pub use mesh::mtl::{mtl_bsdf, mtl_material, phong_roughness, DEFAULT_GLASS_IOR};
 

@@ -42,11 +42,6 @@ use std::path::Path;
 pub use error::{in_words, one_line, FormatError};
 pub use sahara_kd::Mesh;
 
-/// The mesh every mesh reader returns: [`Mesh`] itself (`sahara-kd`'s, the
-/// one mesh type readers, renderer and benchmarks share), by the name this
-/// crate's callers know.
-pub type TriangleMesh = Mesh;
-
 /// Loads a mesh, choosing the format by extension (`.obj`, `.ply`, `.gltf` or
 /// `.glb`, any case); see [`load_mesh_with_warnings`].
 pub fn load_mesh(path: &Path) -> Result<Mesh, FormatError> {

@@ -1,17 +1,7 @@
-//! Triangle meshes as the readers share them: a mesh file's plain
-//! triangles as the renderer's mesh, and smooth vertex normals (pbrt's
-//! subdivided meshes, Mitsuba's meshes without normals).
+//! Smooth vertex normals, as the readers share them (pbrt's subdivided
+//! meshes, Mitsuba's meshes without normals).
 
 use glam::Vec3;
-use sahara_readers::TriangleMesh;
-use sahara_render::Mesh;
-
-/// A mesh as read as the renderer's mesh (both vectors are moved, not copied).
-pub fn render_mesh(mesh: TriangleMesh) -> Mesh {
-    let TriangleMesh { positions, indices } = mesh;
-    Mesh { positions, indices }
-}
-
 /// Per-vertex normals: the area-weighted mean of the faces' (winding) normals.
 pub(crate) fn smooth_normals(positions: &[Vec3], tris: &[[u32; 3]]) -> Vec<Vec3> {
     let mut n = vec![Vec3::ZERO; positions.len()];

@@ -14,7 +14,6 @@ use glam::{Mat4, Vec2};
 use sahara_render::{Scene, SceneMesh};
 
 use crate::common::materials::TextureCache;
-use crate::common::mesh::render_mesh;
 use crate::gltf::material::gltf_material;
 use crate::gltf::volume::volume_medium;
 use crate::mesh::mtl::mtl_material;
@@ -121,7 +120,7 @@ impl MeshLibrary {
         let loaded = match ext.as_str() {
             "obj" => self.load_obj(scene, path, own_materials)?,
             "ply" => {
-                let mesh = render_mesh(sahara_readers::ply::load_ply(path)?);
+                let mesh = sahara_readers::ply::load_ply(path)?;
                 let mesh = scene.add_mesh(mesh);
                 LoadedFile {
                     parts: vec![MeshPart {
@@ -160,7 +159,7 @@ impl MeshLibrary {
         let obj = sahara_readers::obj::load_obj_with_materials(path)?;
         self.warnings.extend(obj.warnings);
         let mut mesh = SceneMesh {
-            mesh: render_mesh(obj.mesh),
+            mesh: obj.mesh,
             normals: obj.normals,
             uvs: obj.uvs,
             ..SceneMesh::default()
@@ -235,7 +234,7 @@ impl MeshLibrary {
             .into_iter()
             .map(|m| {
                 scene.add_mesh(SceneMesh {
-                    mesh: render_mesh(m.mesh),
+                    mesh: m.mesh,
                     normals: m.normals,
                     uvs: flip(m.uvs),
                     uvs1: flip(m.uvs1),

@@ -17,9 +17,7 @@ pub(crate) mod mtl;
 
 use std::path::{Path, PathBuf};
 
-use sahara_render::{Camera, Mesh};
-
-use crate::common::mesh::render_mesh;
+use sahara_render::Camera;
 
 use crate::description::Sky;
 use crate::description::{CameraRequest, Geometry, Object, ObjectPlacement, SceneDescription};
@@ -83,15 +81,6 @@ pub(crate) fn read_mesh_scene(
     Ok(desc)
 }
 
-/// Loads a mesh file as the renderer's mesh: [`sahara_readers::load_mesh`]
-/// and [`render_mesh`].
-pub fn load_mesh(path: &Path) -> Result<Mesh, FormatError> {
-    sahara_readers::load_mesh(path).map(render_mesh)
-}
-
-/// Loads a mesh file as the renderer's mesh, with the problems that did not
-/// stop loading: [`sahara_readers::load_mesh_with_warnings`] and
-/// [`render_mesh`].
-pub fn load_mesh_with_warnings(path: &Path) -> Result<(Mesh, Vec<String>), FormatError> {
-    sahara_readers::load_mesh_with_warnings(path).map(|(mesh, w)| (render_mesh(mesh), w))
-}
+/// Mesh files (OBJ, PLY, glTF's meshes) as the renderer's meshes, the
+/// readers' own functions: their `Mesh` is the renderer's.
+pub use sahara_readers::{load_mesh, load_mesh_with_warnings};

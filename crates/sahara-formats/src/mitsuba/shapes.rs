@@ -30,7 +30,6 @@ use super::properties::Object;
 use super::serialized::parse_serialized;
 use super::xml::Node;
 use crate::common::gzip::read_maybe_gz;
-use crate::common::mesh::render_mesh;
 use crate::common::mesh::smooth_normals;
 use crate::description::{Geometry, Object as SceneObject, ObjectPlacement};
 
@@ -397,7 +396,7 @@ impl<'a> Builder<'a> {
                     .map(|u| u.into_iter().map(|v| Vec2::new(v.x, 1.0 - v.y)).collect());
                 (
                     SceneMesh {
-                        mesh: render_mesh(obj.mesh),
+                        mesh: obj.mesh,
                         normals: obj.normals,
                         uvs,
                         ..SceneMesh::default()
@@ -411,7 +410,7 @@ impl<'a> Builder<'a> {
                     sahara_readers::ply::parse_ply_with_attributes(&bytes, &name).map_err(at)?;
                 (
                     SceneMesh {
-                        mesh: render_mesh(ply.mesh),
+                        mesh: ply.mesh,
                         normals: ply.normals,
                         uvs: ply.uvs,
                         ..SceneMesh::default()

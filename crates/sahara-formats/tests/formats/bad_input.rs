@@ -24,7 +24,7 @@ use std::time::{Duration, Instant};
 
 use sahara_formats::decode_rgb_f32;
 use sahara_formats::parse_scene;
-use sahara_formats::{render_mesh, FormatError};
+use sahara_formats::FormatError;
 use sahara_readers::gltf::load_gltf;
 use sahara_readers::obj::parse_obj;
 use sahara_readers::ply::parse_ply;
@@ -361,11 +361,7 @@ fn ply_non_finite_and_zero_area_triangles_load_and_are_never_hit() {
     );
     assert!(mesh.positions[3].x.is_nan());
     assert_eq!(mesh.positions[4].x, f32::INFINITY);
-    let hittable: Vec<bool> = render_mesh(mesh)
-        .triangles()
-        .iter()
-        .map(|t| t.is_hittable())
-        .collect();
+    let hittable: Vec<bool> = mesh.triangles().iter().map(|t| t.is_hittable()).collect();
     assert_eq!(hittable, vec![true, false, false, false]);
 }
 
@@ -447,11 +443,7 @@ fn obj_non_finite_and_zero_area_triangles_load_and_are_never_hit() {
     assert_eq!(corners[2][0].y, f32::NEG_INFINITY);
     // 1e39 does not fit in f32: it reads as infinity.
     assert_eq!(corners[3][0].x, f32::INFINITY);
-    let hittable: Vec<bool> = render_mesh(mesh)
-        .triangles()
-        .iter()
-        .map(|t| t.is_hittable())
-        .collect();
+    let hittable: Vec<bool> = mesh.triangles().iter().map(|t| t.is_hittable()).collect();
     // Repeated corner and three collinear corners have zero area.
     assert_eq!(hittable, vec![true, false, false, false, false, false]);
 }
@@ -605,13 +597,13 @@ fn gltf_bad_accessors_and_indices_name_the_file_and_object() {
     let odd = [f32::NAN, 0.0, 0.0, 1.0, f32::INFINITY, 0.0, 0.0, 1.0, 0.0];
     let (result, _, _) = load("nan.glb", glb(&odd, &[0, 1, 2], 3, 3));
     let scene = result.unwrap();
-    let triangles = render_mesh(scene.meshes[0].mesh.clone()).triangles();
+    let triangles = scene.meshes[0].mesh.clone().triangles();
     assert_eq!(triangles.len(), 1);
     assert!(!triangles[0].is_hittable());
     // A zero-area triangle loads; never hit.
     let (result, _, _) = load("flat.glb", glb(&TRIANGLE, &[0, 1, 1], 3, 3));
     let mesh = result.unwrap().meshes.swap_remove(0).mesh;
-    assert!(!render_mesh(mesh).triangles()[0].is_hittable());
+    assert!(!mesh.triangles()[0].is_hittable());
     // Broken JSON: its line.
     let (result, _, path) = load(
         "broken.gltf",

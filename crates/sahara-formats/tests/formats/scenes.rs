@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 
 use glam::Vec3;
-use sahara_formats::render_mesh;
 use sahara_readers::camera::{read_sidecar, sidecar_path};
 use sahara_readers::load_mesh;
 
@@ -30,7 +29,7 @@ fn cornell_box_matches_the_catalogue() {
     };
     let mesh = load_mesh(&path).unwrap();
     assert_eq!(mesh.triangle_count(), 32);
-    let bounds = render_mesh(mesh.clone()).bounds();
+    let bounds = mesh.clone().bounds();
     assert_eq!(bounds.min, Vec3::ZERO);
     assert_eq!(bounds.max, Vec3::new(556.0, 548.8, 559.2));
     // The first object is the floor: "f 1 2 3" over the first three vertices.
@@ -60,7 +59,7 @@ fn bunny_obj_and_ply_are_the_same_triangles() {
     // Every vertex is used, so tobj's per-object compaction keeps them all.
     assert_eq!(from_obj.positions.len(), 34834);
     assert!(corners(&from_obj) == corners(&from_ply));
-    let b = render_mesh(from_ply).bounds();
+    let b = from_ply.bounds();
     assert!(
         (b.min - Vec3::new(-0.09469, 0.03299, -0.06187))
             .abs()
