@@ -149,7 +149,7 @@ impl<'a> World<'a> {
             .iter()
             .filter_map(|l| match l {
                 LightSource::Area(a) => a.instance,
-                _ => None,
+                LightSource::Explicit(_) | LightSource::Environment(_) => None,
             })
             .collect();
         let accel = Accel::build(&scene.meshes, &scene.instances, params, &ignorable);
@@ -625,7 +625,7 @@ impl<'a> World<'a> {
         };
         match &self.lights[l as usize] {
             LightSource::Area(a) => self.select.pmf(l as usize) * a.pdf(p_ref, hit.p, hit.ng, wi),
-            _ => 0.0,
+            LightSource::Explicit(_) | LightSource::Environment(_) => 0.0,
         }
     }
 
@@ -634,7 +634,7 @@ impl<'a> World<'a> {
         match self.env {
             Some(i) => match &self.lights[i as usize] {
                 LightSource::Environment(e) => e.radiance(w),
-                _ => Vec3::ZERO,
+                LightSource::Explicit(_) | LightSource::Area(_) => Vec3::ZERO,
             },
             None => Vec3::ZERO,
         }
@@ -646,7 +646,7 @@ impl<'a> World<'a> {
         match self.env {
             Some(i) => match &self.lights[i as usize] {
                 LightSource::Environment(e) => self.select.pmf(i as usize) * e.pdf(w),
-                _ => 0.0,
+                LightSource::Explicit(_) | LightSource::Area(_) => 0.0,
             },
             None => 0.0,
         }

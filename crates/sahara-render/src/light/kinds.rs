@@ -274,6 +274,9 @@ mod tests {
         for &kind in LightKind::ALL {
             assert!(kind.keys().iter().filter(|k| k.textured).count() <= 1);
         }
+        for name in AREA_SHAPES {
+            assert!(crate::ShapeKind::from_name(name).is_ok(), "{name}");
+        }
     }
 
     #[test]
