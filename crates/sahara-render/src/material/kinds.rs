@@ -105,6 +105,9 @@ const ALPHA_CUTOFF: Key = number(
 
 impl MaterialKind {
     /// The keys of this kind, in the order documents list them.
+    ///
+    /// One piece on purpose: it is the table of every kind's keys, read
+    /// as a whole (as the document's table generated from it is).
     pub fn keys(self) -> &'static [Key] {
         const COLOR: Key = reflectance("color", 0.9, "reflectance at normal incidence");
         const DIFFUSE: &[Key] = &[
