@@ -19,8 +19,9 @@
 //! for more is refused with a [`SettingsError`] before it starts.
 //!
 //! The crate's parts, each importing only those before it in this list:
-//! `math` (hashing, piecewise distributions, warps) and `names` (the name
-//! tables of settings); `texture`; `material`, `light`, `medium` and
+//! `math` (hashing, piecewise distributions, warps), `names` (the name
+//! tables of settings) and `keys` (the keys of material and light
+//! kinds); `texture`; `material`, `light`, `medium` and
 //! `sampler`;
 //! `scene` (camera, meshes, shapes, instances); `film` (the image,
 //! reconstruction filters, exact sums, pixel windows) and `accel` (the
@@ -35,6 +36,7 @@ mod accel;
 mod cpu_time;
 mod film;
 mod integrator;
+mod keys;
 mod light;
 mod material;
 mod math;
@@ -57,10 +59,10 @@ pub use scene::{Scene, ShapeInstance};
 
 // Materials, textures and lights.
 pub use light::environment::{coordinates as environment_uv, direction as environment_direction};
-pub use light::{Environment, Light};
+pub use light::{Environment, Light, LightKind, LightOf, AREA_SHAPES};
 pub use material::{
-    fresnel, metals, AlphaMode, Bsdf, Clearcoat, Distribution, Material, MaterialTextures,
-    NormalMap, OcclusionMap,
+    fresnel, metals, AlphaMode, Bsdf, Clearcoat, Distribution, Material, MaterialKind,
+    MaterialTextures, NormalMap, OcclusionMap,
 };
 pub use medium::{DensityGrid, GridMedium, HenyeyGreenstein, Homogeneous, Medium, MediumInterface};
 pub use texture::footprint::UvFootprint;
@@ -75,6 +77,7 @@ pub use film::ToneMap;
 pub use integrator::{
     defaults, Feature, Integrator, IntegratorKind, SettingsError, Support, Supports, TraceStats,
 };
+pub use keys::{Fallback, Key, KeyError, KeyType, Value, Values};
 pub use names::{one_of, Accepts, Named, Parameter, UnknownName};
 pub use render::{Adaptive, AdaptiveStats, RenderSettings, UNLIMITED_SPP};
 pub use sampler::SamplerKind;

@@ -12,6 +12,9 @@ pub trait Named: Copy + Sized + 'static {
     const WHAT: &'static str;
     /// Every value, in the order messages and documents list them.
     const ALL: &'static [Self];
+    /// Other names files may use for a value (`glossy` for `conductor`),
+    /// read but never written.
+    const ALIASES: &'static [(&'static str, Self)] = &[];
 
     /// The value's name, as written in files and on the command line.
     fn name(self) -> &'static str;
@@ -22,6 +25,12 @@ pub trait Named: Copy + Sized + 'static {
             .iter()
             .copied()
             .find(|v| v.name() == name)
+            .or_else(|| {
+                Self::ALIASES
+                    .iter()
+                    .find(|(alias, _)| *alias == name)
+                    .map(|(_, v)| *v)
+            })
             .ok_or_else(|| UnknownName {
                 what: Self::WHAT,
                 name: name.to_owned(),
@@ -60,6 +69,39 @@ pub enum Accepts {
     /// A whole number of at least this (and at most 2^24, which `f32`
     /// holds exactly).
     WholeAtLeast(u32),
+    /// A finite number greater than this.
+    Above(f32),
+    /// A finite number from the first to the second, both included.
+    Between(f32, f32),
+}
+
+impl Accepts {
+    /// True if `value` is accepted.
+    pub fn takes(self, value: f32) -> bool {
+        const WHOLE_MAX: f32 = (1 << 24) as f32;
+        match self {
+            Accepts::Finite => value.is_finite(),
+            Accepts::Positive => value.is_finite() && value > 0.0,
+            Accepts::AtLeast(m) => value.is_finite() && value >= m,
+            Accepts::WholeAtLeast(m) => {
+                value.fract() == 0.0 && value >= m as f32 && value <= WHOLE_MAX
+            }
+            Accepts::Above(m) => value.is_finite() && value > m,
+            Accepts::Between(lo, hi) => value.is_finite() && (lo..=hi).contains(&value),
+        }
+    }
+
+    /// What an accepted value is, after "must be" (`greater than 0`).
+    pub fn must(self) -> String {
+        match self {
+            Accepts::Finite => "finite".to_string(),
+            Accepts::Positive => "greater than 0".to_string(),
+            Accepts::AtLeast(m) => format!("at least {m}"),
+            Accepts::WholeAtLeast(m) => format!("a whole number of at least {m}"),
+            Accepts::Above(m) => format!("greater than {m}"),
+            Accepts::Between(lo, hi) => format!("between {lo} and {hi}"),
+        }
+    }
 }
 
 impl Parameter {
@@ -70,23 +112,14 @@ impl Parameter {
 
     /// `value` if the parameter accepts it, else why not (one line).
     pub fn check(&self, value: f32) -> Result<f32, String> {
-        const WHOLE_MAX: f32 = (1 << 24) as f32;
-        let (ok, must) = match self.accepts {
-            Accepts::Finite => (value.is_finite(), "finite".to_string()),
-            Accepts::Positive => (
-                value.is_finite() && value > 0.0,
-                "greater than 0".to_string(),
-            ),
-            Accepts::AtLeast(m) => (value.is_finite() && value >= m, format!("at least {m}")),
-            Accepts::WholeAtLeast(m) => (
-                value.fract() == 0.0 && value >= m as f32 && value <= WHOLE_MAX,
-                format!("a whole number of at least {m}"),
-            ),
-        };
-        if ok {
+        if self.accepts.takes(value) {
             Ok(value)
         } else {
-            Err(format!("`{}` is {value} but must be {must}", self.name))
+            Err(format!(
+                "`{}` is {value} but must be {}",
+                self.name,
+                self.accepts.must()
+            ))
         }
     }
 }
@@ -126,12 +159,15 @@ pub fn one_of(names: &[&str]) -> String {
 }
 
 /// Implements [`Named`], `FromStr` and `Display` for a type from its one
-/// table of `value => "name"` pairs.
+/// table of `value => "name"` pairs (and, optionally, `aliases { "other"
+/// => value }`).
 macro_rules! name_table {
-    ($ty:ty, $what:literal, { $($value:path => $name:literal),+ $(,)? }) => {
+    ($ty:ty, $what:literal, { $($value:path => $name:literal),+ $(,)? }
+     $(, aliases { $($alias:literal => $avalue:path),* $(,)? })?) => {
         impl $crate::names::Named for $ty {
             const WHAT: &'static str = $what;
             const ALL: &'static [Self] = &[$($value),+];
+            const ALIASES: &'static [(&'static str, Self)] = &[$($(($alias, $avalue)),*)?];
 
             fn name(self) -> &'static str {
                 match self {

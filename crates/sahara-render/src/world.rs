@@ -7,7 +7,7 @@ use sahara_kd::{BuildParams, Counters, NoCounters, Ray};
 
 use crate::accel::{Accel, BatchBuffers, RawHit};
 use crate::light::area::{EmissionTextures, Emitter};
-use crate::light::{AreaLight, EnvLight, Light, LightSample, LightSource};
+use crate::light::{AreaLight, EnvLight, LightSample, LightSource};
 use crate::material::Material;
 use crate::math::piecewise::Distribution1D;
 use crate::math::warp::Frame;
@@ -153,7 +153,7 @@ impl<'a> World<'a> {
             .iter()
             .filter_map(|l| match l {
                 LightSource::Area(a) => a.instance,
-                _ => None,
+                LightSource::Explicit(_) | LightSource::Environment(_) => None,
             })
             .collect();
         let accel = Accel::build(&scene.meshes, &scene.instances, params, &ignorable);
@@ -633,7 +633,7 @@ impl<'a> World<'a> {
         };
         match &self.lights[l as usize] {
             LightSource::Area(a) => self.nee.pmf(l as usize) * a.pdf(p_ref, hit.p, hit.ng, wi),
-            _ => 0.0,
+            LightSource::Explicit(_) | LightSource::Environment(_) => 0.0,
         }
     }
 
@@ -642,7 +642,7 @@ impl<'a> World<'a> {
         match self.env {
             Some(i) => match &self.lights[i as usize] {
                 LightSource::Environment(e) => e.radiance(w),
-                _ => Vec3::ZERO,
+                LightSource::Explicit(_) | LightSource::Area(_) => Vec3::ZERO,
             },
             None => Vec3::ZERO,
         }
@@ -654,7 +654,7 @@ impl<'a> World<'a> {
         match self.env {
             Some(i) => match &self.lights[i as usize] {
                 LightSource::Environment(e) => self.nee.pmf(i as usize) * e.pdf(w),
-                _ => 0.0,
+                LightSource::Explicit(_) | LightSource::Area(_) => 0.0,
             },
             None => 0.0,
         }
@@ -677,12 +677,7 @@ pub const SHADOW_EPS: f32 = 1.0 / 4096.0;
 /// a dim sky around a room would take nearly every choice from the lamp
 /// that lights the room (pbrt-v4's light samplers split the same way).
 fn next_event_choice(lights: &[LightSource], powers: &[f32]) -> Vec<f32> {
-    let infinite = |l: &LightSource| {
-        matches!(
-            l,
-            LightSource::Environment(_) | LightSource::Explicit(Light::Directional { .. })
-        )
-    };
+    let infinite = LightSource::is_infinite;
     let (mut far, mut near) = (0.0f64, 0.0f64);
     for (l, &p) in lights.iter().zip(powers) {
         if infinite(l) {

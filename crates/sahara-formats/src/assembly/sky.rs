@@ -58,10 +58,11 @@ impl std::fmt::Display for SkyUsed {
 }
 
 /// Power (luminance) of the scene's own lights: emitting triangles
-/// (radiance times area times pi, per emitting face), point and spot
-/// lights (intensity times the solid angle they light), directional
-/// lights and the environment (what they shed on the bounding sphere of
-/// radius `radius`). An emissive ground (a flat object many times the
+/// (radiance times area times pi, per emitting face), point, spot and
+/// directional lights (their power as the renderer chooses lights by it,
+/// [`Light::power`]: a directional light's is what it sheds on the
+/// bounding sphere of radius `radius`) and the environment (likewise).
+/// An emissive ground (a flat object many times the
 /// size of the rest, such as glowing water or a lit floor: see the
 /// automatic camera's `grounds`) does not count: it is context, lighting
 /// the subject from below, and cannot stand in for a sky above it.
@@ -100,15 +101,7 @@ pub fn own_power(scene: &Scene, radius: f32) -> f32 {
     }
     let sphere = std::f32::consts::PI * radius * radius;
     for l in &scene.lights {
-        power += match *l {
-            Light::Point { intensity, .. } => 4.0 * std::f32::consts::PI * luminance(intensity),
-            Light::Spot {
-                intensity,
-                cos_outer,
-                ..
-            } => 2.0 * std::f32::consts::PI * (1.0 - cos_outer) * luminance(intensity),
-            Light::Directional { irradiance, .. } => sphere * luminance(irradiance),
-        } as f64;
+        power += l.power(radius) as f64;
     }
     if let Some(env) = &scene.environment {
         let mean = match env {

@@ -36,6 +36,12 @@ pub fn phong_roughness(ns: f32) -> f32 {
 
 /// The BSDF an MTL material stands for (rules in the module documentation).
 pub fn mtl_bsdf(m: &MtlMaterial) -> Bsdf {
+    mtl_kind(m).0
+}
+
+/// The BSDF an MTL material stands for, and whether its `map_Kd` applies
+/// (to a diffuse or glossy colour; not to glass or a mirror).
+fn mtl_kind(m: &MtlMaterial) -> (Bsdf, bool) {
     let (kd, ks) = (unit(m.kd), unit(m.ks));
     if matches!(m.illum, 4 | 6 | 7) || m.d < 1.0 {
         let ior = if m.ni > 1.0 && m.ni.is_finite() {
@@ -43,22 +49,23 @@ pub fn mtl_bsdf(m: &MtlMaterial) -> Bsdf {
         } else {
             DEFAULT_GLASS_IOR
         };
-        Bsdf::Dielectric { ior }
+        (Bsdf::Dielectric { ior }, false)
     } else if matches!(m.illum, 3 | 5) {
         let color = if ks.max_element() > 0.0 {
             ks
         } else {
             Vec3::ONE
         };
-        Bsdf::Mirror { color }
+        (Bsdf::Mirror { color }, false)
     } else if m.illum >= 2 && ks.max_element() > kd.max_element() {
-        Bsdf::Conductor {
+        let bsdf = Bsdf::Conductor {
             color: ks,
             roughness: phong_roughness(m.ns),
             distribution: Distribution::Ggx,
-        }
+        };
+        (bsdf, true)
     } else {
-        Bsdf::Diffuse { albedo: kd }
+        (Bsdf::Diffuse { albedo: kd }, true)
     }
 }
 
@@ -68,14 +75,12 @@ pub fn mtl_material(
     textures: &mut TextureCache,
     warnings: &mut Vec<String>,
 ) -> Material {
-    let bsdf = mtl_bsdf(m);
+    let (bsdf, textured) = mtl_kind(m);
     let mut out = Material::new(bsdf).with_emission(emission(m.ke));
-    if let Some(path) = &m.map_kd {
-        if matches!(bsdf, Bsdf::Diffuse { .. } | Bsdf::Conductor { .. }) {
-            out.textures.base_color = textures
-                .file(path, Encoding::Srgb, warnings)
-                .map(TextureMap::new);
-        }
+    if let (Some(path), true) = (&m.map_kd, textured) {
+        out.textures.base_color = textures
+            .file(path, Encoding::Srgb, warnings)
+            .map(TextureMap::new);
     }
     out
 }

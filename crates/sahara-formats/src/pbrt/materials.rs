@@ -15,7 +15,8 @@
 //! | v3 `substrate` | the same, the layer's normal reflectance `Ks` | Ashikhmin-Shirley's coupling |
 //! | `diffusetransmission`, v3 `translucent` | diffuse (or layered) reflection | transmission |
 //! | `mix` | the blend when exact (two diffuse colours, or the same material), else the material of larger weight | the blend |
-//! | `measured`, `hair`, `subsurface`, v3 `kdsubsurface`, `fourier`, `disney` | diffuse | the model |
+//! | `subsurface` | a dielectric boundary around a homogeneous medium (`media.rs`); diffuse inside a `mix` | the `reflectance` form |
+//! | `measured`, `hair`, v3 `kdsubsurface`, `fourier`, `disney` | diffuse | the model |
 //! | `interface`, `""`, `none` | no surface (the shape is skipped) | |
 //!
 //! Roughness: Sahara's is perceptual (`alpha = roughness^2`). pbrt-v4 maps

@@ -17,11 +17,9 @@ use std::sync::Arc;
 use glam::Vec3;
 use sahara_readers::FormatError;
 use sahara_render::Encoding;
-use sahara_render::{Bsdf, Camera, Environment, Light, Material, Shape, Texture, TextureMap};
+use sahara_render::{Camera, Environment, Material, Shape, Texture, TextureMap};
 
-use super::file::{
-    CameraSpec, EnvironmentSpec, LightSpec, MaterialKind, MaterialSpec, SceneFile, ShapeSpec,
-};
+use super::file::{CameraSpec, EnvironmentSpec, LightSpec, MaterialSpec, SceneFile, ShapeSpec};
 use crate::common::image::load_rgb_f32;
 use crate::common::materials::TextureCache;
 use crate::description::{
@@ -100,25 +98,17 @@ pub fn camera_of(c: &CameraSpec, aspect: f32) -> Camera {
         .with_shutter(c.shutter_open, c.shutter_close)
 }
 
-/// The renderer material of a `[[material]]` (a texture that cannot be
-/// read is a warning); its texture's alpha channel, if any, cuts out
-/// holes when the material's alpha mode says so.
+/// The renderer material of a `[[material]]`, with its texture if it has
+/// one (a texture that cannot be read is a warning); the texture's alpha
+/// channel, if any, cuts out holes when the material's alpha mode says so.
 fn material_of(
     m: &MaterialSpec,
     textures: &mut TextureCache,
     warnings: &mut Vec<String>,
     name: &str,
 ) -> Material {
-    let mut out = material_kind_of(m)
-        .with_two_sided(m.two_sided)
-        .with_alpha(m.alpha_mode, m.alpha);
-    let file = match &m.kind {
-        MaterialKind::Diffuse { texture, .. }
-        | MaterialKind::MetallicRoughness { texture, .. }
-        | MaterialKind::CoatedDiffuse { texture, .. } => texture.as_deref(),
-        _ => None,
-    };
-    if let Some(path) = file {
+    let mut out = m.material.clone();
+    if let Some(path) = &m.texture {
         let mut problems = Vec::new();
         out.textures.base_color = textures
             .file(path, Encoding::Srgb, &mut problems)
@@ -130,83 +120,6 @@ fn material_of(
         );
     }
     out
-}
-
-fn material_kind_of(m: &MaterialSpec) -> Material {
-    match &m.kind {
-        MaterialKind::ComplexConductor {
-            eta,
-            k,
-            roughness,
-            distribution,
-            multiple_scattering,
-        } => Material::new(Bsdf::ComplexConductor {
-            eta: *eta,
-            k: *k,
-            roughness: *roughness,
-            distribution: *distribution,
-            multiple_scattering: *multiple_scattering,
-        }),
-        MaterialKind::MetallicRoughness {
-            base_color,
-            metallic,
-            roughness,
-            ior,
-            specular,
-            specular_color,
-            ..
-        } => Material::new(Bsdf::MetallicRoughness {
-            base_color: *base_color,
-            metallic: *metallic,
-            roughness: *roughness,
-            ior: *ior,
-            specular: *specular,
-            specular_color: *specular_color,
-        }),
-        MaterialKind::CoatedDiffuse {
-            albedo,
-            ior,
-            roughness,
-            distribution,
-            ..
-        } => Material::new(Bsdf::CoatedDiffuse {
-            albedo: *albedo,
-            ior: *ior,
-            roughness: *roughness,
-            distribution: *distribution,
-        }),
-        MaterialKind::ThinDielectric { ior } => Material::new(Bsdf::ThinDielectric { ior: *ior }),
-        MaterialKind::Diffuse { albedo, .. } => Material::diffuse(*albedo),
-        MaterialKind::Conductor {
-            color,
-            roughness,
-            distribution,
-        } => Material::new(Bsdf::Conductor {
-            color: *color,
-            roughness: *roughness,
-            distribution: *distribution,
-        }),
-        MaterialKind::Mirror { color } => Material::mirror(*color),
-        MaterialKind::Dielectric { ior } => Material::glass(*ior),
-        MaterialKind::RoughDielectric {
-            ior,
-            roughness,
-            distribution,
-        } => Material::new(Bsdf::RoughDielectric {
-            ior: *ior,
-            roughness: *roughness,
-            distribution: *distribution,
-        }),
-        MaterialKind::Emission {
-            radiance,
-            two_sided,
-            albedo,
-        } => {
-            let mut out = Material::diffuse(*albedo).with_emission(*radiance);
-            out.two_sided_emission = *two_sided;
-            out
-        }
-    }
 }
 
 /// Adds a `[[light]]`: explicit lights, emissive shapes, or the environment.
@@ -221,25 +134,7 @@ fn add_light(
     name: &str,
 ) -> Result<(), FormatError> {
     match l {
-        LightSpec::Point {
-            position,
-            intensity,
-        } => desc.lights.push(Light::point(*position, *intensity)),
-        LightSpec::Spot {
-            position,
-            target,
-            intensity,
-            inner_deg,
-            outer_deg,
-        } => desc.lights.push(Light::spot(
-            *position, *target, *intensity, *inner_deg, *outer_deg,
-        )),
-        LightSpec::Directional {
-            direction,
-            irradiance,
-        } => desc
-            .lights
-            .push(Light::directional(*direction, *irradiance)),
+        LightSpec::Explicit(light) => desc.lights.push(*light),
         LightSpec::Area {
             shape,
             radiance,

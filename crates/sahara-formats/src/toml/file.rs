@@ -17,7 +17,7 @@
 //!
 //! [[material]]                   # named; objects refer to them by name
 //! name = "red"
-//! type = "diffuse"               # diffuse | conductor (alias glossy) | mirror | dielectric | rough_dielectric | emission
+//! type = "diffuse"               # a material kind: docs/scene-format.md lists them
 //! albedo = [0.6, 0.1, 0.1]
 //!
 //! [[object]]
@@ -27,7 +27,7 @@
 //! transform = { translate = [0, 0, 0], rotate = { axis = [0, 1, 0], degrees = 30 }, scale = 2 }
 //!
 //! [[light]]
-//! type = "point"                 # point | spot | directional | area | environment
+//! type = "point"                 # a light kind: docs/scene-format.md lists them
 //! position = [0, 5, 0]
 //! intensity = [10, 10, 10]
 //!
@@ -61,7 +61,7 @@ use std::path::PathBuf;
 
 use glam::{Mat4, Quat, Vec3};
 use sahara_render::{
-    Distribution, Filter, Integrator, Medium, MediumInterface, SamplerKind, Shape, ToneMap,
+    Filter, Integrator, Light, Material, Medium, MediumInterface, SamplerKind, Shape, ToneMap,
 };
 
 /// A parsed and checked scene file.
@@ -121,120 +121,11 @@ pub struct CameraSpec {
 pub struct MaterialSpec {
     /// The name objects use to refer to it (unique in the file).
     pub name: String,
-    /// What kind of material, with its parameters.
-    pub kind: MaterialKind,
-    /// Whether a reflector scatters light on both faces (`two_sided`,
-    /// default true; for `emission`, which uses the key for its emission,
-    /// always true).
-    pub two_sided: bool,
-    /// How opacity cuts the surface (`alpha_mode` `opaque`, `mask` with
-    /// `alpha_cutoff`, or `blend`; default opaque).
-    pub alpha_mode: sahara_render::AlphaMode,
-    /// Opacity in [0, 1], times the texture's alpha channel (`alpha`,
-    /// default 1).
-    pub alpha: f32,
-}
-
-/// The kinds of material and their parameters.
-#[derive(Clone, Debug, PartialEq)]
-pub enum MaterialKind {
-    /// Lambertian: `albedo` in [0, 1] (default 0.5 grey), optionally times an sRGB texture.
-    Diffuse {
-        /// Reflectance.
-        albedo: Vec3,
-        /// Texture file multiplying `albedo` (resolved; exists).
-        texture: Option<PathBuf>,
-    },
-    /// Rough metal (`type = "conductor"` or `"glossy"`): microfacets with
-    /// Schlick Fresnel.
-    Conductor {
-        /// Reflectance at normal incidence, in [0, 1].
-        color: Vec3,
-        /// Perceptual roughness in [0, 1].
-        roughness: f32,
-        /// `distribution` (default GGX).
-        distribution: Distribution,
-    },
-    /// A metal given by its complex index of refraction (`type =
-    /// "conductor"` with `metal = "gold"` or `eta` and `k`): microfacets
-    /// with the exact conductor Fresnel term.
-    ComplexConductor {
-        /// Real part of the index per RGB channel (> 0).
-        eta: Vec3,
-        /// Extinction coefficient per RGB channel (>= 0).
-        k: Vec3,
-        /// Perceptual roughness in [0, 1].
-        roughness: f32,
-        /// `distribution` (default GGX).
-        distribution: Distribution,
-        /// `multiple_scattering` (default true): add the light that
-        /// bounces between microfacets.
-        multiple_scattering: bool,
-    },
-    /// The glTF metallic-roughness model.
-    MetallicRoughness {
-        /// Base colour in [0, 1] (default 0.8 grey).
-        base_color: Vec3,
-        /// Texture file multiplying `base_color` (resolved; exists).
-        texture: Option<PathBuf>,
-        /// Metalness in [0, 1] (default 0).
-        metallic: f32,
-        /// Perceptual roughness in [0, 1] (default 0.5).
-        roughness: f32,
-        /// Index of refraction of the specular layer (>= 1, default 1.5).
-        ior: f32,
-        /// Strength of the specular layer in [0, 1] (default 1).
-        specular: f32,
-        /// Colour of the specular layer at normal incidence (default white).
-        specular_color: Vec3,
-    },
-    /// A diffuse base under a clear coat.
-    CoatedDiffuse {
-        /// Reflectance of the base in [0, 1] (default 0.5 grey).
-        albedo: Vec3,
-        /// Texture file multiplying `albedo` (resolved; exists).
-        texture: Option<PathBuf>,
-        /// Index of refraction of the coat (> 1, default 1.5).
-        ior: f32,
-        /// Perceptual roughness of the coat in [0, 1] (default 0.1).
-        roughness: f32,
-        /// `distribution` of the coat (default GGX).
-        distribution: Distribution,
-    },
-    /// A thin pane of glass.
-    ThinDielectric {
-        /// Index of refraction (> 0, default 1.5).
-        ior: f32,
-    },
-    /// A perfect mirror.
-    Mirror {
-        /// Reflectance at normal incidence, in [0, 1] (default 1).
-        color: Vec3,
-    },
-    /// Smooth glass.
-    Dielectric {
-        /// Index of refraction (> 0, default 1.5).
-        ior: f32,
-    },
-    /// Rough glass.
-    RoughDielectric {
-        /// Index of refraction (> 0, default 1.5).
-        ior: f32,
-        /// Perceptual roughness in [0, 1].
-        roughness: f32,
-        /// `distribution` (default GGX).
-        distribution: Distribution,
-    },
-    /// A light-emitting surface that also reflects diffusely with `albedo`
-    /// (default 0: black but for its emission).
-    Emission {
-        /// Emitted radiance (>= 0).
-        radiance: Vec3,
-        /// Emit from both faces (default: only the front).
-        two_sided: bool,
-        /// Lambertian reflectance in [0, 1] (default 0).
-        albedo: Vec3,
-    },
+    /// The material its kind built from its keys (without its texture).
+    pub material: Material,
+    /// The texture file (resolved; exists) multiplying its kind's
+    /// textured key (`texture`), if given.
+    pub texture: Option<PathBuf>,
 }
 
 /// `[[object]]`: a shape, its material and where it is.
@@ -325,33 +216,8 @@ impl TransformSpec {
 /// `[[light]]`.
 #[derive(Clone, Debug, PartialEq)]
 pub enum LightSpec {
-    /// An isotropic point light.
-    Point {
-        /// Position.
-        position: Vec3,
-        /// Radiant intensity (>= 0).
-        intensity: Vec3,
-    },
-    /// A spot light aimed at `target`, full inside `inner_deg`, dark beyond `outer_deg`.
-    Spot {
-        /// Position.
-        position: Vec3,
-        /// Point the cone's axis passes through (not `position`).
-        target: Vec3,
-        /// Radiant intensity on the axis (>= 0).
-        intensity: Vec3,
-        /// Half-angle where the falloff starts, degrees (default `outer_deg`).
-        inner_deg: f32,
-        /// Half-angle where the light ends, degrees, in (0, 180].
-        outer_deg: f32,
-    },
-    /// A distant light.
-    Directional {
-        /// Direction the light travels (non-zero).
-        direction: Vec3,
-        /// Irradiance on a surface facing the light (>= 0).
-        irradiance: Vec3,
-    },
+    /// A point, spot or directional light.
+    Explicit(Light),
     /// An emitting quad, disc or sphere.
     Area {
         /// The shape (never a mesh or box).

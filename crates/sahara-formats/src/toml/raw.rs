@@ -1,9 +1,10 @@
 //! The TOML shape of a scene file, as serde reads it, before any check.
 //!
 //! Every table rejects unknown keys. Values that are checked later are kept
-//! `Spanned` so an error can point at their line and column. Tables whose
-//! keys depend on a `type` (materials, objects, lights) list the union of
-//! all types' keys; which apply to which type is checked in `resolve`.
+//! `Spanned` so an error can point at their line and column. Objects list
+//! the union of their shapes' keys (which apply to which shape is checked
+//! in `resolve`); materials and lights are kept as tables of values, read
+//! through the renderer's descriptions of their kinds.
 
 use std::fmt;
 
@@ -24,11 +25,11 @@ pub(super) struct RawScene {
     pub sky: Opt<String>,
     pub camera: Option<Spanned<RawCamera>>,
     #[serde(default)]
-    pub material: Vec<Spanned<RawMaterial>>,
+    pub material: Vec<Spanned<RawDescribed>>,
     #[serde(default)]
     pub object: Vec<Spanned<RawObject>>,
     #[serde(default)]
-    pub light: Vec<Spanned<RawLight>>,
+    pub light: Vec<Spanned<RawDescribed>>,
     #[serde(default)]
     pub medium: Vec<Spanned<RawMedium>>,
     pub integrator: Option<Spanned<RawNamedTable>>,
@@ -74,59 +75,6 @@ pub(super) struct RawMedium {
     pub file: Opt<String>,
     pub min: Opt<V3>,
     pub max: Opt<V3>,
-}
-
-/// Material kinds (`type` of a `[[material]]`).
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub(super) enum MaterialType {
-    Diffuse,
-    #[serde(alias = "glossy")]
-    Conductor,
-    Mirror,
-    Dielectric,
-    RoughDielectric,
-    ThinDielectric,
-    MetallicRoughness,
-    CoatedDiffuse,
-    Emission,
-}
-
-/// `[[material]]`.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawMaterial {
-    pub name: Spanned<String>,
-    #[serde(rename = "type")]
-    pub kind: Spanned<MaterialType>,
-    pub albedo: Opt<V3>,
-    pub texture: Opt<String>,
-    pub color: Opt<V3>,
-    pub roughness: Opt<f32>,
-    pub distribution: Opt<String>,
-    pub ior: Opt<f32>,
-    pub radiance: Opt<V3>,
-    pub two_sided: Opt<bool>,
-    pub metal: Opt<String>,
-    pub eta: Opt<V3>,
-    pub k: Opt<V3>,
-    pub multiple_scattering: Opt<bool>,
-    pub base_color: Opt<V3>,
-    pub metallic: Opt<f32>,
-    pub specular: Opt<f32>,
-    pub specular_color: Opt<V3>,
-    pub alpha: Opt<f32>,
-    pub alpha_mode: Opt<AlphaModeName>,
-    pub alpha_cutoff: Opt<f32>,
-}
-
-/// `alpha_mode` of a `[[material]]`.
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub(super) enum AlphaModeName {
-    Opaque,
-    Mask,
-    Blend,
 }
 
 /// A setting's value read by its name in the renderer's name table, so an
@@ -233,44 +181,6 @@ pub(super) struct RawMotion {
     pub close: Spanned<RawTransform>,
 }
 
-/// Light kinds (`type` of a `[[light]]`).
-#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
-#[serde(rename_all = "snake_case")]
-pub(super) enum LightType {
-    Point,
-    Spot,
-    Directional,
-    Area,
-    Environment,
-}
-
-/// `[[light]]`.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct RawLight {
-    #[serde(rename = "type")]
-    pub kind: Spanned<LightType>,
-    pub position: Opt<V3>,
-    pub target: Opt<V3>,
-    pub direction: Opt<V3>,
-    pub intensity: Opt<V3>,
-    pub irradiance: Opt<V3>,
-    pub inner_angle: Opt<f32>,
-    pub outer_angle: Opt<f32>,
-    pub radiance: Opt<V3>,
-    pub two_sided: Opt<bool>,
-    pub shape: Opt<ShapeType>,
-    pub corner: Opt<V3>,
-    pub edge_u: Opt<V3>,
-    pub edge_v: Opt<V3>,
-    pub center: Opt<V3>,
-    pub normal: Opt<V3>,
-    pub radius: Opt<f32>,
-    pub map: Opt<String>,
-    pub scale: Opt<f32>,
-    pub material: Opt<String>,
-}
-
 /// `[sampler]`.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -286,6 +196,11 @@ pub(super) struct RawSampler {
 /// and the named filter's parameters, which the renderer lists), with the
 /// position of every value.
 pub(super) type RawNamedTable = std::collections::BTreeMap<String, Spanned<toml::Value>>;
+
+/// A table of a kind the renderer describes (`[[material]]`,
+/// `[[light]]`): `type`, the kind's keys and the few the reader reads
+/// itself, with the position of every value.
+pub(super) type RawDescribed = RawNamedTable;
 
 /// `[film]`.
 #[derive(Deserialize)]

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use sahara_readers::FormatError;
-use sahara_render::{defaults, Distribution};
+use sahara_render::defaults;
 use sahara_render::{
     Adaptive, Filter, FilterKind, Integrator, IntegratorKind, Named, Parameter, SamplerKind, Shape,
     ShapeKind, ToneMap,
@@ -18,6 +18,7 @@ use super::raw::*;
 use crate::description::Sky;
 use crate::output::image::ImageFormat;
 
+mod kinds;
 mod media;
 
 /// Largest film width or height.
@@ -50,13 +51,17 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
     let materials = raw
         .material
         .iter()
-        .map(|m| ctx.material(m.get_ref()))
+        .map(|m| ctx.material(m))
         .collect::<Result<Vec<_>, _>>()?;
     let mut seen = HashSet::new();
     for (m, raw_m) in materials.iter().zip(&raw.material) {
         if !seen.insert(m.name.as_str()) {
+            let at = raw_m
+                .get_ref()
+                .get("name")
+                .map_or(raw_m.span(), Spanned::span);
             return Err(ctx.at(
-                raw_m.get_ref().name.span(),
+                at,
                 format!("a material named '{}' is already defined", m.name),
             ));
         }
@@ -89,12 +94,12 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
         .iter()
         .map(|l| ctx.light(l, &seen))
         .collect::<Result<Vec<_>, _>>()?;
-    let environments: Vec<_> = raw
-        .light
+    let environments: Vec<_> = lights
         .iter()
-        .filter(|l| *l.get_ref().kind.get_ref() == LightType::Environment)
+        .zip(&raw.light)
+        .filter(|(l, _)| matches!(l, LightSpec::Environment(_)))
         .collect();
-    if let Some(second) = environments.get(1) {
+    if let Some((_, second)) = environments.get(1) {
         return Err(ctx.at(second.span(), "a scene has at most one environment light"));
     }
     Ok(SceneFile {
@@ -261,18 +266,6 @@ impl Ctx<'_> {
         Ok(v)
     }
 
-    /// A colour with every component in `[0, 1]`, or `default`.
-    fn reflectance(&self, value: &Opt<V3>, key: &str, default: Vec3) -> Result<Vec3, FormatError> {
-        let v = self.vec_or(value, key, default)?;
-        if v.min_element() < 0.0 || v.max_element() > 1.0 {
-            return Err(self.at(
-                span(value).unwrap_or(0..0),
-                format!("`{key}` {v} must have every component between 0 and 1"),
-            ));
-        }
-        Ok(v)
-    }
-
     /// A colour with every component `>= 0`.
     fn power(&self, value: &Spanned<V3>, key: &str) -> Result<Vec3, FormatError> {
         let v = self.vec(value, key)?;
@@ -398,299 +391,6 @@ impl Ctx<'_> {
             )?,
             shutter_open,
             shutter_close,
-        })
-    }
-
-    /// `[[material]]`.
-    ///
-    /// One piece on purpose: it is the scene file's one material table, an arm per kind, each mapping its
-    /// parameters onto Sahara's; it becomes one mapping per kind family when
-    /// materials and lights are kinds the renderer describes.
-    fn material(&self, m: &RawMaterial) -> Result<MaterialSpec, FormatError> {
-        let kind = *m.kind.get_ref();
-        let what = format!("a {} material", type_name(&m.kind));
-        let present = [
-            ("albedo", span(&m.albedo)),
-            ("texture", span(&m.texture)),
-            ("color", span(&m.color)),
-            ("roughness", span(&m.roughness)),
-            ("distribution", span(&m.distribution)),
-            ("ior", span(&m.ior)),
-            ("radiance", span(&m.radiance)),
-            ("two_sided", span(&m.two_sided)),
-            ("metal", span(&m.metal)),
-            ("eta", span(&m.eta)),
-            ("k", span(&m.k)),
-            ("multiple_scattering", span(&m.multiple_scattering)),
-            ("base_color", span(&m.base_color)),
-            ("metallic", span(&m.metallic)),
-            ("specular", span(&m.specular)),
-            ("specular_color", span(&m.specular_color)),
-            ("alpha", span(&m.alpha)),
-            ("alpha_mode", span(&m.alpha_mode)),
-            ("alpha_cutoff", span(&m.alpha_cutoff)),
-        ];
-        let allowed: &[&str] = match kind {
-            MaterialType::Diffuse => &["albedo", "texture", "two_sided"],
-            MaterialType::Conductor => &[
-                "color",
-                "metal",
-                "eta",
-                "k",
-                "multiple_scattering",
-                "roughness",
-                "distribution",
-                "two_sided",
-            ],
-            MaterialType::Mirror => &["color", "two_sided"],
-            MaterialType::Dielectric => &["ior"],
-            MaterialType::RoughDielectric => &["ior", "roughness", "distribution"],
-            MaterialType::ThinDielectric => &["ior"],
-            MaterialType::MetallicRoughness => &[
-                "base_color",
-                "texture",
-                "metallic",
-                "roughness",
-                "ior",
-                "specular",
-                "specular_color",
-                "two_sided",
-            ],
-            MaterialType::CoatedDiffuse => &[
-                "albedo",
-                "texture",
-                "ior",
-                "roughness",
-                "distribution",
-                "two_sided",
-            ],
-            MaterialType::Emission => &["radiance", "two_sided", "albedo"],
-        };
-        let with_alpha: Vec<&str>;
-        let allowed = if matches!(
-            kind,
-            MaterialType::Diffuse
-                | MaterialType::Conductor
-                | MaterialType::Mirror
-                | MaterialType::MetallicRoughness
-                | MaterialType::CoatedDiffuse
-        ) {
-            with_alpha = allowed
-                .iter()
-                .copied()
-                .chain(["alpha", "alpha_mode", "alpha_cutoff"])
-                .collect();
-            &with_alpha[..]
-        } else {
-            allowed
-        };
-        self.only(&present, allowed, &what)?;
-        if m.name.get_ref().is_empty() {
-            return Err(self.at(m.name.span(), "a material name must not be empty"));
-        }
-        let roughness = |default| {
-            self.number(
-                &m.roughness,
-                "roughness",
-                default,
-                |r| (0.0..=1.0).contains(&r),
-                "between 0 and 1",
-            )
-        };
-        let distribution = self.distribution(&m.distribution)?;
-        let ior = || self.number(&m.ior, "ior", 1.5, |n| n > 0.0, "greater than 0");
-        let texture = || {
-            m.texture
-                .as_ref()
-                .map(|t| self.file(t, "texture"))
-                .transpose()
-        };
-        let unit = |value: &Opt<f32>, key: &str, default: f32| {
-            self.number(
-                value,
-                key,
-                default,
-                |x| (0.0..=1.0).contains(&x),
-                "between 0 and 1",
-            )
-        };
-        let kind = match kind {
-            MaterialType::Diffuse => MaterialKind::Diffuse {
-                albedo: self.reflectance(&m.albedo, "albedo", Vec3::splat(0.5))?,
-                texture: texture()?,
-            },
-            MaterialType::Conductor => self.conductor(m, roughness(0.2)?, distribution)?,
-            MaterialType::Mirror => MaterialKind::Mirror {
-                color: self.reflectance(&m.color, "color", Vec3::ONE)?,
-            },
-            MaterialType::Dielectric => MaterialKind::Dielectric { ior: ior()? },
-            MaterialType::RoughDielectric => MaterialKind::RoughDielectric {
-                ior: ior()?,
-                roughness: roughness(0.2)?,
-                distribution,
-            },
-            MaterialType::ThinDielectric => MaterialKind::ThinDielectric { ior: ior()? },
-            MaterialType::MetallicRoughness => MaterialKind::MetallicRoughness {
-                base_color: self.reflectance(&m.base_color, "base_color", Vec3::splat(0.8))?,
-                texture: texture()?,
-                metallic: unit(&m.metallic, "metallic", 0.0)?,
-                roughness: roughness(0.5)?,
-                ior: self.number(&m.ior, "ior", 1.5, |n| n >= 1.0, "at least 1")?,
-                specular: unit(&m.specular, "specular", 1.0)?,
-                specular_color: self.reflectance(&m.specular_color, "specular_color", Vec3::ONE)?,
-            },
-            MaterialType::CoatedDiffuse => MaterialKind::CoatedDiffuse {
-                albedo: self.reflectance(&m.albedo, "albedo", Vec3::splat(0.5))?,
-                texture: texture()?,
-                ior: self.number(&m.ior, "ior", 1.5, |n| n > 1.0, "greater than 1")?,
-                roughness: roughness(0.1)?,
-                distribution,
-            },
-            MaterialType::Emission => MaterialKind::Emission {
-                radiance: self.power(
-                    self.required(&m.radiance, "radiance", &m.kind.span(), &what)?,
-                    "radiance",
-                )?,
-                two_sided: m.two_sided.as_ref().is_some_and(|b| *b.get_ref()),
-                albedo: self.reflectance(&m.albedo, "albedo", Vec3::ZERO)?,
-            },
-        };
-        let two_sided = kind_uses_two_sided_for_scattering(&kind)
-            .then(|| m.two_sided.as_ref().map(|b| *b.get_ref()))
-            .flatten()
-            .unwrap_or(true);
-        let alpha = self.number(
-            &m.alpha,
-            "alpha",
-            1.0,
-            |a| (0.0..=1.0).contains(&a),
-            "between 0 and 1",
-        )?;
-        let cutoff = self.number(
-            &m.alpha_cutoff,
-            "alpha_cutoff",
-            0.5,
-            |a| (0.0..=1.0).contains(&a),
-            "between 0 and 1",
-        )?;
-        let alpha_mode = match m.alpha_mode.as_ref().map(|a| *a.get_ref()) {
-            None | Some(AlphaModeName::Opaque) => sahara_render::AlphaMode::Opaque,
-            Some(AlphaModeName::Mask) => sahara_render::AlphaMode::Mask { cutoff },
-            Some(AlphaModeName::Blend) => sahara_render::AlphaMode::Blend,
-        };
-        if let (Some(c), false) = (
-            &m.alpha_cutoff,
-            matches!(alpha_mode, sahara_render::AlphaMode::Mask { .. }),
-        ) {
-            return Err(self.at(
-                c.span(),
-                "`alpha_cutoff` applies to `alpha_mode = \"mask\"` only",
-            ));
-        }
-        Ok(MaterialSpec {
-            name: m.name.get_ref().clone(),
-            kind,
-            two_sided,
-            alpha_mode,
-            alpha,
-        })
-    }
-
-    /// A material's microfacet `distribution` (`ggx` if absent).
-    fn distribution(&self, value: &Opt<String>) -> Result<Distribution, FormatError> {
-        let Some(v) = value else {
-            return Ok(Distribution::Ggx);
-        };
-        Distribution::from_name(v.get_ref()).ok_or_else(|| {
-            let names: Vec<_> = Distribution::ALL.iter().map(|d| d.name()).collect();
-            self.at(
-                v.span(),
-                format!(
-                    "no microfacet distribution is named '{}' (known: {})",
-                    v.get_ref(),
-                    names.join(", ")
-                ),
-            )
-        })
-    }
-
-    /// A `conductor`: by `color` (Schlick), by a `metal` preset, or by
-    /// `eta` and `k`; one of the three at most (default: `color`).
-    fn conductor(
-        &self,
-        m: &RawMaterial,
-        roughness: f32,
-        distribution: Distribution,
-    ) -> Result<MaterialKind, FormatError> {
-        let given = [
-            ("color", span(&m.color)),
-            ("metal", span(&m.metal)),
-            ("eta", span(&m.eta).or(span(&m.k))),
-        ];
-        let multiple_scattering = m.multiple_scattering.as_ref().is_none_or(|b| *b.get_ref());
-        let mut seen = given.iter().filter_map(|(k, s)| s.clone().map(|s| (*k, s)));
-        if let (Some((a, _)), Some((b, at))) = (seen.next(), seen.next()) {
-            return Err(self.at(
-                at,
-                format!("a conductor has `{a}` or `{b}`, not both (`eta` and `k` go together)"),
-            ));
-        }
-        if let Some(name) = &m.metal {
-            let Some((eta, k)) = sahara_render::metals::preset(name.get_ref()) else {
-                return Err(self.at(
-                    name.span(),
-                    format!(
-                        "no metal is named '{}' (known: {})",
-                        name.get_ref(),
-                        sahara_render::metals::PRESETS.join(", ")
-                    ),
-                ));
-            };
-            return Ok(MaterialKind::ComplexConductor {
-                eta,
-                k,
-                roughness,
-                distribution,
-                multiple_scattering,
-            });
-        }
-        if m.eta.is_some() || m.k.is_some() {
-            let what = "a conductor given by its index";
-            let entry = m.kind.span();
-            let eta = self.vec(self.required(&m.eta, "eta", &entry, what)?, "eta")?;
-            let k = self.vec(self.required(&m.k, "k", &entry, what)?, "k")?;
-            if eta.min_element() <= 0.0 {
-                return Err(self.at(
-                    span(&m.eta).unwrap_or(entry),
-                    format!("`eta` {eta} must be greater than 0"),
-                ));
-            }
-            if k.min_element() < 0.0 {
-                return Err(self.at(
-                    span(&m.k).unwrap_or(entry),
-                    format!("`k` {k} must not be negative"),
-                ));
-            }
-            return Ok(MaterialKind::ComplexConductor {
-                eta,
-                k,
-                roughness,
-                distribution,
-                multiple_scattering,
-            });
-        }
-        if let Some(at) = span(&m.multiple_scattering) {
-            return Err(self.at(
-                at,
-                "`multiple_scattering` applies to a conductor given by `metal` or by `eta` and `k` \
-                 (the `color` form scatters once)"
-                    .to_string(),
-            ));
-        }
-        Ok(MaterialKind::Conductor {
-            color: self.reflectance(&m.color, "color", Vec3::splat(0.9))?,
-            roughness,
-            distribution,
         })
     }
 
@@ -891,157 +591,6 @@ impl Ctx<'_> {
         })
     }
 
-    /// `[[light]]`.
-    ///
-    /// One piece on purpose: it is the scene file's one light table, an arm per kind, each mapping its
-    /// parameters onto Sahara's; it becomes one mapping per kind family when
-    /// materials and lights are kinds the renderer describes.
-    fn light(
-        &self,
-        raw: &Spanned<RawLight>,
-        materials: &HashSet<&str>,
-    ) -> Result<LightSpec, FormatError> {
-        let l = raw.get_ref();
-        let entry = raw.span();
-        let what = format!("a {} light", type_name(&l.kind));
-        let present = [
-            ("position", span(&l.position)),
-            ("target", span(&l.target)),
-            ("direction", span(&l.direction)),
-            ("intensity", span(&l.intensity)),
-            ("irradiance", span(&l.irradiance)),
-            ("inner_angle", span(&l.inner_angle)),
-            ("outer_angle", span(&l.outer_angle)),
-            ("radiance", span(&l.radiance)),
-            ("two_sided", span(&l.two_sided)),
-            ("shape", span(&l.shape)),
-            ("map", span(&l.map)),
-            ("scale", span(&l.scale)),
-            ("material", span(&l.material)),
-        ];
-        let allowed: &[&str] = match l.kind.get_ref() {
-            LightType::Point => &["position", "intensity"],
-            LightType::Spot => &[
-                "position",
-                "target",
-                "intensity",
-                "inner_angle",
-                "outer_angle",
-            ],
-            LightType::Directional => &["direction", "irradiance"],
-            LightType::Area => &[
-                "shape",
-                "radiance",
-                "two_sided",
-                "material",
-                "corner",
-                "edge_u",
-                "edge_v",
-                "center",
-                "normal",
-                "radius",
-            ],
-            LightType::Environment => &["radiance", "map", "scale"],
-        };
-        self.only(&present, allowed, &what)?;
-        if *l.kind.get_ref() != LightType::Area {
-            let shape_keys = [
-                ("corner", span(&l.corner)),
-                ("edge_u", span(&l.edge_u)),
-                ("edge_v", span(&l.edge_v)),
-                ("center", span(&l.center)),
-                ("normal", span(&l.normal)),
-                ("radius", span(&l.radius)),
-            ];
-            self.only(&shape_keys, allowed, &what)?;
-        }
-        let need = |value: &'_ Opt<V3>, key: &str| -> Result<Vec3, FormatError> {
-            self.vec(self.required(value, key, &entry, &what)?, key)
-        };
-        let need_power = |value: &'_ Opt<V3>, key: &str| -> Result<Vec3, FormatError> {
-            self.power(self.required(value, key, &entry, &what)?, key)
-        };
-        Ok(match l.kind.get_ref() {
-            LightType::Point => LightSpec::Point {
-                position: need(&l.position, "position")?,
-                intensity: need_power(&l.intensity, "intensity")?,
-            },
-            LightType::Spot => {
-                let position = need(&l.position, "position")?;
-                let target_raw = self.required(&l.target, "target", &entry, &what)?;
-                let target = self.vec(target_raw, "target")?;
-                if target == position {
-                    return Err(self.at(target_raw.span(), "a spot light's target must differ from its position"));
-                }
-                let outer = self.required(&l.outer_angle, "outer_angle", &entry, &what)?;
-                let outer_deg = self.number(&l.outer_angle, "outer_angle", 0.0, |a| a > 0.0 && a <= 180.0, "in (0, 180] degrees")
-                    .map_err(|_| self.at(outer.span(), format!("`outer_angle` is {} but must be in (0, 180] degrees", outer.get_ref())))?;
-                LightSpec::Spot {
-                    position,
-                    target,
-                    intensity: need_power(&l.intensity, "intensity")?,
-                    inner_deg: self.number(&l.inner_angle, "inner_angle", outer_deg, |a| (0.0..=outer_deg).contains(&a), "between 0 and outer_angle")?,
-                    outer_deg,
-                }
-            }
-            LightType::Directional => LightSpec::Directional {
-                direction: self.direction(self.required(&l.direction, "direction", &entry, &what)?, "direction")?,
-                irradiance: need_power(&l.irradiance, "irradiance")?,
-            },
-            LightType::Area => {
-                let kind = self.required(&l.shape, "shape", &entry, &what)?;
-                if matches!(kind.get_ref(), ShapeType::Mesh | ShapeType::Builtin(ShapeKind::Box)) {
-                    return Err(self.at(kind.span(), "an area light's shape is quad, disc or sphere (for an emitting mesh, give the object an emission material)"));
-                }
-                let keys = ShapeKeys {
-                    file: &None,
-                    corner: &l.corner,
-                    edge_u: &l.edge_u,
-                    edge_v: &l.edge_v,
-                    center: &l.center,
-                    normal: &l.normal,
-                    radius: &l.radius,
-                    min: &None,
-                    max: &None,
-                };
-                if let Some(m) = &l.material {
-                    if !materials.contains(m.get_ref().as_str()) {
-                        return Err(self.at(m.span(), format!("no [[material]] is named '{}'", m.get_ref())));
-                    }
-                }
-                LightSpec::Area {
-                    shape: self.shape(*kind.get_ref(), &entry, &keys, &format!("{what} ({})", kind.get_ref()))?,
-                    radiance: need_power(&l.radiance, "radiance")?,
-                    two_sided: l.two_sided.as_ref().is_some_and(|b| *b.get_ref()),
-                    material: l.material.as_ref().map(|m| m.get_ref().clone()),
-                }
-            }
-            LightType::Environment => match (&l.radiance, &l.map) {
-                (Some(r), None) => {
-                    if l.scale.is_some() {
-                        return Err(self.at(span(&l.scale).unwrap_or(entry), "`scale` applies only to an environment `map`"));
-                    }
-                    LightSpec::Environment(EnvironmentSpec::Constant(self.power(r, "radiance")?))
-                }
-                (None, Some(m)) => {
-                    let path = self.file(m, "environment map")?;
-                    let extension = path
-                        .extension()
-                        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-                        .unwrap_or_default();
-                    if !["hdr", "exr", "png", "jpg", "jpeg"].contains(&extension.as_str()) {
-                        return Err(self.at(m.span(), format!("environment map '{}' is not .hdr, .exr, .png or .jpg", m.get_ref())));
-                    }
-                    LightSpec::Environment(EnvironmentSpec::Map {
-                        path,
-                        scale: self.number(&l.scale, "scale", 1.0, |s| s > 0.0, "greater than 0")?,
-                    })
-                }
-                _ => return Err(self.at(entry, "an environment light needs exactly one of `radiance` (a constant colour) or `map` (an image file)")),
-            },
-        })
-    }
-
     /// `[integrator]`: `name` and the parameters the renderer lists for
     /// that integrator ([`IntegratorKind::parameters`]), so a new
     /// integrator or parameter needs no change here.
@@ -1217,27 +766,4 @@ struct ShapeKeys<'r> {
     radius: &'r Opt<f32>,
     min: &'r Opt<V3>,
     max: &'r Opt<V3>,
-}
-
-/// The snake_case name of a `type`/`name` value, as written in the file.
-/// True for the kinds whose `two_sided` key means "scatter on both
-/// faces" (emission uses it for its emission).
-fn kind_uses_two_sided_for_scattering(kind: &MaterialKind) -> bool {
-    !matches!(kind, MaterialKind::Emission { .. })
-}
-
-fn type_name<T: std::fmt::Debug>(value: &Spanned<T>) -> String {
-    let debug = format!("{:?}", value.get_ref());
-    let mut out = String::new();
-    for (i, c) in debug.chars().enumerate() {
-        if c.is_ascii_uppercase() {
-            if i > 0 {
-                out.push('_');
-            }
-            out.push(c.to_ascii_lowercase());
-        } else {
-            out.push(c);
-        }
-    }
-    out
 }

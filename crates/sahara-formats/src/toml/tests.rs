@@ -5,7 +5,9 @@ use std::path::{Path, PathBuf};
 use super::file::*;
 use super::{load_scene_file, parse_scene_file};
 use glam::{Mat4, Quat, Vec3};
-use sahara_render::{Distribution, Filter, Integrator, SamplerKind, Shape, ToneMap};
+use sahara_render::{
+    Bsdf, Distribution, Filter, Integrator, Light, Material, SamplerKind, Shape, ToneMap,
+};
 
 use super::test_helpers::TempDir;
 
@@ -169,66 +171,30 @@ fn a_complete_scene_parses_into_the_expected_values() {
             shutter_close: 0.75,
         }
     );
+    let spec = |name: &str, material: Material, texture: Option<PathBuf>| MaterialSpec {
+        name: name.into(),
+        material,
+        texture,
+    };
+    let mut lamp = Material::emitter(Vec3::new(5., 5., 4.));
+    lamp.two_sided_emission = true;
     assert_eq!(
         s.materials,
         vec![
-            MaterialSpec {
-                name: "wood".into(),
-                kind: MaterialKind::Diffuse {
-                    albedo: Vec3::new(0.6, 0.4, 0.2),
-                    texture: Some(at("wood.png"))
-                },
-                two_sided: true,
-                alpha_mode: sahara_render::AlphaMode::Opaque,
-                alpha: 1.0
-            },
-            MaterialSpec {
-                name: "gold".into(),
-                kind: MaterialKind::Conductor {
-                    color: Vec3::new(1.0, 0.8, 0.3),
-                    roughness: 0.1,
-                    distribution: Distribution::Ggx,
-                },
-                two_sided: true,
-                alpha_mode: sahara_render::AlphaMode::Opaque,
-                alpha: 1.0
-            },
-            MaterialSpec {
-                name: "mirror".into(),
-                kind: MaterialKind::Mirror { color: Vec3::ONE },
-                two_sided: true,
-                alpha_mode: sahara_render::AlphaMode::Opaque,
-                alpha: 1.0
-            },
-            MaterialSpec {
-                name: "glass".into(),
-                kind: MaterialKind::Dielectric { ior: 1.33 },
-                two_sided: true,
-                alpha_mode: sahara_render::AlphaMode::Opaque,
-                alpha: 1.0
-            },
-            MaterialSpec {
-                name: "frosted".into(),
-                kind: MaterialKind::RoughDielectric {
-                    ior: 1.5,
-                    roughness: 0.4,
-                    distribution: Distribution::Ggx,
-                },
-                two_sided: true,
-                alpha_mode: sahara_render::AlphaMode::Opaque,
-                alpha: 1.0
-            },
-            MaterialSpec {
-                name: "lamp".into(),
-                kind: MaterialKind::Emission {
-                    radiance: Vec3::new(5., 5., 4.),
-                    two_sided: true,
-                    albedo: Vec3::ZERO
-                },
-                two_sided: true,
-                alpha_mode: sahara_render::AlphaMode::Opaque,
-                alpha: 1.0
-            },
+            spec(
+                "wood",
+                Material::diffuse(Vec3::new(0.6, 0.4, 0.2)),
+                Some(at("wood.png"))
+            ),
+            spec(
+                "gold",
+                Material::conductor(Vec3::new(1.0, 0.8, 0.3), 0.1),
+                None
+            ),
+            spec("mirror", Material::mirror(Vec3::ONE), None),
+            spec("glass", Material::glass(1.33), None),
+            spec("frosted", Material::rough_glass(1.5, 0.4), None),
+            spec("lamp", lamp, None),
         ]
     );
 
@@ -298,13 +264,13 @@ fn a_complete_scene_parses_into_the_expected_values() {
     assert_eq!(s.lights.len(), 5);
     assert_eq!(
         s.lights[1],
-        LightSpec::Spot {
-            position: Vec3::new(0., 4., 0.),
-            target: Vec3::ZERO,
-            intensity: Vec3::splat(20.),
-            inner_deg: 20.,
-            outer_deg: 30.
-        }
+        LightSpec::Explicit(Light::spot(
+            Vec3::new(0., 4., 0.),
+            Vec3::ZERO,
+            Vec3::splat(20.),
+            20.,
+            30.
+        ))
     );
     assert!(matches!(
         &s.lights[3],
@@ -650,11 +616,11 @@ fn every_example_scene_loads() {
     assert!(cornell
         .materials
         .iter()
-        .any(|m| matches!(m.kind, MaterialKind::Conductor { roughness, .. } if roughness > 0.0)));
+        .any(|m| matches!(m.material.bsdf, Bsdf::Conductor { roughness, .. } if roughness > 0.0)));
     assert!(cornell
         .materials
         .iter()
-        .any(|m| matches!(m.kind, MaterialKind::Dielectric { .. })));
+        .any(|m| matches!(m.material.bsdf, Bsdf::Dielectric { .. })));
     assert!(matches!(
         cornell.integrator,
         Integrator::Distribution { .. }
@@ -687,10 +653,9 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
          [[material]]\nname = \"f\"\ntype = \"conductor\"\neta = [0.2, 0.9, 1.1]\nk = [3.9, 2.4, 2.1]\nmultiple_scattering = false\n",
     );
     assert_eq!(
-        m[0].kind,
-        MaterialKind::MetallicRoughness {
+        m[0].material.bsdf,
+        Bsdf::MetallicRoughness {
             base_color: Vec3::splat(0.8),
-            texture: None,
             metallic: 0.0,
             roughness: 0.5,
             ior: 1.5,
@@ -698,12 +663,11 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
             specular_color: Vec3::ONE,
         }
     );
-    assert!(m[0].two_sided);
+    assert!(m[0].material.two_sided);
     assert_eq!(
-        m[1].kind,
-        MaterialKind::MetallicRoughness {
+        m[1].material.bsdf,
+        Bsdf::MetallicRoughness {
             base_color: Vec3::X,
-            texture: None,
             metallic: 1.0,
             roughness: 0.3,
             ior: 1.4,
@@ -711,24 +675,23 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
             specular_color: Vec3::Y,
         }
     );
-    assert!(!m[1].two_sided);
-    assert_eq!(m[0].alpha_mode, sahara_render::AlphaMode::Opaque);
-    assert_eq!(m[0].alpha, 1.0);
+    assert!(!m[1].material.two_sided);
+    assert_eq!(m[0].material.alpha_mode, sahara_render::AlphaMode::Opaque);
+    assert_eq!(m[0].material.alpha, 1.0);
     assert_eq!(
-        m[2].kind,
-        MaterialKind::CoatedDiffuse {
+        m[2].material.bsdf,
+        Bsdf::CoatedDiffuse {
             albedo: Vec3::splat(0.5),
-            texture: None,
             ior: 1.5,
             roughness: 0.1,
             distribution: Distribution::Ggx,
         }
     );
-    assert_eq!(m[3].kind, MaterialKind::ThinDielectric { ior: 1.52 });
+    assert_eq!(m[3].material.bsdf, Bsdf::ThinDielectric { ior: 1.52 });
     let (eta, k) = sahara_render::metals::preset("gold").unwrap();
     assert_eq!(
-        m[4].kind,
-        MaterialKind::ComplexConductor {
+        m[4].material.bsdf,
+        Bsdf::ComplexConductor {
             eta,
             k,
             roughness: 0.1,
@@ -737,8 +700,8 @@ fn layered_conductor_and_thin_materials_parse_with_defaults() {
         }
     );
     assert_eq!(
-        m[5].kind,
-        MaterialKind::ComplexConductor {
+        m[5].material.bsdf,
+        Bsdf::ComplexConductor {
             eta: Vec3::new(0.2, 0.9, 1.1),
             k: Vec3::new(3.9, 2.4, 2.1),
             roughness: 0.2,
@@ -802,11 +765,11 @@ fn rough_materials_take_a_microfacet_distribution() {
     );
     let dist: Vec<_> = m
         .iter()
-        .map(|m| match m.kind {
-            MaterialKind::ComplexConductor { distribution, .. }
-            | MaterialKind::RoughDielectric { distribution, .. }
-            | MaterialKind::CoatedDiffuse { distribution, .. }
-            | MaterialKind::Conductor { distribution, .. } => distribution,
+        .map(|m| match m.material.bsdf {
+            Bsdf::ComplexConductor { distribution, .. }
+            | Bsdf::RoughDielectric { distribution, .. }
+            | Bsdf::CoatedDiffuse { distribution, .. }
+            | Bsdf::Conductor { distribution, .. } => distribution,
             ref other => panic!("{other:?}"),
         })
         .collect();
@@ -816,7 +779,7 @@ fn rough_materials_take_a_microfacet_distribution() {
         "[[material]]\nname = \"m\"\ntype = \"conductor\"\ndistribution = \"phong\"\n",
     ));
     assert!(
-        m.contains("line 10:") && m.contains("'phong' (known: ggx, beckmann)"),
+        m.contains("line 10:") && m.contains("'phong'; expected ggx or beckmann"),
         "{m}"
     );
     let m = error_of(&with_head(
@@ -832,11 +795,11 @@ fn alpha_keys_parse_and_apply_to_reflectors_only() {
          [[material]]\nname = \"veil\"\ntype = \"metallic_roughness\"\nalpha_mode = \"blend\"\nalpha = 0.25\n",
     );
     assert_eq!(
-        m[0].alpha_mode,
+        m[0].material.alpha_mode,
         sahara_render::AlphaMode::Mask { cutoff: 0.3 }
     );
-    assert_eq!(m[1].alpha_mode, sahara_render::AlphaMode::Blend);
-    assert_eq!(m[1].alpha, 0.25);
+    assert_eq!(m[1].material.alpha_mode, sahara_render::AlphaMode::Blend);
+    assert_eq!(m[1].material.alpha, 0.25);
     let e = error_of(&with_head(
         "[[material]]\nname = \"m\"\ntype = \"dielectric\"\nalpha = 0.5\n",
     ));
@@ -962,4 +925,66 @@ fn bad_media_are_errors_at_the_value() {
         m.contains("short.vol: byte 48:") && m.contains("needs 80 bytes"),
         "{m}"
     );
+}
+
+/// The keys of a family of described kinds as `docs/scene-format.md`
+/// lists them: a row per key, from the renderer's table (`image`: what
+/// the file's key for an image does to the textured key).
+fn keys_table<K: sahara_render::Named + std::fmt::Display>(
+    keys: fn(K) -> &'static [sahara_render::Key],
+    image: &str,
+) -> String {
+    let mut out = String::from(
+        "| `type` | key | takes | default | what it is |\n| --- | --- | --- | --- | --- |\n",
+    );
+    for &kind in K::ALL {
+        for (i, k) in keys(kind).iter().enumerate() {
+            let ty = if i == 0 {
+                format!("`{kind}`")
+            } else {
+                String::new()
+            };
+            let default = match k.default_text().as_str() {
+                "" => "none".to_string(),
+                "required" => "required".to_string(),
+                d => format!("`{d}`"),
+            };
+            let about = if k.textured {
+                format!("{}; {image}", k.about)
+            } else {
+                k.about.to_string()
+            };
+            out += &format!(
+                "| {ty} | `{}` | {} | {default} | {about} |\n",
+                k.name,
+                k.type_text()
+            );
+        }
+    }
+    out
+}
+
+/// The document's tables of material and light keys are the renderer's
+/// (regenerate them from this test's message when a kind changes).
+#[test]
+fn the_documented_keys_are_the_described_kinds() {
+    let doc = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/scene-format.md"),
+    )
+    .unwrap();
+    for table in [
+        keys_table(
+            sahara_render::MaterialKind::keys,
+            "times `texture`, an image file, if given",
+        ),
+        keys_table(
+            sahara_render::LightKind::keys,
+            "or instead `map`, a lat-long image file (`.hdr`, `.exr`, `.png`, `.jpg`)",
+        ),
+    ] {
+        assert!(
+            doc.contains(&table),
+            "docs/scene-format.md should hold this table:\n{table}"
+        );
+    }
 }

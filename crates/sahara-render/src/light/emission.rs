@@ -118,10 +118,11 @@ impl AreaLight {
 impl LightSource {
     /// True for the lights at infinity (environment, directional).
     pub(crate) fn is_infinite(&self) -> bool {
-        matches!(
-            self,
-            LightSource::Environment(_) | LightSource::Explicit(Light::Directional { .. })
-        )
+        match self {
+            LightSource::Environment(_) | LightSource::Explicit(Light::Directional { .. }) => true,
+            LightSource::Explicit(Light::Point { .. } | Light::Spot { .. })
+            | LightSource::Area(_) => false,
+        }
     }
 
     /// Light leaving this light: position from `u_pos`, direction from

@@ -5,6 +5,7 @@ pub mod area;
 pub mod directional;
 pub(crate) mod emission;
 pub mod environment;
+mod kinds;
 pub mod point;
 pub mod spot;
 
@@ -12,6 +13,7 @@ use glam::Vec3;
 
 pub use area::AreaLight;
 pub use environment::{EnvLight, Environment};
+pub use kinds::{LightKind, LightOf, AREA_SHAPES};
 
 /// A light given explicitly (area lights come from emissive materials).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,6 +82,22 @@ impl Light {
             irradiance,
         }
     }
+
+    /// Emitted power (luminance), by which lights are chosen and a
+    /// scene's own lights measured; a directional light's is what falls
+    /// on a disc of `scene_radius`.
+    pub fn power(&self, scene_radius: f32) -> f32 {
+        match *self {
+            Light::Point { intensity, .. } => point::power(intensity),
+            Light::Spot {
+                intensity,
+                cos_inner,
+                cos_outer,
+                ..
+            } => spot::power(intensity, cos_inner, cos_outer),
+            Light::Directional { irradiance, .. } => directional::power(irradiance, scene_radius),
+        }
+    }
 }
 
 /// Light arriving at a point from a sampled direction.
@@ -142,22 +160,16 @@ impl LightSource {
 
     /// True for lights a ray can never hit.
     pub fn is_delta(&self) -> bool {
-        matches!(self, LightSource::Explicit(_))
+        match self {
+            LightSource::Explicit(_) => true,
+            LightSource::Area(_) | LightSource::Environment(_) => false,
+        }
     }
 
     /// Emitted power (luminance) used to choose lights.
     pub fn power(&self, scene_radius: f32) -> f32 {
         match self {
-            LightSource::Explicit(Light::Point { intensity, .. }) => point::power(*intensity),
-            LightSource::Explicit(Light::Spot {
-                intensity,
-                cos_inner,
-                cos_outer,
-                ..
-            }) => spot::power(*intensity, *cos_inner, *cos_outer),
-            LightSource::Explicit(Light::Directional { irradiance, .. }) => {
-                directional::power(*irradiance, scene_radius)
-            }
+            LightSource::Explicit(l) => l.power(scene_radius),
             LightSource::Area(a) => a.power(),
             LightSource::Environment(e) => e.power(scene_radius),
         }

@@ -10,7 +10,6 @@
 
 use glam::{Vec2, Vec3};
 
-use super::Bsdf;
 use crate::texture::footprint::UvFootprint;
 use crate::texture::{ScalarMap, TextureMap};
 
@@ -101,28 +100,6 @@ pub struct Clearcoat {
     /// The coat's own normal map; without one the coat follows the
     /// surface's normal, not the base's normal map (glTF's rule).
     pub normal_map: Option<NormalMap>,
-}
-
-impl Bsdf {
-    /// This BSDF with its `metallic` (metallic-roughness only) and
-    /// roughness (every rough BSDF) multiplied by the factors given.
-    pub fn modulated(mut self, metallic: Option<f32>, roughness: Option<f32>) -> Bsdf {
-        let unit = |x: f32| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
-        if let Some(r) = roughness {
-            match &mut self {
-                Bsdf::Conductor { roughness, .. }
-                | Bsdf::RoughDielectric { roughness, .. }
-                | Bsdf::ComplexConductor { roughness, .. }
-                | Bsdf::MetallicRoughness { roughness, .. }
-                | Bsdf::CoatedDiffuse { roughness, .. } => *roughness = unit(*roughness * r),
-                _ => {}
-            }
-        }
-        if let (Some(m), Bsdf::MetallicRoughness { metallic, .. }) = (metallic, &mut self) {
-            *metallic = unit(*metallic * m);
-        }
-        self
-    }
 }
 
 /// A tangent-space normal `t` (a normal map's texel, linear RGB) as a

@@ -32,8 +32,11 @@ impl Distribution {
     /// Every distribution, in a fixed order (tables are built per entry).
     pub const ALL: [Distribution; 2] = [Distribution::Ggx, Distribution::Beckmann];
 
+    /// The names of [`Distribution::ALL`], in its order.
+    pub const NAMES: [&'static str; 2] = [Distribution::Ggx.name(), Distribution::Beckmann.name()];
+
     /// The name scene files use (`ggx`, `beckmann`).
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             Distribution::Ggx => "ggx",
             Distribution::Beckmann => "beckmann",

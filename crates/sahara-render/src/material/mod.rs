@@ -11,6 +11,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
+mod kinds;
 mod layered;
 pub mod maps;
 pub mod metals;
@@ -24,6 +25,7 @@ use crate::texture::footprint::UvFootprint;
 use crate::texture::{Texture, TextureMap};
 pub use coat::Coat;
 use fresnel::schlick;
+pub use kinds::MaterialKind;
 use layered::Layered;
 pub use maps::{Clearcoat, MaterialTextures, NormalMap, OcclusionMap};
 pub use microfacet::Distribution;
@@ -172,10 +174,17 @@ impl Bsdf {
 
     /// True if the BSDF only reflects (such surfaces are two-sided).
     pub fn is_reflective_only(&self) -> bool {
-        !matches!(
-            self,
-            Bsdf::Dielectric { .. } | Bsdf::RoughDielectric { .. } | Bsdf::ThinDielectric { .. }
-        )
+        match self {
+            Bsdf::Dielectric { .. }
+            | Bsdf::RoughDielectric { .. }
+            | Bsdf::ThinDielectric { .. } => false,
+            Bsdf::Diffuse { .. }
+            | Bsdf::Conductor { .. }
+            | Bsdf::Mirror { .. }
+            | Bsdf::ComplexConductor { .. }
+            | Bsdf::MetallicRoughness { .. }
+            | Bsdf::CoatedDiffuse { .. } => true,
+        }
     }
 
     /// The layered form of the BSDFs that have one, `tint` multiplying
@@ -210,13 +219,55 @@ impl Bsdf {
                 roughness,
                 distribution,
             } => Layered::coated_diffuse(albedo * tint, ior, distribution, roughness),
-            _ => return None,
+            Bsdf::Diffuse { .. }
+            | Bsdf::Conductor { .. }
+            | Bsdf::Mirror { .. }
+            | Bsdf::Dielectric { .. }
+            | Bsdf::RoughDielectric { .. }
+            | Bsdf::ThinDielectric { .. } => return None,
         })
+    }
+
+    /// This BSDF with its `metallic` (metallic-roughness only) and
+    /// roughness (every rough BSDF) multiplied by the factors given.
+    pub fn modulated(mut self, metallic: Option<f32>, roughness: Option<f32>) -> Bsdf {
+        let unit = |x: f32| if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+        let scale = |x: &mut f32, by: Option<f32>| {
+            if let Some(by) = by {
+                *x = unit(*x * by);
+            }
+        };
+        match &mut self {
+            Bsdf::MetallicRoughness {
+                metallic: m,
+                roughness: r,
+                ..
+            } => {
+                scale(r, roughness);
+                scale(m, metallic);
+            }
+            Bsdf::Conductor { roughness: r, .. }
+            | Bsdf::RoughDielectric { roughness: r, .. }
+            | Bsdf::ComplexConductor { roughness: r, .. }
+            | Bsdf::CoatedDiffuse { roughness: r, .. } => scale(r, roughness),
+            Bsdf::Diffuse { .. }
+            | Bsdf::Mirror { .. }
+            | Bsdf::Dielectric { .. }
+            | Bsdf::ThinDielectric { .. } => {}
+        }
+        self
     }
 
     /// True for the Lambertian BSDF.
     pub fn is_diffuse(&self) -> bool {
-        matches!(self, Bsdf::Diffuse { .. })
+        match self {
+            Bsdf::Diffuse { .. } => true,
+            Bsdf::Conductor { .. } | Bsdf::Mirror { .. } | Bsdf::ComplexConductor { .. } => false,
+            Bsdf::Dielectric { .. }
+            | Bsdf::RoughDielectric { .. }
+            | Bsdf::ThinDielectric { .. } => false,
+            Bsdf::MetallicRoughness { .. } | Bsdf::CoatedDiffuse { .. } => false,
+        }
     }
 
     /// Value and density for the pair `(wo, wi)`, with `tint` multiplying the
@@ -631,11 +682,22 @@ impl PointBsdf {
     #[inline]
     pub(crate) fn adjoint_scale(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self.bsdf {
-            Bsdf::Dielectric { ior } | Bsdf::RoughDielectric { ior, .. } if wo.z * wi.z < 0.0 => {
-                let eta = if wo.z > 0.0 { ior } else { 1.0 / ior };
-                eta * eta
+            Bsdf::Dielectric { ior } | Bsdf::RoughDielectric { ior, .. } => {
+                if wo.z * wi.z < 0.0 {
+                    let eta = if wo.z > 0.0 { ior } else { 1.0 / ior };
+                    eta * eta
+                } else {
+                    1.0
+                }
             }
-            _ => 1.0,
+            // A thin pane passes light straight through, out into the
+            // medium it came from: no change of index.
+            Bsdf::ThinDielectric { .. } => 1.0,
+            // Reflectors do not refract.
+            Bsdf::Diffuse { .. } | Bsdf::Conductor { .. } | Bsdf::Mirror { .. } => 1.0,
+            Bsdf::ComplexConductor { .. }
+            | Bsdf::MetallicRoughness { .. }
+            | Bsdf::CoatedDiffuse { .. } => 1.0,
         }
     }
 
