@@ -1,7 +1,7 @@
 //! What the scene readers share: positions in files ([`position`]),
 //! warnings counted by kind ([`warnings`]), gzip-compressed files
 //! ([`gzip`]), spectra as RGB ([`spectrum`]), tints and blends ([`tint`]),
-//! meshes as the renderer's and smooth normals ([`mesh`]), images in as linear colour ([`image`])
+//! smooth vertex normals ([`mesh`]), images in as linear colour ([`image`])
 //! and textures decoded once ([`materials`]). Nothing here knows a
 //! format's vocabulary; each reader maps its own onto these.
 
@@ -13,3 +13,6 @@ pub(crate) mod position;
 pub(crate) mod spectrum;
 pub(crate) mod tint;
 pub(crate) mod warnings;
+
+#[cfg(test)]
+pub(crate) mod media_tests;

@@ -1188,24 +1188,7 @@ fn mitsuba_and_toml_media_make_the_same_scene_and_image() {
     let m = load_mitsuba(&dir.join("m.xml")).unwrap();
     let t = load_scene(&dir.join("m.toml")).unwrap();
     assert!(m.warnings.is_empty(), "{:?}", m.warnings);
-    assert_eq!(m.scene.camera_medium, Some(0));
-    assert_eq!(m.scene.camera_medium, t.scene.camera_medium);
-    assert_eq!(m.scene.media.len(), 3);
-    for (i, (a, b)) in m.scene.media.iter().zip(&t.scene.media).enumerate() {
-        match (a, b) {
-            (sahara_render::Medium::Grid(a), sahara_render::Medium::Grid(b)) => {
-                assert_eq!(a.density, b.density);
-                assert_eq!(
-                    (a.sigma_a, a.sigma_s, a.phase),
-                    (b.sigma_a, b.sigma_s, b.phase)
-                );
-                assert!(a.to_medium.abs_diff_eq(b.to_medium, 1e-6), "{a:?} {b:?}");
-            }
-            (a, b) => assert_eq!(a, b, "medium {i}"),
-        }
-    }
-    assert_eq!(m.scene.medium_interfaces, t.scene.medium_interfaces);
-    assert_eq!(m.scene.medium_interfaces.len(), 3);
+    crate::common::media_tests::assert_same_media(&m.scene, &t.scene, 3, 3);
     let (a, b) = (image(&m.scene, 4), image(&t.scene, 4));
     assert!(b.iter().any(|v| v.max_element() > 0.0), "black");
     let worst = a

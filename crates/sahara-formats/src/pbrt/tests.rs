@@ -807,25 +807,8 @@ fn pbrt_and_toml_media_make_the_same_scene_and_image() {
     let p = load_pbrt(&dir.join("s.pbrt")).unwrap();
     let t = load_scene(&dir.join("s.toml")).unwrap();
     assert!(p.warnings.is_empty(), "{:#?}", p.warnings);
-    assert_eq!(p.scene.camera_medium, Some(0));
-    assert_eq!(p.scene.camera_medium, t.scene.camera_medium);
-    assert_eq!(p.scene.media.len(), 3);
-    for (i, (a, b)) in p.scene.media.iter().zip(&t.scene.media).enumerate() {
-        match (a, b) {
-            (sahara_render::Medium::Grid(a), sahara_render::Medium::Grid(b)) => {
-                assert_eq!(a.density, b.density);
-                assert_eq!(
-                    (a.sigma_a, a.sigma_s, a.phase),
-                    (b.sigma_a, b.sigma_s, b.phase)
-                );
-                assert!(a.to_medium.abs_diff_eq(b.to_medium, 1e-6), "{a:?} {b:?}");
-            }
-            (a, b) => assert_eq!(a, b, "medium {i}"),
-        }
-    }
     // The sphere with the same medium on both sides bounds nothing.
-    assert_eq!(p.scene.medium_interfaces, t.scene.medium_interfaces);
-    assert_eq!(p.scene.medium_interfaces.len(), 3);
+    crate::common::media_tests::assert_same_media(&p.scene, &t.scene, 3, 3);
     let (a, b) = (image(&p.scene, 4), image(&t.scene, 4));
     assert!(b.iter().any(|v| v.max_element() > 0.0), "black");
     let worst = a

@@ -22,6 +22,7 @@ use sahara_kd::Ray;
 
 use super::path::roulette;
 use super::{light_contribution, through_hole, AuxSample, Context, Shading};
+use crate::light::LightSample;
 use crate::math::warp::power_heuristic;
 use crate::medium::Medium;
 use crate::sampler::{dims, PixelSampler};
@@ -230,13 +231,21 @@ fn surface_light(
     if tr == Vec3::ZERO {
         return Vec3::ZERO;
     }
+    let (w, light_pdf) = light_weight(&ls, pmf, bsdf_pdf);
+    beta * c * tr * (w / light_pdf)
+}
+
+/// The power heuristic's weight of light sample `ls` (chosen with
+/// probability `pmf`) against scattering's density `other_pdf` for its
+/// direction (1 for a delta light), and the sample's whole density.
+fn light_weight(ls: &LightSample, pmf: f32, other_pdf: f32) -> (f32, f32) {
     let light_pdf = pmf * ls.pdf;
     let w = if ls.delta {
         1.0
     } else {
-        power_heuristic(light_pdf, bsdf_pdf)
+        power_heuristic(light_pdf, other_pdf)
     };
-    beta * c * tr * (w / light_pdf)
+    (w, light_pdf)
 }
 
 /// Light arriving at `p` in medium `m` (index `medium`) from one light
@@ -274,12 +283,7 @@ fn medium_light(
     if tr == Vec3::ZERO {
         return Vec3::ZERO;
     }
-    let light_pdf = pmf * ls.pdf;
-    let w = if ls.delta {
-        1.0
-    } else {
-        power_heuristic(light_pdf, f)
-    };
+    let (w, light_pdf) = light_weight(&ls, pmf, f);
     ls.li * tr * (f * w / light_pdf)
 }
 
