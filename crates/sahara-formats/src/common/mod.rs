@@ -15,4 +15,4 @@ pub(crate) mod tint;
 pub(crate) mod warnings;
 
 #[cfg(test)]
-pub(crate) mod media_tests;
+pub(crate) mod test_scenes;

@@ -8,11 +8,12 @@ use std::path::{Path, PathBuf};
 use glam::{Affine3A, Vec3};
 use sahara_readers::FormatError;
 use sahara_render::{
-    render, AlphaMode, Bsdf, Distribution, Environment, Filter, Integrator, Light, Material,
-    RenderSettings, SamplerKind, Scene, Shape,
+    AlphaMode, Bsdf, Distribution, Environment, Filter, Integrator, Light, Material, SamplerKind,
+    Shape,
 };
 
 use super::{described, read_mitsuba_with, xml};
+use crate::common::test_scenes::image;
 use crate::common::warnings::Warnings;
 use crate::description::{CameraRequest, FileCrop, Geometry, ObjectPlacement, SceneDescription};
 use crate::{load_mitsuba, load_scene};
@@ -892,20 +893,6 @@ fn approximations_are_warned_once_per_kind_with_a_count() {
     );
 }
 
-/// Renders a scene small and fast.
-fn image(scene: &Scene, spp: u32) -> Vec<Vec3> {
-    let settings = RenderSettings {
-        width: 24,
-        height: 24,
-        spp,
-        pass_spp: spp,
-        ..RenderSettings::default()
-    };
-    let mut scene = scene.clone();
-    scene.camera.aspect = 1.0;
-    render(&scene, &settings, &|_| {}).unwrap().film.pixels
-}
-
 /// A Cornell box: walls of rectangles placed by exact matrices, two
 /// cubes, a glass sphere, a metal block and a light.
 const CORNELL_XML: &str = r#"<scene version="3.0.0">
@@ -1188,15 +1175,8 @@ fn mitsuba_and_toml_media_make_the_same_scene_and_image() {
     let m = load_mitsuba(&dir.join("m.xml")).unwrap();
     let t = load_scene(&dir.join("m.toml")).unwrap();
     assert!(m.warnings.is_empty(), "{:?}", m.warnings);
-    crate::common::media_tests::assert_same_media(&m.scene, &t.scene, 3, 3);
-    let (a, b) = (image(&m.scene, 4), image(&t.scene, 4));
-    assert!(b.iter().any(|v| v.max_element() > 0.0), "black");
-    let worst = a
-        .iter()
-        .zip(&b)
-        .map(|(x, y)| (*x - *y).abs().max_element())
-        .fold(0.0, f32::max);
-    assert!(worst < 1e-3, "the images differ by up to {worst}");
+    crate::common::test_scenes::assert_same_media(&m.scene, &t.scene, 3, 3);
+    crate::common::test_scenes::assert_same_render(&m.scene, &t.scene);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
