@@ -176,24 +176,28 @@ fn a_mitsuba_crop_window_renders_those_pixels_of_the_whole_frame() {
 }
 
 #[test]
-fn the_example_mitsuba_scene_renders_without_warnings() {
+fn the_example_mitsuba_scenes_render_without_warnings() {
     let dir = temp_dir("mitsuba-example");
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell_box.xml");
-    let png = dir.join("cbox.png");
-    let out = sahara(&[
-        "render",
-        scene.to_str().unwrap(),
-        "-D",
-        "res=16",
-        "-D",
-        "spp=2",
-        "-o",
-        png.to_str().unwrap(),
-    ]);
-    let err = stderr(&out);
-    assert!(out.status.success(), "{err}");
-    assert!(!err.contains("warning"), "{err}");
-    let mean = checked_mean(&png, 16, 16);
-    assert!(mean > 0.05, "a lit box: {mean}");
+    for name in ["cornell_box.xml", "wax_bunny.xml"] {
+        let scene = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenes")
+            .join(name);
+        let png = dir.join(name).with_extension("png");
+        let out = sahara(&[
+            "render",
+            scene.to_str().unwrap(),
+            "-D",
+            "res=16",
+            "-D",
+            "spp=2",
+            "-o",
+            png.to_str().unwrap(),
+        ]);
+        let err = stderr(&out);
+        assert!(out.status.success(), "{name}: {err}");
+        assert!(!err.contains("warning"), "{name}: {err}");
+        let mean = checked_mean(&png, 16, 16);
+        assert!(mean > 0.05, "{name}: a lit box: {mean}");
+    }
     let _ = fs::remove_dir_all(&dir);
 }
