@@ -51,6 +51,7 @@ impl Ctx<'_> {
                     sigma_a,
                     sigma_s,
                     phase,
+                    emission: Vec3::ZERO,
                 })
             }
             MediumType::Grid => {
