@@ -15,7 +15,6 @@ use sahara_render::{DensityGrid, GridMedium, HenyeyGreenstein, Material, Medium}
 
 use super::declarations::{Entity, MediaDecl, MediumDecl};
 use super::measured_media::{measured, names};
-use super::params::SpectrumParam;
 use super::textures::rgb_of;
 use crate::common::spectrum::Use;
 use crate::common::warnings::Warnings;
@@ -82,34 +81,41 @@ fn named_medium(d: &MediumDecl, w: &mut Warnings) -> Result<Medium, FormatError>
     let medium = match kind {
         "homogeneous" => {
             let c = coefficients(e, &what, w)?;
-            emission(e, kind, w)?;
-            Medium::homogeneous(c.sigma_a, c.sigma_s, c.g)
+            let le = emission(e, w)? * scalar_lescale(e, &what)?;
+            Medium::homogeneous(c.sigma_a, c.sigma_s, c.g).with_emission(le)
         }
         "uniformgrid" => {
             let c = coefficients(e, &what, w)?;
-            emission(e, kind, w)?;
+            let le = emission(e, w)?;
             for k in [
-                "Lescale",
                 "temperature",
                 "temperaturescale",
                 "temperaturecutoff",
+                "temperatureoffset",
             ] {
                 if e.params.get(k).is_some() {
                     w.add(
-                        format!("medium '{kind}': emission ('{k}') is not rendered"),
+                        format!("medium '{kind}': blackbody emission ('{k}') is not rendered"),
                         &e.loc,
                     );
                 }
             }
             let grid = density_grid(e, &what)?;
             let to_world = grid_to_world(e, &d.xform.m[0])?;
-            Medium::Grid(Box::new(GridMedium::new(
+            let mut m = GridMedium::new(
                 grid,
                 c.sigma_a,
                 c.sigma_s,
                 HenyeyGreenstein::new(c.g),
                 to_world,
-            )))
+            );
+            if le != Vec3::ZERO {
+                let scale = lescale_grid(e, &what, m.density.size())?;
+                m = m.with_emission_scale(scale);
+            } else {
+                e.params.get("Lescale");
+            }
+            Medium::Grid(Box::new(m)).with_emission(le)
         }
         "rgbgrid" => {
             return Err(e.loc.error(format!(
@@ -197,22 +203,49 @@ fn spectrum(e: &Entity, name: &str, default: Vec3, w: &mut Warnings) -> Result<V
     }
 }
 
-/// Warns once if the medium emits (`Le` other than zero): Sahara's media
-/// do not.
-fn emission(e: &Entity, kind: &str, w: &mut Warnings) -> Result<(), FormatError> {
-    let le = match e.params.spectrum("Le", false)? {
-        Some(SpectrumParam::Rgb(c)) => c.iter().any(|&v| v != 0.0),
-        Some(_) => true,
-        None => false,
-    };
-    let scale = e.params.float("Lescale", 1.0)?;
-    if le && scale != 0.0 {
-        w.add(
-            format!("medium '{kind}': emission ('Le') is not rendered"),
-            &e.loc,
-        );
+/// The radiance a medium emits per unit of absorption: `Le` (an
+/// illuminant, normalised as pbrt normalises emitted spectra; default 0).
+fn emission(e: &Entity, w: &mut Warnings) -> Result<Vec3, FormatError> {
+    match e.params.spectrum("Le", false)? {
+        Some(p) => rgb_of(&p, Use::Illuminant, &e.folders, w),
+        None => Ok(Vec3::ZERO),
     }
-    Ok(())
+}
+
+/// A homogeneous medium's `Lescale` (default 1): one number.
+fn scalar_lescale(e: &Entity, what: &str) -> Result<f32, FormatError> {
+    let s = e.params.float("Lescale", 1.0)? as f32;
+    if !(s.is_finite() && s >= 0.0) {
+        return Err(e.loc.error(format!(
+            "{what}: Lescale {s} must be finite and not negative"
+        )));
+    }
+    Ok(s)
+}
+
+/// A `uniformgrid`'s `Lescale`: the emission's scale over the grid, one
+/// value per density value. Without it (or with one value), pbrt-v4
+/// scales by a grid of one cell, which like any of its grids is
+/// interpolated from the cell's centre towards zero half a cell beyond
+/// it: full at the box's centre, half at its faces. So does Sahara.
+fn lescale_grid(e: &Entity, what: &str, size: [u32; 3]) -> Result<DensityGrid, FormatError> {
+    let values = e.params.floats("Lescale")?.unwrap_or(&[1.0]);
+    let want = size.iter().map(|&v| u64::from(v)).product::<u64>();
+    let n = if values.len() == 1 {
+        [1, 1, 1]
+    } else if values.len() as u64 == want {
+        size
+    } else {
+        return Err(e.loc.error(format!(
+            "{what}: grid size {}x{}x{} needs {want} \"Lescale\" values (or one) but {} are given",
+            size[0],
+            size[1],
+            size[2],
+            values.len()
+        )));
+    };
+    DensityGrid::new(n, values.iter().map(|&v| v as f32).collect())
+        .map_err(|m| e.loc.error(format!("{what}: Lescale {m}")))
 }
 
 /// A `uniformgrid`'s density: `nx` x `ny` x `nz` values, x fastest; the

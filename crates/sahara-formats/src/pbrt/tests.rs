@@ -761,7 +761,7 @@ fn vol_bytes(size: [u32; 3], lo: [f32; 3], hi: [f32; 3], values: &[f32]) -> Vec<
 #[test]
 fn pbrt_and_toml_media_make_the_same_scene_and_image() {
     let pbrt = "Scale -1 1 1\nLookAt 0 0 0  0 0 1  0 1 0\nMediumInterface \"\" \"fog\"\nCamera \"perspective\" \"float fov\" 40\nWorldBegin\n\
-                MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.02 0.03 0.04] \"rgb sigma_s\" [0.1 0.1 0.1] \"float scale\" 2 \"float g\" 0.3\n\
+                MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.02 0.03 0.04] \"rgb sigma_s\" [0.1 0.1 0.1] \"float scale\" 2 \"float g\" 0.3 \"rgb Le\" [0.5 0.25 1] \"float Lescale\" 2\n\
                 AttributeBegin Translate 0 1 4 Scale 2 2 2\n\
                 MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"integer ny\" 1 \"integer nz\" 2 \"float density\" [0 1 2 0.5] \
                 \"point3 p0\" [-0.5 -0.5 -0.5] \"point3 p1\" [0.5 0.5 0.5] \"rgb sigma_s\" [3 3 3] \"rgb sigma_a\" [0.5 0.5 0.5]\nAttributeEnd\n\
@@ -772,7 +772,7 @@ fn pbrt_and_toml_media_make_the_same_scene_and_image() {
                 AttributeBegin MediumInterface \"\" \"fog\" Material \"subsurface\" \"string name\" \"Skin1\" \"float scale\" 0.5 \"float eta\" 1.4\n\
                 Translate 1.25 -0.5 4 Shape \"sphere\" \"float radius\" 0.5 AttributeEnd\n";
     let toml = "[camera]\neye = [0, 0, 0]\ntarget = [0, 0, 1]\nvfov = 40\nmedium = \"fog\"\n\
-                [[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nsigma_a = [0.04, 0.06, 0.08]\nsigma_s = [0.2, 0.2, 0.2]\ng = 0.3\n\
+                [[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nsigma_a = [0.04, 0.06, 0.08]\nsigma_s = [0.2, 0.2, 0.2]\ng = 0.3\nemission = [0.5, 0.25, 1]\nemission_scale = 2\n\
                 [[medium]]\nname = \"smoke\"\ntype = \"grid\"\nfile = \"smoke.vol\"\nmin = [-1, 0, 3]\nmax = [1, 2, 5]\nsigma_s = [3, 3, 3]\nsigma_a = [0.5, 0.5, 0.5]\n\
                 [[medium]]\nname = \"skin\"\ntype = \"homogeneous\"\nsigma_a = [0.016, 0.085, 0.24]\nsigma_s = [0.37, 0.44, 0.505]\n\
                 [[material]]\nname = \"grey\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\
@@ -820,6 +820,22 @@ fn bad_media_are_errors_naming_the_line() {
         "{e}"
     );
     let e = err(&medium(
+        "\"string type\" \"homogeneous\" \"rgb Le\" [1 -1 1]",
+    ));
+    assert!(
+        e.contains("t.pbrt: line 2") && e.contains("emission"),
+        "{e}"
+    );
+    let e = err(&medium(
+        "\"string type\" \"homogeneous\" \"rgb Le\" [1 1 1] \"float Lescale\" -2",
+    ));
+    assert!(e.contains("line 2") && e.contains("Lescale"), "{e}");
+    let e = err(&medium("\"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [1 1] \"rgb Le\" [1 1 1] \"float Lescale\" [1 2 3]"));
+    assert!(
+        e.contains("line 2") && e.contains("needs 2 \"Lescale\" values (or one) but 3"),
+        "{e}"
+    );
+    let e = err(&medium(
         "\"string type\" \"homogeneous\" \"string preset\" \"Jam\"",
     ));
     assert!(e.contains("no measured medium is named \"Jam\""), "{e}");
@@ -844,10 +860,12 @@ fn bad_media_are_errors_naming_the_line() {
 }
 
 #[test]
-fn media_follow_the_graphics_state_and_presets_and_emission_warn() {
+fn media_follow_the_graphics_state_and_presets_and_emit() {
     let text = "MediumInterface \"a\"\nCamera \"perspective\"\nWorldBegin\n\
                 MakeNamedMedium \"a\" \"string type\" \"homogeneous\" \"string preset\" \"Ketchup\" \"float scale\" 10 \"rgb Le\" [1 1 1]\n\
                 MakeNamedMedium \"b\" \"string type\" \"homogeneous\"\n\
+                MakeNamedMedium \"c\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [1 2] \"rgb Le\" [0 2 0] \"float Lescale\" [3 4] \"float temperaturescale\" 2\n\
+                MakeNamedMedium \"d\" \"string type\" \"uniformgrid\" \"float density\" [1] \"rgb Le\" [1 1 1]\n\
                 AttributeBegin MediumInterface \"b\" \"a\" Shape \"sphere\" AttributeEnd\n\
                 Shape \"sphere\"\n\
                 AttributeBegin Material \"interface\" Shape \"sphere\" AttributeEnd\n";
@@ -869,10 +887,25 @@ fn media_follow_the_graphics_state_and_presets_and_emission_warn() {
     assert_eq!(s.scene.medium_interfaces[0].1.inside, Some(1));
     assert_eq!(s.scene.medium_interfaces[0].1.outside, Some(0));
     assert!(!s.scene.medium_interfaces[0].1.index_matched);
+    // Emission: Le times Lescale; a grid's Lescale is a grid of its own
+    // (pbrt's one-cell grid without one); blackbody emission is warned.
+    assert_eq!(s.scene.media[0].emission(), Vec3::ONE);
+    for (k, le, scale) in [
+        (2, Vec3::new(0.0, 2.0, 0.0), vec![3.0, 4.0]),
+        (3, Vec3::ONE, vec![1.0]),
+    ] {
+        let sahara_render::Medium::Grid(c) = &s.scene.media[k] else {
+            panic!()
+        };
+        assert_eq!(c.emission, le);
+        let grid = c.emission_scale.as_ref().unwrap();
+        let want = [scale.len() as u32, 1, 1];
+        assert_eq!(*grid, sahara_render::DensityGrid::new(want, scale).unwrap());
+    }
     assert!(
-        s.warnings
-            .iter()
-            .any(|l| l.contains("medium 'homogeneous': emission ('Le') is not rendered")),
+        s.warnings.iter().any(|l| l.contains(
+            "medium 'uniformgrid': blackbody emission ('temperaturescale') is not rendered"
+        )),
         "{:#?}",
         s.warnings
     );

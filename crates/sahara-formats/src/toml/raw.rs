@@ -72,6 +72,8 @@ pub(super) struct RawMedium {
     pub sigma_s: Opt<V3>,
     pub scale: Opt<f32>,
     pub g: Opt<f32>,
+    pub emission: Opt<V3>,
+    pub emission_scale: Opt<f32>,
     pub file: Opt<String>,
     pub min: Opt<V3>,
     pub max: Opt<V3>,

@@ -836,7 +836,7 @@ fn media_parse_and_bind_to_objects_and_the_camera() {
         "media.toml",
         with_head(
             "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nsigma_s = [0.5, 0.5, 0.5]\nsigma_a = [0.1, 0.2, 0.3]\nscale = 2\ng = 0.4\n\
-             [[medium]]\nname = \"cloud\"\ntype = \"grid\"\nfile = \"blob.vol\"\nsigma_s = [1, 1, 1]\n\
+             [[medium]]\nname = \"cloud\"\ntype = \"grid\"\nfile = \"blob.vol\"\nsigma_s = [1, 1, 1]\nemission = [1, 2, 3]\nemission_scale = 0.5\n\
              [[material]]\nname = \"glass\"\ntype = \"dielectric\"\n\
              [[object]]\ntype = \"box\"\nmin = [-2, -2, -2]\nmax = [2, 2, 2]\nmedium_inside = \"fog\"\n\
              [[object]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"glass\"\nmedium_inside = \"cloud\"\nmedium_outside = \"fog\"\n",
@@ -856,6 +856,8 @@ fn media_parse_and_bind_to_objects_and_the_camera() {
         m => panic!("{m:?}"),
     }
     assert!(matches!(s.media[1].medium, sahara_render::Medium::Grid(_)));
+    assert_eq!(s.media[0].medium.emission(), Vec3::ZERO);
+    assert_eq!(s.media[1].medium.emission(), Vec3::new(0.5, 1.0, 1.5));
     let fog_box = s.objects[0].interface.unwrap();
     assert_eq!((fog_box.inside, fog_box.outside), (Some(0), None));
     assert!(
@@ -881,6 +883,13 @@ fn bad_media_are_errors_at_the_value() {
     ));
     assert!(
         m.contains("line 10:") && m.contains("must not be negative"),
+        "{m}"
+    );
+    let m = error_of(&with_head(
+        "[[medium]]\nname = \"fog\"\ntype = \"homogeneous\"\nemission = [1, -1, 1]\n",
+    ));
+    assert!(
+        m.contains("line 10:") && m.contains("`emission`") && m.contains("must not be negative"),
         "{m}"
     );
     let m = error_of(&with_head(

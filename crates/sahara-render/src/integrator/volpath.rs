@@ -12,7 +12,10 @@
 //! and pass index-matched boundaries, which change the medium without
 //! bending or scattering light. Every ray leaves its vertex in the medium
 //! on the side it leaves to: the interface of the surface decides, by the
-//! side of its geometric normal.
+//! side of its geometric normal. An emitting medium adds its light along
+//! every segment of the path that crosses it, estimated by the same
+//! free-flight sample, at every bounce (the segment after the last
+//! scattering included).
 //!
 //! Paths are traced one at a time (not in the render loop's batches): the
 //! media's cost stays in the scenes that have them.
@@ -91,6 +94,12 @@ pub(crate) fn li(
             let m = world.medium(m);
             let t_max = hit.map_or(f32::INFINITY, |h| h.t);
             let flight = m.free_flight(ray.origin, ray.dir, t_max, &mut flights);
+            // What the medium emits along the segment arrives with the
+            // throughput so far. Light sampling never picks a medium, so
+            // this is the only estimate of it: no MIS weight.
+            if flight.emitted != Vec3::ZERO {
+                l += beta * flight.emitted;
+            }
             beta *= flight.weight;
             if beta == Vec3::ZERO {
                 break;
@@ -369,11 +378,16 @@ mod tests {
     /// The mean pixel of a `size`² render of `scene` at `spp`, path traced
     /// to `max_depth` without Russian roulette, box filtered.
     fn mean(scene: &Scene, size: u32, spp: u32, max_depth: u32) -> Vec3 {
+        mean_seeded(scene, size, spp, max_depth, 7)
+    }
+
+    /// [`mean`] with the sampler's `seed`.
+    fn mean_seeded(scene: &Scene, size: u32, spp: u32, max_depth: u32, seed: u64) -> Vec3 {
         let settings = RenderSettings {
             width: size,
             height: size,
             spp,
-            seed: 7,
+            seed,
             filter: Filter::Box { radius: 0.5 },
             integrator: Integrator::Path {
                 max_depth,
@@ -601,5 +615,107 @@ mod tests {
             / (8.0 * std::f32::consts::PI * sigma_t);
         let rel = ((got - want) / want).abs().max_element();
         assert!(rel < 0.015, "got {got}, want {want}");
+    }
+
+    /// An absorbing slab of thickness 2 that emits, seen head-on against
+    /// black: each channel's radiance is `Le (1 - exp(-σa d))` (the
+    /// emission `σa Le` per unit length, attenuated by `exp(-σa t)` from
+    /// depth t). Over six seeds the image mean's largest relative
+    /// deviation from it is 0.49 %; the tolerance is 1.5 %.
+    #[test]
+    fn an_emitting_slab_glows_by_its_absorption() {
+        let cam = Camera::look_at(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 1.0, 1.0);
+        let mut scene = Scene::new(cam);
+        let mat = scene.add_material(Material::diffuse(Vec3::ONE));
+        let slab = scene.add_shape(
+            Shape::Box {
+                min: Vec3::new(-20.0, -20.0, -1.0),
+                max: Vec3::new(20.0, 20.0, 1.0),
+            },
+            mat,
+        );
+        let sigma_a = Vec3::new(0.2, 1.0, 2.0);
+        let le = Vec3::new(1.0, 2.0, 0.5);
+        fill(
+            &mut scene,
+            slab,
+            Medium::homogeneous(sigma_a, Vec3::ZERO, 0.0).with_emission(le),
+        );
+        let want = le * (Vec3::ONE - (-2.0 * sigma_a).exp());
+        let got = mean(&scene, 32, 64, 4);
+        let rel = ((got - want) / want).abs().max_element();
+        assert!(rel < 0.015, "got {got}, want {want}");
+    }
+
+    /// Inside an unbounded medium that absorbs, scatters and emits `Le`
+    /// (and nothing else in the scene), the radiance is `Le` everywhere
+    /// and in every direction: what a stretch absorbs, it emits again,
+    /// whatever the scattering coefficient or the phase function. A
+    /// coloured medium (the channels' extinctions and albedos differ) and
+    /// a forward-scattering one; homogeneous, and a grid whose density
+    /// varies (its emission follows its absorption, so the balance holds
+    /// point by point) over a box too deep for paths to leave. Paths end
+    /// after n = 40 (and 2) scatterings, so what arrives is
+    /// `Le (1 - α^(n+1))` per channel (α = σs / σt, the same at every density): the emission of
+    /// the 41 segments of each path, the last one included. Over six
+    /// seeds the largest relative deviation of the image mean from it is
+    /// 0.62 %; the tolerance is 2 %.
+    #[test]
+    fn an_emitting_medium_is_in_equilibrium_at_its_emission() {
+        let sigma_a = Vec3::new(0.5, 1.0, 0.2);
+        let sigma_s = Vec3::new(1.0, 0.5, 2.0);
+        let le = Vec3::new(1.0, 0.5, 2.0);
+        // The grid's blue scatters less: spectral tracking's weights vary
+        // with how far a channel's albedo is from the others', and at 0.91
+        // against 0.67 and 0.33 blue's spread over seeds is 5 %.
+        let grid_sigma_s = Vec3::new(1.0, 0.5, 0.8);
+        let grid = |g: f32| {
+            let n = 12;
+            let mut v = Vec::new();
+            for z in 0..n {
+                for y in 0..n {
+                    for x in 0..n {
+                        let p = (Vec3::new(x as f32, y as f32, z as f32) + 0.5) / n as f32 - 0.5;
+                        v.push(1.0 + (p.x * 20.0).sin() * (p.y * 13.0).cos() * 0.7);
+                    }
+                }
+            }
+            Medium::Grid(Box::new(GridMedium::new(
+                DensityGrid::new([n; 3], v).unwrap(),
+                sigma_a,
+                grid_sigma_s,
+                crate::medium::HenyeyGreenstein::new(g),
+                glam::Affine3A::from_scale_rotation_translation(
+                    Vec3::splat(100.0),
+                    glam::Quat::IDENTITY,
+                    Vec3::splat(-50.0),
+                ),
+            )))
+            .with_emission(le)
+        };
+        let media = [
+            Medium::homogeneous(sigma_a, sigma_s, 0.0).with_emission(le),
+            Medium::homogeneous(sigma_a, sigma_s, 0.8).with_emission(le),
+            grid(0.0),
+            grid(0.8),
+        ];
+        for (k, medium) in media.into_iter().enumerate() {
+            let sigma_s = if k < 2 { sigma_s } else { grid_sigma_s };
+            let cam = Camera::look_at(Vec3::ZERO, -Vec3::Z, Vec3::Y, 60.0, 1.0);
+            let mut scene = Scene::new(cam);
+            scene.camera_medium = Some(scene.add_medium(medium));
+            let albedo = sigma_s / (sigma_a + sigma_s);
+            // Up to 40 scatterings, and (where the last segment's share
+            // is large) up to 2.
+            for depth in [40, 2] {
+                let want = le * (Vec3::ONE - albedo.powf(depth as f32 + 1.0));
+                let got = mean(&scene, 16, 32, depth);
+                let rel = ((got - want) / want).abs().max_element();
+                assert!(
+                    rel < 0.02,
+                    "medium {k}, depth {depth}: got {got}, want {want}"
+                );
+            }
+        }
     }
 }

@@ -15,6 +15,12 @@
 //! balance heuristic over the three channels, so a coloured medium is
 //! unbiased in every channel and no channel's noise explodes where
 //! another's extinction dominates.
+//!
+//! A medium may also emit: at a point of absorption σa and emitted
+//! radiance Le it adds `σa Le` per unit length (pbrt-v4's convention: a
+//! medium glows as strongly as it absorbs, so a thick one approaches Le
+//! and a thin one adds `σa Le d`). The free-flight sample estimates what a
+//! segment emits towards its start along with where the path goes on.
 
 mod grid;
 mod phase;
@@ -42,6 +48,9 @@ pub struct Homogeneous {
     pub sigma_s: Vec3,
     /// How scattered light leaves.
     pub phase: HenyeyGreenstein,
+    /// Radiance emitted per unit of absorption, per channel (the medium
+    /// adds `sigma_a * emission` per unit length); zero for most media.
+    pub emission: Vec3,
 }
 
 /// The media on the two sides of a surface, by index into
@@ -83,6 +92,10 @@ pub(crate) struct FreeFlight {
     /// sampling density for a scattering event, transmittance over the
     /// probability of passing for the segment's end.
     pub weight: Vec3,
+    /// The light the medium emits along the segment towards its start,
+    /// estimated with the same samples (zero in a medium that does not
+    /// emit): to be added with the throughput before `weight`.
+    pub emitted: Vec3,
 }
 
 impl Medium {
@@ -94,7 +107,28 @@ impl Medium {
             sigma_a,
             sigma_s,
             phase: HenyeyGreenstein::new(g),
+            emission: Vec3::ZERO,
         })
+    }
+
+    /// The medium emitting radiance `le` per unit of absorption (it adds
+    /// `σa le` per unit length, where σa is the local absorption); for a
+    /// grid, times its emission scale at each point.
+    pub fn with_emission(mut self, le: Vec3) -> Self {
+        match &mut self {
+            Medium::Homogeneous(h) => h.emission = le,
+            Medium::Grid(m) => m.emission = le,
+        }
+        self
+    }
+
+    /// The radiance the medium emits per unit of absorption, before any
+    /// per-point scale (zero if it does not emit).
+    pub fn emission(&self) -> Vec3 {
+        match self {
+            Medium::Homogeneous(h) => h.emission,
+            Medium::Grid(m) => m.emission,
+        }
     }
 
     /// Why the medium cannot be rendered (negative or non-finite
@@ -105,6 +139,7 @@ impl Medium {
             Medium::Homogeneous(h) => (h.sigma_a, h.sigma_s, h.phase.g),
             Medium::Grid(m) => (m.sigma_a, m.sigma_s, m.phase.g),
         };
+        let emission = self.emission();
         let bad = |v: Vec3| !v.is_finite() || v.min_element() < 0.0;
         if bad(sigma_a) {
             Some(format!(
@@ -113,6 +148,10 @@ impl Medium {
         } else if bad(sigma_s) {
             Some(format!(
                 "scattering {sigma_s} must be finite and not negative"
+            ))
+        } else if bad(emission) {
+            Some(format!(
+                "emission {emission} must be finite and not negative"
             ))
         } else if !(g > -1.0 && g < 1.0) {
             Some(format!("phase asymmetry g = {g} must lie in (-1, 1)"))
@@ -199,14 +238,23 @@ impl Homogeneous {
         if t < t_max {
             let tr = exp_neg(sigma_t, t);
             let density = (sigma_t * tr).element_sum() / 3.0;
-            FreeFlight {
-                t,
-                scattered: true,
-                weight: if density > 0.0 {
-                    h.sigma_s * tr / density
-                } else {
-                    Vec3::ZERO
-                },
+            if density > 0.0 {
+                // The emission's integral `∫ Tr σa Le` over the segment,
+                // estimated at the same sampled distance: where this
+                // density is zero, so is σa.
+                FreeFlight {
+                    t,
+                    scattered: true,
+                    weight: h.sigma_s * tr / density,
+                    emitted: h.sigma_a * h.emission * tr / density,
+                }
+            } else {
+                FreeFlight {
+                    t,
+                    scattered: true,
+                    weight: Vec3::ZERO,
+                    emitted: Vec3::ZERO,
+                }
             }
         } else {
             let tr = exp_neg(sigma_t, t_max);
@@ -215,6 +263,7 @@ impl Homogeneous {
                 t: t_max,
                 scattered: false,
                 weight: if pass > 0.0 { tr / pass } else { Vec3::ZERO },
+                emitted: Vec3::ZERO,
             }
         }
     }

@@ -14,7 +14,9 @@ use crate::FormatError;
 
 impl Ctx<'_> {
     /// `[[medium]]`: a homogeneous medium, or a density grid read from a
-    /// `.vol` file over a box (the file's own unless `min` and `max` say).
+    /// `.vol` file over a box (the file's own unless `min` and `max` say);
+    /// either may emit (`emission` times `emission_scale`, per unit of
+    /// absorption).
     pub(super) fn medium(&self, raw: &Spanned<RawMedium>) -> Result<MediumSpec, FormatError> {
         let m = raw.get_ref();
         let what = format!("a {} medium", type_name(*m.kind.get_ref()));
@@ -23,6 +25,8 @@ impl Ctx<'_> {
             ("sigma_s", span(&m.sigma_s)),
             ("scale", span(&m.scale)),
             ("g", span(&m.g)),
+            ("emission", span(&m.emission)),
+            ("emission_scale", span(&m.emission_scale)),
             ("file", span(&m.file)),
             ("min", span(&m.min)),
             ("max", span(&m.max)),
@@ -44,19 +48,49 @@ impl Ctx<'_> {
             "between -1 and 1 (exclusive)",
         )?;
         let phase = HenyeyGreenstein::new(g);
+        let emission_scale = self.number(
+            &m.emission_scale,
+            "emission_scale",
+            1.0,
+            |s| s >= 0.0,
+            "at least 0",
+        )?;
+        let emission = coefficient(&m.emission, "emission")? * emission_scale;
         let medium = match m.kind.get_ref() {
             MediumType::Homogeneous => {
-                self.only(&present, &["sigma_a", "sigma_s", "scale", "g"], &what)?;
+                self.only(
+                    &present,
+                    &[
+                        "sigma_a",
+                        "sigma_s",
+                        "scale",
+                        "g",
+                        "emission",
+                        "emission_scale",
+                    ],
+                    &what,
+                )?;
                 Medium::Homogeneous(sahara_render::Homogeneous {
                     sigma_a,
                     sigma_s,
                     phase,
+                    emission,
                 })
             }
             MediumType::Grid => {
                 self.only(
                     &present,
-                    &["sigma_a", "sigma_s", "scale", "g", "file", "min", "max"],
+                    &[
+                        "sigma_a",
+                        "sigma_s",
+                        "scale",
+                        "g",
+                        "emission",
+                        "emission_scale",
+                        "file",
+                        "min",
+                        "max",
+                    ],
                     &what,
                 )?;
                 let file = self.required(&m.file, "file", &raw.span(), &what)?;
@@ -87,6 +121,7 @@ impl Ctx<'_> {
                 Medium::Grid(Box::new(GridMedium::new(
                     density, sigma_a, sigma_s, phase, to_world,
                 )))
+                .with_emission(emission)
             }
         };
         Ok(MediumSpec {
