@@ -16,11 +16,13 @@
 //! unbiased in every channel and no channel's noise explodes where
 //! another's extinction dominates.
 
+mod cloud;
 mod grid;
 mod phase;
 
 use glam::Vec3;
 
+pub use cloud::CloudMedium;
 pub use grid::{DensityGrid, GridMedium};
 pub use phase::HenyeyGreenstein;
 
@@ -31,6 +33,8 @@ pub enum Medium {
     Homogeneous(Homogeneous),
     /// Coefficients scaled by a density on a grid.
     Grid(Box<GridMedium>),
+    /// Coefficients scaled by pbrt-v4's procedural noise cloud.
+    Cloud(Box<CloudMedium>),
 }
 
 /// A medium whose coefficients are the same everywhere.
@@ -98,12 +102,22 @@ impl Medium {
     }
 
     /// Why the medium cannot be rendered (negative or non-finite
-    /// coefficients, an asymmetry outside (-1, 1)), in one line; `None` if
-    /// it can.
+    /// coefficients, an asymmetry outside (-1, 1), a cloud's non-finite
+    /// shape parameters), in one line; `None` if it can.
     pub fn problem(&self) -> Option<String> {
+        if let Medium::Cloud(c) = self {
+            let shape = [c.density, c.wispiness, c.frequency];
+            if shape.iter().any(|v| !v.is_finite()) {
+                return Some(format!(
+                    "cloud density {}, wispiness {} and frequency {} must be finite",
+                    c.density, c.wispiness, c.frequency
+                ));
+            }
+        }
         let (sigma_a, sigma_s, g) = match self {
             Medium::Homogeneous(h) => (h.sigma_a, h.sigma_s, h.phase.g),
             Medium::Grid(m) => (m.sigma_a, m.sigma_s, m.phase.g),
+            Medium::Cloud(m) => (m.sigma_a, m.sigma_s, m.phase.g),
         };
         let bad = |v: Vec3| !v.is_finite() || v.min_element() < 0.0;
         if bad(sigma_a) {
@@ -129,6 +143,7 @@ impl Medium {
         let (sigma_a, sigma_s) = match self {
             Medium::Homogeneous(h) => (h.sigma_a, h.sigma_s),
             Medium::Grid(m) => (m.sigma_a, m.sigma_s),
+            Medium::Cloud(m) => (m.sigma_a, m.sigma_s),
         };
         let sigma_t = sigma_a + sigma_s;
         Vec3::select(sigma_t.cmpgt(Vec3::ZERO), sigma_s / sigma_t, Vec3::ZERO)
@@ -140,6 +155,7 @@ impl Medium {
         match self {
             Medium::Homogeneous(h) => h.phase,
             Medium::Grid(m) => m.phase,
+            Medium::Cloud(m) => m.phase,
         }
     }
 
@@ -158,6 +174,7 @@ impl Medium {
         match self {
             Medium::Homogeneous(h) => exp_neg(h.sigma_a + h.sigma_s, d),
             Medium::Grid(m) => m.transmittance(origin, dir, d, draw),
+            Medium::Cloud(m) => m.transmittance(origin, dir, d, draw),
         }
     }
 
@@ -177,6 +194,7 @@ impl Medium {
                 h.free_flight(u_channel, draw(), t_max)
             }
             Medium::Grid(m) => m.free_flight(origin, dir, t_max, draw),
+            Medium::Cloud(m) => m.free_flight(origin, dir, t_max, draw),
         }
     }
 }
