@@ -73,6 +73,7 @@ pub(super) struct RawMedium {
     pub scale: Opt<f32>,
     pub g: Opt<f32>,
     pub file: Opt<String>,
+    pub grid: Opt<String>,
     pub min: Opt<V3>,
     pub max: Opt<V3>,
 }
