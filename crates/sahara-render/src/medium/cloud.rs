@@ -89,9 +89,8 @@ impl CloudMedium {
             weight *= 0.5;
             scale *= 1.99;
         }
-        // max before min: a NaN (a non-finite point) becomes 0.
-        let d = ((1.0 - p.y) * 4.5 * self.density * sum).max(0.0).min(1.0);
-        (d + 2.0 * (0.5 - p.y).max(0.0)).max(0.0).min(1.0)
+        let d = unit((1.0 - p.y) * 4.5 * self.density * sum);
+        unit(d + 2.0 * (0.5 - p.y).max(0.0))
     }
 
     /// The density at world point `p`, zero outside the box.
@@ -225,6 +224,16 @@ impl CloudMedium {
             None => tr,
             Some(_) => Vec3::ZERO,
         }
+    }
+}
+
+/// `x` clamped to [0, 1], a NaN (from a non-finite point) to 0.
+#[inline]
+fn unit(x: f32) -> f32 {
+    if x > 0.0 {
+        x.min(1.0)
+    } else {
+        0.0
     }
 }
 
