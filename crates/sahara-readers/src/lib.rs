@@ -35,6 +35,7 @@ pub mod mtl;
 pub mod obj;
 pub mod ply;
 pub mod sniff;
+pub mod vdb;
 pub mod vol;
 
 use std::path::Path;

@@ -64,7 +64,9 @@ pub use material::{
     fresnel, metals, AlphaMode, Bsdf, Clearcoat, Distribution, Material, MaterialKind,
     MaterialTextures, NormalMap, OcclusionMap,
 };
-pub use medium::{DensityGrid, GridMedium, HenyeyGreenstein, Homogeneous, Medium, MediumInterface};
+pub use medium::{
+    CloudMedium, DensityGrid, GridMedium, HenyeyGreenstein, Homogeneous, Medium, MediumInterface,
+};
 pub use texture::footprint::UvFootprint;
 pub use texture::{
     linear_to_srgb8, srgb8_to_linear, srgb_to_linear, Channel, Encoding, ScalarMap, Texture,

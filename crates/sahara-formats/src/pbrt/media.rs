@@ -1,5 +1,5 @@
-//! pbrt's participating media: `MakeNamedMedium` (homogeneous media and
-//! density grids), the media a `MediumInterface` puts on either side of
+//! pbrt's participating media: `MakeNamedMedium` (homogeneous media,
+//! density grids and the procedural cloud), the media a `MediumInterface` puts on either side of
 //! the shapes after it and around the camera, and the `subsurface`
 //! material (a dielectric boundary around a homogeneous medium).
 //!
@@ -11,7 +11,7 @@ use std::collections::HashMap;
 
 use glam::{Affine3A, DMat4, DVec3, Vec3};
 use sahara_readers::FormatError;
-use sahara_render::{DensityGrid, GridMedium, HenyeyGreenstein, Material, Medium};
+use sahara_render::{CloudMedium, DensityGrid, GridMedium, HenyeyGreenstein, Material, Medium};
 
 use super::declarations::{Entity, MediaDecl, MediumDecl};
 use super::measured_media::{measured, names};
@@ -124,15 +124,33 @@ fn named_medium(d: &MediumDecl, w: &mut Warnings) -> Result<Medium, FormatError>
             )))
         }
         "cloud" => {
-            return Err(e.loc.error(format!(
-                "{what}: type 'cloud' (pbrt's procedural noise cloud) is not supported; \
-                 bake it into a 'uniformgrid'"
+            let c = coefficients(e, &what, w)?;
+            let density = e.params.float("density", 1.0)? as f32;
+            let wispiness = e.params.float("wispiness", 1.0)? as f32;
+            let frequency = e.params.float("frequency", 5.0)? as f32;
+            let p0 = Vec3::from_array(e.params.triple("p0", [0.0; 3])?.map(|v| v as f32));
+            let p1 = Vec3::from_array(e.params.triple("p1", [1.0; 3])?.map(|v| v as f32));
+            if (p1 - p0).min_element() <= 0.0 {
+                return Err(e.loc.error(format!(
+                    "{what}: bounds p0 {p0} to p1 {p1}: p1 must be above p0 on every axis"
+                )));
+            }
+            let to_world = Affine3A::from_mat4(d.xform.m[0].as_mat4());
+            Medium::Cloud(Box::new(CloudMedium::new(
+                c.sigma_a,
+                c.sigma_s,
+                HenyeyGreenstein::new(c.g),
+                density,
+                wispiness,
+                frequency,
+                (p0, p1),
+                to_world,
             )))
         }
         "nanovdb" => {
             return Err(e.loc.error(format!(
-                "{what}: type 'nanovdb' is not supported (no NanoVDB reader); \
-                 convert the grid to a 'uniformgrid' or a Mitsuba .vol file"
+                "{what}: type 'nanovdb' is not supported; convert the grid to a \
+                 'uniformgrid', or use it as an OpenVDB .vdb or Mitsuba .vol file in a Sahara scene"
             )))
         }
         other => {

@@ -75,6 +75,7 @@ pub(super) struct RawMedium {
     pub emission: Opt<V3>,
     pub emission_scale: Opt<f32>,
     pub file: Opt<String>,
+    pub grid: Opt<String>,
     pub min: Opt<V3>,
     pub max: Opt<V3>,
 }

@@ -997,3 +997,99 @@ fn the_documented_keys_are_the_described_kinds() {
         );
     }
 }
+
+/// The repository's scene assets folder.
+fn repo_assets() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/assets")
+}
+
+/// scenes/cloud.toml with its grid read from the .vdb twin of its .vol
+/// file (scripts/make_vdb.py) has the same density everywhere in the
+/// world, within 1e-6, with the grid named or not. (The renders differ by their noise alone: the majorant cells
+/// span the .vdb's smaller active box.)
+#[test]
+fn vdb_grids_place_the_density_as_their_vol_twin() {
+    let dir = TempDir::new("vdb");
+    let assets = repo_assets();
+    let text = std::fs::read_to_string(assets.join("../cloud.toml")).unwrap();
+    // The file's own box for both (the .vdb's spans its active voxels).
+    let text = text.replacen("min = [-1, 0.05, -1]\nmax = [1, 2.05, 1]\n", "", 1);
+    let grid = |file: &str, extra: &str| {
+        let t = text.replace(
+            "file = \"assets/blob.vol\"",
+            &format!(
+                "file = {:?}{extra}",
+                assets.join(file).display().to_string()
+            ),
+        );
+        assert_ne!(t, text);
+        let s = crate::load_scene(&dir.write(&format!("{file}.toml"), &t))
+            .unwrap_or_else(|e| panic!("{e}"))
+            .scene;
+        let sahara_render::Medium::Grid(g) = &s.media[0] else {
+            panic!("{:?}", s.media[0])
+        };
+        g.clone()
+    };
+    let vol = grid("blob.vol", "");
+    let density =
+        |g: &sahara_render::GridMedium, p: Vec3| g.density.lookup(g.to_medium.transform_point3(p));
+    for (file, extra, tolerance) in [
+        ("blob.vdb", "", 1e-6),
+        ("blob.vdb", "\ngrid = \"density\"", 1e-6),
+    ] {
+        let vdb = grid(file, extra);
+        let (mut worst, mut sum) = (0.0f32, 0.0f32);
+        let mut f = 0.123f32;
+        for _ in 0..50_000 {
+            let mut r = || {
+                f = (f * 9301.0 + 0.4929).fract();
+                f
+            };
+            // The .vol file's box, [-1, 0, -1] to [1, 2, 1], and a margin.
+            let p = Vec3::new(r() * 2.2 - 1.1, r() * 2.2 - 0.1, r() * 2.2 - 1.1);
+            let want = density(&vol, p);
+            worst = worst.max((density(&vdb, p) - want).abs());
+            sum += want;
+        }
+        assert!(
+            worst < tolerance,
+            "{file}: the densities differ by up to {worst}"
+        );
+        assert!(sum > 1000.0, "{sum}");
+    }
+}
+
+#[test]
+fn vdb_grid_errors_name_the_file() {
+    let assets = repo_assets();
+    let dir = TempDir::new("vdb-errors");
+    let grid = |file: &str, extra: &str| {
+        let text = with_head(&format!(
+            "[[medium]]\nname = \"c\"\ntype = \"grid\"\nfile = {:?}\n{extra}",
+            assets.join(file).display().to_string()
+        ));
+        let path = dir.write("bad.toml", text);
+        load_scene_file(&path).unwrap_err().to_string()
+    };
+    let e = grid("blob.vdb", "grid = \"smoke\"\n");
+    assert!(
+        e.contains("blob.vdb: no grid is named 'smoke'; the file holds 'density'"),
+        "{e}"
+    );
+    let e = grid("blob.vol", "grid = \"density\"\n");
+    assert!(
+        e.contains("line 11") && e.contains("'grid' names a grid of a .vdb file"),
+        "{e}"
+    );
+    let e = grid("blob_half.vdb", "");
+    assert!(
+        e.contains("blob_half.vdb: grid 'density' is saved as 16-bit"),
+        "{e}"
+    );
+    let e = grid("vdb_huge.vdb", "");
+    assert!(
+        e.contains("vdb_huge.vdb: grid 'density': its active voxels span"),
+        "{e}"
+    );
+}

@@ -520,7 +520,8 @@ mod tests {
     }
 
     /// A white furnace: a sphere of non-absorbing medium (isotropic and
-    /// strongly forward scattering; homogeneous, and a grid's blob) under
+    /// strongly forward scattering; homogeneous, a grid's blob, and
+    /// pbrt's noise cloud) under
     /// a uniform environment of radiance 1, bounded by an index-matched
     /// sphere. Every path ends in the
     /// environment, so every pixel's expected value is 1, with and
@@ -557,6 +558,21 @@ mod tests {
             Medium::homogeneous(Vec3::ZERO, Vec3::splat(2.0), 0.7),
             blob(0.0),
             blob(0.7),
+            // pbrt-v4's noise cloud over the sphere's bounding cube.
+            Medium::Cloud(Box::new(crate::medium::CloudMedium::new(
+                Vec3::ZERO,
+                Vec3::splat(4.0),
+                crate::medium::HenyeyGreenstein::new(0.7),
+                1.0,
+                1.0,
+                5.0,
+                (Vec3::ZERO, Vec3::ONE),
+                glam::Affine3A::from_scale_rotation_translation(
+                    Vec3::splat(2.0),
+                    glam::Quat::IDENTITY,
+                    Vec3::splat(-1.0),
+                ),
+            ))),
         ];
         for (k, medium) in media.into_iter().enumerate() {
             let cam = Camera::look_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 40.0, 1.0);

@@ -22,11 +22,13 @@
 //! and a thin one adds `σa Le d`). The free-flight sample estimates what a
 //! segment emits towards its start along with where the path goes on.
 
+mod cloud;
 mod grid;
 mod phase;
 
 use glam::Vec3;
 
+pub use cloud::CloudMedium;
 pub use grid::{DensityGrid, GridMedium};
 pub use phase::HenyeyGreenstein;
 
@@ -37,6 +39,8 @@ pub enum Medium {
     Homogeneous(Homogeneous),
     /// Coefficients scaled by a density on a grid.
     Grid(Box<GridMedium>),
+    /// Coefficients scaled by pbrt-v4's procedural noise cloud.
+    Cloud(Box<CloudMedium>),
 }
 
 /// A medium whose coefficients are the same everywhere.
@@ -113,11 +117,13 @@ impl Medium {
 
     /// The medium emitting radiance `le` per unit of absorption (it adds
     /// `σa le` per unit length, where σa is the local absorption); for a
-    /// grid, times its emission scale at each point.
+    /// grid, times its emission scale at each point. A noise cloud does not
+    /// emit (pbrt-v4's has no emission either) and stays as it is.
     pub fn with_emission(mut self, le: Vec3) -> Self {
         match &mut self {
             Medium::Homogeneous(h) => h.emission = le,
             Medium::Grid(m) => m.emission = le,
+            Medium::Cloud(_) => debug_assert_eq!(le, Vec3::ZERO, "a noise cloud does not emit"),
         }
         self
     }
@@ -128,16 +134,27 @@ impl Medium {
         match self {
             Medium::Homogeneous(h) => h.emission,
             Medium::Grid(m) => m.emission,
+            Medium::Cloud(_) => Vec3::ZERO,
         }
     }
 
     /// Why the medium cannot be rendered (negative or non-finite
-    /// coefficients, an asymmetry outside (-1, 1)), in one line; `None` if
-    /// it can.
+    /// coefficients, an asymmetry outside (-1, 1), a cloud's non-finite
+    /// shape parameters), in one line; `None` if it can.
     pub fn problem(&self) -> Option<String> {
+        if let Medium::Cloud(c) = self {
+            let shape = [c.density, c.wispiness, c.frequency];
+            if shape.iter().any(|v| !v.is_finite()) {
+                return Some(format!(
+                    "cloud density {}, wispiness {} and frequency {} must be finite",
+                    c.density, c.wispiness, c.frequency
+                ));
+            }
+        }
         let (sigma_a, sigma_s, g) = match self {
             Medium::Homogeneous(h) => (h.sigma_a, h.sigma_s, h.phase.g),
             Medium::Grid(m) => (m.sigma_a, m.sigma_s, m.phase.g),
+            Medium::Cloud(m) => (m.sigma_a, m.sigma_s, m.phase.g),
         };
         let emission = self.emission();
         let bad = |v: Vec3| !v.is_finite() || v.min_element() < 0.0;
@@ -168,6 +185,7 @@ impl Medium {
         let (sigma_a, sigma_s) = match self {
             Medium::Homogeneous(h) => (h.sigma_a, h.sigma_s),
             Medium::Grid(m) => (m.sigma_a, m.sigma_s),
+            Medium::Cloud(m) => (m.sigma_a, m.sigma_s),
         };
         let sigma_t = sigma_a + sigma_s;
         Vec3::select(sigma_t.cmpgt(Vec3::ZERO), sigma_s / sigma_t, Vec3::ZERO)
@@ -179,6 +197,7 @@ impl Medium {
         match self {
             Medium::Homogeneous(h) => h.phase,
             Medium::Grid(m) => m.phase,
+            Medium::Cloud(m) => m.phase,
         }
     }
 
@@ -197,6 +216,7 @@ impl Medium {
         match self {
             Medium::Homogeneous(h) => exp_neg(h.sigma_a + h.sigma_s, d),
             Medium::Grid(m) => m.transmittance(origin, dir, d, draw),
+            Medium::Cloud(m) => m.transmittance(origin, dir, d, draw),
         }
     }
 
@@ -216,6 +236,7 @@ impl Medium {
                 h.free_flight(u_channel, draw(), t_max)
             }
             Medium::Grid(m) => m.free_flight(origin, dir, t_max, draw),
+            Medium::Cloud(m) => m.free_flight(origin, dir, t_max, draw),
         }
     }
 }

@@ -14,9 +14,9 @@ use crate::FormatError;
 
 impl Ctx<'_> {
     /// `[[medium]]`: a homogeneous medium, or a density grid read from a
-    /// `.vol` file over a box (the file's own unless `min` and `max` say);
-    /// either may emit (`emission` times `emission_scale`, per unit of
-    /// absorption).
+    /// Mitsuba `.vol` file or a grid of an OpenVDB `.vdb` file, over a box
+    /// (the file's own unless `min` and `max` say); either may emit
+    /// (`emission` times `emission_scale`, per unit of absorption).
     pub(super) fn medium(&self, raw: &Spanned<RawMedium>) -> Result<MediumSpec, FormatError> {
         let m = raw.get_ref();
         let what = format!("a {} medium", type_name(*m.kind.get_ref()));
@@ -28,6 +28,7 @@ impl Ctx<'_> {
             ("emission", span(&m.emission)),
             ("emission_scale", span(&m.emission_scale)),
             ("file", span(&m.file)),
+            ("grid", span(&m.grid)),
             ("min", span(&m.min)),
             ("max", span(&m.max)),
         ];
@@ -88,6 +89,7 @@ impl Ctx<'_> {
                         "emission",
                         "emission_scale",
                         "file",
+                        "grid",
                         "min",
                         "max",
                     ],
@@ -95,29 +97,56 @@ impl Ctx<'_> {
                 )?;
                 let file = self.required(&m.file, "file", &raw.span(), &what)?;
                 let path = self.file(file, "density grid")?;
-                let grid = sahara_readers::vol::read_vol(&path)?;
-                if grid.channels != 1 {
+                let is_vdb = path
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
+                if let (false, Some(g)) = (is_vdb, &m.grid) {
                     return Err(self.at(
-                        file.span(),
-                        format!(
-                            "'{}' holds {} channels; a density grid holds 1",
-                            file.get_ref(),
-                            grid.channels
-                        ),
+                        g.span(),
+                        "'grid' names a grid of a .vdb file; a .vol file holds one",
                     ));
                 }
-                let lo = self.vec_or(&m.min, "min", Vec3::from_array(grid.bounds_min))?;
-                let hi = self.vec_or(&m.max, "max", Vec3::from_array(grid.bounds_max))?;
-                if (hi - lo).min_element() <= 0.0 {
-                    return Err(self.at(
-                        span(&m.max).or(span(&m.min)).unwrap_or(file.span()),
-                        format!("the grid's box {lo} to {hi} must be above its min on every axis"),
-                    ));
-                }
-                let density = DensityGrid::new(grid.size, grid.values)
+                // The grid's values, size, and the box the file places it in.
+                let (size, values, file_box) = if is_vdb {
+                    let name = m.grid.as_ref().map_or("density", |g| g.get_ref().as_str());
+                    let grid = sahara_readers::vdb::read_vdb(&path, name)?;
+                    let to_world = grid.to_world();
+                    (grid.size, grid.values, to_world)
+                } else {
+                    let grid = sahara_readers::vol::read_vol(&path)?;
+                    if grid.channels != 1 {
+                        return Err(self.at(
+                            file.span(),
+                            format!(
+                                "'{}' holds {} channels; a density grid holds 1",
+                                file.get_ref(),
+                                grid.channels
+                            ),
+                        ));
+                    }
+                    let lo = Vec3::from_array(grid.bounds_min);
+                    let hi = Vec3::from_array(grid.bounds_max);
+                    let to_world =
+                        Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo);
+                    (grid.size, grid.values, to_world)
+                };
+                let to_world = if m.min.is_some() || m.max.is_some() {
+                    let lo = self.vec_or(&m.min, "min", file_box.transform_point3(Vec3::ZERO))?;
+                    let hi = self.vec_or(&m.max, "max", file_box.transform_point3(Vec3::ONE))?;
+                    if (hi - lo).min_element() <= 0.0 {
+                        return Err(self.at(
+                            span(&m.max).or(span(&m.min)).unwrap_or(file.span()),
+                            format!(
+                                "the grid's box {lo} to {hi} must be above its min on every axis"
+                            ),
+                        ));
+                    }
+                    Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo)
+                } else {
+                    file_box
+                };
+                let density = DensityGrid::new(size, values)
                     .map_err(|e| FormatError::in_file(&path.display().to_string(), e))?;
-                let to_world =
-                    Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo);
                 Medium::Grid(Box::new(GridMedium::new(
                     density, sigma_a, sigma_s, phase, to_world,
                 )))
