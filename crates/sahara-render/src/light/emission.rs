@@ -9,6 +9,10 @@
 //! send their light through a disc of the scene's bounding radius facing
 //! the direction, as pbrt does: the position density is then per unit area
 //! of that disc.
+//!
+//! Here are the surfaces and the environment; a point, spot or
+//! directional light's own emission is in its module, through
+//! `Light::emission`.
 
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
