@@ -169,7 +169,7 @@ impl<'a> World<'a> {
             nee,
             instance_light,
             env,
-            default_material: Scene::default_material(),
+            default_material: Material::default(),
             has_holes: scene.materials.iter().any(Material::has_holes),
             spread: None,
             center,

@@ -319,11 +319,12 @@ pub fn auto_camera_framing(scene: &Scene, name: &str) -> Result<(Camera, String)
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sahara_render::Material;
 
     #[test]
     fn auto_camera_sees_the_bounds_centre() {
         let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
-        let m = scene.add_material(Scene::default_material());
+        let m = scene.add_material(Material::default());
         scene.add_shape(
             sahara_render::Shape::Box {
                 min: Vec3::splat(1.0),
@@ -340,7 +341,7 @@ mod tests {
     /// A unit sphere on a square ground plane of side `side`.
     fn sphere_on_ground(side: f32) -> Scene {
         let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
-        let m = scene.add_material(Scene::default_material());
+        let m = scene.add_material(Material::default());
         scene.add_shape(
             sahara_render::Shape::Sphere {
                 center: Vec3::ZERO,
@@ -407,7 +408,7 @@ mod tests {
     /// A palm of sorts, about 6 units tall: a trunk and a crown of flat
     /// leaves, on an island of sand 20 units across.
     fn palm_island(scene: &mut Scene) {
-        let m = scene.add_material(Scene::default_material());
+        let m = scene.add_material(Material::default());
         let boxed = |min: Vec3, max: Vec3| sahara_render::Shape::Box { min, max };
         scene.add_shape(
             boxed(Vec3::new(-10.0, -1.0, -10.0), Vec3::new(10.0, 0.5, 10.0)),
@@ -451,7 +452,7 @@ mod tests {
 
     /// The Cornell box as five one-sided walls (open at +z), with a block.
     fn cornell_room(scene: &mut Scene, closed: bool) {
-        let m = scene.add_material(Scene::default_material());
+        let m = scene.add_material(Material::default());
         let (s, h, d) = (556.0, 548.0, 559.0);
         let quad = |corner: Vec3, edge_u: Vec3, edge_v: Vec3| sahara_render::Shape::Quad {
             corner,

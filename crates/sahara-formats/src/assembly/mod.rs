@@ -29,11 +29,11 @@ pub(crate) mod camera;
 pub(crate) mod sky;
 
 use std::collections::{BTreeMap, HashSet};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use glam::{Affine3A, Mat4, Vec3};
 use sahara_readers::gltf::GltfCamera;
-use sahara_render::{Camera, Instance, Placement, Scene, Shape, Srt};
+use sahara_render::{Camera, Instance, MediumInterface, Placement, Scene, SceneMesh, Shape, Srt};
 
 use crate::description::{
     CameraRequest, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
@@ -101,7 +101,8 @@ impl AssembledScene {
     }
 }
 
-/// Assembles the scene `desc` describes.
+/// Assembles the scene `desc` describes: its objects, then its lights,
+/// camera and sky.
 pub fn assemble(mut desc: SceneDescription) -> Result<AssembledScene, FormatError> {
     let name = desc.name.clone();
     let mut warnings = desc.warnings;
@@ -112,102 +113,29 @@ pub fn assemble(mut desc: SceneDescription) -> Result<AssembledScene, FormatErro
     });
     scene.materials = desc.materials;
     let mut object_names: Vec<String> = Vec::new();
-    let mut meshes: Vec<Option<u32>> = vec![None; desc.meshes.len()];
-    let mut inline = desc.meshes.into_iter().map(Some).collect::<Vec<_>>();
-    let mut library = MeshLibrary::new();
-    let mut cameras: Vec<GltfCamera> = Vec::new();
-    let own = shown_with_own_materials(&desc.objects);
+    let mut objects = Objects {
+        meshes: vec![None; desc.meshes.len()],
+        inline: desc.meshes.into_iter().map(Some).collect(),
+        library: MeshLibrary::new(),
+        cameras: Vec::new(),
+        own: shown_with_own_materials(&desc.objects),
+        interfaces: desc.medium_interfaces.iter().copied().collect(),
+        filled: HashSet::new(),
+    };
     let mut moving_emitters = 0;
-    // Each object's media go on every instance it adds.
-    let interfaces: BTreeMap<u32, _> = desc.medium_interfaces.iter().copied().collect();
     // The file's media come first (the objects' interfaces name them by
     // index); a mesh file's glass volumes are added after them.
     scene.media = std::mem::take(&mut desc.media);
-    // Instances whose glTF material fills them with a medium.
-    let mut filled: HashSet<u32> = HashSet::new();
     for (k, o) in desc.objects.iter().enumerate() {
         let first_instance = scene.instances.len() as u32;
-        let emits = match &o.geometry {
-            Geometry::File(path) => {
-                let first = library.file_count();
-                let f = library
-                    .load(&mut scene, path, own.contains(&file_key(path)))
-                    .map_err(|e| {
-                        if path.display().to_string() == name {
-                            e
-                        } else {
-                            FormatError::in_file(&name, format!("object {}: {e}", k + 1))
-                        }
-                    })?;
-                if library.file_count() > first {
-                    cameras.extend(f.cameras.iter().cloned());
-                }
-                for part in &f.parts {
-                    let instance = scene.add_instance(Instance {
-                        mesh: part.mesh,
-                        placement: placed(&o.placement, part.transform),
-                        material: o.material.or(f.material),
-                    });
-                    if o.material.is_none() && !f.volumes.is_empty() {
-                        let outside = interfaces.get(&(k as u32)).and_then(|mi| mi.outside);
-                        if let Some(mi) = volume_interface(&scene, part.mesh, &f.volumes, outside) {
-                            scene.set_medium_interface(instance, mi);
-                            filled.insert(instance);
-                        }
-                    }
-                }
-                // The file's lights, where the object puts the file
-                // (where it starts, if it moves).
-                let at = Mat4::from(placed(&o.placement, Mat4::IDENTITY).at(0.0));
-                for l in &f.lights {
-                    scene.add_light(gltf_light(l, at));
-                }
-                o.material.map_or(f.emissive, |m| is_emissive(&scene, m))
-            }
-            Geometry::Shape(shape) => {
-                let material = match o.material {
-                    Some(m) => m,
-                    None => library.default_material(&mut scene),
-                };
-                add_placed_shape(&mut scene, *shape, &o.placement, material);
-                is_emissive(&scene, material)
-            }
-            Geometry::Mesh(i) => {
-                let i = *i as usize;
-                let mesh = match meshes[i] {
-                    Some(id) => id,
-                    None => {
-                        let id = scene.add_mesh(inline[i].take().expect("added once"));
-                        meshes[i] = Some(id);
-                        id
-                    }
-                };
-                scene.add_instance(Instance {
-                    mesh,
-                    placement: placed(&o.placement, Mat4::IDENTITY),
-                    material: o.material,
-                });
-                match o.material {
-                    Some(m) => is_emissive(&scene, m),
-                    None => scene.meshes[mesh as usize]
-                        .material_ids
-                        .as_ref()
-                        .is_some_and(|ids| ids.iter().any(|&m| is_emissive(&scene, m))),
-                }
-            }
-        };
+        let emits = objects.add(&mut scene, k, o, &name)?;
         if o.placement.is_moving() && emits {
             moving_emitters += 1;
         }
-        if let Some(&mi) = interfaces.get(&(k as u32)) {
-            for i in first_instance..scene.instances.len() as u32 {
-                if !filled.contains(&i) {
-                    scene.set_medium_interface(i, mi);
-                }
-            }
-        }
-        name_instances(&mut object_names, &scene, &library, o, k);
+        objects.add_media(&mut scene, k, first_instance);
+        name_instances(&mut object_names, &scene, &objects.library, o, k);
     }
+    let mut library = objects.library;
     scene.camera_medium = desc.camera_medium;
     warnings.append(&mut library.warnings);
     if moving_emitters > 0 {
@@ -223,7 +151,7 @@ pub fn assemble(mut desc: SceneDescription) -> Result<AssembledScene, FormatErro
     }
     scene.generate_tangents();
     let (camera, camera_source) =
-        choose_camera(desc.camera, &cameras, &scene, &name, &mut warnings)?;
+        choose_camera(desc.camera, &objects.cameras, &scene, &name, &mut warnings)?;
     scene.camera = camera;
     let (sky, sky_share) = sky::apply(&mut scene, &desc.sky)
         .map_err(|e| FormatError::in_file(&name, format!("sky: {e}")))?;
@@ -242,6 +170,133 @@ pub fn assemble(mut desc: SceneDescription) -> Result<AssembledScene, FormatErro
         names,
         warnings,
     })
+}
+
+/// What adding a description's objects to a scene keeps track of.
+struct Objects {
+    /// The scene's mesh of each description mesh, once added.
+    meshes: Vec<Option<u32>>,
+    /// The description's meshes not yet added.
+    inline: Vec<Option<SceneMesh>>,
+    /// The mesh files, each loaded once.
+    library: MeshLibrary,
+    /// The cameras of the mesh files, in the order they were loaded.
+    cameras: Vec<GltfCamera>,
+    /// The mesh files some object shows with their own materials.
+    own: HashSet<PathBuf>,
+    /// Each object's media, which go on every instance it adds.
+    interfaces: BTreeMap<u32, MediumInterface>,
+    /// Instances whose glTF material fills them with a medium.
+    filled: HashSet<u32>,
+}
+
+impl Objects {
+    /// Adds object `o` (number `k` in the file `name`) to `scene`: true if
+    /// it emits light.
+    fn add(
+        &mut self,
+        scene: &mut Scene,
+        k: usize,
+        o: &Object,
+        name: &str,
+    ) -> Result<bool, FormatError> {
+        Ok(match &o.geometry {
+            Geometry::File(path) => self.add_file(scene, k, o, path, name)?,
+            Geometry::Shape(shape) => {
+                let material = match o.material {
+                    Some(m) => m,
+                    None => self.library.default_material(scene),
+                };
+                add_placed_shape(scene, *shape, &o.placement, material);
+                is_emissive(scene, material)
+            }
+            Geometry::Mesh(i) => self.add_mesh(scene, o, *i as usize),
+        })
+    }
+
+    /// Adds object `o` showing the mesh file `path`: an instance per
+    /// part, the file's glass volumes and its lights. True if it emits.
+    fn add_file(
+        &mut self,
+        scene: &mut Scene,
+        k: usize,
+        o: &Object,
+        path: &Path,
+        name: &str,
+    ) -> Result<bool, FormatError> {
+        let first = self.library.file_count();
+        let f = self
+            .library
+            .load(scene, path, self.own.contains(&file_key(path)))
+            .map_err(|e| {
+                if path.display().to_string() == name {
+                    e
+                } else {
+                    FormatError::in_file(name, format!("object {}: {e}", k + 1))
+                }
+            })?;
+        if self.library.file_count() > first {
+            self.cameras.extend(f.cameras.iter().cloned());
+        }
+        for part in &f.parts {
+            let instance = scene.add_instance(Instance {
+                mesh: part.mesh,
+                placement: placed(&o.placement, part.transform),
+                material: o.material.or(f.material),
+            });
+            if o.material.is_none() && !f.volumes.is_empty() {
+                let outside = self.interfaces.get(&(k as u32)).and_then(|mi| mi.outside);
+                if let Some(mi) = volume_interface(scene, part.mesh, &f.volumes, outside) {
+                    scene.set_medium_interface(instance, mi);
+                    self.filled.insert(instance);
+                }
+            }
+        }
+        // The file's lights, where the object puts the file (where it
+        // starts, if it moves).
+        let at = Mat4::from(placed(&o.placement, Mat4::IDENTITY).at(0.0));
+        for l in &f.lights {
+            scene.add_light(gltf_light(l, at));
+        }
+        Ok(o.material.map_or(f.emissive, |m| is_emissive(scene, m)))
+    }
+
+    /// Adds object `o` showing the description's mesh `i` (added to the
+    /// scene on first use). True if it emits.
+    fn add_mesh(&mut self, scene: &mut Scene, o: &Object, i: usize) -> bool {
+        let mesh = match self.meshes[i] {
+            Some(id) => id,
+            None => {
+                let id = scene.add_mesh(self.inline[i].take().expect("added once"));
+                self.meshes[i] = Some(id);
+                id
+            }
+        };
+        scene.add_instance(Instance {
+            mesh,
+            placement: placed(&o.placement, Mat4::IDENTITY),
+            material: o.material,
+        });
+        match o.material {
+            Some(m) => is_emissive(scene, m),
+            None => scene.meshes[mesh as usize]
+                .material_ids
+                .as_ref()
+                .is_some_and(|ids| ids.iter().any(|&m| is_emissive(scene, m))),
+        }
+    }
+
+    /// Puts object `k`'s media on the instances it added from
+    /// `first_instance` on, except those a glTF volume fills.
+    fn add_media(&self, scene: &mut Scene, k: usize, first_instance: u32) {
+        if let Some(&mi) = self.interfaces.get(&(k as u32)) {
+            for i in first_instance..scene.instances.len() as u32 {
+                if !self.filled.contains(&i) {
+                    scene.set_medium_interface(i, mi);
+                }
+            }
+        }
+    }
 }
 
 /// The mesh files some object shows with their own materials.

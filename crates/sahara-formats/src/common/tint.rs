@@ -1,12 +1,11 @@
-//! Tints and blends, as the pbrt and Mitsuba readers both map them: a
+//! Tints, as the pbrt and Mitsuba readers both map them: a
 //! colour times at most one image ([`Tint`]), an opacity image folded into
-//! a colour texture's alpha ([`with_opacity`]), and the mix of two
-//! materials where Sahara can blend them exactly ([`blend`]).
+//! a colour texture's alpha ([`with_opacity`]).
 
 use std::sync::Arc;
 
 use glam::{Affine2, Vec3};
-use sahara_render::{Bsdf, Material, Texture, TextureMap, Wrap};
+use sahara_render::{Texture, TextureMap, Wrap};
 
 /// A colour, optionally times an image.
 #[derive(Clone, Debug, PartialEq)]
@@ -144,31 +143,5 @@ pub(crate) fn with_alpha_of(src: &Texture, out: Texture) -> Texture {
     match alpha_of(src) {
         Some(a) => out.with_alpha(a),
         None => out,
-    }
-}
-
-/// A `mix` of materials (pbrt's `mix`, Mitsuba's `blendbsdf`) `a` and `b` with weight `t` of `b`, when
-/// Sahara can blend them exactly: the same material, or two diffuse
-/// colours without textures (a Lambertian BSDF is linear in its colour).
-pub(crate) fn blend(a: &Material, b: &Material, t: f32) -> Option<Material> {
-    if a == b {
-        return Some(a.clone());
-    }
-    match (a.bsdf, b.bsdf) {
-        (Bsdf::Diffuse { albedo: x }, Bsdf::Diffuse { albedo: y })
-            if a.textures.base_color.is_none()
-                && b.textures.base_color.is_none()
-                && Material {
-                    bsdf: a.bsdf,
-                    ..b.clone()
-                } == *a =>
-        {
-            let mut m = a.clone();
-            m.bsdf = Bsdf::Diffuse {
-                albedo: x.lerp(y, t),
-            };
-            Some(m)
-        }
-        _ => None,
     }
 }

@@ -11,7 +11,7 @@ use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec2};
-use sahara_render::{Scene, SceneMesh};
+use sahara_render::{Material, Scene, SceneMesh};
 
 use crate::common::materials::TextureCache;
 use crate::gltf::material::gltf_material;
@@ -93,7 +93,7 @@ impl MeshLibrary {
     /// The scene's grey default material, added on first use.
     pub fn default_material(&mut self, scene: &mut Scene) -> u32 {
         *self.default_material.get_or_insert_with(|| {
-            let id = scene.add_material(Scene::default_material());
+            let id = scene.add_material(Material::default());
             self.material_names.insert(id, "default".into());
             id
         })

@@ -34,7 +34,7 @@ use super::builder::{key, Builder};
 use super::properties::Object;
 use super::spectra::{conductor_rgb, Color, Usage};
 use super::xml::Node;
-use crate::common::tint::{blend, with_opacity, Tint};
+use crate::common::tint::{with_opacity, Tint};
 
 /// Deepest chain of bsdfs nested in bsdfs.
 const MAX_NESTING: usize = 16;
@@ -250,9 +250,9 @@ impl<'a> Builder<'a> {
 
     /// The material of a bsdf element; `None` for no surface.
     ///
-    /// One piece on purpose: it is Mitsuba's one bsdf table, an arm per kind, each mapping its
-    /// parameters onto Sahara's; it becomes one mapping per kind family when
-    /// materials and lights are kinds the renderer describes.
+    /// One piece on purpose: it is Mitsuba's one mapping of its bsdfs onto
+    /// Sahara's material kinds, an arm per Mitsuba type, read as a table;
+    /// a new kind is an arm here.
     fn bsdf(&mut self, node: &'a Node, depth: usize) -> Result<Option<Material>, FormatError> {
         if depth > MAX_NESTING {
             return Err(node.error("bsdfs nest too deep (a cycle of references?)"));
@@ -413,8 +413,8 @@ impl<'a> Builder<'a> {
                 let [a, b] = <[Option<Material>; 2]>::try_from(inner)
                     .map_err(|_| o.error("blendbsdf needs two nested bsdfs"))?;
                 match (&a, &b) {
-                    (Some(x), Some(y)) if blend(x, y, t).is_some() => {
-                        blend(x, y, t).expect("checked")
+                    (Some(x), Some(y)) if Material::blend(x, y, t).is_some() => {
+                        Material::blend(x, y, t).expect("checked")
                     }
                     _ => {
                         if t > 0.0 && t < 1.0 && a != b {

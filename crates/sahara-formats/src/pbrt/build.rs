@@ -28,14 +28,14 @@ use sahara_render::{
     TextureMap, ToneMap,
 };
 
-use super::declarations::{Declarations, Entity, MaterialRef, ShapeDecl, Xform};
+use super::declarations::{unknown_params, Declarations, Entity, MaterialRef, ShapeDecl, Xform};
 use super::lights::{add_light, area_emission};
-use super::materials::{map_material, Mapped};
+use super::materials::{default_material, map_material, Mapped};
 use super::media::{add_media, interface};
 use super::shapes::shape_geometry;
 use super::textures::Textures;
 use crate::common::mesh::smooth_normals;
-use crate::common::tint::{blend, with_opacity};
+use crate::common::tint::with_opacity;
 use crate::common::warnings::Warnings;
 use crate::description::{
     CameraRequest, FileCrop, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
@@ -43,19 +43,6 @@ use crate::description::{
 
 /// Deepest chain of `mix` materials followed.
 const MAX_MIX_DEPTH: usize = 16;
-
-/// Reports the parameters of `e` nothing asked for.
-pub(super) fn unknown_params(e: &Entity, what: &str, w: &mut Warnings) {
-    for p in e.params.unused() {
-        w.add(
-            format!(
-                "{what} '{}': unknown parameter \"{} {}\", ignored",
-                e.kind, p.ty, p.name
-            ),
-            &p.loc,
-        );
-    }
-}
 
 /// The materials of the file, mapped on first use.
 struct Materials<'a> {
@@ -123,7 +110,7 @@ impl Materials<'_> {
         match r {
             MaterialRef::Default => {
                 Ok(Some(*self.default.get_or_insert_with(|| {
-                    scene.add_material(Material::diffuse(Vec3::splat(0.5)))
+                    scene.add_material(default_material())
                 })))
             }
             MaterialRef::Anonymous(i) => {
@@ -202,7 +189,7 @@ impl Materials<'_> {
                 let t = amount.clamp(0.0, 1.0) as f32;
                 if let (Some(a), Some(b)) = (a, b) {
                     let (ma, mb) = (&scene.materials[a as usize], &scene.materials[b as usize]);
-                    if let Some(m) = blend(ma, mb, t) {
+                    if let Some(m) = Material::blend(ma, mb, t) {
                         return Ok(Some(scene.add_material(m)));
                     }
                 }
@@ -853,7 +840,8 @@ fn oriented_geometry(
     Ok(Some((mesh, exact)))
 }
 
-/// The scene description of `desc`, read from the file `name` in `folder`.
+/// The scene description of `desc`, read from the file `name` in `folder`:
+/// settings and camera, media, shapes, object instances, lights.
 pub(crate) fn build(
     desc: &Declarations,
     name: &str,
@@ -885,105 +873,172 @@ pub(crate) fn build(
     if let Some(d) = &desc.camera_medium {
         scene.camera_medium = interface(&media, d)?.1;
     }
-    let times = desc.transform_times;
+    let timing = (desc.transform_times, shutter);
     for s in &desc.shapes {
-        let m = s.xform.m[0];
-        // pbrt's media on the shape's sides; equal sides are no boundary.
-        let sides = match &s.media {
-            Some(d) => Some(interface(&media, d)?),
-            None => None,
-        };
-        let transition = sides.filter(|(inside, outside)| inside != outside);
-        let (material, medium_interface) = match materials.resolve(&mut scene, &s.material, w)? {
-            None => match transition {
-                // No surface between two media: an index-matched boundary.
-                Some((inside, outside)) => (
-                    None,
-                    Some(MediumInterface {
-                        inside,
-                        outside,
-                        index_matched: true,
-                    }),
-                ),
-                None => {
-                    w.add(
-                        "shapes with an 'interface' material (no surface) and no media \
-                             to bound are not rendered",
-                        &s.entity.loc,
-                    );
-                    shape_geometry(&s.entity, w)?;
-                    continue;
-                }
-            },
-            Some(material) => {
-                let inner = materials.subsurface.get(&material).copied();
-                let Some(material) = materials.cut(&mut scene, material, &s.entity, w)? else {
-                    shape_geometry(&s.entity, w)?;
-                    continue;
-                };
-                let mi = match inner {
-                    Some(inner) => Some(MediumInterface {
-                        inside: Some(inner),
-                        outside: sides.and_then(|(_, outside)| outside),
-                        index_matched: false,
-                    }),
-                    None => transition.map(|(inside, outside)| MediumInterface {
-                        inside,
-                        outside,
-                        index_matched: false,
-                    }),
-                };
-                (Some(material), mi)
-            }
-        };
-        let Some((mesh, exact)) = oriented_geometry(s, &m, w)? else {
-            continue;
-        };
-        let material = match (&s.area_light, material) {
-            (None, material) => material,
-            (Some(a), None) => {
+        add_shape(s, &media, timing, &mut scene, &mut materials, w)?;
+    }
+    add_instances(desc, timing, &mut scene, &mut materials, w)?;
+    for l in &desc.lights {
+        add_light(&mut scene, l, w)?;
+        unknown_params(&l.entity, "light", w);
+    }
+    Ok(scene)
+}
+
+/// The transform times of a file and the camera's shutter interval, which
+/// place moving things.
+type Timing = ((f64, f64), (f64, f64));
+
+/// Adds shape `s` to `scene` as an object with its material, area light
+/// and medium interface (`media`: the file's media by name); nothing for a
+/// shape that is not rendered.
+fn add_shape(
+    s: &ShapeDecl,
+    media: &HashMap<String, u32>,
+    (times, shutter): Timing,
+    scene: &mut SceneDescription,
+    materials: &mut Materials,
+    w: &mut Warnings,
+) -> Result<(), FormatError> {
+    let m = s.xform.m[0];
+    let Some((material, medium_interface)) = surface(s, media, scene, materials, w)? else {
+        return Ok(());
+    };
+    let Some((mesh, exact)) = oriented_geometry(s, &m, w)? else {
+        return Ok(());
+    };
+    let material = match (&s.area_light, material) {
+        (None, material) => material,
+        (Some(a), None) => {
+            w.add(
+                "area lights on shapes with an 'interface' material do not emit",
+                &a.loc,
+            );
+            a.params.mark_all_used();
+            None
+        }
+        (Some(a), Some(material)) => Some(emitting(a, material, &mesh, &m, scene, w)?),
+    };
+    let placement = placement(&s.xform, times, shutter);
+    let geometry = match (exact, placement) {
+        (Some(shape), ObjectPlacement::Static(_)) => Geometry::Shape(shape),
+        _ if mesh.mesh.indices.is_empty() => return Ok(()),
+        _ => Geometry::Mesh(scene.add_mesh(mesh)),
+    };
+    scene.objects.push(Object {
+        geometry,
+        placement,
+        material,
+        name: None,
+    });
+    if let Some(mi) = medium_interface {
+        let k = scene.objects.len() as u32 - 1;
+        scene.medium_interfaces.push((k, mi));
+    }
+    Ok(())
+}
+
+/// A shape's material (`None`: no surface) and the media on its sides.
+type Surface = (Option<u32>, Option<MediumInterface>);
+
+/// What shape `s` is made of: its material (`None`: no surface, an
+/// index-matched boundary between two media) and the media on its sides.
+/// `None` when the shape is not rendered (its geometry is still read, for
+/// its warnings).
+fn surface(
+    s: &ShapeDecl,
+    media: &HashMap<String, u32>,
+    scene: &mut SceneDescription,
+    materials: &mut Materials,
+    w: &mut Warnings,
+) -> Result<Option<Surface>, FormatError> {
+    // pbrt's media on the shape's sides; equal sides are no boundary.
+    let sides = match &s.media {
+        Some(d) => Some(interface(media, d)?),
+        None => None,
+    };
+    let transition = sides.filter(|(inside, outside)| inside != outside);
+    Ok(match materials.resolve(scene, &s.material, w)? {
+        None => match transition {
+            // No surface between two media: an index-matched boundary.
+            Some((inside, outside)) => Some((
+                None,
+                Some(MediumInterface {
+                    inside,
+                    outside,
+                    index_matched: true,
+                }),
+            )),
+            None => {
                 w.add(
-                    "area lights on shapes with an 'interface' material do not emit",
-                    &a.loc,
+                    "shapes with an 'interface' material (no surface) and no media \
+                         to bound are not rendered",
+                    &s.entity.loc,
                 );
-                a.params.mark_all_used();
+                shape_geometry(&s.entity, w)?;
                 None
             }
-            (Some(a), Some(material)) => {
-                let em = area_emission(a, w)?;
-                unknown_params(a, "area light", w);
-                let mut radiance = em.radiance;
-                if let Some(power) = em.power {
-                    let sides = if em.two_sided { 2.0 } else { 1.0 };
-                    let area = world_area(&mesh, &m);
-                    if area > 0.0 {
-                        radiance *= (power / (std::f64::consts::PI * area * sides)) as f32;
-                    }
-                }
-                let mut mat = scene.materials[material as usize]
-                    .clone()
-                    .with_emission(radiance);
-                mat.two_sided_emission = em.two_sided;
-                Some(scene.add_material(mat))
-            }
-        };
-        let placement = placement(&s.xform, times, shutter);
-        let geometry = match (exact, placement) {
-            (Some(shape), ObjectPlacement::Static(_)) => Geometry::Shape(shape),
-            _ if mesh.mesh.indices.is_empty() => continue,
-            _ => Geometry::Mesh(scene.add_mesh(mesh)),
-        };
-        scene.objects.push(Object {
-            geometry,
-            placement,
-            material,
-            name: None,
-        });
-        if let Some(mi) = medium_interface {
-            let k = scene.objects.len() as u32 - 1;
-            scene.medium_interfaces.push((k, mi));
+        },
+        Some(material) => {
+            let inner = materials.subsurface.get(&material).copied();
+            let Some(material) = materials.cut(scene, material, &s.entity, w)? else {
+                shape_geometry(&s.entity, w)?;
+                return Ok(None);
+            };
+            let mi = match inner {
+                Some(inner) => Some(MediumInterface {
+                    inside: Some(inner),
+                    outside: sides.and_then(|(_, outside)| outside),
+                    index_matched: false,
+                }),
+                None => transition.map(|(inside, outside)| MediumInterface {
+                    inside,
+                    outside,
+                    index_matched: false,
+                }),
+            };
+            Some((Some(material), mi))
+        }
+    })
+}
+
+/// `material` emitting as area light `a` says, on `mesh` under transform
+/// `m` (a power is spread over the mesh's area in the world): the index of
+/// the emitting copy added to `scene`.
+fn emitting(
+    a: &Entity,
+    material: u32,
+    mesh: &SceneMesh,
+    m: &DMat4,
+    scene: &mut SceneDescription,
+    w: &mut Warnings,
+) -> Result<u32, FormatError> {
+    let em = area_emission(a, w)?;
+    unknown_params(a, "area light", w);
+    let mut radiance = em.radiance;
+    if let Some(power) = em.power {
+        let sides = if em.two_sided { 2.0 } else { 1.0 };
+        let area = world_area(mesh, m);
+        if area > 0.0 {
+            radiance *= (power / (std::f64::consts::PI * area * sides)) as f32;
         }
     }
+    let mut mat = scene.materials[material as usize]
+        .clone()
+        .with_emission(radiance);
+    mat.two_sided_emission = em.two_sided;
+    Ok(scene.add_material(mat))
+}
+
+/// Adds the file's object instances to `scene`, each object's shapes made
+/// one mesh on first use; warns of objects never instanced.
+fn add_instances(
+    desc: &Declarations,
+    (times, shutter): Timing,
+    scene: &mut SceneDescription,
+    materials: &mut Materials,
+    w: &mut Warnings,
+) -> Result<(), FormatError> {
     let mut objects: HashMap<&str, Option<u32>> = HashMap::new();
     for inst in &desc.instances {
         let mesh = match objects.get(inst.name.as_str()) {
@@ -995,7 +1050,7 @@ pub(crate) fn build(
                         inst.name
                     )));
                 };
-                let m = object_mesh(&mut scene, shapes, &mut materials, w)?;
+                let m = object_mesh(scene, shapes, materials, w)?;
                 objects.insert(inst.name.as_str(), m);
                 m
             }
@@ -1013,11 +1068,7 @@ pub(crate) fn build(
             w.add(format!("object \"{name}\" is never instanced"), loc);
         }
     }
-    for l in &desc.lights {
-        add_light(&mut scene, l, w)?;
-        unknown_params(&l.entity, "light", w);
-    }
-    Ok(scene)
+    Ok(())
 }
 
 /// The one mesh of an object: its shapes with their transforms applied,

@@ -9,6 +9,20 @@ use glam::DMat4;
 
 use super::params::ParamList;
 use crate::common::position::Loc;
+use crate::common::warnings::Warnings;
+
+/// Reports the parameters of `e` nothing asked for.
+pub(super) fn unknown_params(e: &Entity, what: &str, w: &mut Warnings) {
+    for p in e.params.unused() {
+        w.add(
+            format!(
+                "{what} '{}': unknown parameter \"{} {}\", ignored",
+                e.kind, p.ty, p.name
+            ),
+            &p.loc,
+        );
+    }
+}
 
 /// A directive's type name (`"perspective"`, `"trianglemesh"`, ...) with its parameters.
 #[derive(Clone, Debug)]

@@ -56,9 +56,9 @@ fn v3(p: [f64; 3]) -> DVec3 {
 
 /// Adds the light `l` to `scene`.
 ///
-/// One piece on purpose: it is pbrt's one light table, an arm per kind, each mapping its
-/// parameters onto Sahara's; it becomes one mapping per kind family when
-/// materials and lights are kinds the renderer describes.
+/// One piece on purpose: it is pbrt's one mapping of its lights onto
+/// Sahara's light kinds, an arm per pbrt type, read as a table;
+/// a new kind is an arm here.
 pub(crate) fn add_light(
     scene: &mut SceneDescription,
     l: &LightDecl,

@@ -92,6 +92,23 @@ fn roughness(
     Ok(sahara_roughness(0.5 * (u + v), remap, v3))
 }
 
+/// The material of shapes declared before any `Material` directive:
+/// pbrt-v4's default, diffuse of reflectance 0.5.
+pub(crate) fn default_material() -> Material {
+    Material::diffuse(Vec3::splat(0.5))
+}
+
+/// pbrt's dielectric of index `eta` and Sahara roughness `roughness`
+/// (a material's, or a `subsurface` boundary's): smooth glass at most
+/// 1e-3, rough glass above.
+pub(super) fn glass(eta: f32, roughness: f32) -> Material {
+    if roughness <= 1e-3 {
+        Material::glass(eta)
+    } else {
+        Material::rough_glass(eta, roughness)
+    }
+}
+
 /// A diffuse material of reflectance `tint`.
 fn diffuse(tint: Tint) -> Material {
     let mut m = Material::diffuse(tint.color.clamp(Vec3::ZERO, Vec3::ONE));
@@ -300,9 +317,9 @@ fn layered(kd: &Tint, f0: Vec3, f90: f32, r: f32) -> Material {
 /// put its `"string type"` there). Approximations are counted in `w`,
 /// one kind per material type.
 ///
-/// One piece on purpose: it is pbrt's one material table, an arm per kind, each mapping its
-/// parameters onto Sahara's; it becomes one mapping per kind family when
-/// materials and lights are kinds the renderer describes.
+/// One piece on purpose: it is pbrt's one mapping of its materials onto
+/// Sahara's material kinds, an arm per pbrt type, read as a table;
+/// a new kind is an arm here.
 pub(crate) fn map_material(
     e: &Entity,
     tex: &mut Textures,
@@ -385,12 +402,7 @@ pub(crate) fn map_material(
             if e.kind == "thindielectric" {
                 Material::new(Bsdf::ThinDielectric { ior: eta })
             } else {
-                let r = roughness(e, "", 0.0, v3, tex, w)?;
-                if r <= 1e-3 {
-                    Material::glass(eta)
-                } else {
-                    Material::rough_glass(eta, r)
-                }
+                glass(eta, roughness(e, "", 0.0, v3, tex, w)?)
             }
         }
         "mirror" => {

@@ -162,7 +162,7 @@ fn named_medium(d: &MediumDecl, w: &mut Warnings) -> Result<Medium, FormatError>
     if let Some(problem) = medium.problem() {
         return Err(e.loc.error(format!("{what}: {problem}")));
     }
-    super::build::unknown_params(e, "medium", w);
+    super::declarations::unknown_params(e, "medium", w);
     Ok(medium)
 }
 
@@ -362,11 +362,7 @@ pub(crate) fn subsurface(e: &Entity, w: &mut Warnings) -> Result<(Material, Medi
     // pbrt-v4 remaps roughness to alpha = sqrt(r); Sahara's roughness is sqrt(alpha).
     let alpha = if remap { r.max(0.0).sqrt() } else { r };
     let roughness = alpha.clamp(0.0, 1.0).sqrt() as f32;
-    let boundary = if roughness <= 1e-3 {
-        Material::glass(eta)
-    } else {
-        Material::rough_glass(eta, roughness)
-    };
+    let boundary = super::materials::glass(eta, roughness);
     for k in ["mfp", "displacement", "normalmap"] {
         if e.params.get(k).is_some() {
             w.add(format!("{what}: '{k}' is ignored"), &e.loc);

@@ -3,6 +3,7 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
+use super::emission::Emission;
 use super::LightSample;
 use crate::math::warp::luminance;
 
@@ -24,4 +25,18 @@ pub fn sample(direction: Vec3, irradiance: Vec3) -> Option<LightSample> {
 /// Power through a disc of the scene's radius, for light selection.
 pub fn power(irradiance: Vec3, scene_radius: f32) -> f32 {
     PI * scene_radius * scene_radius * luminance(irradiance)
+}
+
+/// Light leaving a directional light through `origin`, a point of the
+/// disc of the scene's `radius` facing it.
+pub(crate) fn emission(direction: Vec3, irradiance: Vec3, origin: Vec3, radius: f32) -> Emission {
+    Emission {
+        p: origin,
+        n: Vec3::ZERO,
+        dir: direction,
+        le: irradiance,
+        pdf_pos: 1.0 / (PI * radius * radius),
+        pdf_dir: 1.0,
+        two_sided: false,
+    }
 }

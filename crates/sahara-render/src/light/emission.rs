@@ -9,13 +9,17 @@
 //! send their light through a disc of the scene's bounding radius facing
 //! the direction, as pbrt does: the position density is then per unit area
 //! of that disc.
+//!
+//! Here are the surfaces and the environment; a point, spot or
+//! directional light's own emission is in its module, through
+//! `Light::emission`.
 
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
 use super::area::{AreaLight, Emitter};
-use super::{spot, Light, LightSource};
-use crate::math::warp::{concentric_disc, cosine_hemisphere, uniform_cone, uniform_sphere, Frame};
+use super::LightSource;
+use crate::math::warp::{concentric_disc, cosine_hemisphere, uniform_sphere, Frame};
 
 /// Light leaving a light: where, where to, how much, and how likely.
 #[derive(Clone, Copy, Debug)]
@@ -119,9 +123,9 @@ impl LightSource {
     /// True for the lights at infinity (environment, directional).
     pub(crate) fn is_infinite(&self) -> bool {
         match self {
-            LightSource::Environment(_) | LightSource::Explicit(Light::Directional { .. }) => true,
-            LightSource::Explicit(Light::Point { .. } | Light::Spot { .. })
-            | LightSource::Area(_) => false,
+            LightSource::Environment(_) => true,
+            LightSource::Explicit(light) => light.is_infinite(),
+            LightSource::Area(_) => false,
         }
     }
 
@@ -143,49 +147,7 @@ impl LightSource {
             center + f.s * d.x + f.t * d.y - dir * radius
         };
         let e = match self {
-            LightSource::Explicit(Light::Point {
-                position,
-                intensity,
-            }) => Emission {
-                p: *position,
-                n: Vec3::ZERO,
-                dir: uniform_sphere(u_dir),
-                le: *intensity,
-                pdf_pos: 1.0,
-                pdf_dir: 1.0 / (4.0 * PI),
-                two_sided: false,
-            },
-            LightSource::Explicit(Light::Spot {
-                position,
-                direction,
-                intensity,
-                cos_inner,
-                cos_outer,
-            }) => {
-                let local = uniform_cone(u_dir, *cos_outer);
-                let dir = Frame::from_normal(*direction).to_world(local);
-                Emission {
-                    p: *position,
-                    n: Vec3::ZERO,
-                    dir,
-                    le: *intensity * spot::falloff(local.z, *cos_inner, *cos_outer),
-                    pdf_pos: 1.0,
-                    pdf_dir: 1.0 / (2.0 * PI * (1.0 - cos_outer)),
-                    two_sided: false,
-                }
-            }
-            LightSource::Explicit(Light::Directional {
-                direction,
-                irradiance,
-            }) => Emission {
-                p: disc(*direction),
-                n: Vec3::ZERO,
-                dir: *direction,
-                le: *irradiance,
-                pdf_pos: 1.0 / (PI * radius * radius),
-                pdf_dir: 1.0,
-                two_sided: false,
-            },
+            LightSource::Explicit(light) => light.emission(u_dir, disc, radius),
             LightSource::Environment(env) => {
                 let s = env.sample(u_dir)?;
                 let dir = -s.wi;
@@ -225,21 +187,10 @@ impl LightSource {
     /// surfaces.
     pub(crate) fn pdf_dir(&self, n: Vec3, dir: Vec3, two_sided: bool) -> f32 {
         match self {
-            LightSource::Explicit(Light::Point { .. }) => 1.0 / (4.0 * PI),
-            LightSource::Explicit(Light::Spot {
-                direction,
-                cos_outer,
-                ..
-            }) => {
-                if dir.dot(*direction) >= *cos_outer {
-                    1.0 / (2.0 * PI * (1.0 - cos_outer))
-                } else {
-                    0.0
-                }
-            }
+            LightSource::Explicit(light) => light.pdf_dir(dir),
             LightSource::Area(_) => surface_pdf_dir(n.dot(dir), two_sided),
             // Lights at infinity: see `pdf_disc`.
-            LightSource::Explicit(Light::Directional { .. }) | LightSource::Environment(_) => 0.0,
+            LightSource::Environment(_) => 0.0,
         }
     }
 
@@ -267,6 +218,7 @@ pub(crate) fn pdf_disc(radius: f32) -> f32 {
 mod tests {
     use super::*;
     use crate::light::area::Emitter;
+    use crate::light::Light;
 
     /// Every light's sampled directions have the density `pdf_dir` gives,
     /// and integrate to one over the sphere (estimated by the sample mean

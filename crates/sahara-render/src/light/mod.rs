@@ -98,6 +98,56 @@ impl Light {
             Light::Directional { irradiance, .. } => directional::power(irradiance, scene_radius),
         }
     }
+
+    /// True for the light at infinity (directional).
+    pub(crate) fn is_infinite(&self) -> bool {
+        match self {
+            Light::Directional { .. } => true,
+            Light::Point { .. } | Light::Spot { .. } => false,
+        }
+    }
+
+    /// Light leaving this light, its direction from `u_dir`; `disc` gives
+    /// a light at infinity's origin on the disc of the scene's `radius`
+    /// facing its direction.
+    pub(crate) fn emission(
+        &self,
+        u_dir: glam::Vec2,
+        disc: impl Fn(Vec3) -> Vec3,
+        radius: f32,
+    ) -> emission::Emission {
+        match *self {
+            Light::Point {
+                position,
+                intensity,
+            } => point::emission(position, intensity, u_dir),
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+            } => spot::emission(position, direction, intensity, cos_inner, cos_outer, u_dir),
+            Light::Directional {
+                direction,
+                irradiance,
+            } => directional::emission(direction, irradiance, disc(direction), radius),
+        }
+    }
+
+    /// Density of direction `dir` leaving this light (zero for a light at
+    /// infinity: see `emission::pdf_disc`).
+    pub(crate) fn pdf_dir(&self, dir: Vec3) -> f32 {
+        match *self {
+            Light::Point { .. } => point::PDF_DIR,
+            Light::Spot {
+                direction,
+                cos_outer,
+                ..
+            } => spot::pdf_dir(direction, cos_outer, dir),
+            Light::Directional { .. } => 0.0,
+        }
+    }
 }
 
 /// Light arriving at a point from a sampled direction.

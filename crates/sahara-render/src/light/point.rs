@@ -3,8 +3,9 @@
 use glam::Vec3;
 use std::f32::consts::PI;
 
+use super::emission::Emission;
 use super::LightSample;
-use crate::math::warp::luminance;
+use crate::math::warp::{luminance, uniform_sphere};
 
 /// Incident radiance at `p` from a point light of `intensity` (W/sr) at
 /// `position`: `I / d^2` along the connecting direction.
@@ -31,3 +32,20 @@ pub fn sample(position: Vec3, intensity: Vec3, p: Vec3) -> Option<LightSample> {
 pub fn power(intensity: Vec3) -> f32 {
     4.0 * PI * luminance(intensity)
 }
+
+/// Light leaving a point light, its direction uniform on the sphere
+/// (`u_dir`).
+pub(crate) fn emission(position: Vec3, intensity: Vec3, u_dir: glam::Vec2) -> Emission {
+    Emission {
+        p: position,
+        n: Vec3::ZERO,
+        dir: uniform_sphere(u_dir),
+        le: intensity,
+        pdf_pos: 1.0,
+        pdf_dir: PDF_DIR,
+        two_sided: false,
+    }
+}
+
+/// Density of any direction leaving a point light.
+pub(crate) const PDF_DIR: f32 = 1.0 / (4.0 * PI);

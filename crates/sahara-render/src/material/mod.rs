@@ -403,6 +403,13 @@ pub struct Material {
     pub alpha: f32,
 }
 
+/// A neutral grey diffuse material, for geometry without one.
+impl Default for Material {
+    fn default() -> Self {
+        Material::diffuse(Vec3::splat(0.8))
+    }
+}
+
 impl Material {
     /// A material from a BSDF, without texture or emission.
     pub fn new(bsdf: Bsdf) -> Self {
@@ -449,6 +456,41 @@ impl Material {
             roughness,
             distribution: Distribution::Ggx,
         })
+    }
+
+    /// The mix of materials `a` and `b` with weight `t` of `b` (pbrt's
+    /// `mix`, Mitsuba's `blendbsdf`), when it is itself a material: the
+    /// same material, or two diffuse colours without textures (a
+    /// Lambertian BSDF is linear in its colour). `None` otherwise.
+    pub fn blend(a: &Material, b: &Material, t: f32) -> Option<Material> {
+        if a == b {
+            return Some(a.clone());
+        }
+        // Each kind says whether its mix is itself: only a colour a BSDF
+        // is linear in blends.
+        let bsdf = match (a.bsdf, b.bsdf) {
+            (Bsdf::Diffuse { albedo: x }, Bsdf::Diffuse { albedo: y }) => Bsdf::Diffuse {
+                albedo: x.lerp(y, t),
+            },
+            (
+                Bsdf::Diffuse { .. }
+                | Bsdf::Conductor { .. }
+                | Bsdf::Mirror { .. }
+                | Bsdf::Dielectric { .. }
+                | Bsdf::RoughDielectric { .. }
+                | Bsdf::ComplexConductor { .. }
+                | Bsdf::MetallicRoughness { .. }
+                | Bsdf::CoatedDiffuse { .. }
+                | Bsdf::ThinDielectric { .. },
+                _,
+            ) => return None,
+        };
+        let same_but_bsdf = Material {
+            bsdf: a.bsdf,
+            ..b.clone()
+        } == *a;
+        (a.textures.base_color.is_none() && b.textures.base_color.is_none() && same_but_bsdf)
+            .then(|| Material { bsdf, ..a.clone() })
     }
 
     /// A black emitter of radiance `radiance`.

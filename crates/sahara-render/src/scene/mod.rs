@@ -337,9 +337,4 @@ impl Scene {
         }
         true
     }
-
-    /// A neutral grey diffuse material, for geometry without one.
-    pub fn default_material() -> Material {
-        Material::diffuse(Vec3::splat(0.8))
-    }
 }
