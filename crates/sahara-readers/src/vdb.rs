@@ -31,7 +31,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
 use glam::{Affine3A, DVec3, Quat, Vec3};
-use vdb_rs::{Map, MetadataValue, VdbLevel, VdbReader};
+use vdb_rs::{GridDescriptor, Map, MetadataValue, VdbLevel, VdbReader};
 
 use crate::FormatError;
 
@@ -94,33 +94,11 @@ fn panic_text(p: Box<dyn std::any::Any + Send>) -> String {
 /// Parses the bytes of a `.vdb` file and reads its float grid named
 /// `grid`; `name` names the file in errors.
 pub fn parse_vdb(bytes: &[u8], name: &str, grid: &str) -> Result<VdbGrid, FormatError> {
-    let at = |offset: u64, message: String| FormatError::AtByte {
-        path: name.to_owned(),
-        offset,
-        message,
-    };
     let in_file = |message: String| FormatError::InFile {
         path: name.to_owned(),
         message,
     };
-    // `vdb-rs` does not check the magic number itself.
-    if bytes.len() < 12 || bytes[0..8] != [0x20, 0x42, 0x44, 0x56, 0, 0, 0, 0] {
-        return Err(at(
-            0,
-            "not an OpenVDB file (it does not start with the bytes of ' BDV')".into(),
-        ));
-    }
-    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
-    if !VERSIONS.contains(&version) {
-        return Err(at(
-            8,
-            format!(
-                "OpenVDB file format version {version}; versions {} to {} are read",
-                VERSIONS.start(),
-                VERSIONS.end()
-            ),
-        ));
-    }
+    check_header(bytes, name)?;
     // `vdb-rs` panics (rather than failing) on some structures it does not
     // read; those become errors naming the file.
     let guarded = |what: &str, f: &mut dyn FnMut() -> Result<(), String>| match catch_unwind(
@@ -155,40 +133,7 @@ pub fn parse_vdb(bytes: &[u8], name: &str, grid: &str) -> Result<VdbGrid, Format
         )));
     };
     let what = format!("grid '{grid}'");
-    let kind = desc.grid_type.trim_end_matches("_HalfFloat");
-    if kind != "Tree_float_5_4_3" {
-        return Err(in_file(format!(
-            "{what} is of type '{}'; a density is read from a float grid (Tree_float_5_4_3)",
-            desc.grid_type
-        )));
-    }
-    // vdb-rs 0.6 misreads the tree of a grid saved as half floats and
-    // then asks for petabytes (an abort, not an error): refused here.
-    if desc.grid_type.ends_with("_HalfFloat") || desc.meta_data.is_half_float() {
-        return Err(in_file(format!(
-            "{what} is saved as 16-bit (half) floats, which the VDB reader (vdb-rs 0.6) \
-             cannot read; save it with 32-bit floats"
-        )));
-    }
-    if !desc.instance_parent.is_empty() {
-        return Err(in_file(format!(
-            "{what} shares the tree of grid '{}' (an instanced grid), which is not read",
-            desc.instance_parent
-        )));
-    }
-    // The active box the file records, checked before the tree is read.
-    let meta_box = match (
-        desc.meta_data.0.get("file_bbox_min"),
-        desc.meta_data.0.get("file_bbox_max"),
-    ) {
-        (Some(MetadataValue::Vec3i(a)), Some(MetadataValue::Vec3i(b))) => {
-            Some(([a.x, a.y, a.z], [b.x, b.y, b.z]))
-        }
-        _ => None,
-    };
-    if let Some((lo, hi)) = meta_box {
-        check_size(lo, hi, name, &what)?;
-    }
+    check_descriptor(&desc, name, &what)?;
     let mut read = None;
     guarded(&format!("reading {what}"), &mut || {
         read = Some(reader.read_grid::<f32>(grid).map_err(|e| e.to_string())?);
@@ -227,6 +172,102 @@ pub fn parse_vdb(bytes: &[u8], name: &str, grid: &str) -> Result<VdbGrid, Format
     if items.is_empty() {
         return Err(in_file(format!("{what} has no active voxels")));
     }
+    let (size, lo, values) = dense(items, name, &what)?;
+    Ok(VdbGrid {
+        size,
+        index_min: lo,
+        values,
+        voxel_size,
+        translation,
+    })
+}
+
+/// Refuses a file that is not OpenVDB or is of a format version `vdb-rs`
+/// does not read, naming the byte; `vdb-rs` does not check the magic
+/// number itself.
+fn check_header(bytes: &[u8], name: &str) -> Result<(), FormatError> {
+    let at = |offset: u64, message: String| FormatError::AtByte {
+        path: name.to_owned(),
+        offset,
+        message,
+    };
+    if bytes.len() < 12 || bytes[0..8] != [0x20, 0x42, 0x44, 0x56, 0, 0, 0, 0] {
+        return Err(at(
+            0,
+            "not an OpenVDB file (it does not start with the bytes of ' BDV')".into(),
+        ));
+    }
+    let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
+    if !VERSIONS.contains(&version) {
+        return Err(at(
+            8,
+            format!(
+                "OpenVDB file format version {version}; versions {} to {} are read",
+                VERSIONS.start(),
+                VERSIONS.end()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a grid `vdb-rs` cannot read into a density (another type,
+/// half floats, an instance of another grid) or whose recorded active box
+/// is too large, before its tree is read.
+fn check_descriptor(desc: &GridDescriptor, name: &str, what: &str) -> Result<(), FormatError> {
+    let in_file = |message: String| FormatError::InFile {
+        path: name.to_owned(),
+        message,
+    };
+    let kind = desc.grid_type.trim_end_matches("_HalfFloat");
+    if kind != "Tree_float_5_4_3" {
+        return Err(in_file(format!(
+            "{what} is of type '{}'; a density is read from a float grid (Tree_float_5_4_3)",
+            desc.grid_type
+        )));
+    }
+    // vdb-rs 0.6 misreads the tree of a grid saved as half floats and
+    // then asks for petabytes (an abort, not an error): refused here.
+    if desc.grid_type.ends_with("_HalfFloat") || desc.meta_data.is_half_float() {
+        return Err(in_file(format!(
+            "{what} is saved as 16-bit (half) floats, which the VDB reader (vdb-rs 0.6) \
+             cannot read; save it with 32-bit floats"
+        )));
+    }
+    if !desc.instance_parent.is_empty() {
+        return Err(in_file(format!(
+            "{what} shares the tree of grid '{}' (an instanced grid), which is not read",
+            desc.instance_parent
+        )));
+    }
+    // The active box the file records, checked before the tree is read.
+    let meta_box = match (
+        desc.meta_data.0.get("file_bbox_min"),
+        desc.meta_data.0.get("file_bbox_max"),
+    ) {
+        (Some(MetadataValue::Vec3i(a)), Some(MetadataValue::Vec3i(b))) => {
+            Some(([a.x, a.y, a.z], [b.x, b.y, b.z]))
+        }
+        _ => None,
+    };
+    if let Some((lo, hi)) = meta_box {
+        check_size(lo, hi, name, what)?;
+    }
+    Ok(())
+}
+
+/// A dense block of voxels: its size, its first index and the values,
+/// x fastest.
+type DenseBlock = ([u32; 3], [i32; 3], Vec<f32>);
+
+/// Lays active voxels and tiles (first index, side, value) out densely
+/// over the box that spans them: its size, its first index and the values,
+/// x fastest.
+fn dense(
+    items: Vec<([i32; 3], i32, f32)>,
+    name: &str,
+    what: &str,
+) -> Result<DenseBlock, FormatError> {
     let mut lo = [i32::MAX; 3];
     let mut hi = [i32::MIN; 3];
     for (c, side, _) in &items {
@@ -235,7 +276,7 @@ pub fn parse_vdb(bytes: &[u8], name: &str, grid: &str) -> Result<VdbGrid, Format
             hi[a] = hi[a].max(c[a].saturating_add(side - 1));
         }
     }
-    let size = check_size(lo, hi, name, &what)?;
+    let size = check_size(lo, hi, name, what)?;
     let [nx, ny, nz] = size.map(|n| n as usize);
     let mut values = vec![0.0f32; nx * ny * nz];
     for (c, side, v) in items {
@@ -247,13 +288,7 @@ pub fn parse_vdb(bytes: &[u8], name: &str, grid: &str) -> Result<VdbGrid, Format
             }
         }
     }
-    Ok(VdbGrid {
-        size,
-        index_min: lo,
-        values,
-        voxel_size,
-        translation,
-    })
+    Ok((size, lo, values))
 }
 
 /// The voxels per axis of the inclusive index box `lo` to `hi`, or an

@@ -95,58 +95,7 @@ impl Ctx<'_> {
                     ],
                     &what,
                 )?;
-                let file = self.required(&m.file, "file", &raw.span(), &what)?;
-                let path = self.file(file, "density grid")?;
-                let is_vdb = path
-                    .extension()
-                    .is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
-                if let (false, Some(g)) = (is_vdb, &m.grid) {
-                    return Err(self.at(
-                        g.span(),
-                        "'grid' names a grid of a .vdb file; a .vol file holds one",
-                    ));
-                }
-                // The grid's values, size, and the box the file places it in.
-                let (size, values, file_box) = if is_vdb {
-                    let name = m.grid.as_ref().map_or("density", |g| g.get_ref().as_str());
-                    let grid = sahara_readers::vdb::read_vdb(&path, name)?;
-                    let to_world = grid.to_world();
-                    (grid.size, grid.values, to_world)
-                } else {
-                    let grid = sahara_readers::vol::read_vol(&path)?;
-                    if grid.channels != 1 {
-                        return Err(self.at(
-                            file.span(),
-                            format!(
-                                "'{}' holds {} channels; a density grid holds 1",
-                                file.get_ref(),
-                                grid.channels
-                            ),
-                        ));
-                    }
-                    let lo = Vec3::from_array(grid.bounds_min);
-                    let hi = Vec3::from_array(grid.bounds_max);
-                    let to_world =
-                        Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo);
-                    (grid.size, grid.values, to_world)
-                };
-                let to_world = if m.min.is_some() || m.max.is_some() {
-                    let lo = self.vec_or(&m.min, "min", file_box.transform_point3(Vec3::ZERO))?;
-                    let hi = self.vec_or(&m.max, "max", file_box.transform_point3(Vec3::ONE))?;
-                    if (hi - lo).min_element() <= 0.0 {
-                        return Err(self.at(
-                            span(&m.max).or(span(&m.min)).unwrap_or(file.span()),
-                            format!(
-                                "the grid's box {lo} to {hi} must be above its min on every axis"
-                            ),
-                        ));
-                    }
-                    Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo)
-                } else {
-                    file_box
-                };
-                let density = DensityGrid::new(size, values)
-                    .map_err(|e| FormatError::in_file(&path.display().to_string(), e))?;
+                let (density, to_world) = self.density_grid(raw, &what)?;
                 Medium::Grid(Box::new(GridMedium::new(
                     density, sigma_a, sigma_s, phase, to_world,
                 )))
@@ -157,6 +106,67 @@ impl Ctx<'_> {
             name: m.name.get_ref().clone(),
             medium,
         })
+    }
+
+    /// A `grid` medium's density and the map from the unit cube to the
+    /// world: the `.vol` or `.vdb` file's grid over its own box, or over
+    /// `min` to `max`.
+    fn density_grid(
+        &self,
+        raw: &Spanned<RawMedium>,
+        what: &str,
+    ) -> Result<(DensityGrid, Affine3A), FormatError> {
+        let m = raw.get_ref();
+        let file = self.required(&m.file, "file", &raw.span(), what)?;
+        let path = self.file(file, "density grid")?;
+        let is_vdb = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
+        if let (false, Some(g)) = (is_vdb, &m.grid) {
+            return Err(self.at(
+                g.span(),
+                "'grid' names a grid of a .vdb file; a .vol file holds one",
+            ));
+        }
+        // The grid's values, size, and the box the file places it in.
+        let (size, values, file_box) = if is_vdb {
+            let name = m.grid.as_ref().map_or("density", |g| g.get_ref().as_str());
+            let grid = sahara_readers::vdb::read_vdb(&path, name)?;
+            let to_world = grid.to_world();
+            (grid.size, grid.values, to_world)
+        } else {
+            let grid = sahara_readers::vol::read_vol(&path)?;
+            if grid.channels != 1 {
+                return Err(self.at(
+                    file.span(),
+                    format!(
+                        "'{}' holds {} channels; a density grid holds 1",
+                        file.get_ref(),
+                        grid.channels
+                    ),
+                ));
+            }
+            let lo = Vec3::from_array(grid.bounds_min);
+            let hi = Vec3::from_array(grid.bounds_max);
+            let to_world = Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo);
+            (grid.size, grid.values, to_world)
+        };
+        let to_world = if m.min.is_some() || m.max.is_some() {
+            let lo = self.vec_or(&m.min, "min", file_box.transform_point3(Vec3::ZERO))?;
+            let hi = self.vec_or(&m.max, "max", file_box.transform_point3(Vec3::ONE))?;
+            if (hi - lo).min_element() <= 0.0 {
+                return Err(self.at(
+                    span(&m.max).or(span(&m.min)).unwrap_or(file.span()),
+                    format!("the grid's box {lo} to {hi} must be above its min on every axis"),
+                ));
+            }
+            Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo)
+        } else {
+            file_box
+        };
+        let density = DensityGrid::new(size, values)
+            .map_err(|e| FormatError::in_file(&path.display().to_string(), e))?;
+        Ok((density, to_world))
     }
 
     /// The index of the medium a key names (`None` if the key is absent).
