@@ -65,7 +65,8 @@ pub use material::{
     MaterialTextures, NormalMap, OcclusionMap,
 };
 pub use medium::{
-    CloudMedium, DensityGrid, GridMedium, HenyeyGreenstein, Homogeneous, Medium, MediumInterface,
+    CloudMedium, ColourGrid, ColourVolume, DensityGrid, GridCoefficients, GridMedium,
+    HenyeyGreenstein, Homogeneous, Medium, MediumInterface,
 };
 pub use texture::footprint::UvFootprint;
 pub use texture::{

@@ -5,24 +5,41 @@
 //! Mitsuba gives a medium its extinction `sigma_t` and its single-
 //! scattering `albedo`, both times `scale`: Sahara's scattering is
 //! `albedo sigma_t` and its absorption `(1 - albedo) sigma_t`. A
-//! `gridvolume` for `sigma_t` is a density grid over the unit cube placed
-//! by its `to_world` (or over the box its file gives, with
-//! `use_grid_bbox`), its values times `scale`.
+//! `gridvolume` is a grid over the unit cube placed by its `to_world` (or
+//! over the box its file gives, with `use_grid_bbox`). A one-channel
+//! `sigma_t` grid under a constant albedo is a density scaling fixed
+//! coefficients; a three-channel `sigma_t` grid or an `albedo` grid (one
+//! or three channels) gives the medium colours per voxel, each channel
+//! interpolated on its own, as Mitsuba's RGB variants do.
 
 use glam::{Affine3A, DMat4, DVec3, Vec3};
+use sahara_readers::vol::VolGrid;
 use sahara_readers::FormatError;
-use sahara_render::{DensityGrid, GridMedium, HenyeyGreenstein, Medium, MediumInterface};
+use sahara_render::{
+    ColourGrid, ColourVolume, DensityGrid, GridCoefficients, GridMedium, HenyeyGreenstein, Medium,
+    MediumInterface,
+};
 
 use super::builder::{key, Builder};
 use super::properties::{Child, Object};
 use super::spectra::Usage;
 use super::xml::Node;
 
-/// A medium's `sigma_t` or `albedo`: a constant, or (for `sigma_t`) a
-/// density grid and the grid's box in the world.
+/// A medium's `sigma_t` or `albedo`: a constant, or a grid (one channel
+/// or three) and the grid's box in the world.
 enum Quantity {
     Constant(Vec3),
-    Grid(DensityGrid, Affine3A),
+    Grid(VolGrid, Affine3A),
+}
+
+/// The grid's values, a colour per voxel (one channel repeated in all
+/// three), or why not.
+fn colours(grid: VolGrid) -> Result<ColourGrid, String> {
+    if grid.channels == 1 {
+        return DensityGrid::new(grid.size, grid.values).map(ColourGrid::grey);
+    }
+    let values: Vec<Vec3> = grid.values.chunks_exact(3).map(Vec3::from_slice).collect();
+    ColourGrid::new(grid.size, &values)
 }
 
 impl<'a> Builder<'a> {
@@ -40,36 +57,59 @@ impl<'a> Builder<'a> {
             )));
         }
         let sigma_t = self.quantity(&o, "sigma_t", 1.0, Usage::Index)?;
-        let albedo = match self.quantity(&o, "albedo", 0.75, Usage::Reflectance)? {
-            Quantity::Constant(a) => a,
-            Quantity::Grid(..) => {
-                return Err(
-                    o.error("an albedo given by a grid is not supported; give a constant albedo")
-                )
-            }
-        };
+        let albedo = self.quantity(&o, "albedo", 0.75, Usage::Reflectance)?;
         let scale = o.float("scale", 1.0)? as f32;
         if !(scale.is_finite() && scale >= 0.0) {
             return Err(o.error(format!("'scale' {scale} must be finite and not negative")));
         }
-        if albedo.min_element() < 0.0 || albedo.max_element() > 1.0 {
-            return Err(o.error(format!("'albedo' {albedo} must lie in [0, 1]")));
+        if let Quantity::Constant(albedo) = albedo {
+            if albedo.min_element() < 0.0 || albedo.max_element() > 1.0 {
+                return Err(o.error(format!("'albedo' {albedo} must lie in [0, 1]")));
+            }
         }
         o.get("sample_emitters");
         let g = self.phase(&o)?;
-        let medium = match sigma_t {
-            Quantity::Constant(st) => {
+        let medium = match (sigma_t, albedo) {
+            (Quantity::Constant(st), Quantity::Constant(albedo)) => {
                 let st = st * scale;
                 let sigma_s = albedo * st;
                 Medium::homogeneous((st - sigma_s).max(Vec3::ZERO), sigma_s, g)
             }
-            Quantity::Grid(grid, to_world) => Medium::Grid(Box::new(GridMedium::new(
-                grid,
-                (Vec3::ONE - albedo) * scale,
-                albedo * scale,
-                HenyeyGreenstein::new(g),
-                to_world,
-            ))),
+            (Quantity::Grid(grid, to_world), Quantity::Constant(albedo)) if grid.channels == 1 => {
+                let density = DensityGrid::new(grid.size, grid.values).map_err(|m| o.error(m))?;
+                Medium::Grid(Box::new(GridMedium::new(
+                    density,
+                    (Vec3::ONE - albedo) * scale,
+                    albedo * scale,
+                    HenyeyGreenstein::new(g),
+                    to_world,
+                )))
+            }
+            (Quantity::Constant(_), Quantity::Grid(..)) => {
+                return Err(o.error(
+                    "an albedo grid under a constant 'sigma_t' is not supported; \
+                     give 'sigma_t' as a gridvolume over the same box",
+                ))
+            }
+            (Quantity::Grid(st, to_world), albedo) => {
+                let albedo = match albedo {
+                    Quantity::Constant(a) => ColourVolume::Constant(a),
+                    Quantity::Grid(a, box_) => {
+                        if !box_.abs_diff_eq(to_world, 1e-6) {
+                            return Err(o.error(
+                                "the 'albedo' grid and the 'sigma_t' grid must span the same box",
+                            ));
+                        }
+                        ColourVolume::Grid(colours(a).map_err(|m| o.error(format!("albedo {m}")))?)
+                    }
+                };
+                let sigma_t = ColourVolume::Grid(colours(st).map_err(|m| o.error(m))?);
+                Medium::Grid(Box::new(GridMedium::with_coefficients(
+                    GridCoefficients::extinction_albedo(sigma_t, albedo, scale),
+                    HenyeyGreenstein::new(g),
+                    to_world,
+                )))
+            }
         };
         if let Some(problem) = medium.problem() {
             return Err(o.error(problem));
@@ -131,9 +171,9 @@ impl<'a> Builder<'a> {
                     return Err(v.error("gridvolume needs 'filename'"));
                 };
                 let grid = sahara_readers::vol::read_vol(&path)?;
-                if grid.channels != 1 {
+                if grid.channels != 1 && grid.channels != 3 {
                     return Err(v.error(format!(
-                        "'{}' holds {} channels; a medium's {name} grid must hold 1 (a density)",
+                        "'{}' holds {} channels; a medium's {name} grid must hold 1 or 3",
                         path.display(),
                         grid.channels
                     )));
@@ -162,9 +202,18 @@ impl<'a> Builder<'a> {
                 for k in ["wrap_mode", "raw", "accel"] {
                     v.get(k);
                 }
-                let density = DensityGrid::new(grid.size, grid.values)
-                    .map_err(|m| v.error(format!("'{}': {m}", path.display())))?;
-                Quantity::Grid(density, Affine3A::from_mat4((to_world * box_).as_mat4()))
+                if let Some((i, x)) = grid
+                    .values
+                    .iter()
+                    .enumerate()
+                    .find(|(_, x)| !x.is_finite() || **x < 0.0)
+                {
+                    return Err(v.error(format!(
+                        "'{}': value {i} is {x}; a medium's {name} must be finite and not negative",
+                        path.display()
+                    )));
+                }
+                Quantity::Grid(grid, Affine3A::from_mat4((to_world * box_).as_mat4()))
             }
             other => {
                 return Err(v.error(format!(

@@ -1189,6 +1189,12 @@ fn bad_media_are_errors_naming_the_line() {
     )
     .unwrap();
     std::fs::write(dir.join("short.vol"), &vol_bytes([2, 2, 2], 1, &[1.0])[..]).unwrap();
+    std::fs::write(dir.join("neg.vol"), vol_bytes([1, 1, 1], 1, &[-1.0])).unwrap();
+    std::fs::write(
+        dir.join("bright.vol"),
+        vol_bytes([1, 1, 1], 3, &[1.0, 2.0, 1.0]),
+    )
+    .unwrap();
     let e = |body: &str| match describe_in(body, &dir) {
         Ok(_) => panic!("expected an error for {body:?}"),
         Err(e) => e.to_string(),
@@ -1216,14 +1222,55 @@ fn bad_media_are_errors_naming_the_line() {
     let grid = |file: &str, name: &str| {
         shape(&format!("<medium type=\"heterogeneous\" name=\"interior\"><volume type=\"gridvolume\" name=\"{name}\"><string name=\"filename\" value=\"{file}\"/></volume></medium>"))
     };
-    let m = e(&grid("rgb.vol", "sigma_t"));
-    assert!(m.contains("holds 3 channels"), "{m}");
     let m = e(&grid("short.vol", "sigma_t"));
     assert!(m.contains("short.vol"), "{m}");
+    let m = e(&grid("neg.vol", "sigma_t"));
+    assert!(m.contains("neg.vol': value 0 is -1"), "{m}");
     let m = e(&grid("rgb.vol", "albedo"));
-    assert!(
-        m.contains("albedo given by a grid is not supported") || m.contains("holds 3 channels"),
-        "{m}"
+    assert!(m.contains("albedo grid under a constant 'sigma_t'"), "{m}");
+    let both = |albedo: &str, albedo_to_world: &str| {
+        shape(&format!("<medium type=\"heterogeneous\" name=\"interior\">\
+            <volume type=\"gridvolume\" name=\"sigma_t\"><string name=\"filename\" value=\"rgb.vol\"/></volume>\
+            <volume type=\"gridvolume\" name=\"albedo\"><string name=\"filename\" value=\"{albedo}\"/>{albedo_to_world}</volume></medium>"))
+    };
+    let m = e(&both("bright.vol", ""));
+    assert!(m.contains("albedo reaches 2"), "{m}");
+    let m = e(&both(
+        "rgb.vol",
+        "<transform name=\"to_world\"><scale value=\"2\"/></transform>",
+    ));
+    assert!(m.contains("must span the same box"), "{m}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A three-channel `sigma_t` grid and an albedo grid (one channel, used
+/// in all three) make a medium of colours per voxel, `sigma_t` times
+/// `scale`.
+#[test]
+fn colour_grids_make_a_medium_of_colours_per_voxel() {
+    use sahara_render::{ColourGrid, ColourVolume, GridCoefficients};
+    let dir = folder("colour-media");
+    let st = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0];
+    std::fs::write(dir.join("st.vol"), vol_bytes([2, 1, 1], 3, &st)).unwrap();
+    std::fs::write(dir.join("a.vol"), vol_bytes([2, 1, 1], 1, &[0.25, 0.5])).unwrap();
+    let body = "<shape type=\"sphere\"><medium type=\"heterogeneous\" name=\"interior\">\
+        <float name=\"scale\" value=\"2\"/>\
+        <volume type=\"gridvolume\" name=\"sigma_t\"><string name=\"filename\" value=\"st.vol\"/></volume>\
+        <volume type=\"gridvolume\" name=\"albedo\"><string name=\"filename\" value=\"a.vol\"/></volume>\
+        </medium></shape>";
+    let s = describe_in(body, &dir).unwrap();
+    let sahara_render::Medium::Grid(g) = &s.media[0] else {
+        panic!("{:?}", s.media)
+    };
+    let colours = |v: &[f32]| {
+        let v: Vec<Vec3> = v.chunks(3).map(Vec3::from_slice).collect();
+        ColourGrid::new([2, 1, 1], &v).unwrap()
+    };
+    let want = GridCoefficients::extinction_albedo(
+        ColourVolume::Grid(colours(&st)),
+        ColourVolume::Grid(colours(&[0.25, 0.25, 0.25, 0.5, 0.5, 0.5])),
+        2.0,
     );
+    assert_eq!(g.coefficients, want);
     let _ = std::fs::remove_dir_all(&dir);
 }

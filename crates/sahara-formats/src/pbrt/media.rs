@@ -1,5 +1,5 @@
 //! pbrt's participating media: `MakeNamedMedium` (homogeneous media,
-//! density grids and the procedural cloud), the media a `MediumInterface` puts on either side of
+//! density grids, grids of colours per voxel and the procedural cloud), the media a `MediumInterface` puts on either side of
 //! the shapes after it and around the camera, and the `subsurface`
 //! material (a dielectric boundary around a homogeneous medium).
 //!
@@ -11,7 +11,10 @@ use std::collections::HashMap;
 
 use glam::{Affine3A, DMat4, DVec3, Vec3};
 use sahara_readers::FormatError;
-use sahara_render::{CloudMedium, DensityGrid, GridMedium, HenyeyGreenstein, Material, Medium};
+use sahara_render::{
+    CloudMedium, ColourGrid, ColourVolume, DensityGrid, GridCoefficients, GridMedium,
+    HenyeyGreenstein, Material, Medium,
+};
 
 use super::declarations::{Entity, MediaDecl, MediumDecl};
 use super::measured_media::{measured, names};
@@ -101,6 +104,7 @@ fn named_medium(d: &MediumDecl, w: &mut Warnings) -> Result<Medium, FormatError>
                 }
             }
             let grid = density_grid(e, &what)?;
+            let size = grid.size();
             let to_world = grid_to_world(e, &d.xform.m[0])?;
             let mut m = GridMedium::new(
                 grid,
@@ -110,19 +114,14 @@ fn named_medium(d: &MediumDecl, w: &mut Warnings) -> Result<Medium, FormatError>
                 to_world,
             );
             if le != Vec3::ZERO {
-                let scale = lescale_grid(e, &what, m.density.size())?;
+                let scale = lescale_grid(e, &what, size)?;
                 m = m.with_emission_scale(scale);
             } else {
                 e.params.get("Lescale");
             }
             Medium::Grid(Box::new(m)).with_emission(le)
         }
-        "rgbgrid" => {
-            return Err(e.loc.error(format!(
-                "{what}: type 'rgbgrid' (coefficients per voxel) is not supported; \
-                 use 'uniformgrid' (a density times one sigma_a and sigma_s)"
-            )))
-        }
+        "rgbgrid" => rgb_grid(e, &what, &d.xform.m[0])?,
         "cloud" => {
             let c = coefficients(e, &what, w)?;
             let density = e.params.float("density", 1.0)? as f32;
@@ -269,17 +268,7 @@ fn lescale_grid(e: &Entity, what: &str, size: [u32; 3]) -> Result<DensityGrid, F
 /// A `uniformgrid`'s density: `nx` x `ny` x `nz` values, x fastest; the
 /// sizes checked against the values given.
 fn density_grid(e: &Entity, what: &str) -> Result<DensityGrid, FormatError> {
-    let size = ["nx", "ny", "nz"].map(|k| e.params.int(k, 1));
-    let mut n = [0u32; 3];
-    for (i, s) in size.into_iter().enumerate() {
-        let s = s?;
-        n[i] = u32::try_from(s).ok().filter(|&v| v > 0).ok_or_else(|| {
-            e.loc.error(format!(
-                "{what}: grid size {} = {s} must be a positive integer",
-                ["nx", "ny", "nz"][i]
-            ))
-        })?;
-    }
+    let n = grid_size(e, what)?;
     let Some(values) = e.params.floats("density")? else {
         return Err(e
             .loc
@@ -297,6 +286,85 @@ fn density_grid(e: &Entity, what: &str) -> Result<DensityGrid, FormatError> {
     }
     DensityGrid::new(n, values.iter().map(|&v| v as f32).collect())
         .map_err(|m| e.loc.error(format!("{what}: {m}")))
+}
+
+/// An `rgbgrid`: `sigma_a` and `sigma_s` per voxel (either may be left
+/// out, and is then 1 throughout, as in pbrt-v4), times `scale`; an
+/// optional `Le` per voxel (which needs `sigma_a`) times `Lescale`.
+fn rgb_grid(e: &Entity, what: &str, ctm: &DMat4) -> Result<Medium, FormatError> {
+    let n = grid_size(e, what)?;
+    let grid = |name: &str| -> Result<Option<ColourGrid>, FormatError> {
+        let Some(values) = e.params.rgbs(name)? else {
+            return Ok(None);
+        };
+        let want = n.iter().map(|&v| u64::from(v)).product::<u64>();
+        if want != values.len() as u64 {
+            return Err(e.loc.error(format!(
+                "{what}: grid size {}x{}x{} needs {want} \"{name}\" colours but {} are given",
+                n[0],
+                n[1],
+                n[2],
+                values.len()
+            )));
+        }
+        let values: Vec<Vec3> = values
+            .iter()
+            .map(|c| DVec3::from_array(*c).as_vec3())
+            .collect();
+        ColourGrid::new(n, &values)
+            .map(Some)
+            .map_err(|m| e.loc.error(format!("{what}: \"{name}\" {m}")))
+    };
+    let (sigma_a, sigma_s, le) = (grid("sigma_a")?, grid("sigma_s")?, grid("Le")?);
+    if sigma_a.is_none() && sigma_s.is_none() {
+        return Err(e.loc.error(format!(
+            "{what}: an 'rgbgrid' needs \"rgb sigma_a\" or \"rgb sigma_s\" (or both)"
+        )));
+    }
+    if le.is_some() && sigma_a.is_none() {
+        return Err(e.loc.error(format!(
+            "{what}: an 'rgbgrid' with \"Le\" needs \"rgb sigma_a\" (it emits as it absorbs)"
+        )));
+    }
+    let volume =
+        |g: Option<ColourGrid>| g.map_or(ColourVolume::Constant(Vec3::ONE), ColourVolume::Grid);
+    let scale = e.params.float("scale", 1.0)? as f32;
+    if !(scale.is_finite() && scale >= 0.0) {
+        return Err(e.loc.error(format!(
+            "{what}: scale {scale} must be finite and not negative"
+        )));
+    }
+    let g = e.params.float("g", 0.0)? as f32;
+    let lescale = scalar_lescale(e, what)?;
+    let coefficients =
+        GridCoefficients::absorption_scattering(volume(sigma_a), volume(sigma_s), scale);
+    let mut m = GridMedium::with_coefficients(
+        coefficients,
+        HenyeyGreenstein::new(g),
+        grid_to_world(e, ctm)?,
+    );
+    let mut emission = Vec3::ZERO;
+    if let Some(le) = le {
+        m = m.with_emission_colour(le);
+        emission = Vec3::splat(lescale);
+    }
+    Ok(Medium::Grid(Box::new(m)).with_emission(emission))
+}
+
+/// A grid's size: `nx`, `ny`, `nz` (default 1 each), each positive.
+fn grid_size(e: &Entity, what: &str) -> Result<[u32; 3], FormatError> {
+    let size = ["nx", "ny", "nz"].map(|k| e.params.int(k, 1));
+    let mut n = [0u32; 3];
+    for (i, s) in size.into_iter().enumerate() {
+        let s = s?;
+        n[i] = u32::try_from(s).ok().filter(|&v| v > 0).ok_or_else(|| {
+            e.loc.error(format!(
+                "{what}: grid size {} = {s} must be a positive integer",
+                ["nx", "ny", "nz"][i]
+            ))
+        })?;
+    }
+    Ok(n)
 }
 
 /// The grid's box `p0` to `p1` (default the unit cube) in the medium's

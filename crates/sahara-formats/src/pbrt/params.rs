@@ -293,6 +293,11 @@ impl ParamList {
         self.tuples::<3>(name, &["point3", "vector3", "normal3"])
     }
 
+    /// `rgb` triples (an array of colours, as an `rgbgrid` medium's), if given.
+    pub(crate) fn rgbs(&self, name: &str) -> Result<Option<Vec<[f64; 3]>>, FormatError> {
+        self.tuples::<3>(name, &["rgb"])
+    }
+
     /// Pairs (`point2`, `vector2`, or pbrt-v3's flat `float` uv lists), if given.
     pub(crate) fn pairs(&self, name: &str) -> Result<Option<Vec<[f64; 2]>>, FormatError> {
         self.tuples::<2>(name, &["point2", "vector2", "float"])

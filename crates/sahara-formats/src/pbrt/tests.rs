@@ -839,12 +839,29 @@ fn bad_media_are_errors_naming_the_line() {
         "\"string type\" \"homogeneous\" \"string preset\" \"Jam\"",
     ));
     assert!(e.contains("no measured medium is named \"Jam\""), "{e}");
-    for kind in ["rgbgrid", "nanovdb"] {
-        let e = err(&medium(&format!("\"string type\" \"{kind}\"")));
-        assert!(
-            e.contains("line 2") && e.contains(&format!("'{kind}'")) && e.contains("not supported"),
-            "{e}"
-        );
+    let e = err(&medium("\"string type\" \"nanovdb\""));
+    assert!(
+        e.contains("line 2") && e.contains("'nanovdb'") && e.contains("not supported"),
+        "{e}"
+    );
+    for (params, want) in [
+        ("", "needs \"rgb sigma_a\" or \"rgb sigma_s\""),
+        (
+            "\"integer nx\" 2 \"rgb sigma_a\" [1 1 1]",
+            "needs 2 \"sigma_a\" colours but 1",
+        ),
+        (
+            "\"rgb sigma_s\" [1 1 1] \"rgb Le\" [1 1 1]",
+            "with \"Le\" needs \"rgb sigma_a\"",
+        ),
+        ("\"rgb sigma_a\" [1 -1 1]", "\"sigma_a\" grid value 0 is -1"),
+        (
+            "\"rgb sigma_a\" [1 1 1 1]",
+            "not a whole number of 3-tuples",
+        ),
+    ] {
+        let e = err(&medium(&format!("\"string type\" \"rgbgrid\" {params}")));
+        assert!(e.contains("line 2") && e.contains(want), "{params}: {e}");
     }
     let e = err(&medium("\"float scale\" 2"));
     assert!(e.contains("has no \"string type\""), "{e}");
@@ -925,6 +942,46 @@ fn media_follow_the_graphics_state_and_presets_and_emit() {
         "{:#?}",
         s.warnings
     );
+}
+
+/// An `rgbgrid` keeps its colours per voxel: `sigma_a` and `sigma_s`
+/// times `scale`, a missing one 1 throughout, `Le` as the emission's
+/// colour times `Lescale`.
+#[test]
+fn rgb_grids_keep_their_colours_per_voxel() {
+    use sahara_render::{ColourGrid, ColourVolume, GridCoefficients, GridMedium, HenyeyGreenstein};
+    let text = "WorldBegin\n\
+                MakeNamedMedium \"a\" \"string type\" \"rgbgrid\" \"integer nx\" 2 \"rgb sigma_a\" [1 2 3 4 5 6] \"rgb Le\" [0 1 0 1 0 0] \"float Lescale\" 3 \"float scale\" 2 \"float g\" 0.5 \"point3 p1\" [2 1 1]\n\
+                MakeNamedMedium \"b\" \"string type\" \"rgbgrid\" \"rgb sigma_s\" [0.5 0.25 1]\n\
+                MediumInterface \"a\" \"b\" Material \"interface\" Shape \"sphere\"\n";
+    let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent")).unwrap();
+    assert!(s.warnings.is_empty(), "{:#?}", s.warnings);
+    let colours = |v: &[[f32; 3]]| {
+        let v: Vec<Vec3> = v.iter().map(|c| Vec3::from_array(*c)).collect();
+        ColourGrid::new([v.len() as u32, 1, 1], &v).unwrap()
+    };
+    let a = GridMedium::with_coefficients(
+        GridCoefficients::absorption_scattering(
+            ColourVolume::Grid(colours(&[[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]])),
+            ColourVolume::Constant(Vec3::ONE),
+            2.0,
+        ),
+        HenyeyGreenstein::new(0.5),
+        glam::Affine3A::from_scale(Vec3::new(2.0, 1.0, 1.0)),
+    )
+    .with_emission_colour(colours(&[[0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]));
+    let a = sahara_render::Medium::Grid(Box::new(a)).with_emission(Vec3::splat(3.0));
+    assert_eq!(s.scene.media[0], a);
+    let b = GridMedium::with_coefficients(
+        GridCoefficients::absorption_scattering(
+            ColourVolume::Constant(Vec3::ONE),
+            ColourVolume::Grid(colours(&[[0.5, 0.25, 1.0]])),
+            1.0,
+        ),
+        HenyeyGreenstein::new(0.0),
+        glam::Affine3A::IDENTITY,
+    );
+    assert_eq!(s.scene.media[1], sahara_render::Medium::Grid(Box::new(b)));
 }
 
 /// A `cloud` medium gets its parameters (pbrt's defaults for those left

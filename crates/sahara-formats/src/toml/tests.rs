@@ -1032,8 +1032,12 @@ fn vdb_grids_place_the_density_as_their_vol_twin() {
         g.clone()
     };
     let vol = grid("blob.vol", "");
-    let density =
-        |g: &sahara_render::GridMedium, p: Vec3| g.density.lookup(g.to_medium.transform_point3(p));
+    let density = |g: &sahara_render::GridMedium, p: Vec3| {
+        let sahara_render::GridCoefficients::Density { density, .. } = &g.coefficients else {
+            panic!("{:?}", g.coefficients)
+        };
+        density.lookup(g.to_medium.transform_point3(p))
+    };
     for (file, extra, tolerance) in [
         ("blob.vdb", "", 1e-6),
         ("blob.vdb", "\ngrid = \"density\"", 1e-6),

@@ -29,7 +29,7 @@ mod phase;
 use glam::Vec3;
 
 pub use cloud::CloudMedium;
-pub use grid::{DensityGrid, GridMedium};
+pub use grid::{ColourGrid, ColourVolume, DensityGrid, GridCoefficients, GridMedium};
 pub use phase::HenyeyGreenstein;
 
 /// A participating medium.
@@ -37,7 +37,8 @@ pub use phase::HenyeyGreenstein;
 pub enum Medium {
     /// The same coefficients everywhere.
     Homogeneous(Homogeneous),
-    /// Coefficients scaled by a density on a grid.
+    /// Coefficients that vary over a grid: a density scaling fixed
+    /// coefficients, or colours per voxel.
     Grid(Box<GridMedium>),
     /// Coefficients scaled by pbrt-v4's procedural noise cloud.
     Cloud(Box<CloudMedium>),
@@ -153,7 +154,12 @@ impl Medium {
         }
         let (sigma_a, sigma_s, g) = match self {
             Medium::Homogeneous(h) => (h.sigma_a, h.sigma_s, h.phase.g),
-            Medium::Grid(m) => (m.sigma_a, m.sigma_s, m.phase.g),
+            Medium::Grid(m) => {
+                if let Some(problem) = m.problem() {
+                    return Some(problem);
+                }
+                (Vec3::ZERO, Vec3::ZERO, m.phase.g)
+            }
             Medium::Cloud(m) => (m.sigma_a, m.sigma_s, m.phase.g),
         };
         let emission = self.emission();
@@ -181,10 +187,10 @@ impl Medium {
     /// the light a collision takes that it scatters, σs / (σa + σs), per
     /// channel (0 where the medium neither absorbs nor scatters).
     pub fn albedo(&self, p: Vec3) -> Vec3 {
-        let _ = p; // the same everywhere in today's media: a density scales σa and σs alike
         let (sigma_a, sigma_s) = match self {
             Medium::Homogeneous(h) => (h.sigma_a, h.sigma_s),
-            Medium::Grid(m) => (m.sigma_a, m.sigma_s),
+            Medium::Grid(m) => return m.albedo(p),
+            // A density scales σa and σs alike.
             Medium::Cloud(m) => (m.sigma_a, m.sigma_s),
         };
         let sigma_t = sigma_a + sigma_s;
