@@ -17,6 +17,10 @@ tested").
   on a grey floor, under a square area light and a dim environment: light enters by refraction only.
 - `grid_blob`: a smooth blob of density on a 32^3 grid (written here as `grid_blob.vol`), coloured
   albedo, under a square light and an environment, bounded by its grid's box.
+- `colour_blob`: the blob with colours per voxel: its extinction a three-channel 32^3 grid whose
+  channels ramp differently across it (`colour_blob_sigma_t.vol`), its albedo a three-channel 16^3
+  grid of its own (`colour_blob_albedo.vol`). This case is written as one Mitsuba XML file,
+  `colour_blob.xml`, which Mitsuba renders here and Sahara's Mitsuba reader reads in the test.
 
 Sahara's `max_depth` D is Mitsuba's D + 1 (Mitsuba counts the emitter hit as a bounce); both run
 unidirectional volumetric path tracing with light sampling and MIS, box filter, 64 x 64 pixels.
@@ -49,14 +53,91 @@ def grid_blob(n=32):
     return np.clip(1.0 - 4.0 * r2, 0.0, None).astype(np.float32)
 
 
-def write_vol(path, density, lo, hi):
-    """Mitsuba's `.vol` format, version 3, 32-bit floats, one channel, x fastest."""
-    nz, ny, nx = density.shape
+def colour_field(n, colour):
+    """`colour(x, y, z)` at the voxels' centres in the unit cube: an array (z, y, x, channel)."""
+    c = (np.arange(n) + 0.5) / n
+    z, y, x = np.meshgrid(c, c, c, indexing="ij")
+    return np.stack(colour(x, y, z), axis=-1)
+
+
+def colour_blob(n, colour):
+    """The blob (`grid_blob`) times a colour per voxel (`colour_field`)."""
+    return grid_blob(n)[..., None] * colour_field(n, colour)
+
+
+def write_vol(path, values, lo, hi):
+    """Mitsuba's `.vol` format, version 3, 32-bit floats, one channel ((z, y, x) array) or three
+    ((z, y, x, 3), interleaved), x fastest."""
+    nz, ny, nx = values.shape[:3]
+    channels = values.shape[3] if values.ndim == 4 else 1
     with open(path, "wb") as f:
         f.write(b"VOL" + bytes([3]))
-        f.write(struct.pack("<iiiii", 1, nx, ny, nz, 1))
+        f.write(struct.pack("<iiiii", 1, nx, ny, nz, channels))
         f.write(struct.pack("<6f", *lo, *hi))
-        f.write(density.astype("<f4").tobytes())
+        f.write(values.astype("<f4").tobytes())
+
+
+# colour_blob's grids: extinction (times its scale) and albedo, each a colour per voxel.
+COLOUR_SIGMA_T = lambda x, y, z: (0.6 + 0.8 * x, np.ones_like(x), 1.4 - 0.8 * y)
+COLOUR_ALBEDO = lambda x, y, z: (np.full_like(x, 0.95), 0.5 + 0.45 * x, 0.9 - 0.5 * z)
+
+
+def colour_blob_xml(case, out, spp, seed):
+    """`colour_blob` as a Mitsuba 3 XML scene (the files it names beside it in `out`)."""
+    eye, target, vfov = case["camera"]
+    lo, hi = (np.array(v, float) for v in case["medium"]["bound"][1:])
+    vec = lambda v: ", ".join(repr(float(x)) for x in v)
+    mat = lambda m: '<transform name="to_world"><matrix value="' + " ".join(
+        repr(float(x)) for x in np.asarray(m).reshape(-1)) + '"/></transform>'
+    rgb = lambda name, c: f'<rgb name="{name}" value="{vec(c)}"/>'
+
+    def rect(corner, u, v):
+        c, u, v = (np.array(g, float) for g in (corner, u, v))
+        n = np.cross(u, v)
+        m = np.eye(4)
+        m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = u / 2, v / 2, n / np.linalg.norm(n), c + (u + v) / 2
+        return mat(m)
+
+    box = np.eye(4)
+    box[:3, :3] = np.diag(hi - lo)
+    box[:3, 3] = lo
+    cube = np.eye(4)
+    cube[:3, :3] = np.diag((hi - lo) / 2)
+    cube[:3, 3] = (lo + hi) / 2
+    m = case["medium"]
+    lines = [
+        '<scene version="3.0.0">',
+        f'<integrator type="volpath"><integer name="max_depth" value="{MAX_DEPTH + 1}"/>'
+        f'<integer name="rr_depth" value="{MAX_DEPTH + 1}"/></integrator>',
+        '<sensor type="perspective"><string name="fov_axis" value="y"/>'
+        f'<float name="fov" value="{vfov!r}"/>'
+        f'<transform name="to_world"><lookat origin="{vec(eye)}" target="{vec(target)}" up="0, 1, 0"/></transform>'
+        f'<sampler type="independent"><integer name="sample_count" value="{spp}"/>'
+        f'<integer name="seed" value="{seed}"/></sampler>'
+        f'<film type="hdrfilm"><integer name="width" value="{SIZE}"/><integer name="height" value="{SIZE}"/>'
+        '<string name="pixel_format" value="rgb"/><rfilter type="box"/></film></sensor>',
+        f'<emitter type="constant">{rgb("radiance", case["environment"])}</emitter>',
+    ]
+    for shape, geo, colour in case["objects"]:
+        lines.append(f'<shape type="rectangle">{rect(*geo)}'
+                     f'<bsdf type="twosided"><bsdf type="diffuse">{rgb("reflectance", colour)}</bsdf></bsdf></shape>')
+    corner, eu, ev, radiance = case["light"]
+    lines.append(f'<shape type="rectangle">{rect(corner, eu, ev)}'
+                 f'<bsdf type="diffuse">{rgb("reflectance", (0, 0, 0))}</bsdf>'
+                 f'<emitter type="area">{rgb("radiance", radiance)}</emitter></shape>')
+    grid = lambda name, file: (f'<volume type="gridvolume" name="{name}"><string name="filename" value="{file}"/>'
+                               f'<string name="filter_type" value="trilinear"/>{mat(box)}</volume>')
+    lines += [
+        f'<shape type="cube">{mat(cube)}<bsdf type="null"/>',
+        f'<medium type="heterogeneous" name="interior"><phase type="hg"><float name="g" value="{m["g"]!r}"/></phase>',
+        f'<float name="scale" value="{m["sigma_t"]!r}"/>',
+        grid("sigma_t", "colour_blob_sigma_t.vol"), grid("albedo", "colour_blob_albedo.vol"),
+        '</medium></shape>', '</scene>', ''
+    ]
+    lo_hi = (lo, hi)
+    write_vol(os.path.join(out, "colour_blob_sigma_t.vol"), colour_blob(32, COLOUR_SIGMA_T), *lo_hi)
+    write_vol(os.path.join(out, "colour_blob_albedo.vol"), colour_field(16, COLOUR_ALBEDO), *lo_hi)
+    return "\n".join(lines)
 
 
 def cases():
@@ -90,6 +171,14 @@ def cases():
             "light": ((-1.0, 4.0, 0.0), (1.2, 0, 0), (0, 0, 1.2), (12.0, 12.0, 12.0)),
             "environment": (0.3, 0.35, 0.45),
             "medium": {"kind": "grid", "sigma_t": 6.0, "albedo": (0.95, 0.85, 0.7), "g": 0.2,
+                       "bound": ("box", (-1.0, 0.02, -1.0), (1.0, 2.02, 1.0)), "glass": None},
+        },
+        "colour_blob": {
+            "camera": ((0.0, 1.4, 4.0), (0.0, 0.9, 0.0), 38.0),
+            "objects": floor,
+            "light": ((-1.0, 4.0, 0.0), (1.2, 0, 0), (0, 0, 1.2), (12.0, 12.0, 12.0)),
+            "environment": (0.3, 0.35, 0.45),
+            "medium": {"kind": "colour", "sigma_t": 6.0, "g": 0.2,
                        "bound": ("box", (-1.0, 0.02, -1.0), (1.0, 2.02, 1.0)), "glass": None},
         },
     }
@@ -211,6 +300,16 @@ def main():
         import mitsuba as mi
         mi.set_variant(args.variant)
     for name, case in todo.items():
+        if case["medium"]["kind"] == "colour":
+            path = os.path.join(args.out, f"{name}.xml")
+            with open(path, "w") as f:
+                f.write(colour_blob_xml(case, args.out, args.spp, 7))
+            if args.scenes_only:
+                continue
+            image = mi.render(mi.load_file(path))
+            mi.util.write_bitmap(os.path.join(args.out, f"{name}.exr"), image)
+            print(f"{name}: mean {np.asarray(image).reshape(-1, 3).mean(axis=0)}", flush=True)
+            continue
         if case["medium"]["kind"] == "grid":
             _, lo, hi = case["medium"]["bound"]
             write_vol(os.path.join(args.out, f"{name}.vol"), grid_blob(), lo, hi)

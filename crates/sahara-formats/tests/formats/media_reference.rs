@@ -4,8 +4,10 @@
 //! pixel) is rendered here and compared with the reference per channel over
 //! the whole image and per 8 x 8 block: fog filling a box room around its
 //! light, a glass sphere holding a scattering medium (albedo 0.9, HG g 0.7),
-//! and a density grid read from a `.vol` file under a light and an
-//! environment.
+//! a density grid read from a `.vol` file under a light and an
+//! environment, and the same blob with colours per voxel (three-channel
+//! extinction and albedo grids of different resolutions), whose Mitsuba
+//! XML file Sahara reads as Mitsuba did.
 //!
 //! The tolerances, from Sahara's spread over four seeds at 256 samples per
 //! pixel (`media_spread_over_seeds`): each channel's image mean within
@@ -18,10 +20,13 @@
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
-use sahara_formats::{load_rgb_f32, parse_scene};
+use sahara_formats::{load_rgb_f32, parse_mitsuba, parse_scene};
 use sahara_render::{render, RenderSettings};
 
 use crate::blocks::block_errors;
+
+/// The cases.
+const CASES: [&str; 4] = ["fog_box", "sss_sphere", "grid_blob", "colour_blob"];
 
 /// Samples per pixel of Sahara's renders.
 const SPP: u32 = 256;
@@ -37,7 +42,11 @@ fn errors(name: &str, text: &str, seed: u64) -> (Vec3, f32, f32) {
     let dir = folder();
     let (w, h, rgb) = load_rgb_f32(&dir.join(format!("{name}.exr"))).unwrap();
     let reference: Vec<Vec3> = rgb.chunks(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect();
-    let loaded = parse_scene(text, &format!("{name}.toml"), &dir).unwrap();
+    let loaded = if text.starts_with("<scene") {
+        parse_mitsuba(text.as_bytes(), &format!("{name}.xml"), &dir).unwrap()
+    } else {
+        parse_scene(text, &format!("{name}.toml"), &dir).unwrap()
+    };
     assert!(loaded.warnings.is_empty(), "{name}: {:?}", loaded.warnings);
     assert!(loaded.scene.has_media(), "{name}");
     let s = loaded.settings.as_ref().unwrap();
@@ -69,7 +78,7 @@ fn errors(name: &str, text: &str, seed: u64) -> (Vec3, f32, f32) {
 #[test]
 fn media_agree_with_mitsuba() {
     let mut failures = Vec::new();
-    for name in ["fog_box", "sss_sphere", "grid_blob"] {
+    for name in CASES {
         match check(name, errors(name, &scene_text(name), 1)) {
             Ok(line) => println!("{line}"),
             Err(line) => failures.push(line),
@@ -91,12 +100,21 @@ fn check(name: &str, (mean, p90, max): (Vec3, f32, f32)) -> Result<String, Strin
     }
 }
 
+/// The case's scene: its TOML file, or else its Mitsuba XML file (read by
+/// Sahara's Mitsuba reader, as Mitsuba read it for the reference).
 fn scene_text(name: &str) -> String {
-    std::fs::read_to_string(folder().join(format!("{name}.toml"))).unwrap()
+    let toml = folder().join(format!("{name}.toml"));
+    let path = if toml.exists() {
+        toml
+    } else {
+        folder().join(format!("{name}.xml"))
+    };
+    std::fs::read_to_string(path).unwrap()
 }
 
-/// The comparison can fail: fog 10 % denser, or a sphere's medium that
-/// scatters backwards as much as the reference's does forwards, is caught.
+/// The comparison can fail: fog 10 % denser, a sphere's medium that
+/// scatters backwards as much as the reference's does forwards, or the
+/// colour blob under one constant albedo, is caught.
 #[test]
 fn media_that_differ_from_the_reference_are_caught() {
     let fog = scene_text("fog_box").replace("g = 0.3", "g = 0.3\nscale = 1.1");
@@ -104,6 +122,20 @@ fn media_that_differ_from_the_reference_are_caught() {
     let sphere = scene_text("sss_sphere").replace("g = 0.7", "g = -0.7");
     assert_ne!(sphere, scene_text("sss_sphere"));
     assert!(check("sss_sphere", errors("sss_sphere", &sphere, 1)).is_err());
+    // The colour blob's albedo grid read as the extinction's colours are
+    // (a whiter medium where the extinction's red ramp is high) is caught.
+    let blob: String = scene_text("colour_blob")
+        .lines()
+        .map(|l| {
+            if l.contains("name=\"albedo\"") {
+                "<rgb name=\"albedo\" value=\"0.95, 0.7, 0.65\"/>\n".to_string()
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    assert_ne!(blob, scene_text("colour_blob"));
+    assert!(check("colour_blob", errors("colour_blob", &blob, 1)).is_err());
 }
 
 /// The seed-to-seed spread behind the tolerances (run with `--ignored
@@ -111,7 +143,7 @@ fn media_that_differ_from_the_reference_are_caught() {
 #[test]
 #[ignore]
 fn media_spread_over_seeds() {
-    for name in ["fog_box", "sss_sphere", "grid_blob"] {
+    for name in CASES {
         for seed in 1..=4 {
             let (mean, p90, max) = errors(name, &scene_text(name), seed);
             println!("{name} seed {seed}: mean {mean} p90 {p90:.3} max {max:.3}");
