@@ -32,6 +32,7 @@ pub mod fan;
 pub mod gltf;
 pub mod image_in;
 pub mod mtl;
+pub mod nanovdb;
 pub mod obj;
 pub mod ply;
 pub mod sniff;

@@ -42,7 +42,8 @@ pub const MAX_VALUES: u64 = 1 << 28;
 /// The file versions read (see the module's documentation).
 const VERSIONS: std::ops::RangeInclusive<u32> = 219..=224;
 
-/// One grid of a `.vdb` file, laid out densely over its active box.
+/// One grid of a `.vdb` (or NanoVDB `.nvdb`) file, laid out densely over
+/// its active box.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VdbGrid {
     /// Voxels per axis (x, y, z) of the dense box.
@@ -84,7 +85,7 @@ pub fn read_vdb(path: &Path, grid: &str) -> Result<VdbGrid, FormatError> {
 }
 
 /// The text of a panic's payload.
-fn panic_text(p: Box<dyn std::any::Any + Send>) -> String {
+pub(crate) fn panic_text(p: Box<dyn std::any::Any + Send>) -> String {
     p.downcast_ref::<&str>()
         .map(|s| s.to_string())
         .or_else(|| p.downcast_ref::<String>().cloned())
@@ -293,7 +294,12 @@ fn dense(
 
 /// The voxels per axis of the inclusive index box `lo` to `hi`, or an
 /// error naming the file if it is empty or holds more than [`MAX_VALUES`].
-fn check_size(lo: [i32; 3], hi: [i32; 3], name: &str, what: &str) -> Result<[u32; 3], FormatError> {
+pub(crate) fn check_size(
+    lo: [i32; 3],
+    hi: [i32; 3],
+    name: &str,
+    what: &str,
+) -> Result<[u32; 3], FormatError> {
     let n = [0, 1, 2].map(|a| i64::from(hi[a]) - i64::from(lo[a]) + 1);
     let total = n.iter().map(|&v| v.max(0) as u128).product::<u128>();
     if n.iter().any(|&v| v <= 0) || total > u128::from(MAX_VALUES) {

@@ -1004,8 +1004,9 @@ fn repo_assets() -> PathBuf {
 }
 
 /// scenes/cloud.toml with its grid read from the .vdb twin of its .vol
-/// file (scripts/make_vdb.py) has the same density everywhere in the
-/// world, within 1e-6, with the grid named or not. (The renders differ by their noise alone: the majorant cells
+/// file (scripts/make_vdb.py), or the NanoVDB twin of that, has the same
+/// density everywhere in the world, within 1e-6, with the grid named or
+/// not. (The renders differ by their noise alone: the majorant cells
 /// span the .vdb's smaller active box.)
 #[test]
 fn vdb_grids_place_the_density_as_their_vol_twin() {
@@ -1041,6 +1042,7 @@ fn vdb_grids_place_the_density_as_their_vol_twin() {
     for (file, extra, tolerance) in [
         ("blob.vdb", "", 1e-6),
         ("blob.vdb", "\ngrid = \"density\"", 1e-6),
+        ("blob.nvdb", "", 1e-6),
     ] {
         let vdb = grid(file, extra);
         let (mut worst, mut sum) = (0.0f32, 0.0f32);
@@ -1083,7 +1085,7 @@ fn vdb_grid_errors_name_the_file() {
     );
     let e = grid("blob.vol", "grid = \"density\"\n");
     assert!(
-        e.contains("line 11") && e.contains("'grid' names a grid of a .vdb file"),
+        e.contains("line 11") && e.contains("'grid' names a grid of a .vdb or .nvdb file"),
         "{e}"
     );
     let e = grid("blob_half.vdb", "");

@@ -109,7 +109,7 @@ impl Ctx<'_> {
     }
 
     /// A `grid` medium's density and the map from the unit cube to the
-    /// world: the `.vol` or `.vdb` file's grid over its own box, or over
+    /// world: the `.vol`, `.vdb` or `.nvdb` file's grid over its own box, or over
     /// `min` to `max`.
     fn density_grid(
         &self,
@@ -119,19 +119,22 @@ impl Ctx<'_> {
         let m = raw.get_ref();
         let file = self.required(&m.file, "file", &raw.span(), what)?;
         let path = self.file(file, "density grid")?;
-        let is_vdb = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("vdb"));
-        if let (false, Some(g)) = (is_vdb, &m.grid) {
+        let extension = |x: &str| path.extension().is_some_and(|e| e.eq_ignore_ascii_case(x));
+        let (is_vdb, is_nanovdb) = (extension("vdb"), extension("nvdb"));
+        if let (false, false, Some(g)) = (is_vdb, is_nanovdb, &m.grid) {
             return Err(self.at(
                 g.span(),
-                "'grid' names a grid of a .vdb file; a .vol file holds one",
+                "'grid' names a grid of a .vdb or .nvdb file; a .vol file holds one",
             ));
         }
         // The grid's values, size, and the box the file places it in.
-        let (size, values, file_box) = if is_vdb {
+        let (size, values, file_box) = if is_vdb || is_nanovdb {
             let name = m.grid.as_ref().map_or("density", |g| g.get_ref().as_str());
-            let grid = sahara_readers::vdb::read_vdb(&path, name)?;
+            let grid = if is_vdb {
+                sahara_readers::vdb::read_vdb(&path, name)?
+            } else {
+                sahara_readers::nanovdb::read_nanovdb(&path, name)?
+            };
             let to_world = grid.to_world();
             (grid.size, grid.values, to_world)
         } else {
