@@ -15,7 +15,9 @@ left inactive (the background), so the grid's active box is the blob's.
 writes blob.vdb (32-bit floats, the library's default compression) and
 blob_half.vdb (saved as 16-bit floats), small files the reader refuses
 (vdb_vector.vdb: a vector grid; vdb_huge.vdb: a 4096^3 box of tiles;
-vdb_rotated.vdb: a rotated map), and with --extra DIR a level set there.
+vdb_rotated.vdb: a rotated map), with --extra DIR a level set there, and with
+--fire DIR fireball.vdb there (a density and a temperature grid, the source of
+scenes/assets/fireball.nvdb: `nanovdb_convert -z fireball.vdb fireball.nvdb`).
 """
 import argparse
 import os
@@ -59,6 +61,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default=ASSETS)
     ap.add_argument("--extra", default=None, help="also write other kinds of file here")
+    ap.add_argument("--fire", default=None, help="also write fireball.vdb (density and temperature) here")
     a = ap.parse_args()
     d, lo, hi = read_vol(os.path.join(ASSETS, "blob.vol"))
     g = density_grid(d, lo, hi)
@@ -82,6 +85,17 @@ def main():
     xf.rotate(0.5, vdb.Axis.Y)
     r.transform = xf
     vdb.write(os.path.join(a.out, "vdb_rotated.vdb"), grids=[r])
+    if a.fire:
+        # A fireball for the NanoVDB reader's emission test: the blob at
+        # half resolution (16^3) and a temperature grid over the same
+        # voxels, 1000 K at its edge to 6000 K at its densest. NanoVDB's
+        # converter makes it the asset: nanovdb_convert -z fireball.vdb fireball.nvdb
+        os.makedirs(a.fire, exist_ok=True)
+        half = d.reshape(16, 2, 16, 2, 16, 2).mean(axis=(1, 3, 5))
+        temperature = np.where(half > 0, 1000.0 + 5000.0 * half / half.max(), 0.0)
+        fd = density_grid(half, lo, hi)
+        ft = density_grid(temperature, lo, hi, name="temperature")
+        vdb.write(os.path.join(a.fire, "fireball.vdb"), grids=[fd, ft])
     if a.extra:
         os.makedirs(a.extra, exist_ok=True)
         ls = vdb.createLevelSetSphere(radius=1.0, voxelSize=0.1)

@@ -242,6 +242,19 @@ pub(crate) fn blackbody_rgb(kelvin: f64) -> [f64; 3] {
     spectrum_to_rgb(|l| planck(l, kelvin), Use::Illuminant)
 }
 
+/// The linear sRGB of pbrt-v4's normalised black body at `kelvin` (its
+/// spectral radiance over that at its peak, so 1 at the peak) taken as
+/// radiance (a spectrum of 1 everywhere has luminance 1), negative
+/// components clipped: what a medium's temperature grid emits per unit of
+/// absorption. Unlike [`blackbody_rgb`] it keeps the brightness: a
+/// 1500 K body glows a dim red, a 6500 K one near white at 1.
+pub(crate) fn blackbody_radiance_rgb(kelvin: f64) -> [f64; 3] {
+    // Wien's displacement law: the peak's wavelength in nm.
+    let peak = planck(2.897_771_955e6 / kelvin, kelvin);
+    let y = integrate_xyz(|_| 1.0)[1];
+    xyz_to_srgb(integrate_xyz(|l| planck(l, kelvin) / peak).map(|v| v / y)).map(|c| c.max(0.0))
+}
+
 /// A sampled spectrum, linear between its samples and constant beyond them.
 pub(crate) fn piecewise_linear(pairs: &[(f64, f64)], lambda: f64) -> f64 {
     let Some(first) = pairs.first() else {

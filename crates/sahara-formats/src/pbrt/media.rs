@@ -11,6 +11,7 @@
 use std::collections::HashMap;
 
 use glam::{Affine3A, DMat4, DVec3, Vec3};
+use sahara_readers::vdb::VdbGrid;
 use sahara_readers::FormatError;
 use sahara_render::{
     CloudMedium, ColourGrid, ColourVolume, DensityGrid, GridCoefficients, GridMedium,
@@ -20,7 +21,7 @@ use sahara_render::{
 use super::declarations::{Entity, MediaDecl, MediumDecl};
 use super::measured_media::{measured, names};
 use super::textures::rgb_of;
-use crate::common::spectrum::Use;
+use crate::common::spectrum::{blackbody_radiance_rgb, Use};
 use crate::common::warnings::Warnings;
 use crate::description::SceneDescription;
 
@@ -90,22 +91,16 @@ fn named_medium(d: &MediumDecl, w: &mut Warnings) -> Result<Medium, FormatError>
         }
         "uniformgrid" => {
             let c = coefficients(e, &what, w)?;
-            let le = emission(e, w)?;
-            for k in [
-                "temperature",
-                "temperaturescale",
-                "temperaturecutoff",
-                "temperatureoffset",
-            ] {
-                if e.params.get(k).is_some() {
-                    w.add(
-                        format!("medium '{kind}': blackbody emission ('{k}') is not rendered"),
-                        &e.loc,
-                    );
-                }
-            }
             let grid = density_grid(e, &what)?;
             let size = grid.size();
+            // A temperature grid takes the place of `Le` (as in pbrt-v4).
+            let temperature = temperature_grid(e, &what, size)?;
+            let le = if temperature.is_some() {
+                e.params.get("Le");
+                Vec3::ONE
+            } else {
+                emission(e, w)?
+            };
             let to_world = grid_to_world(e, &d.xform.m[0])?;
             let mut m = GridMedium::new(
                 grid,
@@ -119,6 +114,9 @@ fn named_medium(d: &MediumDecl, w: &mut Warnings) -> Result<Medium, FormatError>
                 m = m.with_emission_scale(scale);
             } else {
                 e.params.get("Lescale");
+            }
+            if let Some(colours) = temperature {
+                m = m.with_emission_colour(colours);
             }
             Medium::Grid(Box::new(m)).with_emission(le)
         }
@@ -378,33 +376,132 @@ fn nano_vdb(e: &Entity, what: &str, ctm: &DMat4, w: &mut Warnings) -> Result<Med
     let path = super::parser::resolve(&e.folders, file);
     let grid_name = e.params.string("gridname")?.unwrap_or("density");
     let grid = sahara_readers::nanovdb::read_nanovdb(&path, grid_name)?;
-    let temperature = e.params.string("temperaturename")?.unwrap_or("temperature");
-    for k in [
-        "Lescale",
-        "temperaturescale",
-        "temperatureoffset",
-        "temperaturecutoff",
-    ] {
-        e.params.get(k);
-    }
-    if sahara_readers::nanovdb::read_nanovdb(&path, temperature).is_ok() {
-        w.add(
-            format!(
-                "medium 'nanovdb': blackbody emission (the '{temperature}' grid of {file}) is not rendered"
-            ),
-            &e.loc,
-        );
-    }
+    let temperature_name = e.params.string("temperaturename")?.unwrap_or("temperature");
+    let (offset, scale) = temperature_map(e, what)?;
+    let lescale = scalar_lescale(e, what)?;
+    // The temperature grid, if the file holds one, over the density's
+    // voxels (pbrt-v4 emits from it only; without it, nothing is emitted).
+    let temperature = match sahara_readers::nanovdb::read_nanovdb(&path, temperature_name) {
+        Ok(t) if t.voxel_size == grid.voxel_size && t.translation == grid.translation => Some(
+            blackbody_colours(&over_box(&t, &grid), offset, scale, grid.size),
+        ),
+        Ok(_) => {
+            w.add(
+                format!(
+                    "medium 'nanovdb': the '{temperature_name}' grid of {file} is placed unlike the \
+                     density's; its blackbody emission is not rendered"
+                ),
+                &e.loc,
+            );
+            None
+        }
+        Err(_) => None,
+    };
     let to_world = Affine3A::from_mat4(ctm.as_mat4()) * grid.to_world();
     let density = DensityGrid::new(grid.size, grid.values)
         .map_err(|m| e.loc.error(format!("{what}: {file}: {m}")))?;
-    Ok(Medium::Grid(Box::new(GridMedium::new(
+    let mut m = GridMedium::new(
         density,
         c.sigma_a,
         c.sigma_s,
         HenyeyGreenstein::new(c.g),
         to_world,
-    ))))
+    );
+    let mut le = Vec3::ZERO;
+    if let Some(colours) = temperature {
+        m = m.with_emission_colour(colours);
+        le = Vec3::splat(lescale);
+    }
+    Ok(Medium::Grid(Box::new(m)).with_emission(le))
+}
+
+/// The values of grid `g` at the voxels of `like`'s box (both of one
+/// index space), zero outside `g`'s own box.
+fn over_box(g: &VdbGrid, like: &VdbGrid) -> Vec<f32> {
+    let n = g.size.map(i64::from);
+    let at = |i: [i64; 3]| {
+        let d = [0, 1, 2].map(|a| i[a] - i64::from(g.index_min[a]));
+        if (0..3).any(|a| d[a] < 0 || d[a] >= n[a]) {
+            0.0
+        } else {
+            g.values[((d[2] * n[1] + d[1]) * n[0] + d[0]) as usize]
+        }
+    };
+    let [nx, ny, nz] = like.size.map(i64::from);
+    let lo = like.index_min.map(i64::from);
+    let mut out = Vec::with_capacity(like.values.len());
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                out.push(at([lo[0] + x, lo[1] + y, lo[2] + z]));
+            }
+        }
+    }
+    out
+}
+
+/// pbrt-v4's map of grid values to kelvin, `(value - offset) * scale`:
+/// `temperatureoffset` (or the older `temperaturecutoff`; default 0) and
+/// `temperaturescale` (default 1).
+fn temperature_map(e: &Entity, what: &str) -> Result<(f32, f32), FormatError> {
+    let cutoff = e.params.float("temperaturecutoff", 0.0)?;
+    let offset = e.params.float("temperatureoffset", cutoff)? as f32;
+    let scale = e.params.float("temperaturescale", 1.0)? as f32;
+    if !(offset.is_finite() && scale.is_finite()) {
+        return Err(e.loc.error(format!(
+            "{what}: temperature offset {offset} and scale {scale} must be finite"
+        )));
+    }
+    Ok((offset, scale))
+}
+
+/// A `uniformgrid`'s `temperature` grid (one value per density value) as
+/// the colours of its blackbody emission, if given.
+fn temperature_grid(
+    e: &Entity,
+    what: &str,
+    size: [u32; 3],
+) -> Result<Option<ColourGrid>, FormatError> {
+    let (offset, scale) = temperature_map(e, what)?;
+    let Some(values) = e.params.floats("temperature")? else {
+        return Ok(None);
+    };
+    let want = size.iter().map(|&v| u64::from(v)).product::<u64>();
+    if values.len() as u64 != want {
+        return Err(e.loc.error(format!(
+            "{what}: grid size {}x{}x{} needs {want} \"temperature\" values but {} are given",
+            size[0],
+            size[1],
+            size[2],
+            values.len()
+        )));
+    }
+    let kelvin: Vec<f32> = values.iter().map(|&v| v as f32).collect();
+    Ok(Some(blackbody_colours(&kelvin, offset, scale, size)))
+}
+
+/// The colour each voxel of temperature `t` emits per unit of absorption:
+/// pbrt-v4's normalised black body at `(t - offset) * scale` kelvin,
+/// nothing at 100 K or below. Temperatures are rounded to the kelvin for
+/// the conversion (a spectral integral, done once per kelvin seen). pbrt
+/// converts the interpolated temperature; Sahara interpolates the voxels'
+/// colours, which differs where neighbouring voxels' temperatures differ.
+fn blackbody_colours(t: &[f32], offset: f32, scale: f32, size: [u32; 3]) -> ColourGrid {
+    let mut cache: HashMap<u32, Vec3> = HashMap::new();
+    let colours: Vec<Vec3> = t
+        .iter()
+        .map(|&v| {
+            let kelvin = (v - offset) * scale;
+            if !(kelvin > 100.0) {
+                return Vec3::ZERO;
+            }
+            let k = kelvin.round().min(1e6) as u32;
+            *cache.entry(k).or_insert_with(|| {
+                DVec3::from_array(blackbody_radiance_rgb(f64::from(k))).as_vec3()
+            })
+        })
+        .collect();
+    ColourGrid::new(size, &colours).expect("blackbody colours are finite and not negative")
 }
 
 /// The grid's box `p0` to `p1` (default the unit cube) in the medium's

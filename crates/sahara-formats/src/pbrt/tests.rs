@@ -918,7 +918,7 @@ fn media_follow_the_graphics_state_and_presets_and_emit() {
     assert_eq!(s.scene.medium_interfaces[0].1.outside, Some(0));
     assert!(!s.scene.medium_interfaces[0].1.index_matched);
     // Emission: Le times Lescale; a grid's Lescale is a grid of its own
-    // (pbrt's one-cell grid without one); blackbody emission is warned.
+    // (pbrt's one-cell grid without one).
     assert_eq!(s.scene.media[0].emission(), Vec3::ONE);
     for (k, le, scale) in [
         (2, Vec3::new(0.0, 2.0, 0.0), vec![3.0, 4.0]),
@@ -932,19 +932,50 @@ fn media_follow_the_graphics_state_and_presets_and_emit() {
         let want = [scale.len() as u32, 1, 1];
         assert_eq!(*grid, sahara_render::DensityGrid::new(want, scale).unwrap());
     }
-    assert!(
-        s.warnings.iter().any(|l| l.contains(
-            "medium 'uniformgrid': blackbody emission ('temperaturescale') is not rendered"
-        )),
-        "{:#?}",
-        s.warnings
-    );
+
     assert!(
         s.warnings
             .iter()
             .any(|l| l.contains("'interface' material (no surface) and no media")),
         "{:#?}",
         s.warnings
+    );
+}
+
+/// A `uniformgrid`'s `temperature` grid emits as pbrt-v4's normalised
+/// black body at `(t - offset) * scale` kelvin per voxel (nothing at 100 K
+/// or below), in place of `Le`, times the `Lescale` grid; the colours
+/// brighten and whiten as the temperature rises.
+#[test]
+fn temperature_grids_glow_as_black_bodies() {
+    let text = "WorldBegin\n\
+                MakeNamedMedium \"fire\" \"string type\" \"uniformgrid\" \"integer nx\" 4 \"float density\" [1 1 1 1] \"float temperature\" [10 150 300 650] \"float temperatureoffset\" 50 \"float temperaturescale\" 10 \"rgb Le\" [9 9 9]\n\
+                MediumInterface \"fire\" \"\" Material \"interface\" Shape \"sphere\"\n";
+    let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/nonexistent")).unwrap();
+    assert!(s.warnings.is_empty(), "{:#?}", s.warnings);
+    let sahara_render::Medium::Grid(g) = &s.scene.media[0] else {
+        panic!("{:?}", s.scene.media)
+    };
+    assert_eq!(g.emission, Vec3::ONE);
+    assert!(g.emission_scale.is_some());
+    let colours = g.emission_colour.as_ref().unwrap();
+    // The voxels' centres: 0 K (below 100), 1000 K, 2500 K, 6000 K.
+    let c: Vec<Vec3> = (0..4)
+        .map(|i| colours.lookup(Vec3::new((i as f32 + 0.5) / 4.0, 0.5, 0.5)))
+        .collect();
+    assert_eq!(c[0], Vec3::ZERO);
+    let luminance = |v: Vec3| v.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    assert!(c[1].x > 0.0 && c[1].x > 10.0 * c[1].z, "{c:?}");
+    assert!(
+        luminance(c[1]) < luminance(c[2]) && luminance(c[2]) < luminance(c[3]),
+        "{c:?}"
+    );
+    assert!(c[2].x / c[2].z > c[3].x / c[3].z, "{c:?}");
+    // Near the peak of its spectrum in the visible, 6000 K is near white
+    // and near 1.
+    assert!(
+        c[3].min_element() > 0.5 && c[3].max_element() < 1.2,
+        "{c:?}"
     );
 }
 
@@ -972,6 +1003,46 @@ fn nanovdb_media_read_their_grid() {
     );
     assert_eq!(g.coefficients, want.coefficients);
     assert!(g.to_medium.abs_diff_eq(want.to_medium, 1e-6));
+}
+
+/// A `nanovdb` medium whose file holds a `temperature` grid glows: each
+/// density voxel's emission colour is the normalised black body of the
+/// temperature at the same voxel, times `Lescale`.
+#[test]
+fn nanovdb_temperature_grids_glow() {
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/assets");
+    let text = "WorldBegin\n\
+                MakeNamedMedium \"fire\" \"string type\" \"nanovdb\" \"string filename\" \"fireball.nvdb\" \"float Lescale\" 2\n\
+                MediumInterface \"fire\" \"\" Material \"interface\" Shape \"sphere\" \"float radius\" 3\n";
+    let s = parse_pbrt(text.as_bytes(), "t.pbrt", &assets).unwrap();
+    assert!(s.warnings.is_empty(), "{:#?}", s.warnings);
+    let sahara_render::Medium::Grid(g) = &s.scene.media[0] else {
+        panic!("{:?}", s.scene.media)
+    };
+    assert_eq!(g.emission, Vec3::splat(2.0));
+    let colours = g.emission_colour.as_ref().unwrap();
+    let t = sahara_readers::nanovdb::read_nanovdb(&assets.join("fireball.nvdb"), "temperature")
+        .unwrap();
+    let d =
+        sahara_readers::nanovdb::read_nanovdb(&assets.join("fireball.nvdb"), "density").unwrap();
+    assert_eq!((t.size, t.index_min), (d.size, d.index_min));
+    let n = d.size.map(|v| v as usize);
+    let mut checked = 0;
+    for (i, &kelvin) in t.values.iter().enumerate() {
+        let (x, y, z) = (i % n[0], i / n[0] % n[1], i / (n[0] * n[1]));
+        let centre = (Vec3::new(x as f32, y as f32, z as f32) + 0.5)
+            / Vec3::new(n[0] as f32, n[1] as f32, n[2] as f32);
+        let got = colours.lookup(centre);
+        let want = if kelvin > 100.0 {
+            let c = crate::common::spectrum::blackbody_radiance_rgb(f64::from(kelvin.round()));
+            DVec3::from_array(c).as_vec3()
+        } else {
+            Vec3::ZERO
+        };
+        assert!((got - want).abs().max_element() < 1e-6, "{i}: {got} {want}");
+        checked += usize::from(kelvin > 1000.0);
+    }
+    assert!(checked > 1000, "{checked}");
 }
 
 /// An `rgbgrid` keeps its colours per voxel: `sigma_a` and `sigma_s`

@@ -531,14 +531,18 @@ impl GridMedium {
     }
 
     /// The radiance emitted per unit length at world point `p` of density
-    /// `rho` in a density medium: `ρ σa Le s(p)`.
+    /// `rho` in a density medium: `ρ σa Le s(p) c(p)`.
     #[inline]
     fn emitted_by_density(&self, p: Vec3, sigma_a: Vec3, rho: f32) -> Vec3 {
-        let s = self
-            .emission_scale
-            .as_ref()
-            .map_or(1.0, |g| g.lookup(self.to_medium.transform_point3(p)));
-        sigma_a * self.emission * (rho * s)
+        let q = self.to_medium.transform_point3(p);
+        let s = self.emission_scale.as_ref().map_or(1.0, |g| g.lookup(q));
+        let e = sigma_a * self.emission * (rho * s);
+        // Without a colour grid, no multiplication by one: images stay the
+        // same to the bit.
+        match &self.emission_colour {
+            Some(c) => e * c.lookup(q),
+            None => e,
+        }
     }
 
     /// Walks the majorant cells that the ray `origin + t dir` (world space)
