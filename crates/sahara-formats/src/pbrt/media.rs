@@ -492,7 +492,8 @@ fn blackbody_colours(t: &[f32], offset: f32, scale: f32, size: [u32; 3]) -> Colo
         .iter()
         .map(|&v| {
             let kelvin = (v - offset) * scale;
-            if !(kelvin > 100.0) {
+            // (NaN as well as cold voxels emit nothing.)
+            if kelvin.is_nan() || kelvin <= 100.0 {
                 return Vec3::ZERO;
             }
             let k = kelvin.round().min(1e6) as u32;

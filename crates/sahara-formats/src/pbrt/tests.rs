@@ -1117,6 +1117,33 @@ fn cloud_media_are_read_with_their_parameters_and_placement() {
     assert_eq!((d.bounds_min, d.bounds_max), (Vec3::ZERO, Vec3::ONE));
 }
 
+/// scenes/fireball.pbrt renders: finite, without warnings, and the fire
+/// brighter than the sky behind it.
+#[test]
+fn the_fireball_scene_renders() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/fireball.pbrt");
+    let s = load_pbrt(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert!(s.warnings.is_empty(), "{:#?}", s.warnings);
+    let sahara_render::Medium::Grid(g) = &s.scene.media[0] else {
+        panic!("{:?}", s.scene.media)
+    };
+    assert!(g.emission_colour.is_some());
+    let with = image(&s.scene, 4);
+    assert!(with.iter().all(|v| v.is_finite()));
+    let mut clear = s.scene.clone();
+    clear.media.clear();
+    clear.medium_interfaces.clear();
+    let without = image(&clear, 4);
+    let centre = |img: &[Vec3]| {
+        (9..15)
+            .flat_map(|y| (9..15).map(move |x| y * 24 + x))
+            .map(|i| img[i])
+            .sum::<Vec3>()
+    };
+    let (a, b) = (centre(&with), centre(&without));
+    assert!(a.min_element() > 5.0 * b.max_element(), "{a} {b}");
+}
+
 /// scenes/noise_cloud.pbrt renders: finite, and the cloud in front of the
 /// sky darker than the sky beside it would be without the medium.
 #[test]
