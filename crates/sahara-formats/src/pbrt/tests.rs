@@ -1128,9 +1128,16 @@ fn the_fireball_scene_renders() {
         panic!("{:?}", s.scene.media)
     };
     assert!(g.emission_colour.is_some());
-    let with = image(&s.scene, 4);
+    let (a, b) = centre_with_and_without_media(&s.scene);
+    assert!(a.min_element() > 5.0 * b.max_element(), "{a} {b}");
+}
+
+/// The summed centre (6 x 6 pixels) of a small render of `scene`, and of
+/// the same scene without its media; the render with media checked finite.
+fn centre_with_and_without_media(scene: &sahara_render::Scene) -> (Vec3, Vec3) {
+    let with = image(scene, 4);
     assert!(with.iter().all(|v| v.is_finite()));
-    let mut clear = s.scene.clone();
+    let mut clear = scene.clone();
     clear.media.clear();
     clear.medium_interfaces.clear();
     let without = image(&clear, 4);
@@ -1140,8 +1147,7 @@ fn the_fireball_scene_renders() {
             .map(|i| img[i])
             .sum::<Vec3>()
     };
-    let (a, b) = (centre(&with), centre(&without));
-    assert!(a.min_element() > 5.0 * b.max_element(), "{a} {b}");
+    (centre(&with), centre(&without))
 }
 
 /// scenes/noise_cloud.pbrt renders: finite, and the cloud in front of the
@@ -1152,20 +1158,8 @@ fn the_noise_cloud_scene_renders() {
     let s = load_pbrt(&path).unwrap_or_else(|e| panic!("{e}"));
     assert!(s.warnings.is_empty(), "{:#?}", s.warnings);
     assert!(matches!(s.scene.media[0], sahara_render::Medium::Cloud(_)));
-    let with = image(&s.scene, 4);
-    assert!(with.iter().all(|v| v.is_finite()));
-    let mut clear = s.scene.clone();
-    clear.media.clear();
-    clear.medium_interfaces.clear();
-    let without = image(&clear, 4);
     // The image's centre, where the cloud is.
-    let centre = |img: &[Vec3]| {
-        (9..15)
-            .flat_map(|y| (9..15).map(move |x| y * 24 + x))
-            .map(|i| img[i])
-            .sum::<Vec3>()
-    };
-    let (a, b) = (centre(&with), centre(&without));
+    let (a, b) = centre_with_and_without_media(&s.scene);
     assert!(
         a.max_element() > 0.0 && (a - b).abs().max_element() > 0.1 * b.max_element(),
         "{a} {b}"

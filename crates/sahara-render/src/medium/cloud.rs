@@ -14,7 +14,7 @@
 use glam::{Affine3A, Vec3};
 
 use super::phase::HenyeyGreenstein;
-use super::FreeFlight;
+use super::{null_collision, FreeFlight};
 
 /// Tentative collisions a tracking walk takes at most before it gives up
 /// (as the grid's walks do).
@@ -177,18 +177,7 @@ impl CloudMedium {
             let rho = self.density_at(origin + dir * t);
             let sigma_s = self.sigma_s * rho;
             let sigma_n = (Vec3::splat(m) - sigma_t * rho).max(Vec3::ZERO);
-            let (ps, pn) = (sigma_s.element_sum(), sigma_n.element_sum());
-            if ps + pn <= 0.0 {
-                weight = Vec3::ZERO;
-                return false;
-            }
-            let p_scatter = ps / (ps + pn);
-            if draw() < p_scatter {
-                weight *= sigma_s / (m * p_scatter);
-                return false;
-            }
-            weight *= sigma_n / (m * (1.0 - p_scatter));
-            true
+            null_collision(&mut weight, sigma_s, sigma_n, m, draw)
         });
         match ended {
             None => FreeFlight {

@@ -103,6 +103,36 @@ pub(crate) struct FreeFlight {
     pub emitted: Vec3,
 }
 
+/// Spectral tracking's choice at a tentative collision of a walk at
+/// majorant `m` (Kutz et al. 2017): real (the path scatters) or null,
+/// with probabilities in proportion to the channels' summed scattering
+/// `sigma_s` and null coefficients `sigma_n` (negative parts left out of
+/// the choice), the throughput `weight` multiplied by each channel's
+/// coefficient over `m` times the probability. True if the collision is
+/// null and the walk goes on; false if it scattered, or was absorbed for
+/// certain (the weight then zero).
+#[inline]
+pub(crate) fn null_collision(
+    weight: &mut Vec3,
+    sigma_s: Vec3,
+    sigma_n: Vec3,
+    m: f32,
+    draw: &mut dyn FnMut() -> f32,
+) -> bool {
+    let (ps, pn) = (sigma_s.element_sum(), sigma_n.max(Vec3::ZERO).element_sum());
+    if ps + pn <= 0.0 {
+        *weight = Vec3::ZERO;
+        return false;
+    }
+    let p_scatter = ps / (ps + pn);
+    if draw() < p_scatter {
+        *weight *= sigma_s / (m * p_scatter);
+        return false;
+    }
+    *weight *= sigma_n / (m * (1.0 - p_scatter));
+    true
+}
+
 impl Medium {
     /// A homogeneous medium of absorption `sigma_a` and scattering
     /// `sigma_s` (per unit length) with a Henyey-Greenstein phase function
