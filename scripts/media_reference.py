@@ -82,7 +82,7 @@ COLOUR_SIGMA_T = lambda x, y, z: (0.6 + 0.8 * x, np.ones_like(x), 1.4 - 0.8 * y)
 COLOUR_ALBEDO = lambda x, y, z: (np.full_like(x, 0.95), 0.5 + 0.45 * x, 0.9 - 0.5 * z)
 
 
-def colour_blob_xml(case, out, spp, seed):
+def colour_blob_xml(case, out, spp, seed, size=SIZE):
     """`colour_blob` as a Mitsuba 3 XML scene (the files it names beside it in `out`)."""
     eye, target, vfov = case["camera"]
     lo, hi = (np.array(v, float) for v in case["medium"]["bound"][1:])
@@ -114,7 +114,7 @@ def colour_blob_xml(case, out, spp, seed):
         f'<transform name="to_world"><lookat origin="{vec(eye)}" target="{vec(target)}" up="0, 1, 0"/></transform>'
         f'<sampler type="independent"><integer name="sample_count" value="{spp}"/>'
         f'<integer name="seed" value="{seed}"/></sampler>'
-        f'<film type="hdrfilm"><integer name="width" value="{SIZE}"/><integer name="height" value="{SIZE}"/>'
+        f'<film type="hdrfilm"><integer name="width" value="{size}"/><integer name="height" value="{size}"/>'
         '<string name="pixel_format" value="rgb"/><rfilter type="box"/></film></sensor>',
         f'<emitter type="constant">{rgb("radiance", case["environment"])}</emitter>',
     ]

@@ -38,7 +38,10 @@ def sahara_run(binary, scene, size, spp, seed, out):
 
 
 def mitsuba_run(mi, name, case, tmp, size, spp, seed):
-    scene = ref.mitsuba_scene(mi, name, case, tmp, spp, seed, size)
+    if case["medium"]["kind"] == "colour":
+        scene = mi.load_file(os.path.join(tmp, f"{name}.xml"))
+    else:
+        scene = ref.mitsuba_scene(mi, name, case, tmp, spp, seed, size)
     t = time.perf_counter()
     img = np.array(mi.render(scene, spp=spp, seed=seed)).astype(np.float64)
     return img[..., :3], time.perf_counter() - t, scene
@@ -65,9 +68,15 @@ def main():
             if case["medium"]["kind"] == "grid":
                 _, lo, hi = case["medium"]["bound"]
                 ref.write_vol(os.path.join(tmp, f"{name}.vol"), ref.grid_blob(), lo, hi)
-            scene = os.path.join(tmp, f"{name}.toml")
-            with open(scene, "w") as f:
-                f.write(ref.sahara_scene(name, case))
+            if case["medium"]["kind"] == "colour":
+                # One Mitsuba XML file (and its grids) that both renderers read.
+                scene = os.path.join(tmp, f"{name}.xml")
+                with open(scene, "w") as f:
+                    f.write(ref.colour_blob_xml(case, tmp, args.spp, 0, args.size))
+            else:
+                scene = os.path.join(tmp, f"{name}.toml")
+                with open(scene, "w") as f:
+                    f.write(ref.sahara_scene(name, case))
             res = {}
             mi.set_variant("scalar_rgb")
             runs = [sahara_run(args.sahara, scene, args.size, args.spp, s, os.path.join(tmp, f"s{s}.exr"))

@@ -57,28 +57,7 @@ impl DensityGrid {
     /// zero, a number of values other than the size's product, a negative
     /// or non-finite value.
     pub fn new(size: [u32; 3], values: Vec<f32>) -> Result<Self, String> {
-        let n = size.iter().map(|&s| s as u64).product::<u64>();
-        if size.contains(&0) {
-            return Err(format!("grid size {size:?} has a zero side"));
-        }
-        if n != values.len() as u64 {
-            return Err(format!(
-                "grid size {}x{}x{} needs {n} values but has {}",
-                size[0],
-                size[1],
-                size[2],
-                values.len()
-            ));
-        }
-        if let Some((i, v)) = values
-            .iter()
-            .enumerate()
-            .find(|(_, v)| !v.is_finite() || **v < 0.0)
-        {
-            return Err(format!(
-                "grid value {i} is {v}; densities must be finite and not negative"
-            ));
-        }
+        check(size, &values)?;
         Ok(Self { size, values })
     }
 
@@ -90,100 +69,181 @@ impl DensityGrid {
     /// The value at sample `(x, y, z)`, zero outside the grid.
     #[inline]
     fn at(&self, x: i64, y: i64, z: i64) -> f32 {
-        let [nx, ny, nz] = self.size.map(i64::from);
-        if x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz {
-            return 0.0;
-        }
-        self.values[((z * ny + y) * nx + x) as usize]
+        sample_at(self.size, &self.values, x, y, z)
     }
 
     /// The density at `p` in the unit cube (trilinear between centres).
     #[inline]
     pub fn lookup(&self, p: Vec3) -> f32 {
-        let s = p * Vec3::from_array(self.size.map(|n| n as f32)) - Vec3::splat(0.5);
-        let f = s.floor();
-        let d = s - f;
-        let (x, y, z) = (f.x as i64, f.y as i64, f.z as i64);
-        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-        let c = |dy: i64, dz: i64| {
-            lerp(
-                self.at(x, y + dy, z + dz),
-                self.at(x + 1, y + dy, z + dz),
-                d.x,
-            )
-        };
-        lerp(
-            lerp(c(0, 0), c(1, 0), d.y),
-            lerp(c(0, 1), c(1, 1), d.y),
-            d.z,
-        )
+        trilinear(self.size, &self.values, p)
     }
 
     /// The largest value among the samples that the lookup reads anywhere
     /// in the box `[lo, hi]` of the unit cube.
     fn max_over(&self, lo: Vec3, hi: Vec3) -> f32 {
-        let n = Vec3::from_array(self.size.map(|n| n as f32));
-        let a = (lo * n - Vec3::splat(0.5)).floor();
-        let b = (hi * n - Vec3::splat(0.5)).floor() + Vec3::ONE;
-        let mut m = 0.0f32;
-        for z in a.z as i64..=b.z as i64 {
-            for y in a.y as i64..=b.y as i64 {
-                for x in a.x as i64..=b.x as i64 {
-                    m = m.max(self.at(x, y, z));
-                }
+        max_over(self.size, &self.values, lo, hi)
+    }
+}
+
+/// What a grid holds per sample: a density, or a colour (three values
+/// interpolated alike, so that one lookup serves the three channels).
+trait Sample:
+    Copy
+    + std::fmt::Display
+    + std::ops::Add<Output = Self>
+    + std::ops::Sub<Output = Self>
+    + std::ops::Mul<f32, Output = Self>
+{
+    /// Zero: the value outside the grid.
+    const ZERO: Self;
+    /// What the values are, in messages.
+    const WHAT: &'static str;
+    /// The larger of the two (per channel).
+    fn max(self, other: Self) -> Self;
+    /// Finite and not negative.
+    fn valid(self) -> bool;
+}
+
+impl Sample for f32 {
+    const ZERO: Self = 0.0;
+    const WHAT: &'static str = "densities";
+    fn max(self, other: Self) -> Self {
+        f32::max(self, other)
+    }
+    fn valid(self) -> bool {
+        self.is_finite() && self >= 0.0
+    }
+}
+
+impl Sample for Vec3 {
+    const ZERO: Self = Vec3::ZERO;
+    const WHAT: &'static str = "colours";
+    fn max(self, other: Self) -> Self {
+        Vec3::max(self, other)
+    }
+    fn valid(self) -> bool {
+        self.is_finite() && self.min_element() >= 0.0
+    }
+}
+
+/// Why `values` cannot fill a grid of `size`: a zero side, a number of
+/// values other than the size's product, a negative or non-finite value.
+fn check<T: Sample>(size: [u32; 3], values: &[T]) -> Result<(), String> {
+    let n = size.iter().map(|&s| s as u64).product::<u64>();
+    if size.contains(&0) {
+        return Err(format!("grid size {size:?} has a zero side"));
+    }
+    if n != values.len() as u64 {
+        return Err(format!(
+            "grid size {}x{}x{} needs {n} values but has {}",
+            size[0],
+            size[1],
+            size[2],
+            values.len()
+        ));
+    }
+    match values.iter().enumerate().find(|(_, v)| !v.valid()) {
+        Some((i, v)) => Err(format!(
+            "grid value {i} is {v}; {} must be finite and not negative",
+            T::WHAT
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The value at sample `(x, y, z)` of a grid of `size`, zero outside it.
+#[inline]
+fn sample_at<T: Sample>(size: [u32; 3], values: &[T], x: i64, y: i64, z: i64) -> T {
+    let [nx, ny, nz] = size.map(i64::from);
+    if x < 0 || y < 0 || z < 0 || x >= nx || y >= ny || z >= nz {
+        return T::ZERO;
+    }
+    values[((z * ny + y) * nx + x) as usize]
+}
+
+/// The value at `p` in the unit cube, trilinear between the samples at
+/// the cells' centres.
+#[inline]
+fn trilinear<T: Sample>(size: [u32; 3], values: &[T], p: Vec3) -> T {
+    let s = p * Vec3::from_array(size.map(|n| n as f32)) - Vec3::splat(0.5);
+    let f = s.floor();
+    let d = s - f;
+    let (x, y, z) = (f.x as i64, f.y as i64, f.z as i64);
+    let at = |x, y, z| sample_at(size, values, x, y, z);
+    let lerp = |a: T, b: T, t: f32| a + (b - a) * t;
+    let c = |dy: i64, dz: i64| lerp(at(x, y + dy, z + dz), at(x + 1, y + dy, z + dz), d.x);
+    lerp(
+        lerp(c(0, 0), c(1, 0), d.y),
+        lerp(c(0, 1), c(1, 1), d.y),
+        d.z,
+    )
+}
+
+/// The largest sample (per channel) that a lookup reads anywhere in the
+/// box `[lo, hi]` of the unit cube.
+fn max_over<T: Sample>(size: [u32; 3], values: &[T], lo: Vec3, hi: Vec3) -> T {
+    let n = Vec3::from_array(size.map(|n| n as f32));
+    let a = (lo * n - Vec3::splat(0.5)).floor();
+    let b = (hi * n - Vec3::splat(0.5)).floor() + Vec3::ONE;
+    let mut m = T::ZERO;
+    for z in a.z as i64..=b.z as i64 {
+        for y in a.y as i64..=b.y as i64 {
+            for x in a.x as i64..=b.x as i64 {
+                m = m.max(sample_at(size, values, x, y, z));
             }
         }
-        m
     }
+    m
 }
 
 /// Three values per sample (red, green, blue) on a regular grid over the
 /// unit cube, with the conventions of [`DensityGrid`]: each channel is
-/// placed and interpolated as a density is.
+/// placed and interpolated as a density is (one lookup serves all three).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ColourGrid {
-    channels: [DensityGrid; 3],
+    size: [u32; 3],
+    values: Vec<Vec3>,
 }
 
 impl ColourGrid {
     /// A grid of `size` (x, y, z) holding `values` (x varying fastest),
     /// or why not (as [`DensityGrid::new`]).
     pub fn new(size: [u32; 3], values: &[Vec3]) -> Result<Self, String> {
-        let channel = |c: usize| DensityGrid::new(size, values.iter().map(|v| v[c]).collect());
+        check(size, values)?;
         Ok(Self {
-            channels: [channel(0)?, channel(1)?, channel(2)?],
+            size,
+            values: values.to_vec(),
         })
     }
 
     /// The same value in every channel: a one-channel grid as a colour.
     pub fn grey(grid: DensityGrid) -> Self {
         Self {
-            channels: [grid.clone(), grid.clone(), grid],
+            size: grid.size,
+            values: grid.values.iter().map(|&v| Vec3::splat(v)).collect(),
         }
     }
 
     /// The grid's size (x, y, z).
     pub fn size(&self) -> [u32; 3] {
-        self.channels[0].size
+        self.size
     }
 
     /// The values at `p` in the unit cube (trilinear between centres).
     #[inline]
     pub fn lookup(&self, p: Vec3) -> Vec3 {
-        Vec3::from_array(self.channels.each_ref().map(|g| g.lookup(p)))
+        trilinear(self.size, &self.values, p)
     }
 
     /// Each channel's largest sample that a lookup reads in the box
     /// `[lo, hi]` of the unit cube.
     fn max_over(&self, lo: Vec3, hi: Vec3) -> Vec3 {
-        Vec3::from_array(self.channels.each_ref().map(|g| g.max_over(lo, hi)))
+        max_over(self.size, &self.values, lo, hi)
     }
 
     /// Every sample times `s`.
     fn scaled(mut self, s: f32) -> Self {
-        for g in &mut self.channels {
-            g.values.iter_mut().for_each(|v| *v *= s);
-        }
+        self.values.iter_mut().for_each(|v| *v *= s);
         self
     }
 }
