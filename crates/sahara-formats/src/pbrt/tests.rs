@@ -858,7 +858,10 @@ fn bad_media_are_errors_naming_the_line() {
             "\"rgb sigma_s\" [1 1 1] \"rgb Le\" [1 1 1]",
             "with \"Le\" needs \"rgb sigma_a\"",
         ),
-        ("\"rgb sigma_a\" [1 -1 1]", "\"sigma_a\" grid value 0 is [1, -1, 1]"),
+        (
+            "\"rgb sigma_a\" [1 -1 1]",
+            "\"sigma_a\" grid value 0 is [1, -1, 1]",
+        ),
         (
             "\"rgb sigma_a\" [1 1 1 1]",
             "not a whole number of 3-tuples",
