@@ -378,7 +378,20 @@ fn nano_vdb(e: &Entity, what: &str, ctm: &DMat4, w: &mut Warnings) -> Result<Med
     let grid = sahara_readers::nanovdb::read_nanovdb(&path, grid_name)?;
     let temperature_name = e.params.string("temperaturename")?.unwrap_or("temperature");
     let (offset, scale) = temperature_map(e, what)?;
-    let lescale = scalar_lescale(e, what)?;
+    // pbrt-v4 first spelled it `LeScale` here, and pbrt-v4-scenes'
+    // explosion.pbrt still does.
+    let lescale = match e.params.float_opt("LeScale")? {
+        Some(v) => {
+            e.params.get("Lescale");
+            v as f32
+        }
+        None => scalar_lescale(e, what)?,
+    };
+    if !(lescale.is_finite() && lescale >= 0.0) {
+        return Err(e.loc.error(format!(
+            "{what}: LeScale {lescale} must be finite and not negative"
+        )));
+    }
     // The temperature grid, if the file holds one, over the density's
     // voxels (pbrt-v4 emits from it only; without it, nothing is emitted).
     let temperature = match sahara_readers::nanovdb::read_nanovdb(&path, temperature_name) {

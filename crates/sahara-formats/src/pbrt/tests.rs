@@ -1010,12 +1010,13 @@ fn nanovdb_media_read_their_grid() {
 
 /// A `nanovdb` medium whose file holds a `temperature` grid glows: each
 /// density voxel's emission colour is the normalised black body of the
-/// temperature at the same voxel, times `Lescale`.
+/// temperature at the same voxel, times `Lescale` (or `LeScale`).
 #[test]
 fn nanovdb_temperature_grids_glow() {
     let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/assets");
     let text = "WorldBegin\n\
                 MakeNamedMedium \"fire\" \"string type\" \"nanovdb\" \"string filename\" \"fireball.nvdb\" \"float Lescale\" 2\n\
+                MakeNamedMedium \"old\" \"string type\" \"nanovdb\" \"string filename\" \"fireball.nvdb\" \"float LeScale\" 5\n\
                 MediumInterface \"fire\" \"\" Material \"interface\" Shape \"sphere\" \"float radius\" 3\n";
     let s = parse_pbrt(text.as_bytes(), "t.pbrt", &assets).unwrap();
     assert!(s.warnings.is_empty(), "{:#?}", s.warnings);
@@ -1023,6 +1024,8 @@ fn nanovdb_temperature_grids_glow() {
         panic!("{:?}", s.scene.media)
     };
     assert_eq!(g.emission, Vec3::splat(2.0));
+    // pbrt-v4's first spelling, as in pbrt-v4-scenes' explosion.pbrt.
+    assert_eq!(s.scene.media[1].emission(), Vec3::splat(5.0));
     let colours = g.emission_colour.as_ref().unwrap();
     let t = sahara_readers::nanovdb::read_nanovdb(&assets.join("fireball.nvdb"), "temperature")
         .unwrap();
