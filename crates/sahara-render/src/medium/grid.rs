@@ -843,6 +843,23 @@ impl GridMedium {
         }
     }
 
+    /// What the segment `origin + t dir`, `t` in `[0, d]`, emits towards
+    /// its start, `∫ Tr(t) σa Le s c dt`, by numerical integration of the
+    /// optical depth and the emission together (for tests).
+    #[cfg(test)]
+    pub(crate) fn emission_exact(&self, origin: Vec3, dir: Vec3, d: f32) -> Vec3 {
+        let steps = 20_000;
+        let h = d / steps as f32;
+        let (mut tau, mut sum) = (Vec3::ZERO, Vec3::ZERO);
+        for i in 0..steps {
+            let p = origin + dir * ((i as f32 + 0.5) * h);
+            let (a, s) = self.coefficients_at(p);
+            sum += (-(tau + 0.5 * (a + s) * h)).exp() * self.emitted_at(p, a) * h;
+            tau += (a + s) * h;
+        }
+        sum
+    }
+
     /// The transmittance along the segment by numerical integration of
     /// the density (for tests).
     #[cfg(test)]
@@ -1060,15 +1077,7 @@ mod tests {
         for m in [&extinction, &emitting] {
             check_tracking(m, o, d, len, &mut draw);
             if m.emission != Vec3::ZERO {
-                let steps = 20_000;
-                let h = len / steps as f32;
-                let (mut tau, mut want) = (Vec3::ZERO, Vec3::ZERO);
-                for i in 0..steps {
-                    let p = o + d * ((i as f32 + 0.5) * h);
-                    let (a, s) = m.coefficients_at(p);
-                    want += (-(tau + 0.5 * (a + s) * h)).exp() * m.emitted_at(p, a) * h;
-                    tau += (a + s) * h;
-                }
+                let want = m.emission_exact(o, d, len);
                 let walks = 200_000;
                 let got = (0..walks)
                     .map(|_| m.free_flight(o, d, len, &mut draw).emitted)
@@ -1106,17 +1115,7 @@ mod tests {
             Vec3::new(-0.9, 0.2, 0.3).normalize(),
             3.0,
         );
-        // Quadrature: the optical depth and the emission together.
-        let steps = 20_000;
-        let h = len / steps as f32;
-        let (mut tau, mut want) = (Vec3::ZERO, Vec3::ZERO);
-        for i in 0..steps {
-            let p = o + d * ((i as f32 + 0.5) * h);
-            let (a, s) = m.coefficients_at(p);
-            let tr = (-(tau + 0.5 * (a + s) * h)).exp();
-            want += tr * m.emitted_at(p, a) * h;
-            tau += (a + s) * h;
-        }
+        let want = m.emission_exact(o, d, len);
         let n = 40_000;
         let mut sum = Vec3::ZERO;
         for _ in 0..n {
