@@ -817,6 +817,44 @@ fn alpha_keys_parse_and_apply_to_reflectors_only() {
     );
 }
 
+/// A `.vol` file of three channels is a density per colour channel: each
+/// scales its channel's `sigma_a` and `sigma_s`.
+#[test]
+fn three_channel_grids_are_a_density_per_channel() {
+    use sahara_render::{ColourGrid, ColourVolume, GridCoefficients};
+    let dir = assets();
+    let values: Vec<f32> = (0..8).flat_map(|i| [i as f32, 1.0, 0.5]).collect();
+    let grid = sahara_readers::vol::VolGrid {
+        size: [2, 2, 2],
+        channels: 3,
+        bounds_min: [-1.0; 3],
+        bounds_max: [1.0; 3],
+        values: values.clone(),
+    };
+    std::fs::write(dir.0.join("rgb.vol"), sahara_readers::vol::vol_bytes(&grid)).unwrap();
+    let path = dir.write(
+        "rgb.toml",
+        &with_head(
+            "[[medium]]\nname = \"smoke\"\ntype = \"grid\"\nfile = \"rgb.vol\"\nsigma_a = [1, 2, 3]\nsigma_s = [2, 2, 2]\n\
+             [[object]]\ntype = \"box\"\nmin = [-1, -1, -1]\nmax = [1, 1, 1]\nmedium_inside = \"smoke\"\n",
+        ),
+    );
+    let s = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+    let sahara_render::Medium::Grid(g) = &s.media[0].medium else {
+        panic!("{:?}", s.media[0].medium)
+    };
+    let colours = |k: Vec3| {
+        let v: Vec<Vec3> = values.chunks(3).map(|c| Vec3::from_slice(c) * k).collect();
+        ColourVolume::Grid(ColourGrid::new([2, 2, 2], &v).unwrap())
+    };
+    let want = GridCoefficients::absorption_scattering(
+        colours(Vec3::new(1.0, 2.0, 3.0)),
+        colours(Vec3::splat(2.0)),
+        1.0,
+    );
+    assert_eq!(g.coefficients, want);
+}
+
 #[test]
 fn media_parse_and_bind_to_objects_and_the_camera() {
     let dir = assets();

@@ -4,13 +4,23 @@
 use std::collections::HashMap;
 
 use glam::{Affine3A, Quat, Vec3};
-use sahara_render::{DensityGrid, GridMedium, HenyeyGreenstein, Medium, MediumInterface};
+use sahara_render::{
+    ColourGrid, ColourVolume, DensityGrid, GridCoefficients, GridMedium, HenyeyGreenstein, Medium,
+    MediumInterface,
+};
 use toml::Spanned;
 
 use super::{span, Ctx};
 use crate::toml::file::MediumSpec;
 use crate::toml::raw::{MediumType, Opt, RawMedium, RawObject};
 use crate::FormatError;
+
+/// A grid medium's density: one value per voxel, or one per colour
+/// channel (its size and values).
+enum Density {
+    One(DensityGrid),
+    Colour([u32; 3], Vec<Vec3>),
+}
 
 impl Ctx<'_> {
     /// `[[medium]]`: a homogeneous medium, or a density grid read from a
@@ -96,10 +106,28 @@ impl Ctx<'_> {
                     &what,
                 )?;
                 let (density, to_world) = self.density_grid(raw, &what)?;
-                Medium::Grid(Box::new(GridMedium::new(
-                    density, sigma_a, sigma_s, phase, to_world,
-                )))
-                .with_emission(emission)
+                let medium = match density {
+                    Density::One(density) => {
+                        GridMedium::new(density, sigma_a, sigma_s, phase, to_world)
+                    }
+                    Density::Colour(size, values) => {
+                        // Each channel's density scales that channel's
+                        // coefficients.
+                        let tinted = |k: Vec3| {
+                            let v: Vec<Vec3> = values.iter().map(|&c| c * k).collect();
+                            ColourGrid::new(size, &v)
+                                .map(ColourVolume::Grid)
+                                .map_err(|e| self.at(raw.span(), format!("{what}: {e}")))
+                        };
+                        let coefficients = GridCoefficients::absorption_scattering(
+                            tinted(sigma_a)?,
+                            tinted(sigma_s)?,
+                            1.0,
+                        );
+                        GridMedium::with_coefficients(coefficients, phase, to_world)
+                    }
+                };
+                Medium::Grid(Box::new(medium)).with_emission(emission)
             }
         };
         Ok(MediumSpec {
@@ -110,12 +138,13 @@ impl Ctx<'_> {
 
     /// A `grid` medium's density and the map from the unit cube to the
     /// world: the `.vol`, `.vdb` or `.nvdb` file's grid over its own box, or over
-    /// `min` to `max`.
+    /// `min` to `max`; a `.vol` file of three channels is a density per
+    /// channel.
     fn density_grid(
         &self,
         raw: &Spanned<RawMedium>,
         what: &str,
-    ) -> Result<(DensityGrid, Affine3A), FormatError> {
+    ) -> Result<(Density, Affine3A), FormatError> {
         let m = raw.get_ref();
         let file = self.required(&m.file, "file", &raw.span(), what)?;
         let path = self.file(file, "density grid")?;
@@ -128,7 +157,7 @@ impl Ctx<'_> {
             ));
         }
         // The grid's values, size, and the box the file places it in.
-        let (size, values, file_box) = if is_vdb || is_nanovdb {
+        let (size, values, file_box, channels) = if is_vdb || is_nanovdb {
             let name = m.grid.as_ref().map_or("density", |g| g.get_ref().as_str());
             let grid = if is_vdb {
                 sahara_readers::vdb::read_vdb(&path, name)?
@@ -136,14 +165,14 @@ impl Ctx<'_> {
                 sahara_readers::nanovdb::read_nanovdb(&path, name)?
             };
             let to_world = grid.to_world();
-            (grid.size, grid.values, to_world)
+            (grid.size, grid.values, to_world, 1)
         } else {
             let grid = sahara_readers::vol::read_vol(&path)?;
-            if grid.channels != 1 {
+            if grid.channels != 1 && grid.channels != 3 {
                 return Err(self.at(
                     file.span(),
                     format!(
-                        "'{}' holds {} channels; a density grid holds 1",
+                        "'{}' holds {} channels; a density grid holds 1 (or 3: one per colour channel)",
                         file.get_ref(),
                         grid.channels
                     ),
@@ -152,7 +181,7 @@ impl Ctx<'_> {
             let lo = Vec3::from_array(grid.bounds_min);
             let hi = Vec3::from_array(grid.bounds_max);
             let to_world = Affine3A::from_scale_rotation_translation(hi - lo, Quat::IDENTITY, lo);
-            (grid.size, grid.values, to_world)
+            (grid.size, grid.values, to_world, grid.channels)
         };
         let to_world = if m.min.is_some() || m.max.is_some() {
             let lo = self.vec_or(&m.min, "min", file_box.transform_point3(Vec3::ZERO))?;
@@ -167,8 +196,15 @@ impl Ctx<'_> {
         } else {
             file_box
         };
-        let density = DensityGrid::new(size, values)
-            .map_err(|e| FormatError::in_file(&path.display().to_string(), e))?;
+        let in_file = |e| FormatError::in_file(&path.display().to_string(), e);
+        let density = if channels == 3 {
+            let colours: Vec<Vec3> = values.chunks_exact(3).map(Vec3::from_slice).collect();
+            // Checked here for the file's sake: the values are read as they are.
+            ColourGrid::new(size, &colours).map_err(in_file)?;
+            Density::Colour(size, colours)
+        } else {
+            Density::One(DensityGrid::new(size, values).map_err(in_file)?)
+        };
         Ok((density, to_world))
     }
 
