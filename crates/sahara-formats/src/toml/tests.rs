@@ -834,7 +834,7 @@ fn three_channel_grids_are_a_density_per_channel() {
     std::fs::write(dir.0.join("rgb.vol"), sahara_readers::vol::vol_bytes(&grid)).unwrap();
     let path = dir.write(
         "rgb.toml",
-        &with_head(
+        with_head(
             "[[medium]]\nname = \"smoke\"\ntype = \"grid\"\nfile = \"rgb.vol\"\nsigma_a = [1, 2, 3]\nsigma_s = [2, 2, 2]\n\
              [[object]]\ntype = \"box\"\nmin = [-1, -1, -1]\nmax = [1, 1, 1]\nmedium_inside = \"smoke\"\n",
         ),
