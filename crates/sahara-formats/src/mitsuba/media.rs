@@ -39,7 +39,7 @@ fn colours(grid: VolGrid) -> Result<ColourGrid, String> {
         return DensityGrid::new(grid.size, grid.values).map(ColourGrid::grey);
     }
     let values: Vec<Vec3> = grid.values.chunks_exact(3).map(Vec3::from_slice).collect();
-    ColourGrid::new(grid.size, &values)
+    ColourGrid::new(grid.size, values)
 }
 
 impl<'a> Builder<'a> {

@@ -1264,7 +1264,7 @@ fn colour_grids_make_a_medium_of_colours_per_voxel() {
     };
     let colours = |v: &[f32]| {
         let v: Vec<Vec3> = v.chunks(3).map(Vec3::from_slice).collect();
-        ColourGrid::new([2, 1, 1], &v).unwrap()
+        ColourGrid::new([2, 1, 1], v).unwrap()
     };
     let want = GridCoefficients::extinction_albedo(
         ColourVolume::Grid(colours(&st)),

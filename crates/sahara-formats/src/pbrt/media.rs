@@ -305,7 +305,7 @@ fn rgb_grid(e: &Entity, what: &str, ctm: &DMat4) -> Result<Medium, FormatError> 
             .iter()
             .map(|c| DVec3::from_array(*c).as_vec3())
             .collect();
-        ColourGrid::new(n, &values)
+        ColourGrid::new(n, values)
             .map(Some)
             .map_err(|m| e.loc.error(format!("{what}: \"{name}\" {m}")))
     };
@@ -515,7 +515,7 @@ fn blackbody_colours(t: &[f32], offset: f32, scale: f32, size: [u32; 3]) -> Colo
             })
         })
         .collect();
-    ColourGrid::new(size, &colours).expect("blackbody colours are finite and not negative")
+    ColourGrid::new(size, colours).expect("blackbody colours are finite and not negative")
 }
 
 /// The grid's box `p0` to `p1` (default the unit cube) in the medium's

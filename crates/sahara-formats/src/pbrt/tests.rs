@@ -1065,7 +1065,7 @@ fn rgb_grids_keep_their_colours_per_voxel() {
     assert!(s.warnings.is_empty(), "{:#?}", s.warnings);
     let colours = |v: &[[f32; 3]]| {
         let v: Vec<Vec3> = v.iter().map(|c| Vec3::from_array(*c)).collect();
-        ColourGrid::new([v.len() as u32, 1, 1], &v).unwrap()
+        ColourGrid::new([v.len() as u32, 1, 1], v).unwrap()
     };
     let a = GridMedium::with_coefficients(
         GridCoefficients::absorption_scattering(

@@ -845,7 +845,7 @@ fn three_channel_grids_are_a_density_per_channel() {
     };
     let colours = |k: Vec3| {
         let v: Vec<Vec3> = values.chunks(3).map(|c| Vec3::from_slice(c) * k).collect();
-        ColourVolume::Grid(ColourGrid::new([2, 2, 2], &v).unwrap())
+        ColourVolume::Grid(ColourGrid::new([2, 2, 2], v).unwrap())
     };
     let want = GridCoefficients::absorption_scattering(
         colours(Vec3::new(1.0, 2.0, 3.0)),

@@ -208,12 +208,9 @@ pub struct ColourGrid {
 impl ColourGrid {
     /// A grid of `size` (x, y, z) holding `values` (x varying fastest),
     /// or why not (as [`DensityGrid::new`]).
-    pub fn new(size: [u32; 3], values: &[Vec3]) -> Result<Self, String> {
-        check(size, values)?;
-        Ok(Self {
-            size,
-            values: values.to_vec(),
-        })
+    pub fn new(size: [u32; 3], values: Vec<Vec3>) -> Result<Self, String> {
+        check(size, &values)?;
+        Ok(Self { size, values })
     }
 
     /// The same value in every channel: a one-channel grid as a colour.
@@ -241,9 +238,9 @@ impl ColourGrid {
         max_over(self.size, &self.values, lo, hi)
     }
 
-    /// Every sample times `s`.
-    fn scaled(mut self, s: f32) -> Self {
-        self.values.iter_mut().for_each(|v| *v *= s);
+    /// Every sample times `k`, channel by channel.
+    pub fn tinted(mut self, k: Vec3) -> Self {
+        self.values.iter_mut().for_each(|v| *v *= k);
         self
     }
 }
@@ -294,7 +291,7 @@ impl ColourVolume {
     fn scaled(self, s: f32) -> Self {
         match self {
             ColourVolume::Constant(v) => ColourVolume::Constant(v * s),
-            ColourVolume::Grid(g) => ColourVolume::Grid(g.scaled(s)),
+            ColourVolume::Grid(g) => ColourVolume::Grid(g.tinted(Vec3::splat(s))),
         }
     }
 
@@ -1029,7 +1026,7 @@ mod tests {
                 }
             }
         }
-        ColourGrid::new([n; 3], &v).unwrap()
+        ColourGrid::new([n; 3], v).unwrap()
     }
 
     /// Colours per voxel are tracked without bias: through grids of

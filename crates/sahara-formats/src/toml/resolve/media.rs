@@ -16,10 +16,10 @@ use crate::toml::raw::{MediumType, Opt, RawMedium, RawObject};
 use crate::FormatError;
 
 /// A grid medium's density: one value per voxel, or one per colour
-/// channel (its size and values).
+/// channel.
 enum Density {
     One(DensityGrid),
-    Colour([u32; 3], Vec<Vec3>),
+    Colour(ColourGrid),
 }
 
 impl Ctx<'_> {
@@ -110,18 +110,12 @@ impl Ctx<'_> {
                     Density::One(density) => {
                         GridMedium::new(density, sigma_a, sigma_s, phase, to_world)
                     }
-                    Density::Colour(size, values) => {
+                    Density::Colour(colours) => {
                         // Each channel's density scales that channel's
                         // coefficients.
-                        let tinted = |k: Vec3| {
-                            let v: Vec<Vec3> = values.iter().map(|&c| c * k).collect();
-                            ColourGrid::new(size, &v)
-                                .map(ColourVolume::Grid)
-                                .map_err(|e| self.at(raw.span(), format!("{what}: {e}")))
-                        };
                         let coefficients = GridCoefficients::absorption_scattering(
-                            tinted(sigma_a)?,
-                            tinted(sigma_s)?,
+                            ColourVolume::Grid(colours.clone().tinted(sigma_a)),
+                            ColourVolume::Grid(colours.tinted(sigma_s)),
                             1.0,
                         );
                         GridMedium::with_coefficients(coefficients, phase, to_world)
@@ -199,9 +193,7 @@ impl Ctx<'_> {
         let in_file = |e| FormatError::in_file(&path.display().to_string(), e);
         let density = if channels == 3 {
             let colours: Vec<Vec3> = values.chunks_exact(3).map(Vec3::from_slice).collect();
-            // Checked here for the file's sake: the values are read as they are.
-            ColourGrid::new(size, &colours).map_err(in_file)?;
-            Density::Colour(size, colours)
+            Density::Colour(ColourGrid::new(size, colours).map_err(in_file)?)
         } else {
             Density::One(DensityGrid::new(size, values).map_err(in_file)?)
         };
