@@ -31,78 +31,108 @@ use crate::FormatError;
 
 /// Reads the float grid named `grid` from the `.nvdb` file at `path`.
 pub fn read_nanovdb(path: &Path, grid: &str) -> Result<VdbGrid, FormatError> {
-    let name = path.display().to_string();
-    let in_file = |message: String| FormatError::InFile {
-        path: name.clone(),
-        message,
-    };
-    // Opening first gives an unreadable file its own error.
-    std::fs::File::open(path).map_err(|source| FormatError::Io {
-        path: name.clone(),
-        source,
-    })?;
-    // `nanovdb-rs` indexes its bytes without checking every offset a
-    // damaged file may hold; such a panic becomes an error naming the
-    // file.
-    let file = catch_unwind(AssertUnwindSafe(|| NvdbFile::open(path)))
-        .map_err(|p| in_file(format!("not a NanoVDB file it can read: {}", panic_text(p))))?
-        .map_err(|e| match e {
-            nanovdb_rs::Error::CompressionUnsupported(codec) => in_file(format!(
-                "its grids are compressed with {codec:?}, which is not read; \
-                 write it uncompressed or with ZIP (nanovdb_convert without -b, or with -z)"
-            )),
-            e => in_file(e.to_string()),
+    NanoVdbFile::open(path)?.grid(grid)
+}
+
+/// An opened `.nvdb` file, whose grids are read by name (one opening, and
+/// one decompression, for a density and a temperature grid alike).
+pub struct NanoVdbFile {
+    file: NvdbFile,
+    name: String,
+}
+
+impl NanoVdbFile {
+    /// Opens the `.nvdb` file at `path` and reads its grids' metadata.
+    pub fn open(path: &Path) -> Result<Self, FormatError> {
+        let name = path.display().to_string();
+        // Opening first gives an unreadable file its own error.
+        std::fs::File::open(path).map_err(|source| FormatError::Io {
+            path: name.clone(),
+            source,
         })?;
-    let Some(g) = file.grids().iter().find(|g| g.name() == grid) else {
-        let mut names: Vec<&str> = file.grids().iter().map(|g| g.name()).collect();
-        names.sort_unstable();
-        return Err(in_file(format!(
-            "no grid is named '{grid}'; the file holds {}",
-            if names.is_empty() {
-                "none".to_string()
-            } else {
-                names.join(", ")
-            }
-        )));
-    };
-    let what = format!("grid '{grid}'");
-    if g.value_type() != GridType::Float {
-        return Err(in_file(format!(
-            "{what} holds {:?} values; a density grid of 32-bit floats is read",
-            g.value_type()
-        )));
+        let in_file = |message: String| FormatError::InFile {
+            path: name.clone(),
+            message,
+        };
+        // `nanovdb-rs` indexes its bytes without checking every offset a
+        // damaged file may hold; such a panic becomes an error naming the
+        // file.
+        let file = catch_unwind(AssertUnwindSafe(|| NvdbFile::open(path)))
+            .map_err(|p| in_file(format!("not a NanoVDB file it can read: {}", panic_text(p))))?
+            .map_err(|e| match e {
+                nanovdb_rs::Error::CompressionUnsupported(codec) => in_file(format!(
+                    "its grids are compressed with {codec:?}, which is not read; \
+                     write it uncompressed or with ZIP (nanovdb_convert without -b, or with -z)"
+                )),
+                e => in_file(e.to_string()),
+            })?;
+        Ok(Self { file, name })
     }
-    let (lo, hi) = g.index_bbox();
-    if g.voxel_count() == 0 {
-        return Err(in_file(format!("{what} has no active voxels")));
+
+    /// Whether the file holds a grid named `grid`.
+    pub fn has(&self, grid: &str) -> bool {
+        self.file.grids().iter().any(|g| g.name() == grid)
     }
-    let size = check_size(lo, hi, &name, &what)?;
-    let read = catch_unwind(AssertUnwindSafe(|| dense(g, lo, size)))
-        .map_err(|p| in_file(format!("{what}: a damaged tree: {}", panic_text(p))))?;
-    let (values, map) = read.ok_or_else(|| {
-        in_file(format!(
-            "{what}: its tree does not hold together (a link points outside the grid)"
-        ))
-    })?;
-    let m = map.mat_d;
-    let diagonal = [m[0][0], m[1][1], m[2][2]];
-    let off_diagonal = [m[0][1], m[0][2], m[1][0], m[1][2], m[2][0], m[2][1]];
-    if off_diagonal.iter().any(|&v| v != 0.0)
-        || diagonal.iter().any(|s| !s.is_finite() || *s == 0.0)
-        || map.vec_d.iter().any(|t| !t.is_finite())
-    {
-        return Err(in_file(format!(
-            "{what}: its map {m:?} + {:?} must scale and translate (no rotation), finitely",
-            map.vec_d
-        )));
+
+    /// The float grid named `grid`, laid out densely over its index
+    /// bounding box.
+    pub fn grid(&self, grid: &str) -> Result<VdbGrid, FormatError> {
+        let name = &self.name;
+        let in_file = |message: String| FormatError::InFile {
+            path: name.clone(),
+            message,
+        };
+        let Some(g) = self.file.grids().iter().find(|g| g.name() == grid) else {
+            let mut names: Vec<&str> = self.file.grids().iter().map(|g| g.name()).collect();
+            names.sort_unstable();
+            return Err(in_file(format!(
+                "no grid is named '{grid}'; the file holds {}",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            )));
+        };
+        let what = format!("grid '{grid}'");
+        if g.value_type() != GridType::Float {
+            return Err(in_file(format!(
+                "{what} holds {:?} values; a density grid of 32-bit floats is read",
+                g.value_type()
+            )));
+        }
+        let (lo, hi) = g.index_bbox();
+        if g.voxel_count() == 0 {
+            return Err(in_file(format!("{what} has no active voxels")));
+        }
+        let size = check_size(lo, hi, name, &what)?;
+        let read = catch_unwind(AssertUnwindSafe(|| dense(g, lo, size)))
+            .map_err(|p| in_file(format!("{what}: a damaged tree: {}", panic_text(p))))?;
+        let (values, map) = read.ok_or_else(|| {
+            in_file(format!(
+                "{what}: its tree does not hold together (a link points outside the grid)"
+            ))
+        })?;
+        let m = map.mat_d;
+        let diagonal = [m[0][0], m[1][1], m[2][2]];
+        let off_diagonal = [m[0][1], m[0][2], m[1][0], m[1][2], m[2][0], m[2][1]];
+        if off_diagonal.iter().any(|&v| v != 0.0)
+            || diagonal.iter().any(|s| !s.is_finite() || *s == 0.0)
+            || map.vec_d.iter().any(|t| !t.is_finite())
+        {
+            return Err(in_file(format!(
+                "{what}: its map {m:?} + {:?} must scale and translate (no rotation), finitely",
+                map.vec_d
+            )));
+        }
+        Ok(VdbGrid {
+            size,
+            index_min: lo,
+            values,
+            voxel_size: diagonal,
+            translation: map.vec_d,
+        })
     }
-    Ok(VdbGrid {
-        size,
-        index_min: lo,
-        values,
-        voxel_size: diagonal,
-        translation: map.vec_d,
-    })
 }
 
 /// The grid's values over the box of `size` voxels from index `lo`, x

@@ -181,12 +181,7 @@ fn coefficients(e: &Entity, what: &str, w: &mut Warnings) -> Result<Coefficients
             spectrum(e, "sigma_s", Vec3::ONE, w)?,
         ),
     };
-    let scale = e.params.float("scale", 1.0)? as f32;
-    if !(scale.is_finite() && scale >= 0.0) {
-        return Err(e.loc.error(format!(
-            "{what}: scale {scale} must be finite and not negative"
-        )));
-    }
+    let scale = non_negative(e, what, "scale")?;
     let g = e.params.float("g", 0.0)? as f32;
     Ok(Coefficients {
         sigma_a: sigma_a * scale,
@@ -225,13 +220,18 @@ fn emission(e: &Entity, w: &mut Warnings) -> Result<Vec3, FormatError> {
 
 /// A homogeneous medium's `Lescale` (default 1): one number.
 fn scalar_lescale(e: &Entity, what: &str) -> Result<f32, FormatError> {
-    let s = e.params.float("Lescale", 1.0)? as f32;
-    if !(s.is_finite() && s >= 0.0) {
+    non_negative(e, what, "Lescale")
+}
+
+/// The float parameter `name` (default 1), finite and not negative.
+fn non_negative(e: &Entity, what: &str, name: &str) -> Result<f32, FormatError> {
+    let v = e.params.float(name, 1.0)? as f32;
+    if !(v.is_finite() && v >= 0.0) {
         return Err(e.loc.error(format!(
-            "{what}: Lescale {s} must be finite and not negative"
+            "{what}: {name} {v} must be finite and not negative"
         )));
     }
-    Ok(s)
+    Ok(v)
 }
 
 /// A `uniformgrid`'s `Lescale`: the emission's scale over the grid, one
@@ -322,12 +322,7 @@ fn rgb_grid(e: &Entity, what: &str, ctm: &DMat4) -> Result<Medium, FormatError> 
     }
     let volume =
         |g: Option<ColourGrid>| g.map_or(ColourVolume::Constant(Vec3::ONE), ColourVolume::Grid);
-    let scale = e.params.float("scale", 1.0)? as f32;
-    if !(scale.is_finite() && scale >= 0.0) {
-        return Err(e.loc.error(format!(
-            "{what}: scale {scale} must be finite and not negative"
-        )));
-    }
+    let scale = non_negative(e, what, "scale")?;
     let g = e.params.float("g", 0.0)? as f32;
     let lescale = scalar_lescale(e, what)?;
     let coefficients =
@@ -375,40 +370,45 @@ fn nano_vdb(e: &Entity, what: &str, ctm: &DMat4, w: &mut Warnings) -> Result<Med
     };
     let path = super::parser::resolve(&e.folders, file);
     let grid_name = e.params.string("gridname")?.unwrap_or("density");
-    let grid = sahara_readers::nanovdb::read_nanovdb(&path, grid_name)?;
+    let nvdb = sahara_readers::nanovdb::NanoVdbFile::open(&path)?;
+    let grid = nvdb.grid(grid_name)?;
     let temperature_name = e.params.string("temperaturename")?.unwrap_or("temperature");
     let (offset, scale) = temperature_map(e, what)?;
     // pbrt-v4 first spelled it `LeScale` here, and pbrt-v4-scenes'
     // explosion.pbrt still does.
-    let lescale = match e.params.float_opt("LeScale")? {
-        Some(v) => {
-            e.params.get("Lescale");
-            v as f32
-        }
-        None => scalar_lescale(e, what)?,
+    let lescale = if e.params.has("LeScale") {
+        e.params.get("Lescale");
+        non_negative(e, what, "LeScale")?
+    } else {
+        scalar_lescale(e, what)?
     };
-    if !(lescale.is_finite() && lescale >= 0.0) {
-        return Err(e.loc.error(format!(
-            "{what}: LeScale {lescale} must be finite and not negative"
-        )));
-    }
     // The temperature grid, if the file holds one, over the density's
     // voxels (pbrt-v4 emits from it only; without it, nothing is emitted).
-    let temperature = match sahara_readers::nanovdb::read_nanovdb(&path, temperature_name) {
-        Ok(t) if t.voxel_size == grid.voxel_size && t.translation == grid.translation => Some(
-            blackbody_colours(&over_box(&t, &grid), offset, scale, grid.size),
-        ),
-        Ok(_) => {
-            w.add(
-                format!(
-                    "medium 'nanovdb': the '{temperature_name}' grid of {file} is placed unlike the \
-                     density's; its blackbody emission is not rendered"
-                ),
-                &e.loc,
-            );
-            None
+    let unrendered = |why: String, w: &mut Warnings| {
+        w.add(
+            format!(
+                "medium 'nanovdb': the '{temperature_name}' grid of {file} {why}; \
+                 its blackbody emission is not rendered"
+            ),
+            &e.loc,
+        );
+        None
+    };
+    let temperature = match nvdb
+        .has(temperature_name)
+        .then(|| nvdb.grid(temperature_name))
+    {
+        None => None,
+        Some(Ok(t)) if t.voxel_size == grid.voxel_size && t.translation == grid.translation => {
+            Some(blackbody_colours(
+                &over_box(&t, &grid),
+                offset,
+                scale,
+                grid.size,
+            ))
         }
-        Err(_) => None,
+        Some(Ok(_)) => unrendered("is placed unlike the density's".into(), w),
+        Some(Err(err)) => unrendered(format!("is not read ({err})"), w),
     };
     let to_world = Affine3A::from_mat4(ctm.as_mat4()) * grid.to_world();
     let density = DensityGrid::new(grid.size, grid.values)
