@@ -15,6 +15,16 @@ use crate::toml::file::MediumSpec;
 use crate::toml::raw::{MediumType, Opt, RawMedium, RawObject};
 use crate::FormatError;
 
+/// The keys every kind of medium takes.
+const EVERY_MEDIUM: [&str; 6] = [
+    "sigma_a",
+    "sigma_s",
+    "scale",
+    "g",
+    "emission",
+    "emission_scale",
+];
+
 /// A grid medium's density: one value per voxel, or one per colour
 /// channel.
 enum Density {
@@ -69,18 +79,7 @@ impl Ctx<'_> {
         let emission = coefficient(&m.emission, "emission")? * emission_scale;
         let medium = match m.kind.get_ref() {
             MediumType::Homogeneous => {
-                self.only(
-                    &present,
-                    &[
-                        "sigma_a",
-                        "sigma_s",
-                        "scale",
-                        "g",
-                        "emission",
-                        "emission_scale",
-                    ],
-                    &what,
-                )?;
+                self.only(&present, &EVERY_MEDIUM, &what)?;
                 Medium::Homogeneous(sahara_render::Homogeneous {
                     sigma_a,
                     sigma_s,
@@ -89,22 +88,8 @@ impl Ctx<'_> {
                 })
             }
             MediumType::Grid => {
-                self.only(
-                    &present,
-                    &[
-                        "sigma_a",
-                        "sigma_s",
-                        "scale",
-                        "g",
-                        "emission",
-                        "emission_scale",
-                        "file",
-                        "grid",
-                        "min",
-                        "max",
-                    ],
-                    &what,
-                )?;
+                let keys = [&EVERY_MEDIUM[..], &["file", "grid", "min", "max"]].concat();
+                self.only(&present, &keys, &what)?;
                 let (density, to_world) = self.density_grid(raw, &what)?;
                 let medium = match density {
                     Density::One(density) => {
