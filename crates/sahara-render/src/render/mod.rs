@@ -13,8 +13,11 @@ pub mod adaptive;
 pub mod aux;
 pub mod digest;
 mod ids;
+mod result;
 mod settings;
 mod sppm;
+mod stats;
+mod watch;
 
 use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::time::{Duration, Instant};
@@ -22,12 +25,10 @@ use std::time::{Duration, Instant};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::accel::AccelLayout;
 use crate::cpu_time::process_cpu_time;
 use crate::film::splat::{Pixels, SplatSums, Splatter};
 use crate::film::sums::{filter_margin, SumBuffer};
 use crate::film::window::PixelWindow;
-use crate::film::{heat_color, Film};
 use crate::integrator::bdpt::batch::{BdptBatch, CameraSample};
 use crate::integrator::bdpt::Splat;
 use crate::integrator::laps::{Lap, Laps};
@@ -40,169 +41,12 @@ use crate::world::World;
 pub use adaptive::{Adaptive, AdaptiveStats};
 use adaptive::{Convergence, TileSums};
 pub use aux::{Aov, Aux, AuxImages, AuxSums};
+use result::develop;
+pub use result::{cost_maps, CostMaps, RenderResult};
 pub use settings::{RenderSettings, UNLIMITED_SPP};
-
-/// Progress report, sent after each tile and each pass.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Progress {
-    /// Current pass (0-based).
-    pub pass: u32,
-    /// Most passes (when only a time limit bounds the render, those of
-    /// [`UNLIMITED_SPP`]).
-    pub passes: u32,
-    /// Tiles finished in this pass.
-    pub tiles_done: u32,
-    /// Tiles per pass.
-    pub tiles: u32,
-    /// Time since the render began.
-    pub elapsed: Duration,
-    /// Rays traced so far (camera, bounce and shadow rays), for a live
-    /// Mrays/s figure.
-    pub rays: u64,
-}
-
-/// Counts and times of a render.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct RenderStats {
-    /// Passes completed (and in the image).
-    pub passes: u32,
-    /// Samples per pixel in the image (of a sample range: those of the
-    /// range in the completed passes, the first of them at the range's start).
-    pub spp: u32,
-    /// Work counted over the completed passes.
-    pub trace: TraceStats,
-    /// Samples whose radiance was NaN or infinite (set to zero). Should be 0.
-    pub nan_samples: u64,
-    /// Samples with a negative component (clamped). Should be 0.
-    pub negative_samples: u64,
-    /// Time to build the acceleration structures and lights.
-    pub build_time: Duration,
-    /// The trees built for the scene's instances.
-    pub layout: AccelLayout,
-    /// Time spent rendering passes.
-    pub render_time: Duration,
-    /// CPU time of all threads spent rendering passes (zero where the
-    /// platform does not report it).
-    pub render_cpu_time: Duration,
-    /// Where the render threads' time went (path-tracing integrators).
-    pub time_split: TimeSplit,
-    /// True if the render stopped on cancel or time limit before `passes`.
-    pub stopped_early: bool,
-    /// Pixels finished (with all `spp` samples of the pass) in a first pass
-    /// stopped by cancel; 0 otherwise. The image holds these pixels and is
-    /// black elsewhere.
-    pub first_pass_pixels: u64,
-    /// What adaptive sampling did, when it was on.
-    pub adaptive: Option<AdaptiveStats>,
-}
-
-/// Where the render threads' time went, summed over the threads: finding
-/// hits and answering shadow rays (the kd-tree walks and the instance
-/// layer), the paths' steps between them (surface interaction, textures,
-/// BSDF and light sampling, MIS), adding the samples into the film's sums,
-/// and the rest of each tile (camera rays, the sampler's set-up, the
-/// strip's buffers). Measured for the integrators that trace their samples
-/// in batches (`path`, `distribution`, `bdpt`, `lightpath`); zero for the
-/// others.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct TimeSplit {
-    /// Time in the batch traversals.
-    pub tracing: Duration,
-    /// Time in the paths' steps.
-    pub shading: Duration,
-    /// Time splatting the samples into the tiles' sums.
-    pub film: Duration,
-    /// Time in tiles altogether (tracing, shading and film included).
-    pub total: Duration,
-}
-
-/// [`TimeSplit`] as shares of its total, each in `[0, 1]`, adding up to 1.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TimeShares {
-    /// The batch traversals.
-    pub tracing: f64,
-    /// The paths' steps.
-    pub shading: f64,
-    /// Splatting into the film.
-    pub film: f64,
-    /// Everything else in the tiles.
-    pub rest: f64,
-}
-
-impl TimeSplit {
-    /// The shares of tracing, shading, the film and the rest of the total;
-    /// `None` when nothing was measured.
-    pub fn shares(&self) -> Option<TimeShares> {
-        let total = self.total.as_secs_f64();
-        if self.tracing.is_zero() || total <= 0.0 {
-            return None;
-        }
-        let share = |d: Duration| d.as_secs_f64() / total;
-        let (tracing, shading, film) = (share(self.tracing), share(self.shading), share(self.film));
-        Some(TimeShares {
-            tracing,
-            shading,
-            film,
-            rest: (1.0 - tracing - shading - film).max(0.0),
-        })
-    }
-}
-
-impl std::ops::AddAssign for TimeSplit {
-    fn add_assign(&mut self, o: Self) {
-        self.tracing += o.tracing;
-        self.shading += o.shading;
-        self.film += o.film;
-        self.total += o.total;
-    }
-}
-
-impl RenderStats {
-    /// All rays traced.
-    pub fn rays(&self) -> u64 {
-        self.trace.camera_rays + self.trace.bounce_rays + self.trace.shadow_rays
-    }
-}
-
-/// Per-pixel averages of the `cost` view.
-#[derive(Clone, Debug, PartialEq)]
-pub struct CostMaps {
-    /// Traversal steps (inner nodes, leaves, top-level box tests) per ray.
-    pub steps: Vec<f32>,
-    /// Ray/triangle tests per ray.
-    pub tests: Vec<f32>,
-    /// The value shown as full heat.
-    pub scale: f32,
-}
-
-/// What [`render_watched`] calls between passes, at most once per `every`.
-pub struct Preview<'a> {
-    /// Shortest time between two calls.
-    pub every: Duration,
-    /// Called with the image of the passes completed so far (not after the
-    /// last pass: that image is the render's result).
-    pub show: &'a mut (dyn FnMut(&RenderResult) + Send),
-}
-
-/// The image and what it cost.
-#[derive(Clone, Debug)]
-pub struct RenderResult {
-    /// The image of the window (black if no pass completed).
-    pub film: Film,
-    /// The window's exact sums over the completed passes (and, in an
-    /// interrupted first pass, over the tiles it finished).
-    pub sums: SumBuffer,
-    /// Counts and times.
-    pub stats: RenderStats,
-    /// Raw per-pixel work of the `cost` view.
-    pub cost: Option<CostMaps>,
-    /// The albedo, normal and depth images and their sums, when
-    /// [`RenderSettings::aovs`] asks for them.
-    pub aux: Option<Aux>,
-    /// With adaptive sampling, the samples each pixel of the window took
-    /// (rows top to bottom).
-    pub samples: Option<Vec<u32>>,
-}
+pub use stats::{RenderStats, TimeShares, TimeSplit};
+use watch::Previews;
+pub use watch::{Preview, Progress};
 
 /// A tile of pixels `[x0, x1) x [y0, y1)`.
 #[derive(Clone, Copy, Debug)]
@@ -377,7 +221,7 @@ pub fn render_world(
                 let mut snapshot = acc.stats;
                 snapshot.render_time = render_start.elapsed();
                 snapshot.stopped_early = true;
-                finish(
+                develop(
                     acc.sums.clone(),
                     acc.aux.clone(),
                     None,
@@ -508,31 +352,6 @@ impl Stop<'_> {
         self.settings
             .time_limit
             .is_some_and(|t| self.start.elapsed() >= t)
-    }
-}
-
-/// Hands images to the caller's [`Preview`] at most once per its `every`.
-pub(super) struct Previews<'a> {
-    preview: Option<Preview<'a>>,
-    last: Instant,
-}
-
-impl<'a> Previews<'a> {
-    fn new(preview: Option<Preview<'a>>) -> Self {
-        Self {
-            preview,
-            last: Instant::now(),
-        }
-    }
-
-    /// Shows the image `image` makes, if a preview is due.
-    pub(super) fn offer(&mut self, image: impl FnOnce() -> RenderResult) {
-        if let Some(p) = self.preview.as_mut() {
-            if self.last.elapsed() >= p.every {
-                (p.show)(&image());
-                self.last = Instant::now();
-            }
-        }
     }
 }
 
@@ -716,7 +535,7 @@ impl Accumulated {
             .as_ref()
             .map(|c| c.stats(window, stats.spp));
         let samples = self.convergence.as_ref().map(|c| c.samples(window));
-        let mut result = finish(
+        let mut result = develop(
             self.sums,
             self.aux,
             self.finished.as_deref(),
@@ -739,53 +558,6 @@ impl Accumulated {
             }
         }
         result
-    }
-}
-
-/// The image of the sums so far (black where `finished` says a pixel was not).
-fn finish(
-    sums: SumBuffer,
-    mut aux: Option<Aux>,
-    finished: Option<&[bool]>,
-    stats: RenderStats,
-    settings: &RenderSettings,
-    samples: Option<Vec<u32>>,
-) -> RenderResult {
-    if let Some(a) = &mut aux {
-        a.develop(finished);
-    }
-    let mut film = Film::new(sums.width, sums.height);
-    for (k, (p, s)) in film.pixels.iter_mut().zip(&sums.sums).enumerate() {
-        let keep = finished.is_none_or(|f| f[k]);
-        *p = if keep { s.value() } else { Vec3::ZERO };
-    }
-    let cost = matches!(settings.integrator, Integrator::Cost)
-        .then(|| cost_maps(&mut film, settings.cost_scale));
-    RenderResult {
-        film,
-        sums,
-        stats,
-        cost,
-        aux,
-        samples,
-    }
-}
-
-/// Turns the raw film of the `cost` view into its heat map (full heat at
-/// `scale` work units per camera ray, or at the image's maximum if None),
-/// returning the raw values.
-pub fn cost_maps(film: &mut Film, scale: Option<f32>) -> CostMaps {
-    let steps: Vec<f32> = film.pixels.iter().map(|p| p.x).collect();
-    let tests: Vec<f32> = film.pixels.iter().map(|p| p.y).collect();
-    let max = film.pixels.iter().map(|p| p.x + p.y).fold(0.0f32, f32::max);
-    let scale = scale.unwrap_or(max).max(1e-6);
-    for p in &mut film.pixels {
-        *p = heat_color((p.x + p.y) / scale);
-    }
-    CostMaps {
-        steps,
-        tests,
-        scale,
     }
 }
 
