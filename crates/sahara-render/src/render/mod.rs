@@ -9,25 +9,28 @@
 //! threads, the order tiles finish in, or the split of the frame into
 //! windows and sample ranges rendered separately and added up.
 
+mod accumulate;
 pub mod adaptive;
 pub mod aux;
 pub mod digest;
 mod ids;
+mod pass;
+mod plan;
 mod result;
 mod settings;
 mod sppm;
 mod stats;
+mod stop;
 mod watch;
 
-use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::AtomicU64;
 use std::time::{Duration, Instant};
 
 use glam::{Vec2, Vec3};
-use rayon::prelude::*;
 
 use crate::cpu_time::process_cpu_time;
 use crate::film::splat::{Pixels, SplatSums, Splatter};
-use crate::film::sums::{filter_margin, SumBuffer};
+use crate::film::sums::SumBuffer;
 use crate::film::window::PixelWindow;
 use crate::integrator::bdpt::batch::{BdptBatch, CameraSample};
 use crate::integrator::bdpt::Splat;
@@ -38,13 +41,17 @@ use crate::math::hash::hash2;
 use crate::sampler::{dims, PixelSampler, SampleId};
 use crate::scene::Scene;
 use crate::world::World;
+use accumulate::Accumulated;
 pub use adaptive::{Adaptive, AdaptiveStats};
 use adaptive::{Convergence, TileSums};
 pub use aux::{Aov, Aux, AuxImages, AuxSums};
+use pass::Run;
+use plan::{Frame, PassPlan};
 use result::develop;
 pub use result::{cost_maps, CostMaps, RenderResult};
 pub use settings::{RenderSettings, UNLIMITED_SPP};
 pub use stats::{RenderStats, TimeShares, TimeSplit};
+use stop::Stop;
 use watch::Previews;
 pub use watch::{Preview, Progress};
 
@@ -238,327 +245,6 @@ pub fn render_world(
     acc.stats.render_time = render_start.elapsed();
     acc.stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
     Ok(acc.finish(world, settings, &run.frame, &plan))
-}
-
-/// The pixels a render covers, cut into tiles.
-struct Frame {
-    /// The image's size.
-    w: u32,
-    h: u32,
-    /// The pixels whose sums the render produces.
-    window: PixelWindow,
-    /// The pixels whose samples reach the window; with adaptive sampling,
-    /// whole blocks of them, so that a piece of the frame judges its pixels
-    /// as the whole frame does.
-    region: PixelWindow,
-    /// The region's tiles, rows top to bottom.
-    tiles: Vec<Tile>,
-}
-
-impl Frame {
-    fn plan(settings: &RenderSettings) -> Self {
-        let (w, h) = (settings.width.max(1), settings.height.max(1));
-        let window = settings
-            .window
-            .unwrap_or(PixelWindow::full(w, h))
-            .intersect(&PixelWindow::full(w, h));
-        let region = window.grow(filter_margin(&settings.filter), w, h);
-        let region = match settings.adaptive {
-            Some(_) => region.align(adaptive::BLOCK, w, h),
-            None => region,
-        };
-        let ts = settings.tile_size.max(1);
-        let tiles: Vec<Tile> = (0..region.height().div_ceil(ts))
-            .flat_map(|ty| {
-                (0..region.width().div_ceil(ts)).map(move |tx| Tile {
-                    x0: region.x0 + tx * ts,
-                    y0: region.y0 + ty * ts,
-                    x1: (region.x0 + (tx + 1) * ts).min(region.x1),
-                    y1: (region.y0 + (ty + 1) * ts).min(region.y1),
-                })
-            })
-            .collect();
-        Self {
-            w,
-            h,
-            window,
-            region,
-            tiles,
-        }
-    }
-}
-
-/// The passes a render's sample range meets, and the range within each.
-struct PassPlan {
-    /// Samples per pixel of a whole pass.
-    spp: u32,
-    /// The first pass rendered.
-    first_pass: u32,
-    /// Passes rendered, at most.
-    passes: u32,
-    /// The sample range, counted over all passes.
-    first: u64,
-    last: u64,
-}
-
-impl PassPlan {
-    fn new(settings: &RenderSettings) -> Self {
-        let spp = settings.pass_size();
-        let (first_pass, passes, first, last) = match &settings.samples {
-            None => (0, settings.passes(), 0u64, u64::from(settings.spp.max(1))),
-            Some(r) if r.start >= r.end => (0, 0, 0, 0),
-            Some(r) => (
-                r.start / spp,
-                r.end.div_ceil(spp) - r.start / spp,
-                u64::from(r.start),
-                u64::from(r.end),
-            ),
-        };
-        Self {
-            spp,
-            first_pass,
-            passes,
-            first,
-            last,
-        }
-    }
-
-    /// The sample indices of `pass` within the range.
-    fn indices(&self, pass: u32) -> std::ops::Range<u32> {
-        let (spp, base) = (u64::from(self.spp), u64::from(pass) * u64::from(self.spp));
-        let i0 = self.first.saturating_sub(base).min(spp) as u32;
-        let i1 = self.last.saturating_sub(base).min(spp) as u32;
-        i0..i1
-    }
-}
-
-/// When a render stops early: on cancel, and (after the first pass) at
-/// the time limit.
-struct Stop<'a> {
-    settings: &'a RenderSettings,
-    /// When the render began; the time limit counts from it.
-    start: Instant,
-}
-
-impl Stop<'_> {
-    fn cancelled(&self) -> bool {
-        self.settings
-            .cancel
-            .as_ref()
-            .is_some_and(|c| c.load(Ordering::Relaxed))
-    }
-
-    fn out_of_time(&self) -> bool {
-        self.settings
-            .time_limit
-            .is_some_and(|t| self.start.elapsed() >= t)
-    }
-}
-
-/// What a render's passes render with: the scene, the settings, the
-/// frame's tiles and when to stop.
-struct Run<'a, 'w> {
-    world: &'a World<'w>,
-    settings: &'a RenderSettings,
-    frame: Frame,
-    stop: Stop<'a>,
-    progress: &'a (dyn Fn(Progress) + Sync),
-    /// Rays traced so far, for the progress reports.
-    rays: AtomicU64,
-}
-
-impl Run<'_, '_> {
-    /// Renders pass `n` (of `passes`) of every tile in parallel, reporting
-    /// progress after each; a tile not started once the render stops
-    /// (cancel, or the time limit after the first pass) is `None`, and in
-    /// the first pass a cancel stops tiles pixel by pixel, so that a long
-    /// first pass still leaves the pixels it finished.
-    fn pass(&self, n: u32, passes: u32, samples: RoundSamples) -> Vec<Option<TileOut>> {
-        let (settings, frame, stop) = (self.settings, &self.frame, &self.stop);
-        let done = AtomicU32::new(0);
-        let abandon = AtomicBool::new(false);
-        let stop_pixel = || n == 0 && stop.cancelled();
-        frame
-            .tiles
-            .par_iter()
-            // One job per tile: rayon otherwise hands out a few large runs
-            // of tiles, and one costly run can leave the other cores idle.
-            .with_max_len(1)
-            .map(|tile| {
-                if abandon.load(Ordering::Relaxed)
-                    || stop.cancelled()
-                    || (n > 0 && stop.out_of_time())
-                {
-                    abandon.store(true, Ordering::Relaxed);
-                    return None;
-                }
-                let out = render_tile(
-                    self.world,
-                    settings,
-                    *tile,
-                    &frame.window,
-                    samples,
-                    &stop_pixel,
-                );
-                if out.pixels_done < tile.pixels() {
-                    abandon.store(true, Ordering::Relaxed);
-                }
-                let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-                let t = &out.stats;
-                let traced = t.camera_rays + t.bounce_rays + t.shadow_rays;
-                let rays = self.rays.fetch_add(traced, Ordering::Relaxed) + traced;
-                (self.progress)(Progress {
-                    pass: n,
-                    passes,
-                    tiles_done: d,
-                    tiles: frame.tiles.len() as u32,
-                    elapsed: stop.start.elapsed(),
-                    rays,
-                });
-                Some(out)
-            })
-            .collect()
-    }
-}
-
-/// What the completed passes add up to.
-struct Accumulated {
-    /// The window's exact sums.
-    sums: SumBuffer,
-    /// The render passes' sums, when asked for.
-    aux: Option<Aux>,
-    /// The adaptive sampling state, when it is on.
-    convergence: Option<Convergence>,
-    stats: RenderStats,
-    /// Pixels finished in an interrupted first pass (None: not interrupted).
-    finished: Option<Vec<bool>>,
-    /// How much each light tracing splat counts: a window renders the
-    /// light subpaths of its region's samples only, which then stand for
-    /// every pixel's of the image.
-    splat_scale: f32,
-}
-
-impl Accumulated {
-    fn new(settings: &RenderSettings, frame: &Frame, stats: RenderStats) -> Self {
-        let window = &frame.window;
-        Self {
-            sums: SumBuffer::new(window.x0, window.y0, window.width(), window.height()),
-            aux: (!settings.aovs.is_empty()).then(|| {
-                Aux::new(
-                    &settings.aovs,
-                    window.x0,
-                    window.y0,
-                    window.width(),
-                    window.height(),
-                )
-            }),
-            convergence: settings.adaptive.map(|a| {
-                let grow = settings.time_limit.is_none();
-                Convergence::new(
-                    frame.region,
-                    a,
-                    settings.pass_size(),
-                    settings.spp.max(1),
-                    grow,
-                )
-            }),
-            stats,
-            finished: None,
-            splat_scale: (frame.w as f64 * frame.h as f64 / frame.region.pixels() as f64) as f32,
-        }
-    }
-
-    /// Marks the window's pixels an interrupted first pass finished.
-    fn keep_finished(&mut self, frame: &Frame, outs: &[Option<TileOut>]) {
-        let window = &frame.window;
-        let mut mask = vec![false; window.pixels() as usize];
-        for (out, tile) in outs.iter().zip(&frame.tiles) {
-            if let Some(out) = out {
-                for k in 0..out.pixels_done {
-                    let (x, y) = tile.pixel(k);
-                    if (window.x0..window.x1).contains(&x) && (window.y0..window.y1).contains(&y) {
-                        let i = (y - window.y0) * window.width() + (x - window.x0);
-                        mask[i as usize] = true;
-                    }
-                }
-            }
-        }
-        self.stats.first_pass_pixels = mask.iter().filter(|&&m| m).count() as u64;
-        self.finished = Some(mask);
-    }
-
-    /// Adds a pass's tiles: their light tracing splats, sums, counts and
-    /// render passes, and each pixel's own samples for adaptive sampling.
-    fn add(&mut self, settings: &RenderSettings, outs: Vec<Option<TileOut>>) {
-        let splats: Vec<&[Splat]> = outs.iter().flatten().map(|o| &o.splats[..]).collect();
-        self.sums
-            .add_splats(&settings.filter, &splats, self.splat_scale);
-        for out in outs.into_iter().flatten() {
-            self.sums.add(&out.sums);
-            self.stats.trace += out.stats;
-            self.stats.time_split += out.split;
-            if let (Some(a), Some(o)) = (&mut self.aux, &out.aux) {
-                a.add(o);
-            }
-            self.stats.nan_samples += out.nan;
-            self.stats.negative_samples += out.negative;
-            if let (Some(c), Some(o)) = (&mut self.convergence, &out.own) {
-                c.add(o);
-            }
-        }
-    }
-
-    /// The adaptive round after a pass: which pixels go on. True when every
-    /// pixel is below the threshold, and the render is complete.
-    fn adaptive_round(&mut self) -> bool {
-        self.convergence.as_mut().is_some_and(|c| c.update() == 0)
-    }
-
-    /// The image of the completed passes, with the counts of samples
-    /// taken, and the object and material ids when asked for.
-    fn finish(
-        mut self,
-        world: &World,
-        settings: &RenderSettings,
-        frame: &Frame,
-        plan: &PassPlan,
-    ) -> RenderResult {
-        let window = &frame.window;
-        if self.finished.is_some() {
-            self.stats.spp = plan.indices(plan.first_pass).len() as u32;
-        } else if let Some(c) = &self.convergence {
-            self.stats.spp = c.most_samples(window);
-        }
-        let stats = &mut self.stats;
-        stats.adaptive = self
-            .convergence
-            .as_ref()
-            .map(|c| c.stats(window, stats.spp));
-        let samples = self.convergence.as_ref().map(|c| c.samples(window));
-        let mut result = develop(
-            self.sums,
-            self.aux,
-            self.finished.as_deref(),
-            self.stats,
-            settings,
-            samples,
-        );
-        let wants = |a: Aov| settings.aovs.contains(&a);
-        if let Some(aux) = result
-            .aux
-            .as_mut()
-            .filter(|_| wants(Aov::Object) || wants(Aov::Material))
-        {
-            let ids = ids::pixel_centres(world, window, frame.w, frame.h);
-            if wants(Aov::Object) {
-                aux.images.object = ids.objects;
-            }
-            if wants(Aov::Material) {
-                aux.images.material = ids.materials;
-            }
-        }
-        result
-    }
 }
 
 /// Rows of a tile whose samples are traced as one batch by the stepped
