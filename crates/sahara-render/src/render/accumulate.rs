@@ -8,7 +8,7 @@ use super::plan::{Frame, PassPlan};
 use super::result::{develop, RenderResult};
 use super::settings::RenderSettings;
 use super::stats::RenderStats;
-use super::TileOut;
+use super::tile::TileOut;
 use crate::film::sums::SumBuffer;
 use crate::integrator::bdpt::Splat;
 use crate::world::World;

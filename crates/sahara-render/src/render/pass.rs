@@ -6,10 +6,11 @@ use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use rayon::prelude::*;
 
 use super::plan::Frame;
+use super::samples::RoundSamples;
 use super::settings::RenderSettings;
 use super::stop::Stop;
+use super::tile::{render_tile, TileOut};
 use super::watch::Progress;
-use super::{render_tile, RoundSamples, TileOut};
 use crate::world::World;
 
 /// What a render's passes render with: the scene, the settings, the

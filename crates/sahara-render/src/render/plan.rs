@@ -3,7 +3,7 @@
 
 use super::adaptive;
 use super::settings::RenderSettings;
-use super::Tile;
+use super::tile::Tile;
 use crate::film::sums::filter_margin;
 use crate::film::window::PixelWindow;
 
@@ -58,9 +58,14 @@ impl Frame {
 }
 
 /// The passes a render's sample range meets, and the range within each.
+///
+/// A pixel's samples are numbered over all passes, so that a sample range
+/// (a render farm's part by samples) draws the very samples the whole
+/// render draws: sample `g` is index `g % spp` of pass `g / spp`, and each
+/// pass draws the numbers of its indices in the range ([`Self::numbered`]).
 pub(super) struct PassPlan {
     /// Samples per pixel of a whole pass.
-    pub(super) spp: u32,
+    spp: u32,
     /// The first pass rendered.
     pub(super) first_pass: u32,
     /// Passes rendered, at most.
@@ -99,5 +104,12 @@ impl PassPlan {
         let i0 = self.first.saturating_sub(base).min(spp) as u32;
         let i1 = self.last.saturating_sub(base).min(spp) as u32;
         i0..i1
+    }
+
+    /// The samples every pixel draws in `pass`, numbered over all passes:
+    /// index `i` of the pass is sample `pass * spp + i`.
+    pub(super) fn numbered(&self, pass: u32) -> std::ops::Range<u32> {
+        let indices = self.indices(pass);
+        pass * self.spp + indices.start..pass * self.spp + indices.end
     }
 }

@@ -70,8 +70,8 @@ pub struct RenderSettings {
     /// False: the window is a crop, an image of those pixels.
     pub part: bool,
     /// The render passes to make beside the beauty, the images a denoiser
-    /// and compositing use ([`AuxImages`]; the integrators whose
-    /// [`Supports::aovs`] says so); empty: none.
+    /// and compositing use ([`AuxImages`](super::AuxImages); the
+    /// integrators whose [`Supports::aovs`] says so); empty: none.
     pub aovs: Vec<Aov>,
     /// Adaptive sampling: pixels stop once their noise is low enough, and
     /// `spp` is a cap (None: every pixel takes `spp`). Needs an integrator

@@ -289,5 +289,5 @@ impl<'a, 'w> Iterations<'a, 'w> {
 /// A NaN or infinite value is zeroed and counted, a negative component
 /// clamped and counted (as the render loop does for samples).
 fn guard(v: Vec3, stats: &mut RenderStats) -> Vec3 {
-    super::guard(v, &mut stats.nan_samples, &mut stats.negative_samples)
+    super::tile::guard(v, &mut stats.nan_samples, &mut stats.negative_samples)
 }
