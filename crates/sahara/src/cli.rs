@@ -9,7 +9,7 @@ use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
 use sahara_bench::SetKind;
 use sahara_kd::{BuildParams, Builder};
 use sahara_render::Mesh;
-use sahara_render::{Aov, FilterKind, IntegratorKind, Named, SamplerKind, ToneMap};
+use sahara_render::{Aov, FilterKind, IntegratorKind, Named, PathLoop, SamplerKind, ToneMap};
 
 /// Default timed runs per set.
 pub const DEFAULT_RUNS: usize = 3;
@@ -122,6 +122,10 @@ pub struct RenderArgs {
     /// Sample generator [default: the scene file's, else sobol].
     #[arg(long, value_name = "NAME", value_parser = NameParser::<SamplerKind>::new())]
     pub sampler: Option<SamplerKind>,
+    /// How the path tracer traces its samples: in SIMD lanes, refilled
+    /// as paths end or not, or the scalar reference [default: scalar].
+    #[arg(long, value_name = "NAME", value_parser = NameParser::<PathLoop>::new())]
+    pub path_loop: Option<PathLoop>,
     /// Reconstruction filter, with its default parameters (or the scene
     /// file's, if it names the same one) [default: the scene file's, else
     /// gaussian].

@@ -109,6 +109,7 @@ pub fn resolve(
                 .builder
                 .map_or_else(BuildParams::default, BuildParams::new),
             adaptive,
+            path_loop: args.path_loop.unwrap_or_default(),
             ..Default::default()
         },
         exposure,

@@ -5,6 +5,7 @@ pub(crate) mod bdpt;
 pub mod debug;
 mod distribution;
 pub(crate) mod laps;
+pub(crate) mod lanes;
 mod path;
 mod queries;
 pub(crate) mod sppm;
@@ -27,6 +28,7 @@ use crate::sampler::PixelSampler;
 use crate::texture::footprint::UvFootprint;
 use crate::world::{ShadowQuery, SurfaceHit, World};
 use state::Deferred;
+pub use lanes::LaneCounts;
 pub(crate) use state::{AuxSample, PathState};
 pub use supports::{Feature, SettingsError, Support, Supports};
 
@@ -391,6 +393,8 @@ pub struct TraceStats {
     pub shadow_rays: u64,
     /// Kd-tree work of camera rays in the `cost` view.
     pub traversal: TraversalCounters,
+    /// How the lane loop shaded its path vertices.
+    pub lanes: LaneCounts,
 }
 
 impl std::ops::AddAssign for TraceStats {
@@ -399,6 +403,7 @@ impl std::ops::AddAssign for TraceStats {
         self.bounce_rays += o.bounce_rays;
         self.shadow_rays += o.shadow_rays;
         self.traversal += o.traversal;
+        self.lanes += o.lanes;
     }
 }
 

@@ -13,6 +13,7 @@ pub mod diffuse;
 pub mod fresnel;
 mod kinds;
 mod layered;
+pub(crate) mod lanes;
 pub mod maps;
 pub mod metals;
 pub mod microfacet;

@@ -59,7 +59,7 @@ use plan::{Frame, PassPlan};
 use result::develop;
 pub use result::{cost_maps, CostMaps, RenderResult};
 use samples::RoundSamples;
-pub use settings::{RenderSettings, UNLIMITED_SPP};
+pub use settings::{PathLoop, RenderSettings, UNLIMITED_SPP};
 pub use stats::{RenderStats, TimeShares, TimeSplit};
 use stop::Stop;
 use watch::Previews;

@@ -78,6 +78,49 @@ pub struct RenderSettings {
     /// that supports it ([`Supports::adaptive`]), and not with `samples`
     /// other than `0..spp` (a pixel's decisions need all its samples).
     pub adaptive: Option<Adaptive>,
+    /// How the path tracer's samples are traced: in SIMD lanes or one
+    /// path step at a time (the other integrators ignore it).
+    pub path_loop: PathLoop,
+}
+
+/// The loop that traces the path tracer's samples (`path`, in a scene
+/// without media). Both run the same estimator; their images are equal
+/// to noise, not bit for bit (the lanes' arithmetic differs in rounding).
+/// Each gives the same bytes for a seed at any thread count, and under a
+/// render farm's split and merge (the frame digest tells the loops apart).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum PathLoop {
+    /// Paths in SIMD lanes (packets of 16 under AVX-512, 8 under AVX2),
+    /// lanes refilled from the next samples as their paths end.
+    Lanes,
+    /// Paths in SIMD lanes, a packet refilled only once all its paths
+    /// have ended.
+    LanesNoRefill,
+    /// The scalar path tracer, a step of every path of a strip at a time
+    /// (the wavefront): the reference the lanes are held to.
+    #[default]
+    Scalar,
+}
+
+crate::names::name_table!(PathLoop, "path loop", {
+    PathLoop::Lanes => "lanes",
+    PathLoop::LanesNoRefill => "lanes-no-refill",
+    PathLoop::Scalar => "scalar",
+});
+
+impl PathLoop {
+    /// Whether `integrator`'s samples in a scene with (`media`) or without
+    /// media go to the lanes, and if so whether lanes are refilled.
+    pub(crate) fn lanes(self, integrator: &Integrator, media: bool) -> Option<bool> {
+        if !matches!(integrator, Integrator::Path { .. }) || media {
+            return None;
+        }
+        match self {
+            PathLoop::Lanes => Some(true),
+            PathLoop::LanesNoRefill => Some(false),
+            PathLoop::Scalar => None,
+        }
+    }
 }
 
 /// The `spp` of a render bounded by its time limit only.
@@ -158,6 +201,7 @@ impl Default for RenderSettings {
             part: false,
             aovs: Vec::new(),
             adaptive: None,
+            path_loop: PathLoop::default(),
         }
     }
 }

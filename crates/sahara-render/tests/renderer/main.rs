@@ -10,6 +10,7 @@ mod bidirectional;
 mod camera;
 mod common;
 mod energy;
+mod lanes;
 mod lighting;
 mod photons;
 mod render_loop;
