@@ -21,6 +21,7 @@ mod render;
 mod render_options;
 mod scene_input;
 mod stats;
+mod status;
 mod warnings;
 
 use std::process::ExitCode;
