@@ -426,6 +426,32 @@ fn steps_that_take_a_while_say_what_they_are_doing() {
 }
 
 #[test]
+fn the_bare_command_takes_renders_options() {
+    // `sahara -o out.png --spp 1 ...` renders the built-in scene as
+    // `sahara render` does with them.
+    let dir = temp_dir("bare");
+    let (bare, render) = (dir.join("bare.png"), dir.join("render.png"));
+    let size = ["--width", "24", "--height", "16", "--spp", "1"];
+    let out = sahara(&[&["-o", bare.to_str().unwrap()][..], &size].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = sahara(&[&["render", "-o", render.to_str().unwrap()][..], &size].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(fs::read(&bare).unwrap(), fs::read(&render).unwrap());
+    // A mistake in them is said as render says it.
+    let out = sahara(&["--spp", "0"]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("0 is not in 1..="),
+        "{}",
+        stderr(&out)
+    );
+    // Help and version stay the tool's.
+    let out = sahara(&["--version"]);
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("sahara "));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn argument_errors_are_one_line_with_exit_code_1() {
     for (args, what) in [
         (&["render", "--spp", "0"][..], "0 is not in 1..="),
