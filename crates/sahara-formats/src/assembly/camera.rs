@@ -252,6 +252,34 @@ fn mark_triangle(grid: &mut [bool], t: [glam::Vec2; 3]) {
     }
 }
 
+/// How far from the centre of the box `lo..hi`, looking at it from the
+/// direction `from` (with +Y up), every corner of the box is within the
+/// field of view (`half_fov` either side, across and up: any image at
+/// least as wide as it is tall shows it all), with a 5 % margin. Tighter
+/// than the bounding sphere, which leaves a model long along the line of
+/// sight (a fox seen from the front) small in the frame.
+fn front_distance(lo: Vec3, hi: Vec3, from: Vec3, half_fov: f32) -> f32 {
+    let right = Vec3::Y.cross(from).normalize();
+    let up = from.cross(right);
+    let (c, tan) = (0.5 * (lo + hi), half_fov.tan());
+    let (mut d, mut nearest) = (0.0f32, 0.0f32);
+    for k in 0..8 {
+        let corner = Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        ) - c;
+        // The corner's offset towards the eye shortens its depth.
+        let nearer = corner.dot(from);
+        let across = corner.dot(right).abs().max(corner.dot(up).abs());
+        d = d.max(across / tan + nearer);
+        nearest = nearest.max(nearer);
+    }
+    let r = (0.5 * (hi - lo).length()).max(1e-6);
+    // Never so close that the box reaches the eye.
+    1.05 * d.max(nearest + 0.1 * r)
+}
+
 /// A camera that sees the scene's objects: looking at the centre of their
 /// bounds from where `view` says (above, the front (+Z) and the right
 /// (+X); or the front and a little above), at the distance where their
@@ -308,16 +336,17 @@ pub(crate) fn auto_camera_framing(
             let up = if axis == 1 { Vec3::NEG_Z } else { Vec3::Y };
             (face + out * d, up)
         }
-        None => {
-            let from = match view {
-                View::ThreeQuarter => Vec3::new(0.3, 0.5, 1.0).normalize(),
-                View::Front => {
-                    let (sin, cos) = FRONT_ELEVATION_DEG.to_radians().sin_cos();
-                    Vec3::new(0.0, sin, cos)
-                }
-            };
-            (c + from * (r / half_fov.sin()), Vec3::Y)
-        }
+        None => match view {
+            View::ThreeQuarter => {
+                let from = Vec3::new(0.3, 0.5, 1.0).normalize();
+                (c + from * (r / half_fov.sin()), Vec3::Y)
+            }
+            View::Front => {
+                let (sin, cos) = FRONT_ELEVATION_DEG.to_radians().sin_cos();
+                let from = Vec3::new(0.0, sin, cos);
+                (c + from * front_distance(lo, hi, from, half_fov), Vec3::Y)
+            }
+        },
     };
     // Coordinates near the float range put the eye at infinity, and
     // coordinates far from the origin beside a tiny mesh leave no room
@@ -568,6 +597,35 @@ mod tests {
         let (c, _) = auto_camera_framing(&scene, "t", View::ThreeQuarter).unwrap();
         let from = (c.eye - Vec3::new(2.0, 2.0, 0.0)).normalize();
         assert!(from.x > 0.2 && from.y > 0.4, "{from}");
+    }
+
+    #[test]
+    fn a_model_long_along_the_line_of_sight_still_fills_the_front_view() {
+        // A box 1 wide, 1 tall and 6 deep (a fox seen from the front): every
+        // corner in the frame, the outermost near its edge (the bounding
+        // sphere would leave it a third of the frame).
+        let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
+        let m = scene.add_material(Material::default());
+        let (lo, hi) = (Vec3::new(-0.5, 0.0, -3.0), Vec3::new(0.5, 1.0, 3.0));
+        scene.add_shape(sahara_render::Shape::Box { min: lo, max: hi }, m);
+        let (c, _) = auto_camera_framing(&scene, "t", View::Front).unwrap();
+        let tan = (0.5 * AUTO_VFOV_DEG.to_radians()).tan();
+        let right = c.forward.cross(Vec3::Y).normalize();
+        let up = right.cross(c.forward);
+        let mut widest = 0.0f32;
+        for k in 0..8 {
+            let p = Vec3::new(
+                [lo.x, hi.x][k & 1],
+                [lo.y, hi.y][(k >> 1) & 1],
+                [lo.z, hi.z][(k >> 2) & 1],
+            ) - c.eye;
+            let depth = p.dot(c.forward);
+            assert!(depth > 0.0, "corner {k} behind the eye");
+            let fill = p.dot(right).abs().max(p.dot(up).abs()) / (depth * tan);
+            assert!(fill <= 1.0, "corner {k} out of the frame: {fill}");
+            widest = widest.max(fill);
+        }
+        assert!(widest > 0.9, "{widest}");
     }
 
     #[test]
