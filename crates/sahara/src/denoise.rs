@@ -62,9 +62,10 @@ pub(crate) fn apply(
         ..Aux::albedo_normal(&albedo, &normal)
     };
     let start = Instant::now();
-    let clean = denoiser
-        .denoise(&image, guide)
-        .map_err(|e| anyhow!("--denoise: {e}"))?;
+    let denoising = crate::status::Step::start("denoising");
+    let clean = denoiser.denoise(&image, guide);
+    drop(denoising);
+    let clean = clean.map_err(|e| anyhow!("--denoise: {e}"))?;
     for (p, c) in result.film.pixels.iter_mut().zip(clean.chunks_exact(3)) {
         // The network may leave tiny negative values: radiance is not negative.
         *p = glam::Vec3::new(c[0], c[1], c[2]).max(glam::Vec3::ZERO);

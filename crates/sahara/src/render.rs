@@ -17,10 +17,11 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use sahara_render::internals::{render_world, World};
 use sahara_render::UNLIMITED_SPP;
 use sahara_render::{
-    render_watched, Aov, Feature, Filter, FilterKind, Preview, Progress, RenderResult,
-    RenderSettings, SettingsError, ToneMap,
+    Aov, Feature, Filter, FilterKind, Preview, Progress, RenderResult, RenderSettings,
+    SettingsError, ToneMap,
 };
 
 use crate::cli::RenderArgs;
@@ -239,16 +240,10 @@ fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
         settings: file,
         name,
         description,
-        mut warnings,
+        warnings,
         names,
         ..
     } = input;
-    // The finished scene's problems, named after the file they come from.
-    let from_file = args.scene.as_ref().map(|p| p.display().to_string());
-    warnings.extend(scene.diagnostics().into_iter().map(|d| match &from_file {
-        Some(f) => format!("{f}: {d}"),
-        None => d,
-    }));
     crate::warnings::print(&warnings);
     let RenderOptions {
         mut settings,
@@ -454,12 +449,22 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
             );
         }
     }
+    // The trees and light tables, built before the bar is drawn so that a
+    // long build is said as such (a scene of millions of triangles takes
+    // seconds).
+    let start = Instant::now();
+    let mut world = pool.install(|| {
+        let _building = crate::status::Step::start("building the trees and light tables");
+        World::new(&job.scene, &settings.build)
+    });
+    let build_time = start.elapsed();
     // Started after the line above, so that it does not draw over it.
     let bar = progress_bar(settings);
     let unlimited = settings.spp == UNLIMITED_SPP;
     let plain = !std::io::stderr().is_terminal();
     let every = plain_progress_every();
-    let last_line = Mutex::new(Instant::now());
+    // When the last plain line was printed, and whether one was.
+    let last_line = Mutex::new((Instant::now(), false));
     let on_progress = |p: Progress| {
         if !unlimited {
             bar.set_length(u64::from(p.passes) * u64::from(p.tiles));
@@ -475,8 +480,8 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
         if plain {
             // No bar is drawn where stderr is not a terminal: a line now and then.
             let mut last = last_line.lock().unwrap_or_else(|e| e.into_inner());
-            if last.elapsed() >= every {
-                *last = Instant::now();
+            if last.0.elapsed() >= every {
+                *last = (Instant::now(), true);
                 eprintln!(
                     "{}",
                     plain_progress_line(&p, unlimited, settings.time_limit)
@@ -496,8 +501,26 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
         every: Duration::from_secs_f64(t),
         show: &mut show_preview,
     });
-    let result = pool.install(|| render_watched(&job.scene, settings, &on_progress, preview));
+    let result = pool.install(|| {
+        render_world(
+            &mut world,
+            settings,
+            &on_progress,
+            preview,
+            start,
+            build_time,
+        )
+    });
     bar.finish_and_clear();
+    let said_progress = last_line.lock().unwrap_or_else(|e| e.into_inner()).1;
+    if let (true, Ok(r)) = (said_progress, &result) {
+        // The lines come every few seconds: the last of them may be short
+        // of the end, and a log should not end on `95.8% done`.
+        eprintln!(
+            "{}",
+            plain_closing_line(r.stats.passes, start.elapsed(), job.interrupted(r))
+        );
+    }
     // The settings were checked before the render (`check_settings`).
     Ok(result?)
 }
@@ -775,6 +798,20 @@ fn plain_progress_line(p: &Progress, unlimited: bool, time_limit: Option<Duratio
     )
 }
 
+/// The plain progress line that closes a render's plain lines: `progress:
+/// 100.0% done, 00:01:05 elapsed, finished (4 passes)`, or for a render a
+/// signal stopped, `progress: stopped, 00:00:40 elapsed, 2 passes complete`.
+fn plain_closing_line(passes: u32, elapsed: Duration, interrupted: bool) -> String {
+    let s = elapsed.as_secs_f64().round() as u64;
+    let hms = format!("{:02}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60);
+    let passes_word = if passes == 1 { "pass" } else { "passes" };
+    if interrupted {
+        format!("progress: stopped, {hms} elapsed, {passes} {passes_word} complete")
+    } else {
+        format!("progress: 100.0% done, {hms} elapsed, finished ({passes} {passes_word})")
+    }
+}
+
 /// The time left, from the average rate since the start (`HH:MM:SS`), or
 /// `--:--:--` until 5% of the work or 3 seconds have passed. indicatif's
 /// own estimate follows the rate of the last few tiles, and the first
@@ -794,7 +831,7 @@ fn eta_text(pos: u64, len: Option<u64>, elapsed: Duration) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{eta_text, plain_progress_line};
+    use super::{eta_text, plain_closing_line, plain_progress_line};
     use sahara_render::Progress;
     use std::time::Duration;
 
@@ -823,6 +860,18 @@ mod tests {
             plain_progress_line(&p, true, Some(Duration::from_secs(60))),
             "progress: 20.0% done, 00:00:12 elapsed, eta 00:00:48, 3.0 Mrays/s \
              (pass 2, tile 130/260 of this pass)"
+        );
+    }
+
+    #[test]
+    fn the_plain_lines_close_with_the_whole_render_done_or_stopped() {
+        assert_eq!(
+            plain_closing_line(4, Duration::from_secs(65), false),
+            "progress: 100.0% done, 00:01:05 elapsed, finished (4 passes)"
+        );
+        assert_eq!(
+            plain_closing_line(1, Duration::from_secs(40), true),
+            "progress: stopped, 00:00:40 elapsed, 1 pass complete"
         );
     }
 

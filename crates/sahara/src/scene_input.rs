@@ -29,11 +29,26 @@ pub(crate) fn load_input(
         defines: defines.to_vec(),
     };
     // A `FormatError`'s message already names the file and place.
-    let input = match path {
+    let loading = crate::status::Step::start(match path {
+        Some(path) => format!("loading {}", path.display()),
+        None => "loading the built-in scene".to_owned(),
+    });
+    let loaded = match path {
         Some(path) => load(path, &options),
         None => load_builtin(&options),
+    };
+    drop(loading);
+    let mut input = loaded.map_err(|e| anyhow!("{e}"))?;
+    // The finished scene's problems (triangles skipped, no light), named
+    // after the file they come from: every command that loads the scene
+    // says them.
+    let diagnostics = input.scene.diagnostics().into_iter();
+    match path {
+        Some(p) => input
+            .warnings
+            .extend(diagnostics.map(|d| format!("{}: {d}", p.display()))),
+        None => input.warnings.extend(diagnostics),
     }
-    .map_err(|e| anyhow!("{e}"))?;
     if let Some(framing) = &input.framing {
         eprintln!("{framing}");
     }

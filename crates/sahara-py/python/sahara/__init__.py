@@ -16,9 +16,12 @@ See docs/python.md in the repository.
 
 from __future__ import annotations
 
+import errno
+import operator
 import os
 import sys
 import time
+import warnings
 from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -62,6 +65,14 @@ def load(
     ``FileNotFoundError``, or ``sahara.FormatError`` (a ``ValueError``)
     with the command line's one-line message naming the file and line.
     """
+    if more_defines and not os.fspath(path).lower().endswith(".xml"):
+        # Only a Mitsuba scene takes parameters: anything else is a
+        # mistyped keyword, said as Python says one.
+        raise TypeError(
+            f"load() got an unexpected keyword argument {next(iter(more_defines))!r} "
+            "(keyword arguments other than camera, sky and defines are the parameters "
+            "of a Mitsuba scene, .xml)"
+        )
     d = {str(k): _define(v) for k, v in dict(defines or {}, **more_defines).items()}
     return _sahara.load(os.fspath(path), camera=camera, sky=sky, defines=list(d.items()) or None)
 
@@ -74,18 +85,68 @@ def _define(v: Any) -> str:
     return str(v)
 
 
+def _whole(name: str, value: Any, low: int, high: int) -> Optional[int]:
+    """``value`` as a whole number in ``low..=high`` (None stays None): a
+    ``TypeError`` for what is not a whole number, a ``ValueError`` naming
+    the argument for one out of range."""
+    if value is None:
+        return None
+    if isinstance(value, bool):
+        raise TypeError(f"{name} must be a whole number, not bool")
+    try:
+        v = operator.index(value)
+    except TypeError:
+        raise TypeError(f"{name} must be a whole number, not {type(value).__name__}") from None
+    if low <= v <= high:
+        return v
+    if high < 2**31:
+        raise ValueError(f"{name} must be {low}..={high}, not {v}")
+    if v < low:
+        raise ValueError(f"{name} must be at least {low}, not {v}")
+    raise ValueError(f"{name} must be at most {high}, not {v}")
+
+
+def _pass_names(aovs: Any) -> Optional[list]:
+    """The render passes asked for: one name, or a sequence of names."""
+    if aovs is None:
+        return None
+    if isinstance(aovs, str):
+        return [aovs]
+    try:
+        names_ = list(aovs)
+    except TypeError:
+        raise TypeError(
+            f"aovs must be a pass name or a sequence of names, not {type(aovs).__name__}"
+        ) from None
+    for n in names_:
+        if not isinstance(n, str):
+            raise TypeError(f"aovs: each pass is named by a str, not {type(n).__name__}")
+    return names_
+
+
 class _Bar:
     """A progress bar on stderr: tqdm's (notebook-aware) when installed,
-    else one line rewritten in place."""
+    else one line rewritten in place on a terminal, and plain lines now and
+    then elsewhere (a log, a notebook's captured stderr), as the command
+    line prints them."""
+
+    #: Seconds between plain lines where stderr is not a terminal.
+    EVERY = 10.0
 
     def __init__(self, label: str):
         self.label, self.bar, self.start = label, None, time.monotonic()
+        self.last_line = None
         try:
             from tqdm.auto import tqdm
 
             self.tqdm = tqdm
         except ImportError:
             self.tqdm = None
+        try:
+            self.terminal = sys.stderr.isatty()
+        except (AttributeError, ValueError):
+            self.terminal = False
+        self.drawn = False
 
     def __call__(self, done: int, total: int) -> None:
         if self.tqdm is not None:
@@ -95,17 +156,36 @@ class _Bar:
             self.bar.n = done
             self.bar.refresh()
             return
+        percent = 100 * done // max(total, 1)
+        elapsed = time.monotonic() - self.start
+        if not self.terminal:
+            # No line rewritten in place where stderr is not a terminal:
+            # a plain line now and then.
+            now = time.monotonic()
+            if self.last_line is None or now - self.last_line >= self.EVERY:
+                self.last_line = now
+                sys.stderr.write(f"{self.label}: {percent}% done, {elapsed:.0f} s\n")
+                sys.stderr.flush()
+            return
         width = 30
         filled = width * done // max(total, 1)
-        line = f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] {100 * done // max(total, 1):3d}% {time.monotonic() - self.start:.0f} s"
+        line = f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] {percent:3d}% {elapsed:.0f} s"
         sys.stderr.write(line)
         sys.stderr.flush()
+        self.drawn = True
 
-    def close(self) -> None:
+    def close(self, finished: bool = True) -> None:
         if self.bar is not None:
             self.bar.close()
-        elif self.tqdm is None:
-            sys.stderr.write("\r" + " " * 60 + "\r")
+        elif self.tqdm is None and self.terminal:
+            if self.drawn:
+                sys.stderr.write("\r" + " " * 60 + "\r")
+                sys.stderr.flush()
+        elif self.tqdm is None and self.last_line is not None:
+            # The plain lines end on the render's end, each on its own line.
+            elapsed = time.monotonic() - self.start
+            end = "100% done, finished" if finished else "stopped"
+            sys.stderr.write(f"{self.label}: {end}, {elapsed:.0f} s\n")
             sys.stderr.flush()
 
 
@@ -118,7 +198,7 @@ def render(
     integrator: Optional[str] = None,
     seed: Optional[int] = None,
     threads: Optional[int] = None,
-    aovs: Optional[Sequence[str]] = None,
+    aovs: Optional[Union[str, Sequence[str]]] = None,
     denoise: bool = False,
     progress: Union[bool, Callable[[int, int], Any]] = True,
     sampler: Optional[str] = None,
@@ -133,14 +213,25 @@ def render(
 
     Returns the linear RGB image, a float32 array (height, width, 3); with
     ``aovs`` (any of ``albedo``, ``normal``, ``depth``, ``position``,
-    ``uv``, ``variance``, ``object``, ``material``) a pair ``(image,
-    passes)`` whose dict holds one array per pass. ``denoise`` runs Intel
+    ``uv``, ``variance``, ``object``, ``material``; one name or a
+    sequence of names) a pair ``(image, passes)`` whose dict holds one
+    array per pass. Settings out of range are a ``ValueError`` naming the
+    argument (``spp`` at least 1, ``width`` and ``height`` 1 to 65536,
+    ``seed`` at least 0, ``threads`` 0 (all) to 1024), what is not a
+    whole number a ``TypeError``. ``denoise`` runs Intel
     Open Image Denoise (``pip install pyoidn``). ``progress``: a bar on
     stderr (True), none (False), or a function called with (tiles done,
     tiles in all). The GIL is released while rendering on ``threads``
     threads (None: all); Ctrl-C stops the render after the tiles under way
     and raises ``KeyboardInterrupt``.
     """
+    spp = _whole("spp", spp, 1, 2**32 - 1)
+    width = _whole("width", width, 1, 65536)
+    height = _whole("height", height, 1, 65536)
+    pass_spp = _whole("pass_spp", pass_spp, 1, 2**32 - 1)
+    seed = _whole("seed", seed, 0, 2**64 - 1)
+    threads = _whole("threads", threads, 0, 1024)
+    aovs = _pass_names(aovs)
     if not isinstance(scene, Scene):
         scene = load(scene)
     bar = None
@@ -151,6 +242,7 @@ def render(
         callback = progress
     else:
         callback = None
+    finished = False
     try:
         image, passes = _sahara.render(
             scene,
@@ -160,7 +252,7 @@ def render(
             integrator=integrator,
             seed=seed,
             threads=threads,
-            aovs=list(aovs) if aovs else None,
+            aovs=aovs or None,
             denoise=denoise,
             sampler=sampler,
             filter=filter,
@@ -168,9 +260,10 @@ def render(
             builder=builder,
             progress=callback,
         )
+        finished = True
     finally:
         if bar is not None:
-            bar.close()
+            bar.close(finished)
     return (image, passes) if aovs else image
 
 
@@ -186,6 +279,45 @@ def write(
     writes its output: ``.exr`` as linear 32-bit floats, ``.png`` as 8-bit
     sRGB after ``exposure`` (stops) and ``tonemap`` (``clamp`` or
     ``filmic``); ``metadata``'s entries as the file's text attributes.
-    The file is written beside the target and renamed over it."""
+    The file is written beside the target and renamed over it.
+
+    Float images are linear. ``uint8`` and ``uint16`` images are read as
+    PIL and imageio give them, sRGB-encoded codes (0 to 255, 0 to 65535),
+    and decoded to linear first (so an 8-bit image read with PIL is
+    written back to the same PNG codes); other integer types are a
+    ``TypeError``. NaN values are written as black (PNG) or NaN (EXR),
+    with a ``RuntimeWarning`` that counts them. A folder is an
+    ``IsADirectoryError``."""
+    target = os.fspath(path)
+    if os.path.isdir(target):
+        raise IsADirectoryError(
+            errno.EISDIR, "is a folder; give a file name ending in .png or .exr", target
+        )
+    image = _linear_image(image, target)
     items = [(str(k), str(v)) for k, v in (metadata or {}).items()]
-    _sahara.write(os.fspath(path), image, exposure=exposure, tonemap=tonemap, metadata=items or None)
+    _sahara.write(target, image, exposure=exposure, tonemap=tonemap, metadata=items or None)
+
+
+def _linear_image(image: Any, target: str) -> Any:
+    """An image for ``write`` as linear floats: 8-bit and 16-bit unsigned
+    codes decoded from sRGB; NaN counted and warned of."""
+    a = np.asarray(image)
+    if a.dtype == np.uint8 or a.dtype == np.uint16:
+        c = a.astype(np.float64) / float(np.iinfo(a.dtype).max)
+        linear = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+        return linear.astype(np.float32)
+    if a.dtype.kind in "biu":
+        raise TypeError(
+            f"image: {a.dtype} pixels cannot be written; give linear floats, or uint8 or "
+            "uint16 sRGB-encoded codes (as PIL and imageio read images)"
+        )
+    if a.dtype.kind == "f":
+        nan = int(np.count_nonzero(np.isnan(a)))
+        if nan:
+            written = "NaN" if target.lower().endswith(".exr") else "black"
+            warnings.warn(
+                f"image: {nan} of {a.size} values are NaN; they are written as {written}",
+                RuntimeWarning,
+                stacklevel=3,
+            )
+    return image
