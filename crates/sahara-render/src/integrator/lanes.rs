@@ -275,7 +275,9 @@ struct Points<const N: usize> {
 #[inline(always)]
 fn spawn_origin<const N: usize>(pt: &Points<N>, w: V<N>) -> V<N> {
     let off = pt.ng * pt.err;
-    w.dot(pt.ng).ge(F::splat(0.0)).select_v(pt.p + off, pt.p - off)
+    w.dot(pt.ng)
+        .ge(F::splat(0.0))
+        .select_v(pt.p + off, pt.p - off)
 }
 
 /// The shading frames of unit normals `n`, as
@@ -357,6 +359,7 @@ impl<'a, 'w> Shared<'a, 'w> {
     /// `owner` the lane of each), the BSDF sample and the next ray,
     /// Russian roulette.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn shade<const N: usize>(
         &self,
         paths: &mut Paths<N>,
@@ -387,14 +390,14 @@ impl<'a, 'w> Shared<'a, 'w> {
             blind: M::splat(false),
             ignore: [None; N],
         };
-        for i in 0..N {
+        for (i, hit) in hits.iter().enumerate() {
             if !paths.alive.0[i] {
                 continue;
             }
             // The surface, if the lanes can shade it; else why not
             // (true: its BSDF has no lane version).
             let mut scalar_material = false;
-            let lane = hits[i].as_ref().and_then(|hit| {
+            let lane = hit.as_ref().and_then(|hit| {
                 let m = world.material(hit.material);
                 if m.has_holes() || paths.aux[i].open || m.textures.normal.is_some() {
                     return None;
@@ -418,7 +421,7 @@ impl<'a, 'w> Shared<'a, 'w> {
                 } else {
                     stats.lanes.scalar_other += 1;
                 }
-                if !self.scalar_step(paths, i, hits[i], deferred, stats) {
+                if !self.scalar_step(paths, i, *hit, deferred, stats) {
                     round.ended.0[i] = true;
                 }
                 continue;
@@ -800,10 +803,26 @@ mod tests {
                 let mut stats = TraceStats::default();
                 let mut refilled = vec![Vec3::ZERO; samples.len()];
                 let mut lanes = PathLanes::default();
-                lanes.trace(&integrator, &world, &samples, &mut refilled, None, &mut stats, true);
+                lanes.trace(
+                    &integrator,
+                    &world,
+                    &samples,
+                    &mut refilled,
+                    None,
+                    &mut stats,
+                    true,
+                );
                 let mut packets = vec![Vec3::ZERO; samples.len()];
                 let mut stats2 = TraceStats::default();
-                lanes.trace(&integrator, &world, &samples, &mut packets, None, &mut stats2, false);
+                lanes.trace(
+                    &integrator,
+                    &world,
+                    &samples,
+                    &mut packets,
+                    None,
+                    &mut stats2,
+                    false,
+                );
                 let bits = |v: &[Vec3]| -> Vec<[u32; 3]> {
                     v.iter().map(|l| l.to_array().map(f32::to_bits)).collect()
                 };
@@ -825,7 +844,10 @@ mod tests {
                     sum_scalar += r;
                 }
                 let share = agree as f64 / samples.len() as f64;
-                assert!(share > 0.97, "{extra} {kind:?}: {share} of the samples agree");
+                assert!(
+                    share > 0.97,
+                    "{extra} {kind:?}: {share} of the samples agree"
+                );
                 assert!(stats.lanes.lane_bounces > 0 && stats.shadow_rays > 0);
                 eprintln!(
                     "{extra} {kind:?}: {share:.4} agree; sums {sum_lanes} vs {sum_scalar}; {:?}",

@@ -4,8 +4,8 @@
 pub(crate) mod bdpt;
 pub mod debug;
 mod distribution;
-pub(crate) mod laps;
 pub(crate) mod lanes;
+pub(crate) mod laps;
 mod path;
 mod queries;
 pub(crate) mod sppm;
@@ -27,8 +27,8 @@ use crate::sampler::dims;
 use crate::sampler::PixelSampler;
 use crate::texture::footprint::UvFootprint;
 use crate::world::{ShadowQuery, SurfaceHit, World};
-use state::Deferred;
 pub use lanes::LaneCounts;
+use state::Deferred;
 pub(crate) use state::{AuxSample, PathState};
 pub use supports::{Feature, SettingsError, Support, Supports};
 

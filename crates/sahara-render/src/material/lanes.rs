@@ -92,7 +92,11 @@ impl<const N: usize> BsdfLanes<N> {
         }
         let rough = |distribution: Distribution, roughness: f32| {
             let mf = Microfacet::new(distribution, roughness);
-            (mf.alpha, distribution == Distribution::Beckmann, mf.is_smooth())
+            (
+                mf.alpha,
+                distribution == Distribution::Beckmann,
+                mf.is_smooth(),
+            )
         };
         let (mut color, mut alpha, mut ior, mut beckmann) = (Vec3::ZERO, 0.0, 1.5, false);
         let kind = match p.bsdf {
@@ -407,10 +411,7 @@ pub(crate) fn cosine_hemisphere<const N: usize>(u: (F<N>, F<N>)) -> V<N> {
     let centre = ox.eq(zero) & oy.eq(zero);
     let along_x = ox.abs().gt(oy.abs());
     let r = along_x.select(ox, oy);
-    let theta = along_x.select(
-        (oy / ox) * FRAC_PI_4,
-        FRAC_PI_2 - (ox / oy) * FRAC_PI_4,
-    );
+    let theta = along_x.select((oy / ox) * FRAC_PI_4, FRAC_PI_2 - (ox / oy) * FRAC_PI_4);
     let (s, c) = theta.sin_cos();
     let dx = centre.select(zero, r * c);
     let dy = centre.select(zero, r * s);
@@ -506,7 +507,10 @@ impl<const N: usize> Microfacets<N> {
         let len2 = vh.x * vh.x + vh.y * vh.y;
         let has = len2.gt(zero);
         let inv = one / len2.sqrt();
-        let t1 = has.select_v(V::new(-vh.y * inv, vh.x * inv, zero), V::new(one, zero, zero));
+        let t1 = has.select_v(
+            V::new(-vh.y * inv, vh.x * inv, zero),
+            V::new(one, zero, zero),
+        );
         let t2 = vh.cross(t1);
         let r = u.0.sqrt();
         let phi = u.1 * (2.0 * PI);
@@ -533,8 +537,8 @@ impl<const N: usize> Microfacets<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::hash::{hash2, unit_f32};
     use crate::material::Material;
+    use crate::math::hash::{hash2, unit_f32};
     use glam::Vec2;
 
     /// The BSDFs with a lane version, textured (tint) and not.
@@ -613,16 +617,37 @@ mod tests {
                 for (a, b) in f.get(i).to_array().into_iter().zip(e.f.to_array()) {
                     assert!(close(a, b), "{p:?} eval {a} vs {b}");
                 }
-                assert!(close(pdf.0[i], e.pdf), "{p:?} pdf {} vs {}", pdf.0[i], e.pdf);
+                assert!(
+                    close(pdf.0[i], e.pdf),
+                    "{p:?} pdf {} vs {}",
+                    pdf.0[i],
+                    e.pdf
+                );
                 let r = p.sample(wo.get(i), u_lobe.0[i], Vec2::new(u.0 .0[i], u.1 .0[i]));
                 assert_eq!(s.ok.0[i], r.is_some(), "{p:?} {:?}", r);
                 if let Some(r) = r {
                     assert_eq!(s.delta.0[i], r.delta);
-                    assert!((s.wi.get(i) - r.wi).length() < 1e-3, "{p:?} {} vs {}", s.wi.get(i), r.wi);
-                    for (a, b) in s.weight.get(i).to_array().into_iter().zip(r.weight.to_array()) {
+                    assert!(
+                        (s.wi.get(i) - r.wi).length() < 1e-3,
+                        "{p:?} {} vs {}",
+                        s.wi.get(i),
+                        r.wi
+                    );
+                    for (a, b) in s
+                        .weight
+                        .get(i)
+                        .to_array()
+                        .into_iter()
+                        .zip(r.weight.to_array())
+                    {
                         assert!(close(a, b), "{p:?} weight {a} vs {b}");
                     }
-                    assert!(close(s.pdf.0[i], r.pdf), "{p:?} pdf {} vs {}", s.pdf.0[i], r.pdf);
+                    assert!(
+                        close(s.pdf.0[i], r.pdf),
+                        "{p:?} pdf {} vs {}",
+                        s.pdf.0[i],
+                        r.pdf
+                    );
                     checked += 1;
                 }
             }

@@ -61,7 +61,7 @@ macro_rules! lanewise {
             #[inline(always)]
             fn $f(mut self, o: Self) -> Self {
                 for i in 0..N {
-                    self.0[i] = self.0[i] $op o.0[i];
+                    self.0[i] $op o.0[i];
                 }
                 self
             }
@@ -71,7 +71,7 @@ macro_rules! lanewise {
             #[inline(always)]
             fn $f(mut self, o: $e) -> Self {
                 for i in 0..N {
-                    self.0[i] = self.0[i] $op o;
+                    self.0[i] $op o;
                 }
                 self
             }
@@ -79,10 +79,10 @@ macro_rules! lanewise {
     };
 }
 
-lanewise!(F, f32, Add, add, +);
-lanewise!(F, f32, Sub, sub, -);
-lanewise!(F, f32, Mul, mul, *);
-lanewise!(F, f32, Div, div, /);
+lanewise!(F, f32, Add, add, +=);
+lanewise!(F, f32, Sub, sub, -=);
+lanewise!(F, f32, Mul, mul, *=);
+lanewise!(F, f32, Div, div, /=);
 
 impl<const N: usize> AddAssign for F<N> {
     #[inline(always)]
@@ -282,16 +282,14 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
     let y = j as f32;
     let r = ((a - y * DP1) - y * DP2) - y * DP3;
     let z = r * r;
-    let cos_p = ((2.443_315_7e-5 * z - 1.388_731_6e-3) * z + 4.166_664_6e-2) * z * z - 0.5 * z + 1.0;
+    let cos_p =
+        ((2.443_315_7e-5 * z - 1.388_731_6e-3) * z + 4.166_664_6e-2) * z * z - 0.5 * z + 1.0;
     let sin_p = ((-1.951_529_6e-4 * z + 8.332_161e-3) * z - 1.666_665_5e-1) * z * r + r;
     let swap = j & 2 != 0;
     let (s, c) = if swap { (cos_p, sin_p) } else { (sin_p, cos_p) };
     let s_neg = (j & 4 != 0) != sign_x;
     let c_neg = ((j + 2) & 4) != 0;
-    (
-        if s_neg { -s } else { s },
-        if c_neg { -c } else { c },
-    )
+    (if s_neg { -s } else { s }, if c_neg { -c } else { c })
 }
 
 /// `e^x` (see [`F::exp`]).
@@ -307,7 +305,7 @@ pub fn exp(x: f32) -> f32 {
     let p = ((((1.987_569_1e-4 * r + 1.398_199_9e-3) * r + 8.333_452e-3) * r + 4.166_579_6e-2) * r
         + 1.666_666_5e-1)
         * r
-        + 5.000_000_1e-1;
+        + 0.5;
     let e = p * z + r + 1.0;
     let scaled = e * f32::from_bits((((n as i32) + 127) as u32) << 23);
     if x < -87.0 {
@@ -647,7 +645,9 @@ mod tests {
             let x = k as f32 * 1e-3;
             let (s, c) = sin_cos(x);
             let (es, ec) = ((x as f64).sin(), (x as f64).cos());
-            worst = worst.max((s as f64 - es).abs() as f32).max((c as f64 - ec).abs() as f32);
+            worst = worst
+                .max((s as f64 - es).abs() as f32)
+                .max((c as f64 - ec).abs() as f32);
         }
         assert!(worst < 3e-7, "{worst}");
     }
@@ -670,7 +670,10 @@ mod tests {
         let b = F::<8>::splat(2.0);
         let m = a.lt(b);
         assert_eq!(m.0, [true, true, true, true, true, false, false, false]);
-        assert_eq!(m.select(a, b).0, [-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 2.0, 2.0]);
+        assert_eq!(
+            m.select(a, b).0,
+            [-3.0, -2.0, -1.0, 0.0, 1.0, 2.0, 2.0, 2.0]
+        );
         assert_eq!((a * b + 1.0).0[7], 9.0);
         assert!(width() == 8 || width() == 16);
     }

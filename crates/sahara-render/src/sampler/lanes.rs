@@ -213,7 +213,10 @@ mod tests {
                 for (i, s) in samplers.iter().enumerate() {
                     assert_eq!(x.0[i].to_bits(), s.get_1d(dim.0[i]).to_bits());
                     let p = s.get_2d(dim.0[i]);
-                    assert_eq!((u.0[i].to_bits(), v.0[i].to_bits()), (p.x.to_bits(), p.y.to_bits()));
+                    assert_eq!(
+                        (u.0[i].to_bits(), v.0[i].to_bits()),
+                        (p.x.to_bits(), p.y.to_bits())
+                    );
                 }
             }
         }

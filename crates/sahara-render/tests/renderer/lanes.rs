@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 use sahara_render::{
-    builtin, Environment, Integrator, Light, Material, PathLoop, RenderResult, SamplerKind,
-    Scene, Shape,
+    builtin, Environment, Integrator, Light, Material, PathLoop, RenderResult, SamplerKind, Scene,
+    Shape,
 };
 
 use crate::common::{run, settings};
@@ -22,7 +22,11 @@ fn scene() -> Scene {
             (400.0, 80.0, 380.0),
             80.0,
         ),
-        (Material::mirror(Vec3::splat(0.9)), (300.0, 330.0, 330.0), 50.0),
+        (
+            Material::mirror(Vec3::splat(0.9)),
+            (300.0, 330.0, 330.0),
+            50.0,
+        ),
         (Material::rough_glass(1.4, 0.4), (420.0, 60.0, 120.0), 60.0),
         (
             Material::new(sahara_render::Bsdf::MetallicRoughness {
@@ -74,14 +78,23 @@ fn diff_stats(a: &[f64], b: &[f64]) -> (f64, f64) {
     (mean, var)
 }
 
-/// The lane loop's image against the scalar loop's, each from its own
-/// seeds, so their difference is noise alone if the two run the same
-/// estimator. The noise is measured, not assumed: the difference of two
-/// scalar images of other seeds has the variance `v` that the lanes'
-/// difference must show (the ratio of the two variances, over
-/// 3 x 48 x 48 values, lies within 0.85..1.18 at six standard deviations),
-/// and the mean of the lanes' difference must lie within 4 standard errors
-/// `sqrt(v / n)` of zero, per channel and over the image.
+/// The lane loop's image against the scalar loop's, two ways.
+///
+/// With the same seed every sample draws the same random numbers in both
+/// loops and follows the same path, so the images agree to rounding (the
+/// lanes' polynomial sines and cosines): measured, no value differs by
+/// more than 1e-4; a path that rounding sends across an edge may differ
+/// wholly, so up to one value in a thousand may differ by more than
+/// 1e-3 (relative above 1).
+///
+/// With other seeds the difference is noise alone: its mean must lie
+/// within 4 standard errors `sqrt(v / n)` of zero, per channel and over
+/// the image, where `v` is the variance of the difference of two scalar
+/// images of other seeds. (The variance of the difference itself is no
+/// test here: the glass and the point light make the noise heavy-tailed,
+/// and the variance of scalar-against-scalar differences measured over
+/// seed pairs spreads by 1.5x; the same-seed test is the sharper check
+/// that the lanes add no noise.)
 #[test]
 fn lanes_render_the_scalar_image_to_noise() {
     let scene = scene();
@@ -94,22 +107,33 @@ fn lanes_render_the_scalar_image_to_noise() {
             run(&scene, &s)
         };
         let lanes = render(PathLoop::Lanes, 11);
+        let same = render(PathLoop::Scalar, 11);
         let scalar = [12, 13].map(|seed| render(PathLoop::Scalar, seed));
         // The metallic-roughness sphere was shaded by the scalar code,
         // everything else in the lanes.
         let counts = lanes.stats.trace.lanes;
         assert!(counts.scalar_material > 0 && counts.lane_bounces > 20 * counts.scalar_material);
         let (l, s0, s1) = (values(&lanes), values(&scalar[0]), values(&scalar[1]));
-        let (noise_mean, noise_var) = diff_stats(&s0, &s1);
-        let (mean, var) = diff_stats(&l, &s0);
         let n = l.len() as f64;
-        let se = (noise_var / n).sqrt();
-        assert!(noise_mean.abs() < 4.0 * se, "{sampler:?}: scalar seeds {noise_mean} vs {se}");
-        assert!(mean.abs() < 4.0 * se, "{sampler:?}: lanes - scalar {mean}, standard error {se}");
-        let ratio = var / noise_var;
+        let off = l
+            .iter()
+            .zip(&values(&same))
+            .filter(|(a, b)| (*a - *b).abs() > 1e-3 * b.abs().max(1.0))
+            .count();
         assert!(
-            (0.85..1.18).contains(&ratio),
-            "{sampler:?}: noise of lanes - scalar / scalar - scalar = {ratio}"
+            off as f64 <= 1e-3 * n,
+            "{sampler:?}: {off} of {n} values of the lanes differ from the scalar loop's of the same seed"
+        );
+        let (noise_mean, noise_var) = diff_stats(&s0, &s1);
+        let (mean, _) = diff_stats(&l, &s0);
+        let se = (noise_var / n).sqrt();
+        assert!(
+            noise_mean.abs() < 4.0 * se,
+            "{sampler:?}: scalar seeds {noise_mean} vs {se}"
+        );
+        assert!(
+            mean.abs() < 4.0 * se,
+            "{sampler:?}: lanes - scalar {mean}, standard error {se}"
         );
         for c in 0..3 {
             let pick = |v: &[f64]| v.iter().skip(c).step_by(3).copied().collect::<Vec<_>>();
