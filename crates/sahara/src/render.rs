@@ -677,8 +677,8 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
         let share = |n: u64| 100.0 * n as f64 / vertices as f64;
         eprintln!(
             "path loop lanes: {:.1}% of path vertices shaded in the lanes, {:.1}% by the scalar \
-             code for want of a lane BSDF, {:.1}% for other reasons (misses, holes, render \
-             passes); lanes busy {:.1}% of the rounds",
+             code for want of a lane BSDF, {:.1}% for other reasons (misses, holes, normal \
+             maps); lanes busy {:.1}% of the rounds",
             share(lanes.lane_bounces),
             share(lanes.scalar_material),
             share(lanes.scalar_other),

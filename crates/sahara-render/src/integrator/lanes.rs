@@ -13,8 +13,7 @@
 //!    ([`Material::at`]), emission and its MIS weight; a lane the lanes
 //!    cannot shade takes its whole step in the scalar code instead
 //!    ([`Integrator::step`], counted in [`LaneCounts`]): a miss, a surface
-//!    with holes, a BSDF with no lane version, a path whose render passes
-//!    are still open;
+//!    with holes or a normal map, a BSDF with no lane version;
 //! 3. in the lanes: the shading frame, the light sample's draws, the
 //!    BSDF's value for the light's direction, the MIS weights, the shadow
 //!    rays' origins; the light's sample itself lane by lane
@@ -68,7 +67,7 @@ pub struct LaneCounts {
     /// lane version.
     pub scalar_material: u64,
     /// Path vertices shaded by the scalar code for another reason: a miss
-    /// (the environment), a surface with holes, open render passes.
+    /// (the environment), a surface with holes or a normal map.
     pub scalar_other: u64,
     /// Rounds of a packet (one closest-hit query each).
     pub rounds: u64,
@@ -399,7 +398,7 @@ impl<'a, 'w> Shared<'a, 'w> {
             let mut scalar_material = false;
             let lane = hit.as_ref().and_then(|hit| {
                 let m = world.material(hit.material);
-                if m.has_holes() || paths.aux[i].open || m.textures.normal.is_some() {
+                if m.has_holes() || m.textures.normal.is_some() {
                     return None;
                 }
                 let uvs = hit.uvs();
@@ -429,6 +428,13 @@ impl<'a, 'w> Shared<'a, 'w> {
             stats.lanes.lane_bounces += 1;
             let dir = paths.ray[i].dir;
             let wo_world = -dir;
+            // The render passes take the scalar code's view of the first
+            // surface; the path itself is shaded in the lanes, so asking
+            // for passes changes no bit of the beauty.
+            if paths.aux[i].open {
+                let sh = super::Shading::new(world, hit, dir);
+                paths.aux[i].surface(&sh, hit, dir, paths.depth.0[i]);
+            }
             // Emission seen here, weighted against light sampling.
             if m.is_emissive() {
                 let le = m.emitted(hit.ng.dot(wo_world), &uvs, &fp);
