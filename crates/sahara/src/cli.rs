@@ -124,7 +124,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "NAME", value_parser = NameParser::<SamplerKind>::new())]
     pub sampler: Option<SamplerKind>,
     /// How the path tracer traces its samples: in SIMD lanes, refilled
-    /// as paths end or not, or the scalar reference [default: scalar].
+    /// as paths end or not, or the scalar reference; auto takes the lanes
+    /// where every material of the scene has a lane BSDF [default: auto].
     #[arg(long, value_name = "NAME", value_parser = NameParser::<PathLoop>::new())]
     pub path_loop: Option<PathLoop>,
     /// Reconstruction filter, with its default parameters (or the scene

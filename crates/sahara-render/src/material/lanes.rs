@@ -24,7 +24,7 @@ use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 use glam::Vec3;
 
 use super::microfacet::{Distribution, Microfacet};
-use super::{Bsdf, PointBsdf};
+use super::{Bsdf, Material, PointBsdf};
 use crate::math::lanes::{F, M, V};
 
 /// The BSDFs of `N` lanes: each lane's kind, and its parameters.
@@ -80,6 +80,24 @@ impl<const N: usize> Default for BsdfLanes<N> {
             ior: F::splat(1.5),
         }
     }
+}
+
+/// True if every material of `materials` is shaded in the lanes wherever
+/// it is hit: a BSDF with a lane version, no clear coat, no normal map,
+/// no holes (each of those sends a lane to the scalar code).
+pub(crate) fn all_in_lanes(materials: &[Material]) -> bool {
+    materials.iter().all(|m| {
+        m.clearcoat.is_none()
+            && m.textures.normal.is_none()
+            && !m.has_holes()
+            && !matches!(
+                m.bsdf,
+                Bsdf::ComplexConductor { .. }
+                    | Bsdf::MetallicRoughness { .. }
+                    | Bsdf::CoatedDiffuse { .. }
+                    | Bsdf::ThinDielectric { .. }
+            )
+    })
 }
 
 impl<const N: usize> BsdfLanes<N> {

@@ -121,10 +121,7 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
     );
     // The lane loop's images differ from the scalar loop's in rounding:
     // parts of one frame must come from one loop.
-    if s.path_loop
-        .lanes(&s.integrator, scene.has_media())
-        .is_some()
-    {
+    if s.path_loop.lanes(&s.integrator, scene).is_some() {
         let _ = write!(h, "\npath loop lanes");
     }
     h.0.finalize()

@@ -185,7 +185,7 @@ impl SampleLoop {
     /// The loop of the settings' integrator in `world`.
     fn of(s: &RenderSettings, world: &World) -> Self {
         let integrator = &s.integrator;
-        if let Some(refill) = s.path_loop.lanes(integrator, world.has_media()) {
+        if let Some(refill) = s.path_loop.lanes(integrator, world.scene) {
             Self::Lanes { refill }
         } else if let Some((max_depth, strategies)) = integrator.bidirectional() {
             Self::Bidirectional {
