@@ -1,7 +1,7 @@
 //! What a benchmark reports, as plain structs whose serde form is the JSON
 //! layout of `sahara bench --json` and `sahara stats --json`.
 
-use sahara_kd::TreeStats;
+use sahara_kd::{AccelSummary, TreeStats};
 use serde::Serialize;
 
 use crate::protocol::{ProtocolCamera, SetKind};
@@ -168,17 +168,17 @@ pub struct CounterReport {
     pub mean_leaves: f64,
     /// Ray/triangle tests per ray.
     pub mean_triangles: f64,
-    /// [`TreeStats::expected_inner`].
+    /// [`AccelSummary::expected_inner`].
     pub expected_inner: f64,
-    /// [`TreeStats::expected_leaves`].
+    /// [`AccelSummary::expected_leaves`].
     pub expected_leaves: f64,
-    /// [`TreeStats::expected_triangles`].
+    /// [`AccelSummary::expected_triangles`].
     pub expected_triangles: f64,
 }
 
 impl CounterReport {
     /// The report of `totals` on a tree with statistics `stats`.
-    pub fn new(totals: &CountTotals, stats: &TreeStats) -> Self {
+    pub fn new(totals: &CountTotals, stats: &AccelSummary) -> Self {
         let n = totals.rays.max(1) as f64;
         Self {
             root_fraction: totals.rays_meeting_root as f64 / n,

@@ -28,8 +28,10 @@
 
 #![deny(missing_docs)]
 
+mod accel;
 pub mod brute;
 mod build;
+mod bvh;
 mod isect;
 mod kd;
 mod leaf;
@@ -40,6 +42,8 @@ mod stats;
 mod test_support;
 mod validate;
 
+pub use accel::{AccelKind, AccelParams, AccelSummary, TriangleAccel};
+pub use bvh::{Bvh, BvhBuilder, BvhParams, BvhStats, WideNode};
 pub use build::{AxisRule, BuildParams, Builder, PositionRule, Primitive, MAX_DEPTH};
 pub use isect::{intersect_ray_triangle, Hit, TriangleHit};
 pub use kd::{

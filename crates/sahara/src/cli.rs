@@ -7,7 +7,7 @@ use std::marker::PhantomData;
 use clap::builder::{PossibleValue, StringValueParser, TypedValueParser};
 use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
 use sahara_bench::SetKind;
-use sahara_kd::{BuildParams, Builder};
+use sahara_kd::{AccelKind, AccelParams, BuildParams, Builder, BvhBuilder, BvhParams};
 use sahara_render::Mesh;
 use sahara_render::{Aov, FilterKind, IntegratorKind, Named, SamplerKind, ToneMap};
 
@@ -434,6 +434,15 @@ pub struct StatsArgs {
 /// Which tree to build over which triangles (shared by `bench` and `stats`).
 #[derive(Debug, Args, Clone, PartialEq)]
 pub struct TreeOptions {
+    /// The structure: `bvh` (the eight-wide hierarchy, the default) or
+    /// `kd` (the kd-tree).
+    #[arg(long, default_value = "bvh", value_parser = parse_accel)]
+    pub accel: AccelKind,
+    /// The hierarchy's build: spatial (SAH with spatial splits, the
+    /// default), binned (object splits only), kd (collapsed from the SAH
+    /// kd-tree).
+    #[arg(long, default_value = "spatial", value_name = "NAME", value_parser = parse_bvh_builder)]
+    pub bvh_builder: BvhBuilder,
     /// Tree builder: sah, binned, binnedN (N bins, 2..=1024), rr-middle,
     /// rr-median, largest-middle, largest-median, middle, median.
     #[arg(long, default_value = "sah", value_parser = parse_builder)]
@@ -484,6 +493,8 @@ pub struct TreeOptions {
 impl Default for TreeOptions {
     fn default() -> Self {
         Self {
+            accel: AccelKind::Bvh,
+            bvh_builder: BvhBuilder::Spatial,
             builder: Builder::Sah,
             traversal_cost: None,
             intersection_cost: None,
@@ -501,7 +512,28 @@ impl Default for TreeOptions {
 }
 
 impl TreeOptions {
-    /// The build parameters these options ask for.
+    /// The structure and build parameters these options ask for.
+    pub fn accel_params(&self) -> AccelParams {
+        let kd = self.params();
+        AccelParams {
+            kind: self.accel,
+            kd,
+            bvh: BvhParams {
+                kd,
+                ..BvhParams::new(self.bvh_builder)
+            },
+        }
+    }
+
+    /// A name for what is built, as `bvh8 (spatial)` or `kd-tree (sah)`.
+    pub fn structure_name(&self) -> String {
+        match self.accel {
+            AccelKind::Bvh => format!("bvh8 ({})", self.bvh_builder.name()),
+            AccelKind::Kd => format!("kd-tree ({})", self.builder.name()),
+        }
+    }
+
+    /// The kd-tree's build parameters these options ask for.
     pub fn params(&self) -> BuildParams {
         let mut p = BuildParams::new(self.builder);
         p.traversal_cost = self.traversal_cost.unwrap_or(p.traversal_cost);
@@ -553,6 +585,17 @@ fn parse_subset(s: &str) -> Result<f64, String> {
         Ok(v) if v > 0.0 && v <= 1.0 => Ok(v),
         _ => Err(format!("'{s}' is not a fraction in (0, 1]")),
     }
+}
+
+/// A structure by name.
+fn parse_accel(s: &str) -> Result<AccelKind, String> {
+    AccelKind::parse(s).ok_or_else(|| format!("unknown structure '{s}'; expected bvh or kd"))
+}
+
+/// A hierarchy builder by name.
+fn parse_bvh_builder(s: &str) -> Result<BvhBuilder, String> {
+    BvhBuilder::parse(s)
+        .ok_or_else(|| format!("unknown hierarchy builder '{s}'; expected spatial, binned or kd"))
 }
 
 /// A builder by name, with the list of names in the error.

@@ -31,12 +31,10 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         mesh.triangle_count(),
         human::count(args.runs, "build")
     );
-    let (tree, build_ms) = build_timed(
-        &mesh.triangles(),
-        &args.tree.params(),
-        args.runs,
-        &pools.all,
-    );
+    let params = args.tree.params();
+    let (tree, build_ms) = build_timed(&mesh.triangles(), args.runs, &pools.all, |t| {
+        sahara_kd::KdTree::build(t, &params)
+    });
     let report = StatsReport {
         mesh: args.mesh.display().to_string(),
         builder: args.tree.builder.name(),

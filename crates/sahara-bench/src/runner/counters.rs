@@ -1,7 +1,7 @@
 //! Traversal work per ray, next to what the SAH predicts.
 
 use rayon::prelude::*;
-use sahara_kd::{KdTree, Ray, TraversalCounters};
+use sahara_kd::{Ray, TraversalCounters, TriangleAccel};
 
 use super::trace::{Query, CHUNK};
 
@@ -28,10 +28,10 @@ impl std::ops::Add for CountTotals {
 
 /// True if the traversal enters the root cell for `ray` (it returns at once
 /// otherwise).
-fn meets_root(tree: &KdTree, ray: &Ray) -> bool {
+fn meets_root(tree: &TriangleAccel, ray: &Ray) -> bool {
     ray.is_valid()
         && ray.tmin <= ray.tmax
-        && !tree.nodes().is_empty()
+        && !tree.bounds().is_empty()
         && tree
             .bounds()
             .intersect_ray(ray.origin, glam::Vec3::ONE / ray.dir, ray.tmin, ray.tmax)
@@ -39,7 +39,7 @@ fn meets_root(tree: &KdTree, ray: &Ray) -> bool {
 }
 
 /// Count the traversal work of `rays` on the current rayon pool.
-pub fn count_set(tree: &KdTree, rays: &[Ray], query: Query) -> CountTotals {
+pub fn count_set(tree: &TriangleAccel, rays: &[Ray], query: Query) -> CountTotals {
     rays.par_chunks(CHUNK)
         .with_max_len(1) // one job per chunk, as in `trace_into`
         .map(|chunk| {
@@ -67,7 +67,7 @@ pub fn count_set(tree: &KdTree, rays: &[Ray], query: Query) -> CountTotals {
 mod tests {
     use super::*;
     use glam::Vec3;
-    use sahara_kd::{BuildParams, Triangle};
+    use sahara_kd::{AccelParams, Triangle};
 
     #[test]
     fn counts_add_up_and_misses_of_the_root_do_no_work() {
@@ -81,7 +81,7 @@ mod tests {
                 )
             })
             .collect();
-        let tree = KdTree::build(tris, &BuildParams::default());
+        let tree = TriangleAccel::build(tris, &AccelParams::default());
         let hit = Ray::new(Vec3::new(0.0, -0.5, 0.0), Vec3::Z);
         let away = Ray::new(Vec3::new(0.0, -0.5, 0.0), Vec3::NEG_Z);
         let t = count_set(&tree, &[hit, away], Query::ClosestHit);
