@@ -9,16 +9,18 @@
 mod batch;
 pub(crate) mod build;
 pub(crate) mod node;
+mod quad;
 mod query;
 mod stats;
 mod walk;
 
 pub use build::{BvhBuilder, BvhParams};
-pub use node::WideNode;
+pub use node::MAX_LEAF;
 pub use stats::BvhStats;
 
-use crate::leaf::TriangleBlock;
 use crate::math::{Aabb, Triangle};
+use node::WideNode;
+use quad::Quad;
 
 /// An eight-wide bounding volume hierarchy over triangles.
 ///
@@ -27,12 +29,10 @@ use crate::math::{Aabb, Triangle};
 /// [`crate::brute`], bit for bit, as the kd-tree's are.
 #[derive(Clone, Debug)]
 pub struct Bvh {
-    /// Wide nodes, root first, depth first.
+    /// Wide nodes, root first, depth first (empty: no triangle).
     pub(crate) nodes: Vec<WideNode>,
-    /// Leaf triangles, a leaf's in consecutive blocks.
-    pub(crate) blocks: Vec<TriangleBlock>,
-    /// The triangle index of every lane of `blocks` (`u32::MAX`: padding).
-    pub(crate) indices: Vec<u32>,
+    /// Leaves, each node's next to one another.
+    pub(crate) quads: Vec<Quad>,
     /// Triangles given to the build (hit indices range over them).
     pub(crate) prim_count: usize,
     /// The bounds of all hittable triangles.
@@ -53,9 +53,33 @@ impl Bvh {
         build::build(triangles, params)
     }
 
-    /// The nodes, root first.
-    pub fn nodes(&self) -> &[WideNode] {
-        &self.nodes
+    /// Number of wide nodes.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Node `i`.
+    ///
+    /// # Safety
+    /// `i` must be an inner child reference (or 0 of a non-empty
+    /// hierarchy).
+    #[inline(always)]
+    pub(crate) unsafe fn node(&self, i: u32) -> &WideNode {
+        debug_assert!((i as usize) < self.nodes.len());
+        // SAFETY: the caller's contract; references name nodes the build
+        // wrote.
+        unsafe { self.nodes.get_unchecked(i as usize) }
+    }
+
+    /// Leaf `i`.
+    ///
+    /// # Safety
+    /// `i` must be a leaf reference's index.
+    #[inline(always)]
+    pub(crate) unsafe fn quad(&self, i: usize) -> &Quad {
+        debug_assert!(i < self.quads.len());
+        // SAFETY: as `node`.
+        unsafe { self.quads.get_unchecked(i) }
     }
 
     /// The bounds of the hittable triangles.

@@ -1,11 +1,11 @@
 //! Closest-hit, any-hit and all-hits queries of one ray, dispatched to
 //! the walk compiled for the best instruction-set level the CPU has.
 
+use super::node::{is_leaf, leaf_parts};
+use super::walk::{portable_step, BoxRay, Stack};
 use super::Bvh;
 use crate::isect::{Hit, RayShear};
 use crate::kd::{Counters, NoCounters};
-use crate::leaf::layout::{Layout, LeafBlock, Whole};
-use crate::leaf::BLOCK_WIDTH;
 use crate::math::Ray;
 use crate::simd::{dispatch, level, Kernel};
 
@@ -55,40 +55,27 @@ impl Bvh {
         if self.nodes.is_empty() || !ray.is_valid() || ray.tmin > ray.tmax {
             return;
         }
-        let r = super::walk::BoxRay::new(ray, self.scale);
+        let r = BoxRay::new(ray, self.scale);
         let shear = RayShear::from_ray(ray);
-        let mut stack = super::walk::Stack::new();
-        let mut node = Some(0u32);
-        let layout = Whole(&self.blocks);
-        while let Some(i) = node.take() {
-            // SAFETY: the portable level needs nothing.
-            unsafe {
-                super::walk::node_step::<{ level::PORTABLE }, false>(
-                    &self.nodes[i as usize],
-                    &r,
-                    ray.tmax,
-                    &mut stack,
-                )
-            };
-            while let Some((c, _)) = stack.pop() {
-                if !super::node::is_leaf(c) {
-                    node = Some(c);
-                    break;
-                }
-                let (first, count) = super::node::leaf_parts(c);
-                // SAFETY: as in the walks' leaf tests.
-                for (b, block) in unsafe { layout.blocks(first * BLOCK_WIDTH, count) }.enumerate() {
-                    let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
-                    for l in 0..lanes {
-                        if let Some(h) = shear.intersect(&block.triangle(l), ray.tmin, ray.tmax) {
-                            hits.push(Hit {
-                                t: h.t,
-                                tri: self.indices[block.run() + l],
-                                u: h.u,
-                                v: h.v,
-                            });
-                        }
-                    }
+        let mut stack = Stack::new();
+        let mut next = Some(0u32);
+        while let Some(c) = next.take().or_else(|| stack.pop().map(|e| e.0)) {
+            if !is_leaf(c) {
+                // SAFETY: inner references name nodes the build wrote.
+                portable_step::<false>(unsafe { self.node(c) }, &r, ray.tmax, &mut stack);
+                continue;
+            }
+            let (line, count) = leaf_parts(c);
+            // SAFETY: leaf references name leaves the build wrote.
+            let q = unsafe { self.quad(line) };
+            for l in 0..count {
+                if let Some(h) = shear.intersect(&q.triangle(l), ray.tmin, ray.tmax) {
+                    hits.push(Hit {
+                        t: h.t,
+                        tri: q.tri[l],
+                        u: h.u,
+                        v: h.v,
+                    });
                 }
             }
         }

@@ -1,8 +1,8 @@
 //! Statistics of a finished hierarchy, with its SAH cost.
 
-use super::node::{is_leaf, leaf_parts, EMPTY};
+use super::node::{is_leaf, leaf_parts, ARITY, EMPTY};
+use super::quad::QUAD;
 use super::Bvh;
-use crate::leaf::BLOCK_WIDTH;
 use crate::math::Aabb;
 
 /// Shape, size and cost of a hierarchy.
@@ -25,18 +25,19 @@ pub struct BvhStats {
     pub references: usize,
     /// References per hittable triangle (1: no spatial split copies).
     pub duplication: f64,
-    /// Bytes of nodes, leaf blocks and indices.
+    /// Bytes of nodes and leaves.
     pub memory_bytes: usize,
-    /// The SAH cost with one unit per wide node visited and one per block
-    /// of eight triangles tested: `sum_nodes SA/SA_root + sum_leaves
-    /// SA/SA_root ceil(n / 8)`.
+    /// The SAH cost with one unit per wide node visited and one per leaf
+    /// of up to four triangles tested: `sum_nodes SA/SA_root + sum_leaves
+    /// SA/SA_root`.
     pub sah_cost: f64,
     /// Wide nodes the SAH expects a ray meeting the root to visit (no
     /// early exit): `sum_nodes SA/SA_root`.
     pub expected_nodes: f64,
     /// Leaves: `sum_leaves SA/SA_root`.
     pub expected_leaves: f64,
-    /// Block tests: `sum_leaves SA/SA_root ceil(n / 8)`.
+    /// Four-triangle tests: `sum_leaves SA/SA_root ceil(n / 4)` (every
+    /// leaf is one).
     pub expected_blocks: f64,
     /// Triangle tests: `sum_leaves SA/SA_root n`.
     pub expected_triangles: f64,
@@ -50,8 +51,7 @@ impl Bvh {
             nodes: self.nodes.len(),
             references: self.references,
             memory_bytes: std::mem::size_of_val(self.nodes.as_slice())
-                + std::mem::size_of_val(self.blocks.as_slice())
-                + std::mem::size_of_val(self.indices.as_slice()),
+                + std::mem::size_of_val(self.quads.as_slice()),
             ..Default::default()
         };
         if self.nodes.is_empty() {
@@ -59,13 +59,14 @@ impl Bvh {
         }
         let root_area = self.bounds.surface_area();
         let inv = if root_area > 0.0 { 1.0 / root_area } else { 0.0 };
-        let mut hittable = std::collections::HashSet::new();
+        let mut hittable = std::collections::HashSet::<u32>::new();
         let mut children = 0usize;
         let mut todo: Vec<(u32, Aabb, u32)> = vec![(0, self.bounds, 1)];
         while let Some((i, b, depth)) = todo.pop() {
-            let n = &self.nodes[i as usize];
+            // SAFETY: `i` is the root or an inner reference.
+            let n = unsafe { self.node(i) };
             s.expected_nodes += b.surface_area() * inv;
-            for slot in 0..super::node::ARITY {
+            for slot in 0..ARITY {
                 let c = n.child[slot];
                 if c == EMPTY {
                     continue;
@@ -73,16 +74,16 @@ impl Bvh {
                 children += 1;
                 let cb = n.child_bounds(slot);
                 if is_leaf(c) {
-                    let (first, count) = leaf_parts(c);
+                    let (line, count) = leaf_parts(c);
                     s.leaves += 1;
                     s.max_depth = s.max_depth.max(depth);
                     let a = cb.surface_area() * inv;
                     s.expected_leaves += a;
-                    s.expected_blocks += a * count.div_ceil(BLOCK_WIDTH) as f64;
+                    s.expected_blocks += a * count.div_ceil(QUAD) as f64;
                     s.expected_triangles += a * count as f64;
-                    for k in 0..count {
-                        hittable.insert(self.indices[first * BLOCK_WIDTH + k]);
-                    }
+                    // SAFETY: a leaf reference.
+                    let q = unsafe { self.quad(line) };
+                    hittable.extend(&q.tri[..count]);
                 } else {
                     todo.push((c, cb, depth + 1));
                 }

@@ -1,9 +1,9 @@
 //! The single-ray walk of the eight-wide hierarchy: all eight child boxes
-//! of a node tested in one step (AVX2 or AVX-512, or a portable loop), the
-//! children that the ray meets pushed on a short stack far to near in the
-//! order the node keeps for the ray's octant (so the nearest is on top),
-//! leaves tested eight triangles at a time with the kd-tree's watertight
-//! block test.
+//! of a node tested in one step (AVX2, or a portable loop), the children
+//! the ray meets visited near to far in the order the node keeps for the
+//! ray's octant (a lone child directly, several through a short stack whose
+//! top is the nearest), leaves of four triangles tested at once with the
+//! watertight test.
 //!
 //! **Exactness.** The box test is a filter: it may keep a child the ray
 //! misses, never drop one holding a hit the triangle test accepts. The
@@ -19,26 +19,26 @@
 //! ones from the origin moved back, per axis, once per ray.
 //!
 //! A zero direction component gives an infinite reciprocal; a slab
-//! distance `0 * inf` (the origin on a widened plane) is NaN and is left
-//! out by the order of the `min`/`max` operands (they return the second
-//! operand, the running interval, for a NaN first one), which treats the
-//! ray as inside that slab: conservative. Children are pruned only when
-//! their entry distance exceeds the closest hit so far (`>`, not `>=`),
-//! so a triangle at the same distance with a smaller index is still found
-//! (the tie rule of every query).
+//! distance that is NaN (`0 * inf`, or `inf - inf` in the fused form) is
+//! left out by the order of the `min`/`max` operands (they return the
+//! second operand, the running interval, for a NaN first one), which
+//! treats the ray as inside that slab: conservative. A child is skipped
+//! only when its entry distance exceeds the closest hit so far (`>`, not
+//! `>=`), so a triangle at the same distance with a smaller index is still
+//! found (the tie rule of every query).
 
 use super::node::{is_leaf, leaf_parts, ChildRef, WideNode, ARITY};
+use super::quad::{quad_edges, QUAD};
 use super::Bvh;
 use crate::isect::{keep_closer, Hit, RayShear};
 use crate::kd::Counters;
-use crate::leaf::layout::{Layout, LeafBlock, Whole};
-use crate::leaf::BLOCK_WIDTH;
 use crate::math::Ray;
+#[cfg(target_arch = "x86_64")]
 use crate::simd::level;
 
-/// Entries of the walk's stack: a node pushes at most eight and pops one,
+/// Entries of the walk's stack: a node pushes at most eight and takes one,
 /// over at most `MAX_BINARY_DEPTH` levels, plus eight of slack for the
-/// AVX2 form's full-width stores.
+/// full-width stores.
 pub(crate) const STACK: usize = 7 * super::build::MAX_BINARY_DEPTH + 16;
 
 /// The relative widening of the boxes (see the module's documentation).
@@ -95,8 +95,7 @@ impl BoxRay {
     }
 }
 
-/// Where a walk stands: the stack of children still to visit with their
-/// entry distances.
+/// The walk's stack: children still to visit and their entry distances.
 pub(crate) struct Stack {
     pub(crate) refs: [std::mem::MaybeUninit<ChildRef>; STACK],
     pub(crate) dist: [std::mem::MaybeUninit<f32>; STACK],
@@ -140,28 +139,18 @@ impl Stack {
     }
 }
 
-/// The eight slab intervals of a node for one ray: the entry distances
-/// and the mask of children entered at or before `tfar` (the closest hit so
-/// far, or the ray's end), at level `SIMD`.
-///
-/// # Safety
-/// The CPU must have the level's instructions and the caller must be
-/// compiled for them.
+/// One node step in plain code: the children of `node` whose boxes the
+/// ray enters at or before `tfar` pushed on `stack`, far to near in the
+/// node's order for the ray's octant (`ORDERED`) or in slot order.
 #[inline(always)]
-pub(crate) unsafe fn node_step<const SIMD: u8, const ORDERED: bool>(
+pub(crate) fn portable_step<const ORDERED: bool>(
     node: &WideNode,
     r: &BoxRay,
     tfar: f32,
     stack: &mut Stack,
 ) {
-    let _ = SIMD;
-    portable_step::<ORDERED>(node, r, tfar, stack)
-}
-
-/// [`node_step`] in plain code: the same operations, one lane at a time.
-#[inline(always)]
-fn portable_step<const ORDERED: bool>(node: &WideNode, r: &BoxRay, tfar: f32, stack: &mut Stack) {
-    let b: &[f32; 48] = bytemuck_bounds(node);
+    // SAFETY: `[[[f32; 8]; 2]; 3]` is 48 contiguous floats.
+    let b: &[f32; 48] = unsafe { &*(node.bounds.as_ptr() as *const [f32; 48]) };
     let mut tn = [0.0f32; ARITY];
     let mut hit = 0u32;
     for (slot, t) in tn.iter_mut().enumerate() {
@@ -189,11 +178,138 @@ fn portable_step<const ORDERED: bool>(node: &WideNode, r: &BoxRay, tfar: f32, st
     }
 }
 
-/// A node's bounds as one flat array of 48 floats.
+/// The closest-hit test of leaf `r`: lowers `best_t` and updates `best`;
+/// true if it found a hit.
 #[inline(always)]
-fn bytemuck_bounds(node: &WideNode) -> &[f32; 48] {
-    // SAFETY: `[[[f32; 8]; 2]; 3]` is 48 contiguous floats.
-    unsafe { &*(node.bounds.as_ptr() as *const [f32; 48]) }
+pub(crate) fn leaf_closest<C: Counters>(
+    bvh: &Bvh,
+    r: ChildRef,
+    edges: impl Fn(&super::quad::Quad, usize) -> (u32, [[f32; QUAD]; 3]),
+    shear: &RayShear,
+    tmin: f32,
+    best_t: &mut f32,
+    best: &mut Hit,
+    counters: &mut C,
+) -> bool {
+    let (line, count) = leaf_parts(r);
+    counters.leaf();
+    (0..count).for_each(|_| counters.triangle());
+    // SAFETY: leaf references name leaves the build wrote.
+    let q = unsafe { bvh.quad(line) };
+    let (mut m, e) = edges(q, count);
+    let mut found = false;
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let uvw = [e[0][l], e[1][l], e[2][l]];
+        if let Some(h) = shear.decide(&q.triangle(l), uvw, tmin, *best_t) {
+            keep_closer(best_t, best, h, q.tri[l]);
+            found = true;
+        }
+    }
+    found
+}
+
+/// True when a triangle of leaf `r` is hit within `(tmin, tmax]`.
+#[inline(always)]
+pub(crate) fn leaf_any<C: Counters>(
+    bvh: &Bvh,
+    r: ChildRef,
+    edges: impl Fn(&super::quad::Quad, usize) -> (u32, [[f32; QUAD]; 3]),
+    shear: &RayShear,
+    tmin: f32,
+    tmax: f32,
+    counters: &mut C,
+) -> bool {
+    let (line, count) = leaf_parts(r);
+    counters.leaf();
+    (0..count).for_each(|_| counters.triangle());
+    // SAFETY: leaf references name leaves the build wrote.
+    let q = unsafe { bvh.quad(line) };
+    let (mut m, e) = edges(q, count);
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let uvw = [e[0][l], e[1][l], e[2][l]];
+        if shear.decide(&q.triangle(l), uvw, tmin, tmax).is_some() {
+            return true;
+        }
+    }
+    false
+}
+
+impl Bvh {
+    /// The closest-hit walk at level `SIMD`.
+    #[inline(always)]
+    pub(crate) fn walk_closest<C: Counters, const SIMD: u8>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+    ) -> Option<Hit> {
+        if self.nodes.is_empty() || !ray.is_valid() || ray.tmin > ray.tmax {
+            return None;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if SIMD >= level::AVX2 {
+            // SAFETY: the caller's contract.
+            return unsafe { x86::closest::<C, SIMD>(self, ray, counters) };
+        }
+        let r = BoxRay::new(ray, self.scale);
+        let shear = RayShear::from_ray(ray);
+        let edges = |q: &super::quad::Quad, n| quad_edges(&shear, q, n);
+        let mut best_t = ray.tmax;
+        let mut best = Hit {
+            t: f32::INFINITY,
+            tri: u32::MAX,
+            u: 0.0,
+            v: 0.0,
+        };
+        let mut stack = Stack::new();
+        stack.push(0, r.tmin);
+        while let Some((c, t)) = stack.pop() {
+            if t > best_t {
+                continue;
+            }
+            if is_leaf(c) {
+                leaf_closest(self, c, edges, &shear, ray.tmin, &mut best_t, &mut best, counters);
+                continue;
+            }
+            counters.inner();
+            // SAFETY: inner references name nodes the build wrote.
+            portable_step::<true>(unsafe { self.node(c) }, &r, best_t, &mut stack);
+        }
+        (best.tri != u32::MAX).then_some(best)
+    }
+
+    /// The any-hit walk at level `SIMD`.
+    #[inline(always)]
+    pub(crate) fn walk_any<C: Counters, const SIMD: u8>(&self, ray: &Ray, counters: &mut C) -> bool {
+        if self.nodes.is_empty() || !ray.is_valid() || ray.tmin > ray.tmax {
+            return false;
+        }
+        #[cfg(target_arch = "x86_64")]
+        if SIMD >= level::AVX2 {
+            // SAFETY: the caller's contract.
+            return unsafe { x86::any::<C, SIMD>(self, ray, counters) };
+        }
+        let r = BoxRay::new(ray, self.scale);
+        let shear = RayShear::from_ray(ray);
+        let edges = |q: &super::quad::Quad, n| quad_edges(&shear, q, n);
+        let mut stack = Stack::new();
+        stack.push(0, r.tmin);
+        while let Some((c, _)) = stack.pop() {
+            if is_leaf(c) {
+                if leaf_any(self, c, edges, &shear, ray.tmin, ray.tmax, counters) {
+                    return true;
+                }
+                continue;
+            }
+            counters.inner();
+            // SAFETY: inner references name nodes the build wrote.
+            portable_step::<false>(unsafe { self.node(c) }, &r, ray.tmax, &mut stack);
+        }
+        false
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -201,7 +317,8 @@ mod x86 {
     use std::arch::x86_64::*;
 
     use super::{leaf_any, leaf_closest, BoxRay, Stack};
-    use crate::bvh::node::is_leaf;
+    use crate::bvh::node::{is_leaf, WideNode};
+    use crate::bvh::quad::sse::{quad_edges, QuadRay};
     use crate::bvh::Bvh;
     use crate::isect::{Hit, RayShear};
     use crate::kd::Counters;
@@ -233,9 +350,7 @@ mod x86 {
     /// the slab distance of a plane `b` is `b * inv - origin * inv`, one
     /// fused multiply-add. Its rounding (of `origin * inv`, then of the
     /// sum) stays below the walk's widening of the boxes (see the module
-    /// documentation); a zero direction component makes it `inf - inf`
-    /// (NaN) only where the plane and the origin lie on the same side of
-    /// zero, and a NaN slab keeps the interval: conservative.
+    /// documentation).
     #[derive(Clone, Copy)]
     struct Lanes {
         inv: [__m256; 3],
@@ -269,70 +384,142 @@ mod x86 {
         /// The entry distances of the eight children and the mask of
         /// those entered at or before `tfar`.
         #[inline(always)]
-        unsafe fn test(&self, b: *const f32, tfar: __m256) -> (__m256, __m256) {
-            // SAFETY: `b` points at a node's 48 bounds (64-byte aligned);
-            // every offset is 16 axis + 8 side; FMA (the caller's contract).
+        unsafe fn test(&self, n: &WideNode, tfar: __m256) -> (__m256, __m256) {
+            // SAFETY: the node's bounds are 48 floats, 64-byte aligned;
+            // every offset is 16 axis + 8 side; FMA (the caller's
+            // contract).
             unsafe {
-                let n = |a: usize| {
+                let b = n.bounds.as_ptr() as *const f32;
+                let near = |a: usize| {
                     _mm256_fmsub_ps(_mm256_load_ps(b.add(self.near[a])), self.inv[a], self.near_oinv[a])
                 };
-                let f = |a: usize| {
+                let far = |a: usize| {
                     _mm256_fmsub_ps(_mm256_load_ps(b.add(self.far[a])), self.inv[a], self.far_oinv[a])
                 };
                 // The running interval is the second operand: a NaN slab
                 // distance leaves it as it is.
-                let tn = _mm256_max_ps(n(0), _mm256_max_ps(n(1), _mm256_max_ps(n(2), self.tmin)));
-                let tf = _mm256_min_ps(f(0), _mm256_min_ps(f(1), _mm256_min_ps(f(2), tfar)));
+                let tn = _mm256_max_ps(near(0), _mm256_max_ps(near(1), _mm256_max_ps(near(2), self.tmin)));
+                let tf = _mm256_min_ps(far(0), _mm256_min_ps(far(1), _mm256_min_ps(far(2), tfar)));
                 (tn, _mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf))
             }
         }
     }
 
-    /// Push the children of `node` in `hit` on the stack: far to near in
-    /// the node's order for the ray's octant (`ORDERED`) or in slot order.
+    /// Compress the lanes of `mask` of `refs` and `dist` to the front and
+    /// store all eight at `at` on the stack (the ones past the count are
+    /// garbage, overwritten by later pushes).
     #[inline(always)]
-    unsafe fn push<const SIMD: u8, const ORDERED: bool>(
-        node: *const crate::bvh::WideNode,
-        l: &Lanes,
-        tn: __m256,
-        hit: __m256,
-        stack: &mut Stack,
-    ) {
-        // SAFETY: the stack has room for eight entries past `len` (its
-        // slack); the node's `child` and `order` are 32-byte aligned; the
-        // CPU has the level's instructions (the caller's contract).
+    unsafe fn store<const SIMD: u8>(stack: &mut Stack, at: usize, mask: u32, refs: __m256i, dist: __m256) {
+        // SAFETY: the stack has room for eight entries past `at` (its
+        // slack); the level's instructions (the caller's contract).
         unsafe {
-            let child = _mm256_load_si256((*node).child.as_ptr() as *const __m256i);
-            let (tn, child, hit) = if ORDERED {
-                let order = _mm256_load_si256((*node).order.as_ptr() as *const __m256i);
-                let perm = _mm256_srlv_epi32(order, l.octant_shift);
-                (
-                    _mm256_permutevar8x32_ps(tn, perm),
-                    _mm256_permutevar8x32_epi32(child, perm),
-                    _mm256_permutevar8x32_ps(hit, perm),
-                )
-            } else {
-                (tn, child, hit)
-            };
-            let mask = _mm256_movemask_ps(hit) as u32;
-            let at = stack.len;
-            let refs = stack.refs.as_mut_ptr().add(at) as *mut __m256i;
-            let dist = stack.dist.as_mut_ptr().add(at) as *mut f32;
+            let r = stack.refs.as_mut_ptr().add(at) as *mut __m256i;
+            let d = stack.dist.as_mut_ptr().add(at) as *mut f32;
             if SIMD >= level::AVX512 {
                 // Compressed in registers, stored whole: the store form of
                 // `vpcompressd` is microcoded and slow on AMD's Zen 4.
                 let k = mask as __mmask8;
-                _mm256_storeu_si256(refs, _mm256_maskz_compress_epi32(k, child));
-                _mm256_storeu_ps(dist, _mm256_maskz_compress_ps(k, tn));
+                _mm256_storeu_si256(r, _mm256_maskz_compress_epi32(k, refs));
+                _mm256_storeu_ps(d, _mm256_maskz_compress_ps(k, dist));
             } else {
                 let idx = _mm256_srlv_epi32(
                     _mm256_set1_epi32(COMPRESS[mask as usize] as i32),
                     _mm256_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28),
                 );
-                _mm256_storeu_si256(refs, _mm256_permutevar8x32_epi32(child, idx));
-                _mm256_storeu_ps(dist, _mm256_permutevar8x32_ps(tn, idx));
+                _mm256_storeu_si256(r, _mm256_permutevar8x32_epi32(refs, idx));
+                _mm256_storeu_ps(d, _mm256_permutevar8x32_ps(dist, idx));
             }
-            stack.len = at + mask.count_ones() as usize;
+        }
+    }
+
+    /// The next child to visit after a node step: the lone child the ray
+    /// enters, or, of several, the nearest (the others pushed, far to near
+    /// in the node's order for the ray's octant when `ORDERED`); `None`
+    /// when the ray enters none.
+    #[inline(always)]
+    unsafe fn step<const SIMD: u8, const ORDERED: bool>(
+        n: &WideNode,
+        l: &Lanes,
+        tfar: __m256,
+        stack: &mut Stack,
+    ) -> Option<u32> {
+        // SAFETY: the node's `child` and `order` are 32-byte aligned; the
+        // level's instructions (the caller's contract).
+        unsafe {
+            let (tn, hit) = l.test(n, tfar);
+            let mask = _mm256_movemask_ps(hit) as u32;
+            if mask == 0 {
+                return None;
+            }
+            if mask.is_power_of_two() {
+                return Some(*n.child.get_unchecked(mask.trailing_zeros() as usize));
+            }
+            let child = _mm256_load_si256(n.child.as_ptr() as *const __m256i);
+            let at = stack.len;
+            if !ORDERED {
+                store::<SIMD>(stack, at, mask, child, tn);
+                let top = at + mask.count_ones() as usize - 1;
+                stack.len = top;
+                return Some(stack.refs.get_unchecked(top).assume_init());
+            }
+            // The child entered first is visited next; the others are
+            // pushed far to near in the node's order for the ray's octant.
+            // (The octant order alone, by box centres, chose badly where
+            // one box is huge: on the teapot in a stadium the ground's
+            // leaf, whose hit would prune the rest, came last, and camera
+            // rays visited 6.5 leaves each.)
+            let entered = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), tn, hit);
+            let m = _mm256_min_ps(entered, _mm256_permute_ps::<0b10_11_00_01>(entered));
+            let m = _mm256_min_ps(m, _mm256_permute_ps::<0b01_00_11_10>(m));
+            let m = _mm256_min_ps(m, _mm256_permute2f128_ps::<1>(m, m));
+            let first = (_mm256_movemask_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(entered, m)) as u32 & mask)
+                .trailing_zeros();
+            let next = *n.child.get_unchecked(first as usize);
+            let rest = _mm256_andnot_ps(
+                _mm256_castsi256_ps(_mm256_cmpeq_epi32(
+                    _mm256_set1_epi32(first as i32),
+                    _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+                )),
+                hit,
+            );
+            let order = _mm256_load_si256(n.order.as_ptr() as *const __m256i);
+            let perm = _mm256_srlv_epi32(order, l.octant_shift);
+            let pushed = _mm256_movemask_ps(_mm256_permutevar8x32_ps(rest, perm)) as u32;
+            store::<SIMD>(
+                stack,
+                at,
+                pushed,
+                _mm256_permutevar8x32_epi32(child, perm),
+                _mm256_permutevar8x32_ps(tn, perm),
+            );
+            stack.len = at + pushed.count_ones() as usize;
+            Some(next)
+        }
+    }
+
+    /// Drop the stacked children entered beyond `best_t` (after a hit),
+    /// keeping the order of the rest: with them gone, every child popped
+    /// may hold a closer hit, so pops need no distance test.
+    #[inline(always)]
+    unsafe fn compact<const SIMD: u8>(stack: &mut Stack, best_t: f32) {
+        // SAFETY: entries below `len` were written; the level's
+        // instructions (the caller's contract). Reading past `len` up to
+        // the next multiple of eight reads slack entries (the stack's
+        // eight spare entries), masked out.
+        unsafe {
+            let t = _mm256_set1_ps(best_t);
+            let mut out = 0;
+            let mut i = 0;
+            while i < stack.len {
+                let refs = _mm256_loadu_si256(stack.refs.as_ptr().add(i) as *const __m256i);
+                let dist = _mm256_loadu_ps(stack.dist.as_ptr().add(i) as *const f32);
+                let live = (1u32 << (stack.len - i).min(8)) - 1;
+                let keep = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(dist, t)) as u32 & live;
+                store::<SIMD>(stack, out, keep, refs, dist);
+                out += keep.count_ones() as usize;
+                i += 8;
+            }
+            stack.len = out;
         }
     }
 
@@ -349,6 +536,9 @@ mod x86 {
     ) -> Option<Hit> {
         let r = BoxRay::new(ray, bvh.scale);
         let shear = RayShear::from_ray(ray);
+        let qr = QuadRay::new(&shear);
+        // SAFETY: SSE2.
+        let edges = |q: &crate::bvh::quad::Quad, n| unsafe { quad_edges(&qr, q, n) };
         let mut best_t = ray.tmax;
         let mut best = Hit {
             t: f32::INFINITY,
@@ -357,38 +547,34 @@ mod x86 {
             v: 0.0,
         };
         let mut stack = Stack::new();
-        let mut node = 0u32;
-        // SAFETY: the level's instructions (the caller's contract); inner
-        // references name nodes the build wrote.
+        let mut c = 0u32;
+        // SAFETY: the level's instructions (the caller's contract); child
+        // references name nodes and leaves the build wrote.
         unsafe {
             let l = Lanes::new(&r);
             let mut tfar = _mm256_set1_ps(best_t);
-            loop {
-                counters.inner();
-                let n = bvh.nodes.as_ptr().add(node as usize);
-                let (tn, hit) = l.test((*n).bounds.as_ptr() as *const f32, tfar);
-                if _mm256_testz_ps(hit, hit) == 0 {
-                    push::<SIMD, true>(n, &l, tn, hit, &mut stack);
+            'walk: loop {
+                while !is_leaf(c) {
+                    counters.inner();
+                    match step::<SIMD, true>(bvh.node(c), &l, tfar, &mut stack) {
+                        Some(next) => c = next,
+                        None => match stack.pop() {
+                            Some((next, _)) => c = next,
+                            None => break 'walk,
+                        },
+                    }
                 }
-                loop {
-                    let Some((c, t)) = stack.pop() else {
-                        return (best.tri != u32::MAX).then_some(best);
-                    };
-                    if t > best_t {
-                        continue;
-                    }
-                    if is_leaf(c) {
-                        leaf_closest::<C, SIMD>(
-                            bvh, c, &shear, ray.tmin, &mut best_t, &mut best, counters,
-                        );
-                        tfar = _mm256_set1_ps(best_t);
-                        continue;
-                    }
-                    node = c;
-                    break;
+                if leaf_closest(bvh, c, edges, &shear, ray.tmin, &mut best_t, &mut best, counters) {
+                    tfar = _mm256_set1_ps(best_t);
+                    compact::<SIMD>(&mut stack, best_t);
+                }
+                match stack.pop() {
+                    Some((next, _)) => c = next,
+                    None => break,
                 }
             }
         }
+        (best.tri != u32::MAX).then_some(best)
     }
 
     /// [`Bvh::walk_any`] in intrinsics.
@@ -403,192 +589,35 @@ mod x86 {
     ) -> bool {
         let r = BoxRay::new(ray, bvh.scale);
         let shear = RayShear::from_ray(ray);
+        let qr = QuadRay::new(&shear);
+        // SAFETY: SSE2.
+        let edges = |q: &crate::bvh::quad::Quad, n| unsafe { quad_edges(&qr, q, n) };
         let mut stack = Stack::new();
-        let mut node = 0u32;
+        let mut c = 0u32;
         // SAFETY: as in `closest`.
         unsafe {
             let l = Lanes::new(&r);
             let tfar = _mm256_set1_ps(ray.tmax);
             loop {
-                counters.inner();
-                let n = bvh.nodes.as_ptr().add(node as usize);
-                let (tn, hit) = l.test((*n).bounds.as_ptr() as *const f32, tfar);
-                if _mm256_testz_ps(hit, hit) == 0 {
-                    push::<SIMD, false>(n, &l, tn, hit, &mut stack);
-                }
-                loop {
-                    let Some((c, _)) = stack.pop() else {
-                        return false;
-                    };
-                    if is_leaf(c) {
-                        if leaf_any::<C, SIMD>(bvh, c, &shear, ray.tmin, ray.tmax, counters) {
-                            return true;
-                        }
-                        continue;
+                while !is_leaf(c) {
+                    counters.inner();
+                    match step::<SIMD, false>(bvh.node(c), &l, tfar, &mut stack) {
+                        Some(next) => c = next,
+                        None => match stack.pop() {
+                            Some((next, _)) => c = next,
+                            None => return false,
+                        },
                     }
-                    node = c;
-                    break;
+                }
+                if leaf_any(bvh, c, edges, &shear, ray.tmin, ray.tmax, counters) {
+                    return true;
+                }
+                match stack.pop() {
+                    Some((next, _)) => c = next,
+                    None => return false,
                 }
             }
         }
     }
 }
 
-/// Triangle tests of one leaf (the blocks of `r`) for the closest hit:
-/// lowers `best_t` and updates `best`.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn leaf_closest<C: Counters, const SIMD: u8>(
-    bvh: &Bvh,
-    r: ChildRef,
-    shear: &RayShear,
-    tmin: f32,
-    best_t: &mut f32,
-    best: &mut Hit,
-    counters: &mut C,
-) {
-    let (first, count) = leaf_parts(r);
-    counters.leaf();
-    let layout = Whole(&bvh.blocks);
-    // SAFETY: the build points every leaf reference at `ceil(count / 8)`
-    // blocks of `blocks` and at the eight indices per block.
-    let blocks = unsafe { layout.blocks(first * BLOCK_WIDTH, count) };
-    for (b, block) in blocks.enumerate() {
-        let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
-        (0..lanes).for_each(|_| counters.triangle());
-        // SAFETY: `SIMD` is the level the walk is compiled for.
-        let (mut m, e) = unsafe { block.edges::<SIMD>(shear, lanes) };
-        while m != 0 {
-            let l = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let uvw = [e[0][l], e[1][l], e[2][l]];
-            if let Some(h) = shear.decide(&block.triangle(l), uvw, tmin, *best_t) {
-                // SAFETY: eight indices per block.
-                let i = unsafe { *bvh.indices.get_unchecked(block.run() + l) };
-                keep_closer(best_t, best, h, i);
-            }
-        }
-    }
-}
-
-/// True when a triangle of leaf `r` is hit within `(tmin, tmax]`.
-#[inline(always)]
-pub(crate) fn leaf_any<C: Counters, const SIMD: u8>(
-    bvh: &Bvh,
-    r: ChildRef,
-    shear: &RayShear,
-    tmin: f32,
-    tmax: f32,
-    counters: &mut C,
-) -> bool {
-    let (first, count) = leaf_parts(r);
-    counters.leaf();
-    let layout = Whole(&bvh.blocks);
-    // SAFETY: as in `leaf_closest`.
-    let blocks = unsafe { layout.blocks(first * BLOCK_WIDTH, count) };
-    for (b, block) in blocks.enumerate() {
-        let lanes = (count - b * BLOCK_WIDTH).min(BLOCK_WIDTH);
-        (0..lanes).for_each(|_| counters.triangle());
-        // SAFETY: `SIMD` is the level the walk is compiled for.
-        let (mut m, e) = unsafe { block.edges::<SIMD>(shear, lanes) };
-        while m != 0 {
-            let l = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let uvw = [e[0][l], e[1][l], e[2][l]];
-            if shear.decide(&block.triangle(l), uvw, tmin, tmax).is_some() {
-                return true;
-            }
-        }
-    }
-    false
-}
-
-impl Bvh {
-    /// The closest-hit walk at level `SIMD`.
-    #[inline(always)]
-    pub(crate) fn walk_closest<C: Counters, const SIMD: u8>(
-        &self,
-        ray: &Ray,
-        counters: &mut C,
-    ) -> Option<Hit> {
-        if self.nodes.is_empty() || !ray.is_valid() || ray.tmin > ray.tmax {
-            return None;
-        }
-        #[cfg(target_arch = "x86_64")]
-        if SIMD >= level::AVX2 {
-            // SAFETY: the caller's contract.
-            return unsafe { x86::closest::<C, SIMD>(self, ray, counters) };
-        }
-        let r = BoxRay::new(ray, self.scale);
-        let shear = RayShear::from_ray(ray);
-        let mut best_t = ray.tmax;
-        let mut best = Hit {
-            t: f32::INFINITY,
-            tri: u32::MAX,
-            u: 0.0,
-            v: 0.0,
-        };
-        let mut stack = Stack::new();
-        let mut node = 0u32;
-        loop {
-            counters.inner();
-            // SAFETY: inner references name nodes the build wrote.
-            let n = unsafe { self.nodes.get_unchecked(node as usize) };
-            // SAFETY: `SIMD` is the level this walk is compiled for.
-            unsafe { node_step::<SIMD, true>(n, &r, best_t, &mut stack) };
-            loop {
-                let Some((c, t)) = stack.pop() else {
-                    return (best.tri != u32::MAX).then_some(best);
-                };
-                if t > best_t {
-                    continue;
-                }
-                if is_leaf(c) {
-                    leaf_closest::<C, SIMD>(
-                        self, c, &shear, ray.tmin, &mut best_t, &mut best, counters,
-                    );
-                    continue;
-                }
-                node = c;
-                break;
-            }
-        }
-    }
-
-    /// The any-hit walk at level `SIMD`.
-    #[inline(always)]
-    pub(crate) fn walk_any<C: Counters, const SIMD: u8>(&self, ray: &Ray, counters: &mut C) -> bool {
-        if self.nodes.is_empty() || !ray.is_valid() || ray.tmin > ray.tmax {
-            return false;
-        }
-        #[cfg(target_arch = "x86_64")]
-        if SIMD >= level::AVX2 {
-            // SAFETY: the caller's contract.
-            return unsafe { x86::any::<C, SIMD>(self, ray, counters) };
-        }
-        let r = BoxRay::new(ray, self.scale);
-        let shear = RayShear::from_ray(ray);
-        let mut stack = Stack::new();
-        let mut node = 0u32;
-        loop {
-            counters.inner();
-            // SAFETY: inner references name nodes the build wrote.
-            let n = unsafe { self.nodes.get_unchecked(node as usize) };
-            // SAFETY: `SIMD` is the level this walk is compiled for.
-            unsafe { node_step::<SIMD, false>(n, &r, ray.tmax, &mut stack) };
-            loop {
-                let Some((c, _)) = stack.pop() else {
-                    return false;
-                };
-                if is_leaf(c) {
-                    if leaf_any::<C, SIMD>(self, c, &shear, ray.tmin, ray.tmax, counters) {
-                        return true;
-                    }
-                    continue;
-                }
-                node = c;
-                break;
-            }
-        }
-    }
-}

@@ -630,3 +630,50 @@ fn partition_spatial(ctx: &Ctx, refs: Vec<Ref>, axis: usize, pos: f32) -> (Vec<R
     }
     (left, right, copies)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::BvhBuilder;
+    use glam::Vec3;
+
+    /// Long thin diagonal triangles crossing a field of small ones: object
+    /// splits overlap badly, spatial splits cut the long ones.
+    #[test]
+    fn spatial_splits_cut_long_triangles() {
+        let mut tris = Vec::new();
+        for i in 0..64 {
+            let y = i as f32 * 0.1;
+            tris.push(Triangle::new(
+                Vec3::new(0.0, y, 0.0),
+                Vec3::new(100.0, y + 100.0, 0.0),
+                Vec3::new(0.0, y + 0.05, 0.1),
+            ));
+        }
+        for i in 0..2000 {
+            let (x, y) = ((i % 50) as f32 * 2.0, (i / 50) as f32 * 2.5);
+            tris.push(Triangle::new(
+                Vec3::new(x, y, 1.0),
+                Vec3::new(x + 0.5, y, 1.0),
+                Vec3::new(x, y + 0.5, 1.0),
+            ));
+        }
+        let live: Vec<u32> = (0..tris.len() as u32).collect();
+        let count = |n: &BinaryNode| -> usize {
+            fn walk(n: &BinaryNode) -> usize {
+                match n {
+                    BinaryNode::Leaf { tris, .. } => tris.len(),
+                    BinaryNode::Inner { kids, .. } => walk(&kids[0]) + walk(&kids[1]),
+                }
+            }
+            walk(n)
+        };
+        let object = build(&tris, &live, &BvhParams::new(BvhBuilder::Binned));
+        assert_eq!(count(&object), tris.len());
+        let p = BvhParams::new(BvhBuilder::Spatial);
+        let spatial = build(&tris, &live, &p);
+        let refs = count(&spatial);
+        assert!(refs > tris.len(), "no spatial split: {refs} references");
+        assert!(refs as f32 <= tris.len() as f32 * p.max_duplication + 1.0, "{refs}");
+    }
+}

@@ -7,18 +7,17 @@
 
 use super::binary::BinaryNode;
 use super::BvhParams;
-use crate::bvh::node::{leaf_ref, ChildRef, WideNode, ARITY, MAX_FIRST_BLOCK, MAX_LEAF};
+use crate::bvh::node::{leaf_ref, ChildRef, WideNode, ARITY, MAX_LEAF, MAX_LEAF_INDEX};
+use crate::bvh::quad::Quad;
 use crate::bvh::Bvh;
-use crate::leaf::{TriangleBlock, BLOCK_WIDTH};
 use crate::math::{Aabb, Triangle};
 
-/// The hierarchy's nodes and leaf blocks from the binary tree `root`
-/// (`None`: no triangle). Bounds, scale and parameters are the caller's.
+/// The hierarchy's nodes and leaves from the binary tree `root` (`None`: no
+/// triangle). Bounds, scale and parameters are the caller's.
 pub(crate) fn collapse(root: Option<&BinaryNode>, tris: &[Triangle], params: &BvhParams) -> Bvh {
     let mut out = Bvh {
         nodes: Vec::new(),
-        blocks: Vec::new(),
-        indices: Vec::new(),
+        quads: Vec::new(),
         prim_count: 0,
         bounds: Aabb::EMPTY,
         scale: 0.0,
@@ -34,10 +33,10 @@ pub(crate) fn collapse(root: Option<&BinaryNode>, tris: &[Triangle], params: &Bv
     };
     match root {
         // A tree of one leaf still has a root node: the walks start at one.
-        BinaryNode::Leaf { bounds, tris } => {
+        BinaryNode::Leaf { .. } => {
             w.out.nodes.push(WideNode::new(&[(Aabb::EMPTY, 0)]));
-            let r = w.leaf(tris);
-            w.out.nodes[0] = WideNode::new(&[(*bounds, r)]);
+            let r = w.child(root);
+            w.out.nodes[0] = WideNode::new(&[(root.bounds(), r)]);
         }
         BinaryNode::Inner { .. } => {
             w.node(root);
@@ -52,8 +51,8 @@ struct Writer<'a> {
 }
 
 impl Writer<'_> {
-    /// Write the wide node rooted at the inner binary node `n` and its
-    /// subtrees, depth first; returns its index.
+    /// Write the wide node rooted at the inner binary node `n`, then its
+    /// leaves, then its inner children depth first; returns its index.
     fn node(&mut self, n: &BinaryNode) -> u32 {
         let index = self.out.nodes.len();
         self.out.nodes.push(WideNode::new(&[(Aabb::EMPTY, 0)]));
@@ -81,37 +80,39 @@ impl Writer<'_> {
             kids[i] = &two[0];
             kids.insert(i + 1, &two[1]);
         }
-        let children: Vec<(Aabb, ChildRef)> = kids
-            .iter()
-            .map(|k| {
-                let r = match k {
-                    BinaryNode::Leaf { tris, .. } => self.leaf(tris),
-                    BinaryNode::Inner { .. } => self.node(k),
-                };
-                (k.bounds(), r)
-            })
-            .collect();
+        // Leaves first, next to the node; then the subtrees.
+        let mut refs = vec![0; kids.len()];
+        for (r, k) in refs.iter_mut().zip(&kids) {
+            if let BinaryNode::Leaf { .. } = k {
+                *r = self.child(k);
+            }
+        }
+        for (r, k) in refs.iter_mut().zip(&kids) {
+            if let BinaryNode::Inner { .. } = k {
+                *r = self.child(k);
+            }
+        }
+        let children: Vec<(Aabb, ChildRef)> = kids.iter().map(|k| k.bounds()).zip(refs).collect();
         self.out.nodes[index] = WideNode::new(&children);
         index as u32
     }
 
-    /// Write a leaf's blocks and indices; returns its reference.
-    fn leaf(&mut self, tris: &[u32]) -> ChildRef {
-        assert!(!tris.is_empty() && tris.len() <= MAX_LEAF);
-        let first = self.out.blocks.len();
-        assert!(
-            first as u64 <= MAX_FIRST_BLOCK as u64,
-            "too many triangles for one hierarchy"
-        );
-        for chunk in tris.chunks(BLOCK_WIDTH) {
-            let ts: Vec<Triangle> = chunk.iter().map(|&i| self.tris[i as usize]).collect();
-            self.out.blocks.push(TriangleBlock::pack(&ts));
-            self.out.indices.extend_from_slice(chunk);
-            self.out
-                .indices
-                .extend(std::iter::repeat_n(u32::MAX, BLOCK_WIDTH - chunk.len()));
+    /// Write a child: a leaf's triangles, or a subtree.
+    fn child(&mut self, k: &BinaryNode) -> ChildRef {
+        match k {
+            BinaryNode::Inner { .. } => self.node(k),
+            BinaryNode::Leaf { tris, .. } => {
+                assert!(!tris.is_empty() && tris.len() <= MAX_LEAF);
+                let index = self.out.quads.len();
+                assert!(
+                    index as u64 <= MAX_LEAF_INDEX as u64,
+                    "too many triangles for one hierarchy"
+                );
+                let ts: Vec<Triangle> = tris.iter().map(|&i| self.tris[i as usize]).collect();
+                self.out.quads.push(Quad::pack(&ts, tris));
+                self.out.references += tris.len();
+                leaf_ref(index as u32, tris.len())
+            }
         }
-        self.out.references += tris.len();
-        leaf_ref(first as u32, tris.len())
     }
 }

@@ -102,7 +102,7 @@ impl BvhParams {
             spatial_bins: 32,
             traversal_cost: 1.0,
             intersection_cost: 1.0,
-            leaf_width: 8,
+            leaf_width: 4,
             max_duplication: 1.3,
             overlap_threshold: 1e-5,
             min_leaf: 1,
