@@ -3,8 +3,8 @@
 //! answer. Callers that trace (the renderer, the benchmark, the Python
 //! package) hold this, so the structure is a setting, not a type.
 
-use crate::bvh::{Bvh, BvhBuilder, BvhParams};
 use crate::build::BuildParams;
+use crate::bvh::{Bvh, BvhBuilder, BvhParams};
 use crate::isect::Hit;
 use crate::kd::{Counters, KdTree};
 use crate::math::{Aabb, Ray, Triangle};

@@ -43,8 +43,8 @@ mod test_support;
 mod validate;
 
 pub use accel::{AccelKind, AccelParams, AccelSummary, TriangleAccel};
-pub use bvh::{Bvh, BvhBuilder, BvhParams, BvhStats, MAX_LEAF as BVH_MAX_LEAF};
 pub use build::{AxisRule, BuildParams, Builder, PositionRule, Primitive, MAX_DEPTH};
+pub use bvh::{Bvh, BvhBuilder, BvhParams, BvhStats, MAX_LEAF as BVH_MAX_LEAF};
 pub use isect::{intersect_ray_triangle, Hit, TriangleHit};
 pub use kd::{
     BoxTree, Counters, KdTree, LeafStorage, NoCounters, Node, TraversalCounters, PACKET, PACKET16,

@@ -23,14 +23,28 @@ impl Bvh {
     /// run their own threads); `out[i]` answers `rays[i]`.
     pub fn closest_hits_serial(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
-        dispatch(level::AVX512, ClosestBatch { bvh: self, rays, out });
+        dispatch(
+            level::AVX512,
+            ClosestBatch {
+                bvh: self,
+                rays,
+                out,
+            },
+        );
     }
 
     /// Occlusion of many rays on the calling thread; `out[i]` answers
     /// `rays[i]`.
     pub fn any_hits_serial(&self, rays: &[Ray], out: &mut [bool]) {
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
-        dispatch(level::AVX512, AnyBatch { bvh: self, rays, out });
+        dispatch(
+            level::AVX512,
+            AnyBatch {
+                bvh: self,
+                rays,
+                out,
+            },
+        );
     }
 }
 

@@ -49,7 +49,10 @@ pub(crate) fn is_leaf(r: ChildRef) -> bool {
 /// A leaf reference's leaf index and triangle count.
 #[inline(always)]
 pub(crate) fn leaf_parts(r: ChildRef) -> (usize, usize) {
-    ((r & (LEAF_BIT - 1) & !(3 << 29)) as usize, ((r >> 29) & 3) as usize + 1)
+    (
+        (r & (LEAF_BIT - 1) & !(3 << 29)) as usize,
+        ((r >> 29) & 3) as usize + 1,
+    )
 }
 
 /// One node of the hierarchy: 256 bytes, four cache lines.
@@ -165,7 +168,10 @@ mod tests {
         let kids: Vec<(Aabb, ChildRef)> = (0..5)
             .map(|i| {
                 let x = [3.0, 1.0, 4.0, 0.0, 2.0][i];
-                (Aabb::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 0.5, 1.0, 1.0)), i as u32)
+                (
+                    Aabb::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 0.5, 1.0, 1.0)),
+                    i as u32,
+                )
             })
             .collect();
         let n = WideNode::new(&kids);

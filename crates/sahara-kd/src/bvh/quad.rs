@@ -152,7 +152,11 @@ pub(crate) mod sse {
     /// # Safety
     /// None beyond x86-64 (SSE2); `unsafe` for the intrinsics.
     #[inline(always)]
-    pub(crate) unsafe fn quad_edges(r: &QuadRay, q: &Quad, lanes: usize) -> (u32, [[f32; QUAD]; 3]) {
+    pub(crate) unsafe fn quad_edges(
+        r: &QuadRay,
+        q: &Quad,
+        lanes: usize,
+    ) -> (u32, [[f32; QUAD]; 3]) {
         // SAFETY: each row is four f32; SSE2.
         unsafe {
             let [kx, ky, kz] = r.k;
@@ -167,8 +171,9 @@ pub(crate) mod sse {
             let (ax, ay) = sheared(0);
             let (bx, by) = sheared(1);
             let (cx, cy) = sheared(2);
-            let cross =
-                |p: __m128, q: __m128, r: __m128, s: __m128| _mm_sub_ps(_mm_mul_ps(p, q), _mm_mul_ps(r, s));
+            let cross = |p: __m128, q: __m128, r: __m128, s: __m128| {
+                _mm_sub_ps(_mm_mul_ps(p, q), _mm_mul_ps(r, s))
+            };
             let u = cross(cx, by, cy, bx);
             let v = cross(ax, cy, ay, cx);
             let w = cross(bx, ay, by, ax);

@@ -190,7 +190,11 @@ mod tests {
     fn empty_and_tiny_hierarchies() {
         let bvh = Bvh::build(Vec::new(), &BvhParams::default());
         assert_eq!(bvh.closest_hit(&Ray::new(Vec3::ZERO, Vec3::X)), None);
-        let t = crate::Triangle::new(Vec3::new(1.0, -1.0, -1.0), Vec3::new(1.0, 1.0, -1.0), Vec3::new(1.0, 0.0, 1.0));
+        let t = crate::Triangle::new(
+            Vec3::new(1.0, -1.0, -1.0),
+            Vec3::new(1.0, 1.0, -1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+        );
         let bvh = Bvh::build(vec![t], &BvhParams::default());
         let h = bvh.closest_hit(&Ray::new(Vec3::ZERO, Vec3::X)).unwrap();
         assert_eq!((h.t, h.tri), (1.0, 0));

@@ -58,7 +58,11 @@ impl Bvh {
             return s;
         }
         let root_area = self.bounds.surface_area();
-        let inv = if root_area > 0.0 { 1.0 / root_area } else { 0.0 };
+        let inv = if root_area > 0.0 {
+            1.0 / root_area
+        } else {
+            0.0
+        };
         let mut hittable = std::collections::HashSet::<u32>::new();
         let mut children = 0usize;
         let mut todo: Vec<(u32, Aabb, u32)> = vec![(0, self.bounds, 1)];

@@ -271,7 +271,16 @@ impl Bvh {
                 continue;
             }
             if is_leaf(c) {
-                leaf_closest(self, c, edges, &shear, ray.tmin, &mut best_t, &mut best, counters);
+                leaf_closest(
+                    self,
+                    c,
+                    edges,
+                    &shear,
+                    ray.tmin,
+                    &mut best_t,
+                    &mut best,
+                    counters,
+                );
                 continue;
             }
             counters.inner();
@@ -283,7 +292,11 @@ impl Bvh {
 
     /// The any-hit walk at level `SIMD`.
     #[inline(always)]
-    pub(crate) fn walk_any<C: Counters, const SIMD: u8>(&self, ray: &Ray, counters: &mut C) -> bool {
+    pub(crate) fn walk_any<C: Counters, const SIMD: u8>(
+        &self,
+        ray: &Ray,
+        counters: &mut C,
+    ) -> bool {
         if self.nodes.is_empty() || !ray.is_valid() || ray.tmin > ray.tmax {
             return false;
         }
@@ -391,14 +404,25 @@ mod x86 {
             unsafe {
                 let b = n.bounds.as_ptr() as *const f32;
                 let near = |a: usize| {
-                    _mm256_fmsub_ps(_mm256_load_ps(b.add(self.near[a])), self.inv[a], self.near_oinv[a])
+                    _mm256_fmsub_ps(
+                        _mm256_load_ps(b.add(self.near[a])),
+                        self.inv[a],
+                        self.near_oinv[a],
+                    )
                 };
                 let far = |a: usize| {
-                    _mm256_fmsub_ps(_mm256_load_ps(b.add(self.far[a])), self.inv[a], self.far_oinv[a])
+                    _mm256_fmsub_ps(
+                        _mm256_load_ps(b.add(self.far[a])),
+                        self.inv[a],
+                        self.far_oinv[a],
+                    )
                 };
                 // The running interval is the second operand: a NaN slab
                 // distance leaves it as it is.
-                let tn = _mm256_max_ps(near(0), _mm256_max_ps(near(1), _mm256_max_ps(near(2), self.tmin)));
+                let tn = _mm256_max_ps(
+                    near(0),
+                    _mm256_max_ps(near(1), _mm256_max_ps(near(2), self.tmin)),
+                );
                 let tf = _mm256_min_ps(far(0), _mm256_min_ps(far(1), _mm256_min_ps(far(2), tfar)));
                 (tn, _mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf))
             }
@@ -409,7 +433,13 @@ mod x86 {
     /// store all eight at `at` on the stack (the ones past the count are
     /// garbage, overwritten by later pushes).
     #[inline(always)]
-    unsafe fn store<const SIMD: u8>(stack: &mut Stack, at: usize, mask: u32, refs: __m256i, dist: __m256) {
+    unsafe fn store<const SIMD: u8>(
+        stack: &mut Stack,
+        at: usize,
+        mask: u32,
+        refs: __m256i,
+        dist: __m256,
+    ) {
         // SAFETY: the stack has room for eight entries past `at` (its
         // slack); the level's instructions (the caller's contract).
         unsafe {
@@ -564,7 +594,16 @@ mod x86 {
                         },
                     }
                 }
-                if leaf_closest(bvh, c, edges, &shear, ray.tmin, &mut best_t, &mut best, counters) {
+                if leaf_closest(
+                    bvh,
+                    c,
+                    edges,
+                    &shear,
+                    ray.tmin,
+                    &mut best_t,
+                    &mut best,
+                    counters,
+                ) {
                     tfar = _mm256_set1_ps(best_t);
                     compact::<SIMD>(&mut stack, best_t);
                 }
@@ -620,4 +659,3 @@ mod x86 {
         }
     }
 }
-

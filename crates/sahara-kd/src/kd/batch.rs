@@ -225,7 +225,11 @@ impl Kernel for AnyBatch<'_> {
 /// a range only a few times unless a thief steals, so a costly quarter of
 /// an image could hold one thread while the other idles (see
 /// `docs/performance.md`).
-pub(crate) fn in_parallel<T: Send>(rays: &[Ray], out: &mut [T], query: impl Fn(&[Ray], &mut [T]) + Sync) {
+pub(crate) fn in_parallel<T: Send>(
+    rays: &[Ray],
+    out: &mut [T],
+    query: impl Fn(&[Ray], &mut [T]) + Sync,
+) {
     assert_eq!(rays.len(), out.len(), "one output slot per ray");
     rays.par_chunks(BATCH)
         .zip(out.par_chunks_mut(BATCH))

@@ -76,6 +76,56 @@ pub fn clipped_bounds(tri: &Triangle, cell: &Aabb) -> Option<Aabb> {
     }
 }
 
+/// The bounds of the part of `tri` between the planes `axis = lo` and
+/// `axis = hi` (`lo <= hi`), intersected with `within`, or `None` if that
+/// part is empty: exact up to an outward rounding to f32, like
+/// [`clipped_bounds`], but for the one-axis slabs of a spatial split's
+/// bins, in O(1): the part's corners are the triangle's vertices inside
+/// the slab and the points where its edges cross the two planes.
+pub fn slab_bounds(tri: &Triangle, axis: usize, lo: f32, hi: f32, within: &Aabb) -> Option<Aabb> {
+    let v = tri.v.map(|p| p.as_dvec3());
+    let (lo64, hi64) = (lo as f64, hi as f64);
+    let mut a = DVec3::splat(f64::INFINITY);
+    let mut b = DVec3::splat(f64::NEG_INFINITY);
+    let mut grow = |p: DVec3| {
+        a = a.min(p);
+        b = b.max(p);
+    };
+    for i in 0..3 {
+        let (p, q) = (v[i], v[(i + 1) % 3]);
+        if p[axis] >= lo64 && p[axis] <= hi64 {
+            grow(p);
+        }
+        for plane in [lo64, hi64] {
+            if (p[axis] < plane && q[axis] > plane) || (p[axis] > plane && q[axis] < plane) {
+                let t = (plane - p[axis]) / (q[axis] - p[axis]);
+                let mut x = p + (q - p) * t;
+                x[axis] = plane;
+                grow(x);
+            }
+        }
+    }
+    if a.x > b.x {
+        return None;
+    }
+    // As in `clipped_bounds`: pad by a bound on the f64 rounding.
+    let scale = tri
+        .v
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element() as f64));
+    let pad = 16.0 * f64::EPSILON * scale.max(lo64.abs()).max(hi64.abs());
+    let (a, b) = (a - DVec3::splat(pad), b + DVec3::splat(pad));
+    let mut out = Aabb::EMPTY;
+    for k in 0..3 {
+        out.min[k] = round_down(a[k]);
+        out.max[k] = round_up(b[k]);
+    }
+    out.min[axis] = out.min[axis].max(lo);
+    out.max[axis] = out.max[axis].min(hi);
+    let out = out.intersection(*within);
+    (!out.is_empty()).then_some(out)
+}
+
 /// One Sutherland-Hodgman step: keep the part of `poly` on the inner side of
 /// the plane `axis = pos` (`keep_above` selects the side `>= pos`).
 fn clip_plane(
@@ -195,6 +245,46 @@ mod tests {
             "{b:?} misses z = {z}"
         );
         assert!(b.min.y >= 0.1 && b.max.y <= 0.47);
+    }
+
+    /// The slab form contains the exact clip of the triangle to the slab
+    /// and is at most a few ulps larger.
+    #[test]
+    fn slab_bounds_agree_with_clipped_bounds() {
+        let mut f = crate::test_support::floats(77);
+        for _ in 0..2000 {
+            let t = Triangle::new(
+                Vec3::new(f(), f(), f()) * 4.0,
+                Vec3::new(f(), f(), f()) * 4.0,
+                Vec3::new(f(), f(), f()) * 4.0,
+            );
+            let axis = (f().abs() * 3.0) as usize % 3;
+            let (x, y) = (f() * 4.0, f() * 4.0);
+            let (lo, hi) = (x.min(y), x.max(y));
+            let within = t.bounds();
+            let mut cell = within;
+            cell.min[axis] = cell.min[axis].max(lo);
+            cell.max[axis] = cell.max[axis].min(hi);
+            let exact = if cell.is_empty() {
+                None
+            } else {
+                clipped_bounds(&t, &cell)
+            };
+            let slab = slab_bounds(&t, axis, lo, hi, &within);
+            match (exact, slab) {
+                (Some(e), Some(s)) => {
+                    assert!(s.min.cmple(e.min + 1e-5).all() && s.max.cmpge(e.max - 1e-5).all());
+                    assert!((s.min - e.min).abs().max_element() < 1e-4, "{s:?} {e:?}");
+                    assert!((s.max - e.max).abs().max_element() < 1e-4, "{s:?} {e:?}");
+                }
+                (None, None) => {}
+                (e, s) => {
+                    // Only a touch at a plane may differ.
+                    let b = e.or(s).unwrap();
+                    assert!(b.extent()[axis] < 1e-5, "{e:?} {s:?}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use super::BvhParams;
 use crate::bvh::node::MAX_LEAF;
-use crate::math::clip::clipped_bounds;
+use crate::math::clip::{clipped_bounds, slab_bounds};
 use crate::math::{Aabb, Triangle};
 
 /// Below this many references a subtree is built on the current thread,
@@ -320,10 +320,7 @@ fn best_split(ctx: &Ctx, refs: &[Ref], bounds: &Aabb, budget: usize) -> Option<S
     }
     let cb = if refs.len() >= PARALLEL_MIN {
         refs.par_chunks(PARALLEL_MIN)
-            .map(|c| {
-                c.iter()
-                    .fold(Aabb::EMPTY, |b, r| b.grow(r.centroid2()))
-            })
+            .map(|c| c.iter().fold(Aabb::EMPTY, |b, r| b.grow(r.centroid2())))
             .reduce(|| Aabb::EMPTY, Aabb::union)
     } else {
         refs.iter().fold(Aabb::EMPTY, |b, r| b.grow(r.centroid2()))
@@ -459,10 +456,8 @@ fn best_spatial(ctx: &Ctx, refs: &[Ref], bounds: &Aabb, max_refs: usize) -> Opti
                 }
                 let tri = &ctx.tris[r.tri as usize];
                 for (b, bin) in bins.iter_mut().enumerate().take(b1 + 1).skip(b0) {
-                    let mut cell = r.bounds;
-                    cell.min[axis] = cell.min[axis].max(plane(b));
-                    cell.max[axis] = cell.max[axis].min(plane(b + 1));
-                    if let Some(c) = clipped_bounds(tri, &cell) {
+                    let (lo, hi) = (plane(b), plane(b + 1));
+                    if let Some(c) = slab_bounds(tri, axis, lo, hi, &r.bounds) {
                         bin.bounds = bin.bounds.union(c);
                     }
                 }
@@ -554,7 +549,12 @@ fn partition_object(
 /// costs less or, split in two clipped parts, to both (Stich et al.'s
 /// reference unsplitting). Returns both sides and the number of copies
 /// made.
-fn partition_spatial(ctx: &Ctx, refs: Vec<Ref>, axis: usize, pos: f32) -> (Vec<Ref>, Vec<Ref>, usize) {
+fn partition_spatial(
+    ctx: &Ctx,
+    refs: Vec<Ref>,
+    axis: usize,
+    pos: f32,
+) -> (Vec<Ref>, Vec<Ref>, usize) {
     let w = ctx.params.leaf_width;
     let mut left = Vec::with_capacity(refs.len());
     let mut right = Vec::with_capacity(refs.len() / 2);
@@ -674,6 +674,9 @@ mod tests {
         let spatial = build(&tris, &live, &p);
         let refs = count(&spatial);
         assert!(refs > tris.len(), "no spatial split: {refs} references");
-        assert!(refs as f32 <= tris.len() as f32 * p.max_duplication + 1.0, "{refs}");
+        assert!(
+            refs as f32 <= tris.len() as f32 * p.max_duplication + 1.0,
+            "{refs}"
+        );
     }
 }

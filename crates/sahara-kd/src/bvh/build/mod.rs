@@ -99,7 +99,7 @@ impl BvhParams {
         Self {
             builder,
             bins: 32,
-            spatial_bins: 32,
+            spatial_bins: 16,
             traversal_cost: 1.0,
             intersection_cost: 1.0,
             leaf_width: 4,
@@ -115,12 +115,24 @@ impl BvhParams {
     // TUNING ONLY (to be removed): environment overrides.
     fn tuned(mut self) -> Self {
         let f = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f32>().ok());
-        if let Some(v) = f("BVH_KT") { self.traversal_cost = v; }
-        if let Some(v) = f("BVH_KI") { self.intersection_cost = v; }
-        if let Some(v) = f("BVH_W") { self.leaf_width = v as u32; }
-        if let Some(v) = f("BVH_DUP") { self.max_duplication = v; }
-        if let Some(v) = f("BVH_SBINS") { self.spatial_bins = v as usize; }
-        if let Some(v) = f("BVH_ALPHA") { self.overlap_threshold = v; }
+        if let Some(v) = f("BVH_KT") {
+            self.traversal_cost = v;
+        }
+        if let Some(v) = f("BVH_KI") {
+            self.intersection_cost = v;
+        }
+        if let Some(v) = f("BVH_W") {
+            self.leaf_width = v as u32;
+        }
+        if let Some(v) = f("BVH_DUP") {
+            self.max_duplication = v;
+        }
+        if let Some(v) = f("BVH_SBINS") {
+            self.spatial_bins = v as usize;
+        }
+        if let Some(v) = f("BVH_ALPHA") {
+            self.overlap_threshold = v;
+        }
         self
     }
 }
