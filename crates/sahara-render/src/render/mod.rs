@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
-use sahara_kd::BuildParams;
+use sahara_kd::AccelParams;
 
 use crate::accel::AccelLayout;
 use crate::cpu_time::process_cpu_time;
@@ -76,8 +76,10 @@ pub struct RenderSettings {
     pub integrator: Integrator,
     /// Tile edge in pixels.
     pub tile_size: u32,
-    /// Kd-tree build parameters for the meshes.
-    pub build: BuildParams,
+    /// The meshes' acceleration structure: which (the eight-wide
+    /// hierarchy by default, or the kd-tree) and its build parameters. A
+    /// speed setting only: every structure finds the same hits.
+    pub build: AccelParams,
     /// Full scale of the `cost` heat map in work units per camera ray
     /// (None: the image's maximum).
     pub cost_scale: Option<f32>,
@@ -181,7 +183,7 @@ impl Default for RenderSettings {
             filter: Filter::default(),
             integrator: Integrator::default(),
             tile_size: 32,
-            build: BuildParams::default(),
+            build: AccelParams::default(),
             cost_scale: None,
             window: None,
             samples: None,
