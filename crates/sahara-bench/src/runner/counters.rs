@@ -70,7 +70,7 @@ mod tests {
     use sahara_kd::{AccelParams, Triangle};
 
     #[test]
-    fn counts_add_up_and_misses_of_the_root_do_no_work() {
+    fn counts_add_up_and_misses_of_the_root_test_no_triangle() {
         let tris: Vec<Triangle> = (0..50)
             .map(|i| {
                 let z = 2.0 + i as f32;
@@ -81,16 +81,26 @@ mod tests {
                 )
             })
             .collect();
-        let tree = TriangleAccel::build(tris, &AccelParams::default());
-        let hit = Ray::new(Vec3::new(0.0, -0.5, 0.0), Vec3::Z);
-        let away = Ray::new(Vec3::new(0.0, -0.5, 0.0), Vec3::NEG_Z);
-        let t = count_set(&tree, &[hit, away], Query::ClosestHit);
-        assert_eq!((t.rays, t.rays_meeting_root), (2, 1));
-        let mut one = TraversalCounters::default();
-        tree.closest_hit_counted(&hit, &mut one);
-        assert_eq!(t.work, one);
-        assert!(one.triangles >= 1 && one.leaves >= 1);
-        let any = count_set(&tree, &[hit], Query::AnyHit);
-        assert!(any.work.triangles <= one.triangles);
+        for params in [AccelParams::default(), AccelParams::kd(Default::default())] {
+            let tree = TriangleAccel::build(tris.clone(), &params);
+            let hit = Ray::new(Vec3::new(0.0, -0.5, 0.0), Vec3::Z);
+            let away = Ray::new(Vec3::new(0.0, -0.5, 0.0), Vec3::NEG_Z);
+            let t = count_set(&tree, &[hit, away], Query::ClosestHit);
+            assert_eq!((t.rays, t.rays_meeting_root), (2, 1));
+            let mut one = TraversalCounters::default();
+            tree.closest_hit_counted(&hit, &mut one);
+            // A ray missing the root cell: no leaf, no triangle; the kd-tree
+            // does not start, the hierarchy tests the root's children once.
+            let mut missed = TraversalCounters::default();
+            tree.closest_hit_counted(&away, &mut missed);
+            assert_eq!((missed.leaves, missed.triangles), (0, 0));
+            assert!(missed.inner <= 1);
+            assert_eq!(t.work.triangles, one.triangles);
+            assert_eq!(t.work.leaves, one.leaves);
+            assert_eq!(t.work.inner, one.inner + missed.inner);
+            assert!(one.triangles >= 1 && one.leaves >= 1);
+            let any = count_set(&tree, &[hit], Query::AnyHit);
+            assert!(any.work.triangles <= one.triangles);
+        }
     }
 }
