@@ -76,54 +76,84 @@ pub fn clipped_bounds(tri: &Triangle, cell: &Aabb) -> Option<Aabb> {
     }
 }
 
-/// The bounds of the part of `tri` between the planes `axis = lo` and
-/// `axis = hi` (`lo <= hi`), intersected with `within`, or `None` if that
-/// part is empty: exact up to an outward rounding to f32, like
-/// [`clipped_bounds`], but for the one-axis slabs of a spatial split's
-/// bins, in O(1): the part's corners are the triangle's vertices inside
-/// the slab and the points where its edges cross the two planes.
-pub fn slab_bounds(tri: &Triangle, axis: usize, lo: f32, hi: f32, within: &Aabb) -> Option<Aabb> {
-    let v = tri.v.map(|p| p.as_dvec3());
-    let (lo64, hi64) = (lo as f64, hi as f64);
-    let mut a = DVec3::splat(f64::INFINITY);
-    let mut b = DVec3::splat(f64::NEG_INFINITY);
-    let mut grow = |p: DVec3| {
-        a = a.min(p);
-        b = b.max(p);
+/// The bounds of the parts of `tri` in the consecutive slabs
+/// `planes[i] <= x[axis] <= planes[i + 1]` (`planes` ascending), each
+/// intersected with `within`: `emit(i, bounds)` for every slab the part of
+/// which is not empty. Exact up to an outward rounding to f32, like
+/// [`clipped_bounds`], for the bins of a spatial split, in O(1) per slab:
+/// a part's corners are the triangle's vertices inside its slab and the
+/// points where the triangle's edges cross its two planes, and the crossings
+/// of a plane are computed once for the two slabs that share it.
+pub fn slab_parts(
+    tri: &Triangle,
+    axis: usize,
+    planes: &[f32],
+    within: &Aabb,
+    mut emit: impl FnMut(usize, Aabb),
+) {
+    let Some(last) = planes.len().checked_sub(1) else {
+        return;
     };
-    for i in 0..3 {
-        let (p, q) = (v[i], v[(i + 1) % 3]);
-        if p[axis] >= lo64 && p[axis] <= hi64 {
-            grow(p);
-        }
-        for plane in [lo64, hi64] {
-            if (p[axis] < plane && q[axis] > plane) || (p[axis] > plane && q[axis] < plane) {
-                let t = (plane - p[axis]) / (q[axis] - p[axis]);
-                let mut x = p + (q - p) * t;
-                x[axis] = plane;
-                grow(x);
-            }
-        }
-    }
-    if a.x > b.x {
-        return None;
-    }
-    // As in `clipped_bounds`: pad by a bound on the f64 rounding.
+    let v = tri.v.map(|p| p.as_dvec3());
+    // As in `clipped_bounds`: pad the crossings by a bound on the f64
+    // rounding (the vertices themselves are exact).
     let scale = tri
         .v
         .iter()
-        .fold(0.0f64, |m, p| m.max(p.abs().max_element() as f64));
-    let pad = 16.0 * f64::EPSILON * scale.max(lo64.abs()).max(hi64.abs());
-    let (a, b) = (a - DVec3::splat(pad), b + DVec3::splat(pad));
-    let mut out = Aabb::EMPTY;
-    for k in 0..3 {
-        out.min[k] = round_down(a[k]);
-        out.max[k] = round_up(b[k]);
+        .fold(0.0f64, |m, p| m.max(p.abs().max_element() as f64))
+        .max((planes[0] as f64).abs())
+        .max((planes[last] as f64).abs());
+    let pad = 16.0 * f64::EPSILON * scale;
+    // The bounds of the triangle's section by the plane `axis = c`: the
+    // edges' crossings (padded, rounded outward) and the vertices on it.
+    let section = |c: f32| -> Aabb {
+        let c64 = c as f64;
+        let mut a = DVec3::splat(f64::INFINITY);
+        let mut b = DVec3::splat(f64::NEG_INFINITY);
+        let mut on = Aabb::EMPTY;
+        for i in 0..3 {
+            let (p, q) = (v[i], v[(i + 1) % 3]);
+            if p[axis] == c64 {
+                on = on.grow(tri.v[i]);
+            }
+            if (p[axis] < c64 && q[axis] > c64) || (p[axis] > c64 && q[axis] < c64) {
+                let t = (c64 - p[axis]) / (q[axis] - p[axis]);
+                let x = p + (q - p) * t;
+                a = a.min(x);
+                b = b.max(x);
+            }
+        }
+        if a.x > b.x {
+            return on;
+        }
+        let (a, b) = (a - DVec3::splat(pad), b + DVec3::splat(pad));
+        let mut out = Aabb::EMPTY;
+        for k in 0..3 {
+            out.min[k] = round_down(a[k]);
+            out.max[k] = round_up(b[k]);
+        }
+        out.min[axis] = c;
+        out.max[axis] = c;
+        out.union(on)
+    };
+    let mut below = section(planes[0]);
+    for i in 0..last {
+        let (lo, hi) = (planes[i], planes[i + 1]);
+        let above = section(hi);
+        let mut part = below.union(above);
+        for p in &tri.v {
+            if p[axis] > lo && p[axis] < hi {
+                part = part.grow(*p);
+            }
+        }
+        part.min[axis] = part.min[axis].max(lo);
+        part.max[axis] = part.max[axis].min(hi);
+        let part = part.intersection(*within);
+        if !part.is_empty() {
+            emit(i, part);
+        }
+        below = above;
     }
-    out.min[axis] = out.min[axis].max(lo);
-    out.max[axis] = out.max[axis].min(hi);
-    let out = out.intersection(*within);
-    (!out.is_empty()).then_some(out)
 }
 
 /// One Sutherland-Hodgman step: keep the part of `poly` on the inner side of
@@ -247,10 +277,10 @@ mod tests {
         assert!(b.min.y >= 0.1 && b.max.y <= 0.47);
     }
 
-    /// The slab form contains the exact clip of the triangle to the slab
-    /// and is at most a few ulps larger.
+    /// The slab parts contain the exact clip of the triangle to each slab
+    /// and are at most a few ulps larger.
     #[test]
-    fn slab_bounds_agree_with_clipped_bounds() {
+    fn slab_parts_agree_with_clipped_bounds() {
         let mut f = crate::test_support::floats(77);
         for _ in 0..2000 {
             let t = Triangle::new(
@@ -259,29 +289,76 @@ mod tests {
                 Vec3::new(f(), f(), f()) * 4.0,
             );
             let axis = (f().abs() * 3.0) as usize % 3;
-            let (x, y) = (f() * 4.0, f() * 4.0);
-            let (lo, hi) = (x.min(y), x.max(y));
+            let mut planes: Vec<f32> = (0..5).map(|_| f() * 4.0).collect();
+            if f() > 0.5 {
+                // A plane through a vertex.
+                planes[0] = t.v[1][axis];
+            }
+            planes.sort_by(f32::total_cmp);
             let within = t.bounds();
-            let mut cell = within;
-            cell.min[axis] = cell.min[axis].max(lo);
-            cell.max[axis] = cell.max[axis].min(hi);
-            let exact = if cell.is_empty() {
-                None
-            } else {
-                clipped_bounds(&t, &cell)
-            };
-            let slab = slab_bounds(&t, axis, lo, hi, &within);
-            match (exact, slab) {
-                (Some(e), Some(s)) => {
-                    assert!(s.min.cmple(e.min + 1e-5).all() && s.max.cmpge(e.max - 1e-5).all());
-                    assert!((s.min - e.min).abs().max_element() < 1e-4, "{s:?} {e:?}");
-                    assert!((s.max - e.max).abs().max_element() < 1e-4, "{s:?} {e:?}");
+            let mut parts = [None; 4];
+            slab_parts(&t, axis, &planes, &within, |i, b| parts[i] = Some(b));
+            for (i, part) in parts.iter().enumerate() {
+                let (lo, hi) = (planes[i], planes[i + 1]);
+                let mut cell = within;
+                cell.min[axis] = cell.min[axis].max(lo);
+                cell.max[axis] = cell.max[axis].min(hi);
+                let exact = if cell.is_empty() {
+                    None
+                } else {
+                    clipped_bounds(&t, &cell)
+                };
+                match (exact, *part) {
+                    (Some(e), Some(s)) => {
+                        assert!(s.min.cmple(e.min + 1e-5).all() && s.max.cmpge(e.max - 1e-5).all());
+                        assert!((s.min - e.min).abs().max_element() < 1e-4, "{s:?} {e:?}");
+                        assert!((s.max - e.max).abs().max_element() < 1e-4, "{s:?} {e:?}");
+                    }
+                    (None, None) => {}
+                    (e, s) => {
+                        // Only a touch at a plane may differ.
+                        let b = e.or(s).unwrap();
+                        assert!(b.extent()[axis] < 1e-5, "{e:?} {s:?}");
+                    }
                 }
-                (None, None) => {}
-                (e, s) => {
-                    // Only a touch at a plane may differ.
-                    let b = e.or(s).unwrap();
-                    assert!(b.extent()[axis] < 1e-5, "{e:?} {s:?}");
+            }
+        }
+    }
+
+    /// Every point of the triangle lies in the part of each slab that
+    /// holds it, with no tolerance: the parts are conservative.
+    #[test]
+    fn slab_parts_contain_the_triangle() {
+        let mut f = crate::test_support::floats(78);
+        for _ in 0..500 {
+            let t = Triangle::new(
+                Vec3::new(f(), f(), f()) * 1e3,
+                Vec3::new(f(), f(), f()) * 1e3,
+                Vec3::new(f(), f(), f()),
+            );
+            let axis = (f().abs() * 3.0) as usize % 3;
+            let within = t.bounds();
+            let (lo, hi) = (within.min[axis], within.max[axis]);
+            let planes: Vec<f32> = (0..=8).map(|i| lo + (hi - lo) * (i as f32 / 8.0)).collect();
+            let mut parts = [Aabb::EMPTY; 8];
+            slab_parts(&t, axis, &planes, &within, |i, b| parts[i] = b);
+            for k in 0..200 {
+                let (a, b) = ((k % 17) as f64 / 16.0, (k / 17) as f64 / 16.0);
+                if a + b > 1.0 {
+                    continue;
+                }
+                let v = t.v.map(|p| p.as_dvec3());
+                let p = v[0] + (v[1] - v[0]) * a + (v[2] - v[0]) * b;
+                for (i, part) in parts.iter().enumerate() {
+                    if p[axis] >= planes[i] as f64 && p[axis] <= planes[i + 1] as f64 {
+                        let (pl, ph) = (part.min.as_dvec3(), part.max.as_dvec3());
+                        // Sample points carry their own f64 rounding.
+                        let tol = 1e-12 * 1e3;
+                        assert!(
+                            p.cmpge(pl - tol).all() && p.cmple(ph + tol).all(),
+                            "{p:?} outside slab {i}: {part:?}"
+                        );
+                    }
                 }
             }
         }

@@ -101,15 +101,17 @@ impl Writer<'_> {
     fn child(&mut self, k: &BinaryNode) -> ChildRef {
         match k {
             BinaryNode::Inner { .. } => self.node(k),
-            BinaryNode::Leaf { tris, .. } => {
+            BinaryNode::Leaf { .. } => {
+                let tris = k.leaf_tris();
                 assert!(!tris.is_empty() && tris.len() <= MAX_LEAF);
                 let index = self.out.quads.len();
                 assert!(
                     index as u64 <= MAX_LEAF_INDEX as u64,
                     "too many triangles for one hierarchy"
                 );
-                let ts: Vec<Triangle> = tris.iter().map(|&i| self.tris[i as usize]).collect();
-                self.out.quads.push(Quad::pack(&ts, tris));
+                let ts: [Triangle; MAX_LEAF] =
+                    std::array::from_fn(|i| self.tris[tris[i.min(tris.len() - 1)] as usize]);
+                self.out.quads.push(Quad::pack(&ts[..tris.len()], tris));
                 self.out.references += tris.len();
                 leaf_ref(index as u32, tris.len())
             }
