@@ -569,7 +569,7 @@ fn best_split(ctx: &Ctx, refs: &[Ref], geom: &Box3, cent: &Box3, budget: usize) 
     } else {
         best_binned(ctx, refs, area, cent)
     };
-    if budget == 0 || !p.builder.spatial_splits() {
+    if budget == 0 || !p.builder.spatial_splits() || refs.len() <= p.spatial_min {
         return best;
     }
     // Spatial splits only where the object split's children overlap
@@ -582,7 +582,7 @@ fn best_split(ctx: &Ctx, refs: &[Ref], geom: &Box3, cent: &Box3, budget: usize) 
         .area(),
         _ => f64::INFINITY,
     };
-    if overlap <= ctx.min_overlap {
+    if overlap <= ctx.min_overlap || overlap <= area * p.node_overlap_threshold as f64 {
         return best;
     }
     match (best, best_spatial(ctx, refs, geom, refs.len() + budget)) {
@@ -766,10 +766,10 @@ impl SpatialBins {
                     &ctx.tris[r.tri() as usize],
                     axis,
                     &slabs.planes[axis][b0..=b1 + 1],
-                    &b.aabb(),
-                    |i, part| {
+                    (b.lo, b.hi),
+                    |i, lo, hi| {
                         let bin = &mut boxes[(b0 + i) & (MAX_BINS - 1)];
-                        *bin = bin.union(Box3::from_aabb(&part));
+                        *bin = bin.union(Box3 { lo, hi });
                     },
                 );
             }
