@@ -22,6 +22,7 @@
 
 use glam::{Vec3A, Vec4};
 
+use super::collapse::{self, WideCount};
 use super::BvhParams;
 use crate::bvh::node::MAX_LEAF;
 use crate::math::clip::{clipped_bounds, slab_parts};
@@ -172,6 +173,8 @@ pub(crate) enum BinaryNode {
     Inner {
         bounds: Aabb,
         kids: Box<[BinaryNode; 2]>,
+        /// The wide nodes and leaves of the hierarchy collapsed from here.
+        wide: WideCount,
     },
 }
 
@@ -181,6 +184,20 @@ impl BinaryNode {
         match self {
             BinaryNode::Leaf { bounds, .. } | BinaryNode::Inner { bounds, .. } => *bounds,
         }
+    }
+
+    /// An inner node over `a` and `b`.
+    pub(crate) fn inner(a: BinaryNode, b: BinaryNode) -> Self {
+        let mut n = BinaryNode::Inner {
+            bounds: a.bounds().union(b.bounds()),
+            kids: Box::new([a, b]),
+            wide: WideCount::default(),
+        };
+        let c = collapse::count(&n);
+        if let BinaryNode::Inner { wide, .. } = &mut n {
+            *wide = c;
+        }
+        n
     }
 
     /// A leaf of the references `refs` (one to [`MAX_LEAF`]).
@@ -414,10 +431,7 @@ fn children(
             recurse(ctx, r, nr, geom[1], cent[1], depth + 1),
         )
     };
-    BinaryNode::Inner {
-        bounds: geom[0].union(geom[1]).aabb(),
-        kids: Box::new([a, b]),
-    }
+    BinaryNode::inner(a, b)
 }
 
 /// Cut the first `n` references of `refs` in two halves by their order (no

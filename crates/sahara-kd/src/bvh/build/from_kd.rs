@@ -60,10 +60,7 @@ impl Kd<'_> {
                     )
                 };
                 match (a, b) {
-                    (Some(a), Some(b)) => Some(BinaryNode::Inner {
-                        bounds: a.bounds().union(b.bounds()),
-                        kids: Box::new([a, b]),
-                    }),
+                    (Some(a), Some(b)) => Some(BinaryNode::inner(a, b)),
                     (a, b) => a.or(b),
                 }
             }
