@@ -60,10 +60,7 @@ impl Kd<'_> {
                     )
                 };
                 match (a, b) {
-                    (Some(a), Some(b)) => Some(BinaryNode::Inner {
-                        bounds: a.bounds().union(b.bounds()),
-                        kids: Box::new([a, b]),
-                    }),
+                    (Some(a), Some(b)) => Some(BinaryNode::inner(a, b)),
                     (a, b) => a.or(b),
                 }
             }
@@ -74,22 +71,18 @@ impl Kd<'_> {
     /// hierarchy's leaf is split further by the binned build over those
     /// parts.
     fn leaf(&self, ids: &[u32], cell: &Aabb) -> Option<BinaryNode> {
-        let refs: Vec<Ref> = ids
+        let parts: Vec<(Aabb, u32)> = ids
             .iter()
             .filter(|&&i| i != u32::MAX)
-            .filter_map(|&i| {
-                clipped_bounds(&self.tris[i as usize], cell).map(|bounds| Ref { bounds, tri: i })
-            })
+            .filter_map(|&i| clipped_bounds(&self.tris[i as usize], cell).map(|bounds| (bounds, i)))
             .collect();
-        if refs.is_empty() {
+        if parts.is_empty() {
             return None;
         }
+        let refs: Vec<Ref> = parts.iter().map(|&(b, i)| Ref::new(b, i)).collect();
         if refs.len() <= MAX_LEAF {
-            let bounds = refs.iter().fold(Aabb::EMPTY, |b, r| b.union(r.bounds));
-            return Some(BinaryNode::Leaf {
-                bounds,
-                tris: refs.iter().map(|r| r.tri).collect(),
-            });
+            let bounds = parts.iter().fold(Aabb::EMPTY, |b, r| b.union(r.0));
+            return Some(BinaryNode::leaf(&refs, bounds));
         }
         let mut p = *self.params;
         p.builder = super::BvhBuilder::Binned;

@@ -79,6 +79,10 @@ pub struct BvhParams {
     /// split's children overlap by more than this fraction of the root's
     /// surface area (Stich et al.'s alpha).
     pub overlap_threshold: f32,
+    /// ... and by more than this fraction of the node's own surface area.
+    pub node_overlap_threshold: f32,
+    /// Spatial splits are tried only at nodes of more references than this.
+    pub spatial_min: usize,
     /// Binary nodes of this many triangles or fewer become leaves.
     pub min_leaf: usize,
     /// Build on the rayon pool.
@@ -105,6 +109,8 @@ impl BvhParams {
             leaf_width: 4,
             max_duplication: 1.3,
             overlap_threshold: 1e-5,
+            node_overlap_threshold: 0.0,
+            spatial_min: 0,
             min_leaf: 1,
             parallel: true,
             kd: BuildParams::default(),
@@ -129,6 +135,12 @@ impl BvhParams {
         }
         if let Some(v) = f("BVH_SBINS") {
             self.spatial_bins = v as usize;
+        }
+        if let Some(v) = f("BVH_NOVL") {
+            self.node_overlap_threshold = v;
+        }
+        if let Some(v) = f("BVH_SMIN") {
+            self.spatial_min = v as usize;
         }
         if let Some(v) = f("BVH_ALPHA") {
             self.overlap_threshold = v;
