@@ -60,6 +60,43 @@ impl AccelParams {
         }
     }
 
+    /// Parameters from names, as the command line and the Python package
+    /// take them: the structure `accel` (`bvh` or `kd`) and, optionally, a
+    /// builder of that structure (`spatial`, `binned` or `kd` for the
+    /// hierarchy; `sah`, `binned`, `binnedN`, ... for the kd-tree). The
+    /// error names the argument at fault.
+    pub fn from_names(accel: &str, builder: Option<&str>) -> Result<Self, String> {
+        let kind = AccelKind::parse(accel)
+            .ok_or_else(|| format!("accel: unknown structure '{accel}' (expected bvh or kd)"))?;
+        let Some(b) = builder else {
+            return Ok(Self {
+                kind,
+                ..Self::default()
+            });
+        };
+        match kind {
+            AccelKind::Bvh => BvhBuilder::parse(b).map(Self::bvh).ok_or_else(|| {
+                format!("builder: unknown builder '{b}' (expected spatial, binned or kd for accel 'bvh')")
+            }),
+            AccelKind::Kd => crate::Builder::parse(b)
+                .map(|b| Self::kd(BuildParams::new(b)))
+                .ok_or_else(|| {
+                    format!(
+                        "builder: unknown builder '{b}' (expected sah, binned, binnedN with N in \
+                         2..=1024, rr-middle, rr-median, largest-middle, largest-median for accel 'kd')"
+                    )
+                }),
+        }
+    }
+
+    /// The builder's name, as `from_names` takes it.
+    pub fn builder_name(&self) -> String {
+        match self.kind {
+            AccelKind::Bvh => self.bvh.builder.name().to_owned(),
+            AccelKind::Kd => self.kd.builder.name(),
+        }
+    }
+
     /// Parameters for a hierarchy built by `builder`.
     pub fn bvh(builder: BvhBuilder) -> Self {
         Self {

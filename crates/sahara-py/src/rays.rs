@@ -11,7 +11,7 @@ use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
-use sahara_kd::{BuildParams, Builder, Hit, KdTree, Ray, Triangle};
+use sahara_kd::{AccelParams, Hit, Ray, Triangle, TriangleAccel};
 
 use crate::arrays::{PerRay, PerRayView, Rows3, Rows3View};
 use crate::pool::run_on;
@@ -45,7 +45,7 @@ impl Geometry {
 /// the tree, kept while the meshes do not change.
 #[derive(Clone)]
 struct Snapshot {
-    tree: Arc<KdTree>,
+    tree: Arc<TriangleAccel>,
     /// The unit geometric normal of each face (one load per hit, rather
     /// than three vertices found through the face).
     normals: Arc<[Vec3]>,
@@ -53,16 +53,18 @@ struct Snapshot {
     starts: Arc<[u32]>,
 }
 
-/// Triangle meshes in one kd-tree, for ray queries on numpy arrays.
+/// Triangle meshes in one acceleration structure (the eight-wide BVH, or
+/// a kd-tree), for ray queries on numpy arrays.
 ///
-/// `RayScene(vertices, faces, builder="sah", threads=None)` holds one mesh;
+/// `RayScene(vertices, faces, accel="bvh", builder=None, threads=None)`
+/// holds one mesh;
 /// `add_mesh` adds more (each with its id: 0, 1, ...), and the tree over
 /// all of them is built at the next query. Every query releases the GIL
 /// and runs on `threads` threads (None: all of the machine's).
 #[pyclass(module = "sahara._sahara", frozen)]
 pub struct RayScene {
     geometry: Mutex<GeometryState>,
-    params: BuildParams,
+    params: AccelParams,
     threads: Option<usize>,
 }
 
@@ -75,20 +77,16 @@ struct GeometryState {
 #[pymethods]
 impl RayScene {
     #[new]
-    #[pyo3(signature = (vertices=None, faces=None, *, builder="sah", threads=None))]
+    #[pyo3(signature = (vertices=None, faces=None, *, accel="bvh", builder=None, threads=None))]
     fn new(
         py: Python<'_>,
         vertices: Option<&Bound<'_, PyAny>>,
         faces: Option<&Bound<'_, PyAny>>,
-        builder: &str,
+        accel: &str,
+        builder: Option<&str>,
         threads: Option<usize>,
     ) -> PyResult<Self> {
-        let Some(b) = Builder::parse(builder) else {
-            return Err(PyValueError::new_err(format!(
-                "builder: unknown builder '{builder}' (expected sah, binned, binnedN with N in \
-                 2..=1024, rr-middle, rr-median, largest-middle, largest-median)"
-            )));
-        };
+        let params = AccelParams::from_names(accel, builder).map_err(PyValueError::new_err)?;
         let scene = RayScene {
             geometry: Mutex::new(GeometryState {
                 geometry: Geometry {
@@ -98,7 +96,7 @@ impl RayScene {
                 },
                 shared: None,
             }),
-            params: BuildParams::new(b),
+            params,
             threads: threads.filter(|&t| t > 0),
         };
         match (vertices, faces) {
@@ -461,8 +459,11 @@ impl RayScene {
     /// traversal work it predicts, and the builder.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let snap = self.snapshot(py, None)?;
-        let stats = py.detach(|| snap.tree.stats());
-        let value = serde_json::to_value(stats)
+        let value = py.detach(|| match &*snap.tree {
+            TriangleAccel::Kd(t) => serde_json::to_value(t.stats()),
+            TriangleAccel::Bvh(b) => serde_json::to_value(b.stats()),
+        });
+        let value = value
             .map_err(|e| PyRuntimeError::new_err(format!("statistics: {e}")))?;
         let d = PyDict::new(py);
         if let serde_json::Value::Object(map) = value {
@@ -476,17 +477,19 @@ impl RayScene {
                 }
             }
         }
-        d.set_item("builder", self.params.builder.name())?;
+        d.set_item("accel", self.params.kind.name())?;
+        d.set_item("builder", self.params.builder_name())?;
         Ok(d)
     }
 
     fn __repr__(&self) -> PyResult<String> {
         let s = self.lock()?;
         Ok(format!(
-            "RayScene({} meshes, {} triangles, builder '{}')",
+            "RayScene({} meshes, {} triangles, accel '{}', builder '{}')",
             s.geometry.starts.len() - 1,
             s.geometry.faces.len(),
-            self.params.builder.name()
+            self.params.kind.name(),
+            self.params.builder_name()
         ))
     }
 }
@@ -526,7 +529,7 @@ impl RayScene {
                 .map(|t| t.normal().normalize_or_zero())
                 .collect();
             let params = &self.params;
-            let tree = Arc::new(run_on(threads, || KdTree::build(tris, params))?);
+            let tree = Arc::new(run_on(threads, || TriangleAccel::build(tris, params))?);
             let snap = Snapshot {
                 tree,
                 normals,

@@ -15,7 +15,7 @@ use pyo3::types::{PyDict, PyList};
 use sahara_formats::FileSettings;
 use sahara_formats::{write_image, Pixels};
 use sahara_formats::{LoadOptions, Loaded};
-use sahara_kd::{BuildParams, Builder};
+use sahara_kd::AccelParams;
 use sahara_render::{
     defaults, render_watched, Aov, AuxImages, Feature, Film, Filter, FilterKind, Integrator,
     IntegratorKind, Named, PixelSum, Progress, RenderResult, RenderSettings, SamplerKind,
@@ -188,7 +188,7 @@ fn named<T: Named>(value: &str) -> PyResult<T> {
 #[pyfunction]
 #[pyo3(signature = (scene, *, spp=None, width=None, height=None, integrator=None, seed=None,
     threads=None, aovs=None, denoise=false, sampler=None, filter=None, pass_spp=None,
-    builder=None, progress=None))]
+    accel=None, builder=None, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -204,6 +204,7 @@ pub fn render<'py>(
     sampler: Option<String>,
     filter: Option<String>,
     pass_spp: Option<u32>,
+    accel: Option<String>,
     builder: Option<String>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray3<f32>>, Bound<'py, PyDict>)> {
@@ -227,13 +228,8 @@ pub fn render<'py>(
         (None, Some(f)) => f.filter,
         (None, None) => Filter::default(),
     };
-    let build = match builder {
-        None => BuildParams::default(),
-        Some(b) => BuildParams::new(
-            Builder::parse(&b)
-                .ok_or_else(|| PyValueError::new_err(format!("builder: unknown builder '{b}'")))?,
-        ),
-    };
+    let build = AccelParams::from_names(accel.as_deref().unwrap_or("bvh"), builder.as_deref())
+        .map_err(PyValueError::new_err)?;
     let spp = spp.or(file.map(|f| f.spp)).unwrap_or(defaults::SPP);
     let width = width.or(file.map(|f| f.width)).unwrap_or(512);
     let height = height.or(file.map(|f| f.height)).unwrap_or(512);

@@ -27,8 +27,8 @@
 //! reconstruction filters, exact sums, pixel windows) and `accel` (the
 //! instances' kd-trees); `world` (the scene prepared for tracing);
 //! `integrator` (light transport); `render` (the settings, the loop of
-//! passes and tiles, the frame digest). See `docs/renderer.md` for the
-//! design.
+//! passes, tiles and strips with the sample loops that trace a strip's
+//! samples, the frame digest). See `docs/renderer.md` for the design.
 
 #![deny(missing_docs)]
 

@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3};
 use sahara_kd::gamma;
-use sahara_kd::{BuildParams, Counters, NoCounters, Ray};
+use sahara_kd::{AccelParams, Counters, NoCounters, Ray};
 
 use crate::accel::{Accel, BatchBuffers, RawHit};
 use crate::light::area::{EmissionTextures, Emitter};
@@ -141,7 +141,7 @@ pub struct World<'a> {
 
 impl<'a> World<'a> {
     /// Builds trees and lights.
-    pub fn new(scene: &'a Scene, params: &BuildParams) -> Self {
+    pub fn new(scene: &'a Scene, params: &AccelParams) -> Self {
         let SceneLights {
             lights,
             instance_light,

@@ -156,8 +156,13 @@ pub struct RenderArgs {
     /// (repeatable).
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
     pub define: Vec<(String, String)>,
-    /// Kd-tree builder (as for `sahara bench`): a speed setting only, the
-    /// image is the same with any [default: sah].
+    /// The acceleration structure: `bvh` (the eight-wide hierarchy) or
+    /// `kd` (the kd-tree); a speed setting only, the image is the same with
+    /// either [default: bvh].
+    #[arg(long, value_name = "bvh|kd", value_parser = parse_accel)]
+    pub accel: Option<AccelKind>,
+    /// Kd-tree builder (as for `sahara bench`), for `--accel kd`: a speed
+    /// setting only, the image is the same with any [default: sah].
     #[arg(long, value_name = "NAME", value_parser = parse_builder)]
     pub builder: Option<Builder>,
     /// During a progressive render, rewrite the output (atomically, marked
@@ -429,6 +434,11 @@ pub struct StatsArgs {
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Also build the kd-tree and the hierarchy by each of its builders
+    /// (spatial, binned, kd) over the same triangles, and put their build
+    /// times, memory, references and expected work per ray side by side.
+    #[arg(long)]
+    pub all: bool,
 }
 
 /// Which tree to build over which triangles (shared by `bench` and `stats`).

@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use sahara_bench::report::{BenchReport, StatsReport};
+use sahara_bench::report::{BenchReport, StatsReport, StructureStats};
 
 /// `1234567` as `1,234,567`.
 pub fn thousands(n: u64) -> String {
@@ -195,11 +195,10 @@ pub fn bench_report(r: &BenchReport) -> String {
 
 /// The statistics, one per line.
 pub fn stats_report(r: &StatsReport) -> String {
-    let t = &r.tree;
     let mut s = String::new();
-    let lines: Vec<(&str, String)> = vec![
+    let mut lines: Vec<(&str, String)> = vec![
         ("mesh", r.mesh.clone()),
-        ("builder", r.builder.clone()),
+        ("builder", format!("{} ({})", r.builder, r.accel)),
         (
             "build",
             format!(
@@ -208,6 +207,46 @@ pub fn stats_report(r: &StatsReport) -> String {
                 count(r.build_runs, "build")
             ),
         ),
+    ];
+    match &r.tree {
+        StructureStats::Kd(t) => lines.extend(kd_lines(t)),
+        StructureStats::Bvh(b) => lines.extend(bvh_lines(b)),
+    }
+    for (k, v) in lines {
+        let _ = writeln!(s, "{k:<11} {v}");
+    }
+    if !r.structures.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n{:<18} {:>10} {:>12} {:>11} {:>9} {:>8} {:>10}",
+            "structure", "build ms", "memory", "references", "inner", "leaves", "triangles"
+        );
+        for row in &r.structures {
+            let m = &row.summary;
+            let _ = writeln!(
+                s,
+                "{:<18} {:>10.1} {:>12} {:>11} {:>9.2} {:>8.2} {:>10.2}",
+                row.structure,
+                row.build_ms,
+                bytes(m.memory_bytes),
+                thousands(m.references as u64),
+                m.expected_inner,
+                m.expected_leaves,
+                m.expected_triangles
+            );
+        }
+        let _ = writeln!(
+            s,
+            "inner, leaves, triangles: what the SAH expects a ray meeting the root to visit and test \
+             (inner: binary kd nodes, or eight-wide nodes)"
+        );
+    }
+    s
+}
+
+/// A kd-tree's statistics, as `stats_report` lines.
+fn kd_lines(t: &sahara_kd::TreeStats) -> Vec<(&'static str, String)> {
+    vec![
         ("triangles", thousands(t.triangles as u64)),
         ("nodes", thousands(t.nodes as u64)),
         ("inner", thousands(t.inner as u64)),
@@ -255,11 +294,49 @@ pub fn stats_report(r: &StatsReport) -> String {
                 t.expected_inner, t.expected_leaves, t.expected_triangles, t.expected_leaf_tests
             ),
         ),
-    ];
-    for (k, v) in lines {
-        let _ = writeln!(s, "{k:<11} {v}");
-    }
-    s
+    ]
+}
+
+/// A hierarchy's statistics, as `stats_report` lines.
+fn bvh_lines(b: &sahara_kd::BvhStats) -> Vec<(&'static str, String)> {
+    vec![
+        ("triangles", thousands(b.triangles as u64)),
+        (
+            "nodes",
+            format!(
+                "{} eight-wide, {:.2} children each",
+                thousands(b.nodes as u64),
+                b.mean_children
+            ),
+        ),
+        (
+            "leaves",
+            format!(
+                "{}, {:.2} triangles each (at most {})",
+                thousands(b.leaves as u64),
+                b.mean_leaf_triangles,
+                sahara_kd::BVH_MAX_LEAF
+            ),
+        ),
+        ("depth", format!("max {}", b.max_depth)),
+        (
+            "references",
+            format!(
+                "{} ({:.3} per triangle)",
+                thousands(b.references as u64),
+                b.duplication
+            ),
+        ),
+        ("memory", bytes(b.memory_bytes)),
+        ("SAH cost", format!("{:.3}", b.sah_cost)),
+        (
+            "expected",
+            format!(
+                "{:.2} nodes, {:.2} leaves, {:.2} triangles per ray meeting the root",
+                b.expected_nodes, b.expected_leaves, b.expected_triangles
+            ),
+        ),
+    ]
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use anyhow::{bail, Result};
 use sahara_formats::FileSettings;
-use sahara_kd::BuildParams;
+use sahara_kd::{AccelParams, BuildParams};
 use sahara_render::UNLIMITED_SPP;
 use sahara_render::{Adaptive, Filter, Integrator, RenderSettings, ToneMap};
 
@@ -105,9 +105,11 @@ pub fn resolve(
             sampler,
             filter,
             integrator,
-            build: args
-                .builder
-                .map_or_else(BuildParams::default, BuildParams::new),
+            build: AccelParams {
+                kind: args.accel.unwrap_or_default(),
+                kd: args.builder.map_or_else(BuildParams::default, BuildParams::new),
+                ..AccelParams::default()
+            },
             adaptive,
             ..Default::default()
         },

@@ -133,11 +133,6 @@ impl WideNode {
         }
     }
 
-    /// The number of used slots.
-    pub(crate) fn child_count(&self) -> usize {
-        self.child.iter().filter(|&&c| c != EMPTY).count()
-    }
-
     /// The slot visited `i`-th from last by a ray in `octant`.
     #[inline(always)]
     pub(crate) fn slot_in_order(&self, i: usize, octant: u32) -> usize {
@@ -181,7 +176,6 @@ mod tests {
         // Octant 1 (-x): the reverse.
         let seq: Vec<usize> = (0..ARITY).map(|i| n.slot_in_order(i, 1)).collect();
         assert_eq!(&seq[..5], &[3, 1, 4, 0, 2]);
-        assert_eq!(n.child_count(), 5);
         assert!(n.child_bounds(6).is_empty());
     }
 }

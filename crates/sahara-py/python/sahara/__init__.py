@@ -124,6 +124,7 @@ def render(
     sampler: Optional[str] = None,
     filter: Optional[str] = None,
     pass_spp: Optional[int] = None,
+    accel: Optional[str] = None,
     builder: Optional[str] = None,
 ) -> Union[np.ndarray, Tuple[np.ndarray, Dict[str, np.ndarray]]]:
     """Renders a scene (a ``Scene`` or a file's path) as ``sahara render``
@@ -165,6 +166,7 @@ def render(
             sampler=sampler,
             filter=filter,
             pass_spp=pass_spp,
+            accel=accel,
             builder=builder,
             progress=callback,
         )

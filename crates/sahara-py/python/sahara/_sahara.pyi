@@ -22,7 +22,8 @@ class RayScene:
         vertices: Optional[npt.ArrayLike] = None,
         faces: Optional[npt.ArrayLike] = None,
         *,
-        builder: str = "sah",
+        accel: str = "bvh",
+        builder: Optional[str] = None,
         threads: Optional[int] = None,
     ) -> None: ...
     def add_mesh(self, vertices: npt.ArrayLike, faces: npt.ArrayLike) -> int:
@@ -122,6 +123,7 @@ def render(
     sampler: Optional[str] = None,
     filter: Optional[str] = None,
     pass_spp: Optional[int] = None,
+    accel: Optional[str] = None,
     builder: Optional[str] = None,
     progress: Optional[Callable[[int, int], Any]] = None,
 ) -> Tuple[npt.NDArray[np.float32], Dict[str, np.ndarray]]: ...

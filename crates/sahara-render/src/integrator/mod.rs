@@ -776,7 +776,7 @@ mod tests {
     use crate::scene::camera::Camera;
     use crate::scene::shape::Shape;
     use crate::scene::Scene;
-    use sahara_kd::BuildParams;
+    use sahara_kd::AccelParams;
 
     /// Radiance seen at the centre of a quad whose back faces the camera
     /// and a point light beside the camera.
@@ -793,7 +793,7 @@ mod tests {
             m,
         );
         scene.add_light(Light::point(Vec3::new(0.3, 0.0, -2.0), Vec3::splat(4.0)));
-        let world = World::new(&scene, &BuildParams::default());
+        let world = World::new(&scene, &AccelParams::default());
         let mut stats = TraceStats::default();
         let mut sum = Vec3::ZERO;
         for index in 0..16 {
@@ -889,13 +889,13 @@ mod tests {
         let up = Vec3::Y;
         let on_floor = |x: f32| Vec3::new(x, 1e-3, 0.0);
         let opaque = cut_out_scene(AlphaMode::Opaque);
-        let world = World::new(&opaque, &BuildParams::default());
+        let world = World::new(&opaque, &AccelParams::default());
         assert!(!world.unoccluded(on_floor(-0.5), up, f32::INFINITY, 0.0, None));
         assert!(!world.unoccluded(on_floor(0.5), up, f32::INFINITY, 0.0, None));
         assert_eq!(radiance_down(&world, 0.5), Vec3::ZERO);
 
         let mask = cut_out_scene(AlphaMode::Mask { cutoff: 0.5 });
-        let world = World::new(&mask, &BuildParams::default());
+        let world = World::new(&mask, &AccelParams::default());
         // The opaque half shadows the floor, the hole lets the light by.
         assert!(!world.unoccluded(on_floor(-0.5), up, f32::INFINITY, 0.0, None));
         assert!(world.unoccluded(on_floor(0.5), up, f32::INFINITY, 0.0, None));
@@ -915,7 +915,7 @@ mod tests {
 
         // Blend at opacity 1 on the left, 0 on the right: the same answers.
         let blend = cut_out_scene(AlphaMode::Blend);
-        let world = World::new(&blend, &BuildParams::default());
+        let world = World::new(&blend, &AccelParams::default());
         assert!(!world.unoccluded(on_floor(-0.5), up, f32::INFINITY, 0.0, None));
         assert!(world.unoccluded(on_floor(0.5), up, f32::INFINITY, 0.0, None));
 
@@ -924,7 +924,7 @@ mod tests {
         let mut half = cut_out_scene(AlphaMode::Blend);
         half.materials[1].textures.base_color = None;
         half.materials[1].alpha = 0.3;
-        let world = World::new(&half, &BuildParams::default());
+        let world = World::new(&half, &AccelParams::default());
         let n = 4000;
         let open = (0..n)
             .filter(|&i| {

@@ -131,7 +131,7 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
 mod tests {
     use super::*;
     use crate::scene::builtin;
-    use sahara_kd::{BuildParams, Builder};
+    use sahara_kd::{AccelParams, BuildParams, Builder};
 
     #[test]
     fn pixel_settings_change_it_and_speed_settings_do_not() {
@@ -140,7 +140,7 @@ mod tests {
         let d = frame_digest(&scene, &base);
         assert_eq!(d.len(), 64);
         let same = RenderSettings {
-            build: BuildParams::new(Builder::Binned { bins: 16 }),
+            build: AccelParams::kd(BuildParams::new(Builder::Binned { bins: 16 })),
             tile_size: 7,
             window: Some(crate::film::window::PixelWindow::full(3, 3)),
             samples: Some(1..2),
