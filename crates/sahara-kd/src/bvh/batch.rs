@@ -1,6 +1,7 @@
 //! Batch queries: many rays on the calling thread or in parallel work
 //! items.
 
+use super::packet::SWITCH;
 use super::Bvh;
 use crate::isect::Hit;
 use crate::kd::batch::in_parallel;
@@ -83,13 +84,78 @@ impl Kernel for AnyBatch<'_> {
 }
 
 impl Bvh {
-    /// Closest hits of up to 8 rays (a packet's worth).
+    /// Closest hits of up to [`crate::PACKET`] (eight) rays traced as one
+    /// packet (e.g. a 4x2 pixel tile of camera rays); `out[i]` answers
+    /// `rays[i]` exactly as [`Bvh::closest_hit`] would. See the `packet`
+    /// module for the walk.
+    ///
+    /// # Panics
+    /// If there are more than eight rays or `out` differs in length.
     pub fn closest_hit_packet(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        self.closest_hits_serial(rays, out);
+        assert!(rays.len() <= PACKET8, "{} rays in a packet", rays.len());
+        assert_eq!(rays.len(), out.len(), "one output slot per ray");
+        dispatch(
+            level::AVX512,
+            PacketQuery {
+                bvh: self,
+                wide16: false,
+                switch: SWITCH,
+                rays,
+                out,
+            },
+        );
     }
 
-    /// Closest hits of up to 16 rays (a packet's worth).
+    /// Closest hits of up to [`crate::PACKET16`] (sixteen) rays traced as
+    /// one packet (e.g. a 4x4 pixel tile); `out[i]` answers `rays[i]`
+    /// exactly as [`Bvh::closest_hit`] would. With AVX-512 the sixteen rays
+    /// share one walk in sixteen-lane registers; with AVX2 in two
+    /// eight-lane halves.
+    ///
+    /// # Panics
+    /// If there are more than sixteen rays or `out` differs in length.
     pub fn closest_hit_packet16(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        self.closest_hits_serial(rays, out);
+        assert!(rays.len() <= PACKET16, "{} rays in a packet", rays.len());
+        assert_eq!(rays.len(), out.len(), "one output slot per ray");
+        dispatch(
+            level::AVX512,
+            PacketQuery {
+                bvh: self,
+                wide16: true,
+                switch: SWITCH,
+                rays,
+                out,
+            },
+        );
+    }
+}
+
+/// Rays in an eight-ray packet.
+const PACKET8: usize = 8;
+
+/// Rays in a sixteen-ray packet.
+const PACKET16: usize = super::packet::LANES;
+
+/// A packet walk in one dispatch.
+pub(super) struct PacketQuery<'a> {
+    pub(super) bvh: &'a Bvh,
+    /// Sixteen lanes (else eight).
+    pub(super) wide16: bool,
+    /// Nodes and leaves that at most this many rays reach are finished
+    /// ray by ray.
+    pub(super) switch: u32,
+    pub(super) rays: &'a [Ray],
+    pub(super) out: &'a mut [Option<Hit>],
+}
+
+impl Kernel for PacketQuery<'_> {
+    type Output = ();
+    #[inline(always)]
+    unsafe fn run<const LEVEL: u8>(self) {
+        // SAFETY: the level's instructions (the caller's contract).
+        unsafe {
+            self.bvh
+                .trace_packet::<LEVEL>(self.wide16, self.switch, self.rays, self.out)
+        }
     }
 }

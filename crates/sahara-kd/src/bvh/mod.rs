@@ -9,6 +9,7 @@
 mod batch;
 pub(crate) mod build;
 pub(crate) mod node;
+mod packet;
 mod quad;
 mod query;
 mod stats;

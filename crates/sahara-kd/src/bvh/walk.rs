@@ -326,7 +326,7 @@ impl Bvh {
 }
 
 #[cfg(target_arch = "x86_64")]
-mod x86 {
+pub(crate) mod x86 {
     use std::arch::x86_64::*;
 
     use super::{leaf_any, leaf_closest, BoxRay, Stack};
@@ -365,7 +365,7 @@ mod x86 {
     /// sum) stays below the walk's widening of the boxes (see the module
     /// documentation).
     #[derive(Clone, Copy)]
-    struct Lanes {
+    pub(crate) struct Lanes {
         inv: [__m256; 3],
         near_oinv: [__m256; 3],
         far_oinv: [__m256; 3],
@@ -377,7 +377,7 @@ mod x86 {
 
     impl Lanes {
         #[inline(always)]
-        unsafe fn new(r: &BoxRay) -> Self {
+        pub(crate) unsafe fn new(r: &BoxRay) -> Self {
             // SAFETY: AVX (the caller's contract).
             unsafe {
                 let v = |f: [f32; 3]| f.map(|x| _mm256_set1_ps(x));
@@ -467,7 +467,7 @@ mod x86 {
     /// in the node's order for the ray's octant when `ORDERED`); `None`
     /// when the ray enters none.
     #[inline(always)]
-    unsafe fn step<const SIMD: u8, const ORDERED: bool>(
+    pub(crate) unsafe fn step<const SIMD: u8, const ORDERED: bool>(
         n: &WideNode,
         l: &Lanes,
         tfar: __m256,
@@ -531,7 +531,7 @@ mod x86 {
     /// keeping the order of the rest: with them gone, every child popped
     /// may hold a closer hit, so pops need no distance test.
     #[inline(always)]
-    unsafe fn compact<const SIMD: u8>(stack: &mut Stack, best_t: f32) {
+    pub(crate) unsafe fn compact<const SIMD: u8>(stack: &mut Stack, best_t: f32) {
         // SAFETY: entries below `len` were written; the level's
         // instructions (the caller's contract). Reading past `len` up to
         // the next multiple of eight reads slack entries (the stack's
