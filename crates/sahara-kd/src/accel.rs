@@ -271,13 +271,24 @@ impl TriangleAccel {
         each!(self, t => t.any_hits_serial(rays, out))
     }
 
-    /// Closest hits of up to 8 coherent rays traced together.
+    /// Closest hits of up to 8 coherent rays (a camera tile), by the
+    /// faster walk of each structure: the kd-tree's packet walk; the
+    /// hierarchy's single-ray walk, ray by ray, because its packet walk
+    /// ([`Bvh::closest_hit_packet`]) measures slower than its single rays on
+    /// every benchmark mesh (`docs/performance.md`).
     pub fn closest_hit_packet(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        each!(self, t => t.closest_hit_packet(rays, out))
+        match self {
+            Self::Kd(t) => t.closest_hit_packet(rays, out),
+            Self::Bvh(t) => t.closest_hits_serial(rays, out),
+        }
     }
 
-    /// Closest hits of up to 16 coherent rays traced together.
+    /// Closest hits of up to 16 coherent rays, as
+    /// [`TriangleAccel::closest_hit_packet`] chooses.
     pub fn closest_hit_packet16(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        each!(self, t => t.closest_hit_packet16(rays, out))
+        match self {
+            Self::Kd(t) => t.closest_hit_packet16(rays, out),
+            Self::Bvh(t) => t.closest_hits_serial(rays, out),
+        }
     }
 }

@@ -463,8 +463,7 @@ impl RayScene {
             TriangleAccel::Kd(t) => serde_json::to_value(t.stats()),
             TriangleAccel::Bvh(b) => serde_json::to_value(b.stats()),
         });
-        let value = value
-            .map_err(|e| PyRuntimeError::new_err(format!("statistics: {e}")))?;
+        let value = value.map_err(|e| PyRuntimeError::new_err(format!("statistics: {e}")))?;
         let d = PyDict::new(py);
         if let serde_json::Value::Object(map) = value {
             for (k, v) in map {

@@ -107,7 +107,9 @@ pub fn resolve(
             integrator,
             build: AccelParams {
                 kind: args.accel.unwrap_or_default(),
-                kd: args.builder.map_or_else(BuildParams::default, BuildParams::new),
+                kd: args
+                    .builder
+                    .map_or_else(BuildParams::default, BuildParams::new),
                 ..AccelParams::default()
             },
             adaptive,

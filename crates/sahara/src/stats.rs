@@ -84,7 +84,8 @@ fn every_structure(
     std::iter::once(kd)
         .chain(bvh)
         .map(|p| {
-            let (t, build_ms) = build_timed(tris, runs, &pools.all, |t| TriangleAccel::build(t, &p));
+            let (t, build_ms) =
+                build_timed(tris, runs, &pools.all, |t| TriangleAccel::build(t, &p));
             let summary = t.summary();
             eprintln!("  {}: {build_ms:.1} ms", summary.structure);
             StructureRow {

@@ -1207,7 +1207,11 @@ mod tests {
     /// from vertex coordinates, rays through vertices and edge midpoints,
     /// mixed `tmin`/`tmax`, invalid rays; one to sixteen rays.
     fn packet(f: &mut impl FnMut() -> f32, tris: &[Triangle], p: usize) -> Vec<Ray> {
-        let n = if p.is_multiple_of(3) { 1 + p % LANES } else { LANES };
+        let n = if p.is_multiple_of(3) {
+            1 + p % LANES
+        } else {
+            LANES
+        };
         let eye = Vec3::new(f(), f(), -6.0) * 0.5;
         let aim = Vec3::new(f() * 0.3, f() * 0.3, 1.0);
         let spread = [0.002, 0.03, 0.3][p % 3];

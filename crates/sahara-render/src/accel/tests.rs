@@ -8,7 +8,10 @@ use sahara_kd::{brute, AccelParams, BuildParams, NoCounters, Ray, Triangle, PACK
 
 /// Both structures, the hierarchy (the default) and the kd-tree.
 fn structures() -> [AccelParams; 2] {
-    [AccelParams::default(), AccelParams::kd(BuildParams::default())]
+    [
+        AccelParams::default(),
+        AccelParams::kd(BuildParams::default()),
+    ]
 }
 
 use super::{Accel, BatchBuffers, RawHit};
@@ -313,7 +316,10 @@ fn a_ground_that_dwarfs_the_rest_keeps_its_own_tree() {
 
 #[test]
 fn hits_equal_the_brute_force_oracle() {
-    for (shared, params) in [0, 3, 12].into_iter().flat_map(|s| structures().map(|p| (s, p))) {
+    for (shared, params) in [0, 3, 12]
+        .into_iter()
+        .flat_map(|s| structures().map(|p| (s, p)))
+    {
         let (meshes, instances, ignorable) = scene(shared);
         let accel = Accel::build(&meshes, &instances, &params, &ignorable);
         let (rays, s) = rays(&meshes, &instances, 1200);
@@ -343,7 +349,10 @@ fn hits_equal_the_brute_force_oracle() {
 
 #[test]
 fn batches_and_packets_equal_single_rays() {
-    for (shared, params) in [0, 12].into_iter().flat_map(|s| structures().map(|p| (s, p))) {
+    for (shared, params) in [0, 12]
+        .into_iter()
+        .flat_map(|s| structures().map(|p| (s, p)))
+    {
         let (meshes, instances, ignorable) = scene(shared);
         let accel = Accel::build(&meshes, &instances, &params, &ignorable);
         assert_eq!(

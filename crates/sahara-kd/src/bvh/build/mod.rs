@@ -77,7 +77,10 @@ pub struct BvhParams {
     pub max_duplication: f32,
     /// Spatial splits are tried at a node only where its best object
     /// split's children overlap by more than this fraction of the root's
-    /// surface area (Stich et al.'s alpha).
+    /// surface area (Stich et al.'s alpha). 1e-3, not the paper's 1e-5:
+    /// measured on the benchmark meshes, it halves the spatial build's time
+    /// (dragon 4.8 s to 2.2 s on one thread) for a SAH cost within 0.4 %
+    /// (Sponza's is lower).
     pub overlap_threshold: f32,
     /// ... and by more than this fraction of the node's own surface area.
     pub node_overlap_threshold: f32,
@@ -108,44 +111,13 @@ impl BvhParams {
             intersection_cost: 1.0,
             leaf_width: 4,
             max_duplication: 1.3,
-            overlap_threshold: 1e-5,
+            overlap_threshold: 1e-3,
             node_overlap_threshold: 0.0,
             spatial_min: 0,
             min_leaf: 1,
             parallel: true,
             kd: BuildParams::default(),
         }
-        .tuned()
-    }
-
-    // TUNING ONLY (to be removed): environment overrides.
-    fn tuned(mut self) -> Self {
-        let f = |k: &str| std::env::var(k).ok().and_then(|v| v.parse::<f32>().ok());
-        if let Some(v) = f("BVH_KT") {
-            self.traversal_cost = v;
-        }
-        if let Some(v) = f("BVH_KI") {
-            self.intersection_cost = v;
-        }
-        if let Some(v) = f("BVH_W") {
-            self.leaf_width = v as u32;
-        }
-        if let Some(v) = f("BVH_DUP") {
-            self.max_duplication = v;
-        }
-        if let Some(v) = f("BVH_SBINS") {
-            self.spatial_bins = v as usize;
-        }
-        if let Some(v) = f("BVH_NOVL") {
-            self.node_overlap_threshold = v;
-        }
-        if let Some(v) = f("BVH_SMIN") {
-            self.spatial_min = v as usize;
-        }
-        if let Some(v) = f("BVH_ALPHA") {
-            self.overlap_threshold = v;
-        }
-        self
     }
 }
 
