@@ -218,17 +218,17 @@ pub fn stats_report(r: &StatsReport) -> String {
     if !r.structures.is_empty() {
         let _ = writeln!(
             s,
-            "\n{:<18} {:>10} {:>12} {:>11} {:>9} {:>8} {:>10}",
-            "structure", "build ms", "memory", "references", "inner", "leaves", "triangles"
+            "\n{:<18} {:>10} {:>10} {:>11} {:>9} {:>8} {:>10}",
+            "structure", "build ms", "MiB", "references", "inner", "leaves", "triangles"
         );
         for row in &r.structures {
             let m = &row.summary;
             let _ = writeln!(
                 s,
-                "{:<18} {:>10.1} {:>12} {:>11} {:>9.2} {:>8.2} {:>10.2}",
+                "{:<18} {:>10.1} {:>10.2} {:>11} {:>9.2} {:>8.2} {:>10.2}",
                 row.structure,
                 row.build_ms,
-                bytes(m.memory_bytes),
+                m.memory_bytes as f64 / (1 << 20) as f64,
                 thousands(m.references as u64),
                 m.expected_inner,
                 m.expected_leaves,
