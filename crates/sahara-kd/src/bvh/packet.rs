@@ -422,34 +422,93 @@ pub(crate) mod x86 {
         #[inline(always)]
         unsafe fn distance(v0: [f64; 3], n: [f64; 3], o: [Self; 3], d: [Self; 3]) -> Self {
             unsafe {
-                let half = |x: __m512, h: usize| -> __m512d {
-                    if h == 0 {
-                        _mm512_cvtps_pd(_mm512_castps512_ps256(x))
-                    } else {
-                        _mm512_cvtps_pd(_mm256_castpd_ps(_mm512_extractf64x4_pd::<1>(
-                            _mm512_castps_pd(x),
-                        )))
-                    }
-                };
-                let dot = |a: [__m512d; 3]| {
-                    let xy = _mm512_add_pd(
-                        _mm512_mul_pd(a[0], _mm512_set1_pd(n[0])),
-                        _mm512_mul_pd(a[1], _mm512_set1_pd(n[1])),
-                    );
-                    _mm512_add_pd(xy, _mm512_mul_pd(a[2], _mm512_set1_pd(n[2])))
-                };
-                let t = |h: usize| {
-                    let den = dot([half(d[0], h), half(d[1], h), half(d[2], h)]);
-                    let to_v0 = |k: usize| _mm512_sub_pd(_mm512_set1_pd(v0[k]), half(o[k], h));
-                    let num = dot([to_v0(0), to_v0(1), to_v0(2)]);
-                    _mm512_cvtpd_ps(_mm512_div_pd(num, den))
-                };
-                let (lo, hi) = (t(0), t(1));
+                // No closures: they would be compiled without the level's
+                // instructions and call each intrinsic.
+                let (dl, dh) = (halves512(d[0]), halves512(d[1]));
+                let dz = halves512(d[2]);
+                let (ol, oh) = (halves512(o[0]), halves512(o[1]));
+                let oz = halves512(o[2]);
+                let lo = plane_t512(v0, n, [ol.0, oh.0, oz.0], [dl.0, dh.0, dz.0]);
+                let hi = plane_t512(v0, n, [ol.1, oh.1, oz.1], [dl.1, dh.1, dz.1]);
                 _mm512_castpd_ps(_mm512_insertf64x4::<1>(
                     _mm512_castpd256_pd512(_mm256_castps_pd(lo)),
                     _mm256_castps_pd(hi),
                 ))
             }
+        }
+    }
+
+    /// The low and high eight lanes of `x` in f64.
+    #[inline(always)]
+    unsafe fn halves512(x: __m512) -> (__m512d, __m512d) {
+        unsafe {
+            (
+                _mm512_cvtps_pd(_mm512_castps512_ps256(x)),
+                _mm512_cvtps_pd(_mm256_castpd_ps(_mm512_extractf64x4_pd::<1>(
+                    _mm512_castps_pd(x),
+                ))),
+            )
+        }
+    }
+
+    /// `((v0 - o) . n) / (d . n)` on eight f64 lanes, rounded to f32.
+    #[inline(always)]
+    unsafe fn plane_t512(v0: [f64; 3], n: [f64; 3], o: [__m512d; 3], d: [__m512d; 3]) -> __m256 {
+        unsafe {
+            let den = _mm512_add_pd(
+                _mm512_add_pd(
+                    _mm512_mul_pd(d[0], _mm512_set1_pd(n[0])),
+                    _mm512_mul_pd(d[1], _mm512_set1_pd(n[1])),
+                ),
+                _mm512_mul_pd(d[2], _mm512_set1_pd(n[2])),
+            );
+            let a0 = _mm512_sub_pd(_mm512_set1_pd(v0[0]), o[0]);
+            let a1 = _mm512_sub_pd(_mm512_set1_pd(v0[1]), o[1]);
+            let a2 = _mm512_sub_pd(_mm512_set1_pd(v0[2]), o[2]);
+            let num = _mm512_add_pd(
+                _mm512_add_pd(
+                    _mm512_mul_pd(a0, _mm512_set1_pd(n[0])),
+                    _mm512_mul_pd(a1, _mm512_set1_pd(n[1])),
+                ),
+                _mm512_mul_pd(a2, _mm512_set1_pd(n[2])),
+            );
+            _mm512_cvtpd_ps(_mm512_div_pd(num, den))
+        }
+    }
+
+    /// The low and high four lanes of `x` in f64.
+    #[inline(always)]
+    unsafe fn halves256(x: __m256) -> (__m256d, __m256d) {
+        unsafe {
+            (
+                _mm256_cvtps_pd(_mm256_castps256_ps128(x)),
+                _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(x)),
+            )
+        }
+    }
+
+    /// `((v0 - o) . n) / (d . n)` on four f64 lanes, rounded to f32.
+    #[inline(always)]
+    unsafe fn plane_t256(v0: [f64; 3], n: [f64; 3], o: [__m256d; 3], d: [__m256d; 3]) -> __m128 {
+        unsafe {
+            let den = _mm256_add_pd(
+                _mm256_add_pd(
+                    _mm256_mul_pd(d[0], _mm256_set1_pd(n[0])),
+                    _mm256_mul_pd(d[1], _mm256_set1_pd(n[1])),
+                ),
+                _mm256_mul_pd(d[2], _mm256_set1_pd(n[2])),
+            );
+            let a0 = _mm256_sub_pd(_mm256_set1_pd(v0[0]), o[0]);
+            let a1 = _mm256_sub_pd(_mm256_set1_pd(v0[1]), o[1]);
+            let a2 = _mm256_sub_pd(_mm256_set1_pd(v0[2]), o[2]);
+            let num = _mm256_add_pd(
+                _mm256_add_pd(
+                    _mm256_mul_pd(a0, _mm256_set1_pd(n[0])),
+                    _mm256_mul_pd(a1, _mm256_set1_pd(n[1])),
+                ),
+                _mm256_mul_pd(a2, _mm256_set1_pd(n[2])),
+            );
+            _mm256_cvtpd_ps(_mm256_div_pd(num, den))
         }
     }
 
@@ -588,27 +647,13 @@ pub(crate) mod x86 {
         #[inline(always)]
         unsafe fn distance(v0: [f64; 3], n: [f64; 3], o: [Self; 3], d: [Self; 3]) -> Self {
             unsafe {
-                let half = |x: __m256, h: usize| -> __m256d {
-                    if h == 0 {
-                        _mm256_cvtps_pd(_mm256_castps256_ps128(x))
-                    } else {
-                        _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(x))
-                    }
-                };
-                let dot = |a: [__m256d; 3]| {
-                    let xy = _mm256_add_pd(
-                        _mm256_mul_pd(a[0], _mm256_set1_pd(n[0])),
-                        _mm256_mul_pd(a[1], _mm256_set1_pd(n[1])),
-                    );
-                    _mm256_add_pd(xy, _mm256_mul_pd(a[2], _mm256_set1_pd(n[2])))
-                };
-                let t = |h: usize| {
-                    let den = dot([half(d[0], h), half(d[1], h), half(d[2], h)]);
-                    let to_v0 = |k: usize| _mm256_sub_pd(_mm256_set1_pd(v0[k]), half(o[k], h));
-                    let num = dot([to_v0(0), to_v0(1), to_v0(2)]);
-                    _mm256_cvtpd_ps(_mm256_div_pd(num, den))
-                };
-                _mm256_set_m128(t(1), t(0))
+                let (dl, dh) = (halves256(d[0]), halves256(d[1]));
+                let dz = halves256(d[2]);
+                let (ol, oh) = (halves256(o[0]), halves256(o[1]));
+                let oz = halves256(o[2]);
+                let lo = plane_t256(v0, n, [ol.0, oh.0, oz.0], [dl.0, dh.0, dz.0]);
+                let hi = plane_t256(v0, n, [ol.1, oh.1, oz.1], [dl.1, dh.1, dz.1]);
+                _mm256_set_m128(hi, lo)
             }
         }
     }
@@ -757,10 +802,20 @@ pub(crate) mod x86 {
         #[inline(always)]
         unsafe fn distance(v0: [f64; 3], n: [f64; 3], o: [Self; 3], d: [Self; 3]) -> Self {
             unsafe {
-                let part = |f: fn(&Pair) -> __m256| {
-                    <__m256 as Wide>::distance(v0, n, o.map(|x| f(&x)), d.map(|x| f(&x)))
-                };
-                Pair(part(|x| x.0), part(|x| x.1))
+                Pair(
+                    <__m256 as Wide>::distance(
+                        v0,
+                        n,
+                        [o[0].0, o[1].0, o[2].0],
+                        [d[0].0, d[1].0, d[2].0],
+                    ),
+                    <__m256 as Wide>::distance(
+                        v0,
+                        n,
+                        [o[0].1, o[1].1, o[2].1],
+                        [d[0].1, d[1].1, d[2].1],
+                    ),
+                )
             }
         }
     }
@@ -846,16 +901,19 @@ pub(crate) mod x86 {
         // SAFETY: the caller's contract; rows are 64-byte aligned; child
         // references name nodes and leaves the build wrote.
         unsafe {
-            let ld = |r: &Row| W::load(r.0.as_ptr());
             let b = BoxLanes {
-                inv: [ld(&p.inv[0]), ld(&p.inv[1]), ld(&p.inv[2])],
+                inv: [ld::<W>(&p.inv[0]), ld::<W>(&p.inv[1]), ld::<W>(&p.inv[2])],
                 near_oinv: [
-                    ld(&p.near_oinv[0]),
-                    ld(&p.near_oinv[1]),
-                    ld(&p.near_oinv[2]),
+                    ld::<W>(&p.near_oinv[0]),
+                    ld::<W>(&p.near_oinv[1]),
+                    ld::<W>(&p.near_oinv[2]),
                 ],
-                far_oinv: [ld(&p.far_oinv[0]), ld(&p.far_oinv[1]), ld(&p.far_oinv[2])],
-                tmin: ld(&p.tmin),
+                far_oinv: [
+                    ld::<W>(&p.far_oinv[0]),
+                    ld::<W>(&p.far_oinv[1]),
+                    ld::<W>(&p.far_oinv[2]),
+                ],
+                tmin: ld::<W>(&p.tmin),
                 near: [0, 1, 2].map(|a| 16 * a + 8 * (octant >> a & 1) as usize),
                 far: [0, 1, 2].map(|a| 16 * a + 8 * (!octant >> a & 1) as usize),
             };
@@ -891,7 +949,7 @@ pub(crate) mod x86 {
                     stack.len -= 1;
                     let i = stack.len;
                     let t = stack.dist.get_unchecked(i).assume_init();
-                    let best = ld(&p.best_t);
+                    let best = ld::<W>(&p.best_t);
                     active = stack.rays.get_unchecked(i).assume_init() & W::bits(t.le(best));
                     if active != 0 {
                         c = stack.refs.get_unchecked(i).assume_init();
@@ -926,7 +984,6 @@ pub(crate) mod x86 {
                 W::splat(f32::NEG_INFINITY),
             );
             let bounds = n.bounds.as_ptr() as *const f32;
-            let plane = |off: usize, slot: usize| W::splat(*bounds.add(off + slot));
             let mut refs = [0u32; 8];
             let mut masks = [0u32; 8];
             let mut keys = [0u64; 8];
@@ -939,10 +996,18 @@ pub(crate) mod x86 {
                 }
                 // The running interval is the second operand: a NaN slab
                 // distance leaves it as it is (as the single-ray walk).
-                let near = |a: usize| plane(b.near[a], slot).fmsub(b.inv[a], b.near_oinv[a]);
-                let far = |a: usize| plane(b.far[a], slot).fmsub(b.inv[a], b.far_oinv[a]);
-                let tn = near(0).max(near(1).max(near(2).max(b.tmin)));
-                let tf = far(0).min(far(1).min(far(2).min(tfar)));
+                let near = [
+                    W::splat(*bounds.add(b.near[0] + slot)).fmsub(b.inv[0], b.near_oinv[0]),
+                    W::splat(*bounds.add(b.near[1] + slot)).fmsub(b.inv[1], b.near_oinv[1]),
+                    W::splat(*bounds.add(b.near[2] + slot)).fmsub(b.inv[2], b.near_oinv[2]),
+                ];
+                let far = [
+                    W::splat(*bounds.add(b.far[0] + slot)).fmsub(b.inv[0], b.far_oinv[0]),
+                    W::splat(*bounds.add(b.far[1] + slot)).fmsub(b.inv[1], b.far_oinv[1]),
+                    W::splat(*bounds.add(b.far[2] + slot)).fmsub(b.inv[2], b.far_oinv[2]),
+                ];
+                let tn = near[0].max(near[1].max(near[2].max(b.tmin)));
+                let tf = far[0].min(far[1].min(far[2].min(tfar)));
                 let m = tn.le(tf);
                 let bits = W::bits(m);
                 if bits == 0 {
@@ -1019,6 +1084,42 @@ pub(crate) mod x86 {
         }
     }
 
+    /// Row `r`'s first `W::N` lanes.
+    ///
+    /// # Safety
+    /// As [`trace`]. (Helpers are functions, not closures: a closure is
+    /// compiled without the level's instructions and would call every
+    /// intrinsic in it.)
+    #[inline(always)]
+    unsafe fn ld<W: Wide>(r: &Row) -> W {
+        unsafe { W::load(r.0.as_ptr()) }
+    }
+
+    /// `RayShear::intersect`'s `a[kx] - s.x * a[kz]` and `a[ky] - s.y *
+    /// a[kz]` with `a = v - origin`, for vertex `k` of triangle `j` of `q`,
+    /// lane by lane.
+    ///
+    /// # Safety
+    /// As [`trace`].
+    #[inline(always)]
+    unsafe fn sheared<W: Wide>(
+        q: &Quad,
+        k: usize,
+        j: usize,
+        [kx, ky, kz]: [usize; 3],
+        [ox, oy, oz]: [W; 3],
+        [sx, sy]: [W; 2],
+    ) -> (W, W) {
+        unsafe {
+            let v = &q.v[k];
+            let z = W::splat(v[kz][j]).sub(oz);
+            (
+                W::splat(v[kx][j]).sub(ox).sub(sx.mul(z)),
+                W::splat(v[ky][j]).sub(oy).sub(sy.mul(z)),
+            )
+        }
+    }
+
     /// Triangle `j` of `q` against the rays `m`, whose watertight
     /// permutation is `k`: [`RayShear::intersect`] lane by lane, the
     /// closest hits updated as [`keep_closer`] does.
@@ -1036,19 +1137,15 @@ pub(crate) mod x86 {
     ) {
         // SAFETY: the caller's contract; rows are 64-byte aligned.
         unsafe {
-            let ld = |r: &Row| W::load(r.0.as_ptr());
-            let (ox, oy, oz) = (ld(&p.shear_o[0]), ld(&p.shear_o[1]), ld(&p.shear_o[2]));
-            let (sx, sy) = (ld(&p.shear_s[0]), ld(&p.shear_s[1]));
-            // `RayShear::intersect`'s `a[kx] - s.x * a[kz]` with
-            // `a = v - origin`, lane by lane.
-            let sheared = |k: usize| {
-                let v = |axis: usize| W::splat(q.v[k][axis][j]);
-                let z = v(kz).sub(oz);
-                (v(kx).sub(ox).sub(sx.mul(z)), v(ky).sub(oy).sub(sy.mul(z)))
-            };
-            let (ax, ay) = sheared(0);
-            let (bx, by) = sheared(1);
-            let (cx, cy) = sheared(2);
+            let o = [
+                ld::<W>(&p.shear_o[0]),
+                ld::<W>(&p.shear_o[1]),
+                ld::<W>(&p.shear_o[2]),
+            ];
+            let s = [ld::<W>(&p.shear_s[0]), ld::<W>(&p.shear_s[1])];
+            let (ax, ay) = sheared::<W>(q, 0, j, [kx, ky, kz], o, s);
+            let (bx, by) = sheared::<W>(q, 1, j, [kx, ky, kz], o, s);
+            let (cx, cy) = sheared::<W>(q, 2, j, [kx, ky, kz], o, s);
             let u = cx.mul(by).sub(cy.mul(bx));
             let v = ax.mul(cy).sub(ay.mul(cx));
             let w = bx.mul(ay).sub(by.mul(ax));
@@ -1065,14 +1162,14 @@ pub(crate) mod x86 {
             let slow = !normal & m;
             if fast != 0 {
                 let (v0, n) = plane(q, j);
-                let o = [ld(&p.org[0]), ld(&p.org[1]), ld(&p.org[2])];
-                let d = [ld(&p.dir[0]), ld(&p.dir[1]), ld(&p.dir[2])];
+                let o = [ld::<W>(&p.org[0]), ld::<W>(&p.org[1]), ld::<W>(&p.org[2])];
+                let d = [ld::<W>(&p.dir[0]), ld::<W>(&p.dir[1]), ld::<W>(&p.dir[2])];
                 let t = W::distance(v0, n, o, d);
-                let best = ld(&p.best_t);
+                let best = ld::<W>(&p.best_t);
                 let tri = q.tri[j];
                 let best_tri = W::load(p.best_tri.0.as_ptr() as *const f32);
                 // As `decide_in_plane`, then `keep_closer`.
-                let inside = W::and(t.gt(ld(&p.tmin)), t.le(best));
+                let inside = W::and(t.gt(ld::<W>(&p.tmin)), t.le(best));
                 let closer = W::or_m(t.lt(best), W::splat_u32(tri).ult(best_tri));
                 let upd = W::bits(W::and(inside, closer)) & fast;
                 if upd != 0 {
@@ -1081,8 +1178,8 @@ pub(crate) mod x86 {
                     W::select(um, t.add(W::splat(0.0)), best).store(p.best_t.0.as_mut_ptr());
                     W::select(um, W::splat_u32(tri), best_tri)
                         .store(p.best_tri.0.as_mut_ptr() as *mut f32);
-                    let bu = ld(&p.best_u);
-                    let bv = ld(&p.best_v);
+                    let bu = ld::<W>(&p.best_u);
+                    let bv = ld::<W>(&p.best_v);
                     W::select(um, v.mul(rcp), bu).store(p.best_u.0.as_mut_ptr());
                     W::select(um, w.mul(rcp), bv).store(p.best_v.0.as_mut_ptr());
                 }
