@@ -9,17 +9,19 @@
 //! octant) walk together; a packet whose rays point into several octants
 //! walks each octant's rays in turn (a camera tile almost always has one).
 //! At a node each child's box is tested against all the rays at once, with
-//! the single-ray walk's slab distances lane for lane ([`BoxRay`]: the same
-//! widened boxes, the same fused multiply-adds, the same NaN rules), so no
-//! ray misses a child that holds its hit. The children some ray enters are
-//! visited near to far by the smallest entry distance among the rays;
-//! those not visited next wait on a stack with each ray's entry distance,
-//! and a ray takes part in a child popped later only if it still enters
-//! it before its closest hit so far. A leaf is tested triangle by triangle
-//! for all its rays at once: each lane repeats the f32 operations of
-//! [`RayShear::intersect`] for its ray (rays grouped by the test's axis
-//! permutation, which camera rays share), and the lanes that pass finish
-//! as [`RayShear::decide`] does (the f64 plane distance, then the hit),
+//! the single-ray walk's slab distances lane for lane
+//! ([`BoxRay`](super::walk::BoxRay): the same widened boxes, the same
+//! fused multiply-adds, the same NaN rules), so no ray misses a child that
+//! holds its hit. The children some ray enters are visited near to far by
+//! the smallest entry distance among the rays; those not visited next wait
+//! on a stack with each ray's entry distance, and a ray takes part in a
+//! child popped later only if it still enters it before its closest hit so
+//! far. A leaf is tested triangle by triangle for all its rays at once:
+//! each lane repeats the f32 operations of
+//! [`RayShear::intersect`](crate::isect::RayShear::intersect) for its ray
+//! (rays grouped by the test's axis permutation, which camera rays share),
+//! and the lanes that pass finish as `RayShear::decide` does (the f64
+//! plane distance, then the hit),
 //! so every hit is bit-identical to the single-ray test's.
 //!
 //! **The switch.** A node or leaf reached by at most [`SWITCH`] of the
@@ -36,9 +38,9 @@
 
 use super::node::{is_leaf, leaf_parts, ChildRef, EMPTY};
 use super::quad::Quad;
-use super::walk::BoxRay;
+
 use super::Bvh;
-use crate::isect::{Hit, RayShear};
+use crate::isect::Hit;
 use crate::kd::NoCounters;
 use crate::math::Ray;
 use crate::simd::level;
@@ -95,51 +97,13 @@ struct Packet {
 }
 
 impl Packet {
-    /// The packet of `rays` (at most [`LANES`]) for `bvh`.
+    /// Set bit `axis` of the octant of the lanes `neg` (their direction's
+    /// sign is negative along `axis`).
     #[inline(always)]
-    fn new(bvh: &Bvh, rays: &[Ray]) -> Self {
-        debug_assert!(rays.len() <= LANES);
-        let z = Row([0.0; LANES]);
-        let mut p = Packet {
-            inv: [z; 3],
-            near_oinv: [z; 3],
-            far_oinv: [z; 3],
-            tmin: Row([f32::INFINITY; LANES]),
-            org: [z; 3],
-            dir: [z; 3],
-            shear_o: [z; 3],
-            shear_s: [z; 2],
-            best_t: Row([f32::NEG_INFINITY; LANES]),
-            best_tri: IntRow([u32::MAX; LANES]),
-            best_u: z,
-            best_v: z,
-            octant: [0; LANES],
-            by_kz: [0; 3],
-            valid: 0,
-        };
-        for (l, ray) in rays.iter().enumerate() {
-            if !ray.is_valid() || ray.tmin > ray.tmax {
-                continue;
-            }
-            p.valid |= 1 << l;
-            let r = BoxRay::new(ray, bvh.scale);
-            let s = RayShear::from_ray(ray);
-            for a in 0..3 {
-                p.inv[a].0[l] = r.inv[a];
-                p.near_oinv[a].0[l] = r.near_origin[a] * r.inv[a];
-                p.far_oinv[a].0[l] = r.far_origin[a] * r.inv[a];
-                p.org[a].0[l] = ray.origin[a];
-                p.dir[a].0[l] = ray.dir[a];
-                p.shear_o[a].0[l] = ray.origin[s.k[a]];
-            }
-            p.shear_s[0].0[l] = s.s.x;
-            p.shear_s[1].0[l] = s.s.y;
-            p.tmin.0[l] = ray.tmin;
-            p.best_t.0[l] = ray.tmax;
-            p.octant[l] = r.octant as u8;
-            p.by_kz[s.k[2]] |= 1 << l;
+    fn octant_bits_into(&mut self, axis: usize, neg: u32) {
+        for l in set_bits(neg) {
+            self.octant[l] |= 1 << axis;
         }
-        p
     }
 
     /// The closest hit of lane `l` so far, as the single-ray walk keeps it.
@@ -272,6 +236,11 @@ pub(crate) mod x86 {
         unsafe fn nonzero(self) -> Self::M;
         /// `|self| < inf`.
         unsafe fn finite(self) -> Self::M;
+        /// `|self|` (for non-NaN lanes).
+        #[inline(always)]
+        unsafe fn abs(self) -> Self {
+            unsafe { self.max(Self::splat(0.0).sub(self)) }
+        }
         /// The sign bit is clear.
         unsafe fn sign_clear(self) -> Self::M;
         /// `self < o` as `u32` bit patterns.
@@ -870,7 +839,8 @@ pub(crate) mod x86 {
         out: &mut [Option<Hit>],
     ) {
         debug_assert!(rays.len() <= W::N && rays.len() == out.len());
-        let mut p = Packet::new(bvh, rays);
+        // SAFETY: the caller's contract.
+        let mut p = unsafe { packet::<W>(bvh, rays) };
         let mut todo = p.valid;
         while todo != 0 {
             let octant = p.octant[todo.trailing_zeros() as usize];
@@ -883,6 +853,146 @@ pub(crate) mod x86 {
             unsafe { walk::<W, SIMD>(bvh, &mut p, rays, switch, group, octant as u32) };
         }
         p.finish(out);
+    }
+
+    /// The packet of `rays` (at most `W::N`) for `bvh`: each lane
+    /// holds [`BoxRay::new`]'s and [`RayShear::new`]'s values for its ray
+    /// (the same operations, so the same bits), computed for all lanes at
+    /// once after one transposition of the rays into rows; lanes without a
+    /// valid ray hold zeros, `tmin = +inf` and `best_t = -inf`.
+    ///
+    /// # Safety
+    /// As [`trace`].
+    #[inline(always)]
+    unsafe fn packet<W: Wide>(bvh: &Bvh, rays: &[Ray]) -> Packet {
+        debug_assert!(rays.len() <= W::N);
+        let z = Row([0.0; LANES]);
+        // Origin, direction, tmin, tmax: eight rows.
+        let mut raw = [z; 8];
+        for (l, ray) in rays.iter().enumerate() {
+            let f = [
+                ray.origin.x,
+                ray.origin.y,
+                ray.origin.z,
+                ray.dir.x,
+                ray.dir.y,
+                ray.dir.z,
+                ray.tmin,
+                ray.tmax,
+            ];
+            for k in 0..8 {
+                raw[k].0[l] = f[k];
+            }
+        }
+        let mut p = Packet {
+            inv: [z; 3],
+            near_oinv: [z; 3],
+            far_oinv: [z; 3],
+            tmin: Row([f32::INFINITY; LANES]),
+            org: [z; 3],
+            dir: [z; 3],
+            shear_o: [z; 3],
+            shear_s: [z; 2],
+            best_t: Row([f32::NEG_INFINITY; LANES]),
+            best_tri: super::IntRow([u32::MAX; LANES]),
+            best_u: z,
+            best_v: z,
+            octant: [0; LANES],
+            by_kz: [0; 3],
+            valid: 0,
+        };
+        // SAFETY: the caller's contract; rows are 64-byte aligned.
+        unsafe {
+            let o = [ld::<W>(&raw[0]), ld::<W>(&raw[1]), ld::<W>(&raw[2])];
+            let d = [ld::<W>(&raw[3]), ld::<W>(&raw[4]), ld::<W>(&raw[5])];
+            let (tmin, tmax) = (ld::<W>(&raw[6]), ld::<W>(&raw[7]));
+            let zero = W::splat(0.0);
+            let all = (1u32 << rays.len()) - 1;
+            // `Ray::is_valid` and `tmin <= tmax` (no NaN passes `<=`).
+            let finite = W::and(
+                W::and(W::and(o[0].finite(), o[1].finite()), o[2].finite()),
+                W::and(W::and(d[0].finite(), d[1].finite()), d[2].finite()),
+            );
+            let nonzero = W::or_m(W::or_m(d[0].nonzero(), d[1].nonzero()), d[2].nonzero());
+            let interval = W::and(zero.le(tmin), tmin.le(tmax));
+            let valid = W::bits(W::and(W::and(finite, nonzero), interval)) & all;
+            p.valid = valid;
+            let vm = W::from_bits(valid);
+            // `BoxRay::new`.
+            let pad = o[0]
+                .abs()
+                .max(o[1].abs().max(o[2].abs()))
+                .add(W::splat(bvh.scale))
+                .mul(W::splat(crate::bvh::walk::PAD));
+            let neg_pad = zero.sub(pad);
+            for a in 0..3 {
+                let pos = d[a].sign_clear();
+                p.octant_bits_into(a, !W::bits(pos) & valid);
+                let inv = W::splat(1.0).div(d[a]);
+                let toward = W::select(pos, pad, neg_pad);
+                let near = o[a].add(toward);
+                let far = o[a].sub(toward);
+                sel0::<W>(vm, inv).store(p.inv[a].0.as_mut_ptr());
+                sel0::<W>(vm, near.mul(inv)).store(p.near_oinv[a].0.as_mut_ptr());
+                sel0::<W>(vm, far.mul(inv)).store(p.far_oinv[a].0.as_mut_ptr());
+                sel0::<W>(vm, o[a]).store(p.org[a].0.as_mut_ptr());
+                sel0::<W>(vm, d[a]).store(p.dir[a].0.as_mut_ptr());
+            }
+            W::select(vm, tmin, W::splat(f32::INFINITY)).store(p.tmin.0.as_mut_ptr());
+            W::select(vm, tmax, W::splat(f32::NEG_INFINITY)).store(p.best_t.0.as_mut_ptr());
+            // `RayShear::new`: the dominant axis (`x >= y && x >= z`, else
+            // `y >= z`), its sign, the permutation.
+            let ad = [d[0].abs(), d[1].abs(), d[2].abs()];
+            let x_wins = W::bits(ad[1].le(ad[0])) & W::bits(ad[2].le(ad[0]));
+            let y_ge_z = W::bits(ad[2].le(ad[1]));
+            let kz = [x_wins, !x_wins & y_ge_z, !x_wins & !y_ge_z];
+            let dz = pick::<W>(kz, d);
+            let neg = W::bits(dz.lt(zero));
+            // `kx`, `ky` follow `kz` cyclically, swapped when negative.
+            let (kz0, kz1, kz2) = (kz[0], kz[1], kz[2]);
+            let kx = [
+                (kz2 & !neg) | (kz1 & neg),
+                (kz0 & !neg) | (kz2 & neg),
+                (kz1 & !neg) | (kz0 & neg),
+            ];
+            let ky = [
+                (kz1 & !neg) | (kz2 & neg),
+                (kz2 & !neg) | (kz0 & neg),
+                (kz0 & !neg) | (kz1 & neg),
+            ];
+            sel0::<W>(vm, pick::<W>(kx, o)).store(p.shear_o[0].0.as_mut_ptr());
+            sel0::<W>(vm, pick::<W>(ky, o)).store(p.shear_o[1].0.as_mut_ptr());
+            sel0::<W>(vm, pick::<W>(kz, o)).store(p.shear_o[2].0.as_mut_ptr());
+            sel0::<W>(vm, pick::<W>(kx, d).div(dz)).store(p.shear_s[0].0.as_mut_ptr());
+            sel0::<W>(vm, pick::<W>(ky, d).div(dz)).store(p.shear_s[1].0.as_mut_ptr());
+            p.by_kz = [kz0 & valid, kz1 & valid, kz2 & valid];
+        }
+        p
+    }
+
+    /// `x` on the lanes `m`, zero on the others.
+    ///
+    /// # Safety
+    /// As [`trace`].
+    #[inline(always)]
+    unsafe fn sel0<W: Wide>(m: W::M, x: W) -> W {
+        unsafe { W::select(m, x, W::splat(0.0)) }
+    }
+
+    /// Lane by lane, `v[0]` on the lanes `m[0]`, else `v[1]` on the lanes
+    /// `m[1]`, else `v[2]`.
+    ///
+    /// # Safety
+    /// As [`trace`].
+    #[inline(always)]
+    unsafe fn pick<W: Wide>(m: [u32; 3], v: [W; 3]) -> W {
+        unsafe {
+            W::select(
+                W::from_bits(m[0]),
+                v[0],
+                W::select(W::from_bits(m[1]), v[1], v[2]),
+            )
+        }
     }
 
     /// The rays `group` of `p`, all in `octant`, through the hierarchy.
