@@ -36,7 +36,7 @@
 //! and it reaches every leaf whose box holds a hit no farther than its
 //! closest: the answers are those of [`Bvh::closest_hit`], bit for bit.
 
-use super::node::{is_leaf, leaf_parts, ChildRef, EMPTY};
+use super::node::{is_leaf, leaf_parts, ChildRef};
 use super::quad::Quad;
 
 use super::Bvh;
@@ -190,7 +190,7 @@ impl Bvh {
 pub(crate) mod x86 {
     use std::arch::x86_64::*;
 
-    use super::{is_leaf, leaf_parts, set_bits, ChildRef, Packet, Quad, Row, EMPTY, LANES};
+    use super::{is_leaf, leaf_parts, set_bits, ChildRef, Packet, Quad, Row, LANES};
     use crate::bvh::quad::sse::{quad_edges, QuadRay};
     use crate::bvh::walk::x86::{compact, step, Lanes};
     use crate::bvh::walk::{leaf_closest, BoxRay, STACK};
@@ -251,8 +251,6 @@ pub(crate) mod x86 {
         unsafe fn from_bits(b: u32) -> Self::M;
         /// `if m { a } else { b }` lane by lane.
         unsafe fn select(m: Self::M, a: Self, b: Self) -> Self;
-        /// The smallest lane.
-        unsafe fn min_lane(self) -> f32;
         /// `((v0 - o) . n) / (d . n)` lane by lane in f64, rounded to f32:
         /// [`crate::isect::TrianglePlane::distance`]'s operations in its
         /// order (see [`plane`]).
@@ -377,16 +375,6 @@ pub(crate) mod x86 {
         #[inline(always)]
         unsafe fn select(m: Self::M, a: Self, b: Self) -> Self {
             unsafe { _mm512_mask_blend_ps(m, b, a) }
-        }
-        #[inline(always)]
-        unsafe fn min_lane(self) -> f32 {
-            unsafe {
-                let m = _mm256_min_ps(
-                    _mm512_castps512_ps256(self),
-                    _mm256_castpd_ps(_mm512_extractf64x4_pd::<1>(_mm512_castps_pd(self))),
-                );
-                <__m256 as Wide>::min_lane(m)
-            }
         }
         #[inline(always)]
         unsafe fn distance(v0: [f64; 3], n: [f64; 3], o: [Self; 3], d: [Self; 3]) -> Self {
@@ -602,18 +590,6 @@ pub(crate) mod x86 {
             unsafe { _mm256_blendv_ps(b, a, m) }
         }
         #[inline(always)]
-        unsafe fn min_lane(self) -> f32 {
-            unsafe {
-                let m = _mm_min_ps(
-                    _mm256_castps256_ps128(self),
-                    _mm256_extractf128_ps::<1>(self),
-                );
-                let m = _mm_min_ps(m, _mm_movehl_ps(m, m));
-                let m = _mm_min_ss(m, _mm_shuffle_ps::<0b01>(m, m));
-                _mm_cvtss_f32(m)
-            }
-        }
-        #[inline(always)]
         unsafe fn distance(v0: [f64; 3], n: [f64; 3], o: [Self; 3], d: [Self; 3]) -> Self {
             unsafe {
                 let (dl, dh) = (halves256(d[0]), halves256(d[1]));
@@ -763,10 +739,6 @@ pub(crate) mod x86 {
                     _mm256_blendv_ps(b.1, a.1, m.1),
                 )
             }
-        }
-        #[inline(always)]
-        unsafe fn min_lane(self) -> f32 {
-            unsafe { <__m256 as Wide>::min_lane(_mm256_min_ps(self.0, self.1)) }
         }
         #[inline(always)]
         unsafe fn distance(v0: [f64; 3], n: [f64; 3], o: [Self; 3], d: [Self; 3]) -> Self {
@@ -1044,7 +1016,9 @@ pub(crate) mod x86 {
                     leaf::<W>(bvh, p, rays, c, active, octant);
                 } else {
                     let n = bvh.node(c);
-                    if let Some((next, rays_next)) = node_step::<W>(n, &b, p, active, &mut stack) {
+                    if let Some((next, rays_next)) =
+                        node_step::<W>(n, &b, p, active, octant, &mut stack)
+                    {
                         c = next;
                         active = rays_next;
                         continue;
@@ -1071,9 +1045,14 @@ pub(crate) mod x86 {
     }
 
     /// One node step for the rays `active`: the children some ray enters
-    /// before its closest hit so far, the nearest (by the smallest entry
-    /// distance among its rays) returned with its rays, the others pushed
-    /// far to near; `None` when no ray enters any.
+    /// before its closest hit so far, the nearest returned with its rays,
+    /// the others pushed far to near; `None` when no ray enters any.
+    ///
+    /// The order is the node's own for the rays' octant (the single-ray
+    /// walk's): all eight boxes are tested first, without a branch per
+    /// child, and no distance is reduced across the lanes to sort them
+    /// (measured faster on camera tiles than ordering by each child's
+    /// smallest entry distance among the rays).
     ///
     /// # Safety
     /// As [`trace`].
@@ -1083,6 +1062,7 @@ pub(crate) mod x86 {
         b: &BoxLanes<W>,
         p: &Packet,
         active: u32,
+        octant: u32,
         stack: &mut Stack<W>,
     ) -> Option<(ChildRef, u32)> {
         // SAFETY: the caller's contract; the node's bounds are 48 floats.
@@ -1094,16 +1074,12 @@ pub(crate) mod x86 {
                 W::splat(f32::NEG_INFINITY),
             );
             let bounds = n.bounds.as_ptr() as *const f32;
-            let mut refs = [0u32; 8];
             let mut masks = [0u32; 8];
-            let mut keys = [0u64; 8];
-            let mut dists = [W::splat(0.0); 8];
-            let mut hits = 0usize;
+            let mut dists = [std::mem::MaybeUninit::<W>::uninit(); 8];
+            let mut hit = 0u32;
+            // Unused slots hold the empty box, which no ray enters (as in
+            // the single-ray step).
             for slot in 0..8 {
-                let child = *n.child.get_unchecked(slot);
-                if child == EMPTY {
-                    break;
-                }
                 // The running interval is the second operand: a NaN slab
                 // distance leaves it as it is (as the single-ray walk).
                 let near = [
@@ -1118,48 +1094,42 @@ pub(crate) mod x86 {
                 ];
                 let tn = near[0].max(near[1].max(near[2].max(b.tmin)));
                 let tf = far[0].min(far[1].min(far[2].min(tfar)));
-                let m = tn.le(tf);
-                let bits = W::bits(m);
-                if bits == 0 {
-                    continue;
-                }
-                let key = W::select(m, tn, W::splat(f32::INFINITY)).min_lane() + 0.0;
-                *refs.get_unchecked_mut(hits) = child;
-                *masks.get_unchecked_mut(hits) = bits;
-                *dists.get_unchecked_mut(hits) = tn;
-                // Entry distances are at least `tmin`, not negative: their
-                // bits order as they do.
-                *keys.get_unchecked_mut(hits) = (key.to_bits() as u64) << 3 | hits as u64;
-                hits += 1;
+                let bits = W::bits(tn.le(tf));
+                *masks.get_unchecked_mut(slot) = bits;
+                dists.get_unchecked_mut(slot).write(tn);
+                hit |= ((bits != 0) as u32) << slot;
             }
-            if hits == 0 {
+            if hit == 0 {
                 return None;
             }
-            if hits == 1 {
-                return Some((refs[0], masks[0]));
+            if hit & (hit - 1) == 0 {
+                let slot = hit.trailing_zeros() as usize;
+                return Some((*n.child.get_unchecked(slot), masks[slot]));
             }
-            // Far to near: insertion sort of at most eight keys.
-            let keys = &mut keys[..hits];
-            for i in 1..hits {
-                let k = keys[i];
-                let mut j = i;
-                while j > 0 && keys[j - 1] < k {
-                    keys[j] = keys[j - 1];
-                    j -= 1;
+            // Far to near, so that the nearest ends on top.
+            for i in 0..8 {
+                let slot = n.slot_in_order(i, octant);
+                if hit >> slot & 1 == 1 {
+                    let at = stack.len;
+                    debug_assert!(at < STACK);
+                    stack
+                        .refs
+                        .get_unchecked_mut(at)
+                        .write(*n.child.get_unchecked(slot));
+                    stack
+                        .rays
+                        .get_unchecked_mut(at)
+                        .write(*masks.get_unchecked(slot));
+                    *stack.dist.get_unchecked_mut(at) = *dists.get_unchecked(slot);
+                    stack.len += 1;
                 }
-                keys[j] = k;
             }
-            for &k in &keys[..hits - 1] {
-                let i = (k & 7) as usize;
-                let at = stack.len;
-                debug_assert!(at < STACK);
-                stack.refs.get_unchecked_mut(at).write(refs[i]);
-                stack.rays.get_unchecked_mut(at).write(masks[i]);
-                stack.dist.get_unchecked_mut(at).write(dists[i]);
-                stack.len += 1;
-            }
-            let i = (keys[hits - 1] & 7) as usize;
-            Some((refs[i], masks[i]))
+            stack.len -= 1;
+            let top = stack.len;
+            Some((
+                stack.refs.get_unchecked(top).assume_init(),
+                stack.rays.get_unchecked(top).assume_init(),
+            ))
         }
     }
 
