@@ -53,7 +53,7 @@ pub(crate) const LANES: usize = 16;
 ///
 /// Measured (16-ray camera tiles, one thread, CPU time, interleaved): see
 /// the module's documentation in `docs/performance.md`.
-pub(crate) const SWITCH: u32 = 4;
+pub(crate) const SWITCH: u32 = 1;
 
 /// Sixteen floats on a cache line: one value per lane.
 #[derive(Clone, Copy, Debug)]
@@ -253,8 +253,16 @@ pub(crate) mod x86 {
         unsafe fn select(m: Self::M, a: Self, b: Self) -> Self;
         /// `((v0 - o) . n) / (d . n)` lane by lane in f64, rounded to f32:
         /// [`crate::isect::TrianglePlane::distance`]'s operations in its
-        /// order (see [`plane`]).
-        unsafe fn distance(v0: [f64; 3], n: [f64; 3], o: [Self; 3], d: [Self; 3]) -> Self;
+        /// order (see [`plane`]). Only the lanes `want` are asked for: a
+        /// half of the register none of them is in may be left undefined
+        /// (its f64 division skipped).
+        unsafe fn distance(
+            v0: [f64; 3],
+            n: [f64; 3],
+            o: [Self; 3],
+            d: [Self; 3],
+            want: u32,
+        ) -> Self;
     }
 
     impl Wide for __m512 {
@@ -377,7 +385,13 @@ pub(crate) mod x86 {
             unsafe { _mm512_mask_blend_ps(m, b, a) }
         }
         #[inline(always)]
-        unsafe fn distance(v0: [f64; 3], n: [f64; 3], o: [Self; 3], d: [Self; 3]) -> Self {
+        unsafe fn distance(
+            v0: [f64; 3],
+            n: [f64; 3],
+            o: [Self; 3],
+            d: [Self; 3],
+            want: u32,
+        ) -> Self {
             unsafe {
                 // No closures: they would be compiled without the level's
                 // instructions and call each intrinsic.
@@ -385,8 +399,16 @@ pub(crate) mod x86 {
                 let dz = halves512(d[2]);
                 let (ol, oh) = (halves512(o[0]), halves512(o[1]));
                 let oz = halves512(o[2]);
-                let lo = plane_t512(v0, n, [ol.0, oh.0, oz.0], [dl.0, dh.0, dz.0]);
-                let hi = plane_t512(v0, n, [ol.1, oh.1, oz.1], [dl.1, dh.1, dz.1]);
+                let lo = if want & 0xff != 0 {
+                    plane_t512(v0, n, [ol.0, oh.0, oz.0], [dl.0, dh.0, dz.0])
+                } else {
+                    _mm256_setzero_ps()
+                };
+                let hi = if want >> 8 & 0xff != 0 {
+                    plane_t512(v0, n, [ol.1, oh.1, oz.1], [dl.1, dh.1, dz.1])
+                } else {
+                    _mm256_setzero_ps()
+                };
                 _mm512_castpd_ps(_mm512_insertf64x4::<1>(
                     _mm512_castpd256_pd512(_mm256_castps_pd(lo)),
                     _mm256_castps_pd(hi),
@@ -590,14 +612,28 @@ pub(crate) mod x86 {
             unsafe { _mm256_blendv_ps(b, a, m) }
         }
         #[inline(always)]
-        unsafe fn distance(v0: [f64; 3], n: [f64; 3], o: [Self; 3], d: [Self; 3]) -> Self {
+        unsafe fn distance(
+            v0: [f64; 3],
+            n: [f64; 3],
+            o: [Self; 3],
+            d: [Self; 3],
+            want: u32,
+        ) -> Self {
             unsafe {
                 let (dl, dh) = (halves256(d[0]), halves256(d[1]));
                 let dz = halves256(d[2]);
                 let (ol, oh) = (halves256(o[0]), halves256(o[1]));
                 let oz = halves256(o[2]);
-                let lo = plane_t256(v0, n, [ol.0, oh.0, oz.0], [dl.0, dh.0, dz.0]);
-                let hi = plane_t256(v0, n, [ol.1, oh.1, oz.1], [dl.1, dh.1, dz.1]);
+                let lo = if want & 0xf != 0 {
+                    plane_t256(v0, n, [ol.0, oh.0, oz.0], [dl.0, dh.0, dz.0])
+                } else {
+                    _mm_setzero_ps()
+                };
+                let hi = if want >> 4 & 0xf != 0 {
+                    plane_t256(v0, n, [ol.1, oh.1, oz.1], [dl.1, dh.1, dz.1])
+                } else {
+                    _mm_setzero_ps()
+                };
                 _mm256_set_m128(hi, lo)
             }
         }
@@ -741,7 +777,13 @@ pub(crate) mod x86 {
             }
         }
         #[inline(always)]
-        unsafe fn distance(v0: [f64; 3], n: [f64; 3], o: [Self; 3], d: [Self; 3]) -> Self {
+        unsafe fn distance(
+            v0: [f64; 3],
+            n: [f64; 3],
+            o: [Self; 3],
+            d: [Self; 3],
+            want: u32,
+        ) -> Self {
             unsafe {
                 Pair(
                     <__m256 as Wide>::distance(
@@ -749,12 +791,14 @@ pub(crate) mod x86 {
                         n,
                         [o[0].0, o[1].0, o[2].0],
                         [d[0].0, d[1].0, d[2].0],
+                        want & 0xff,
                     ),
                     <__m256 as Wide>::distance(
                         v0,
                         n,
                         [o[0].1, o[1].1, o[2].1],
                         [d[0].1, d[1].1, d[2].1],
+                        want >> 8 & 0xff,
                     ),
                 )
             }
@@ -1244,7 +1288,7 @@ pub(crate) mod x86 {
                 let (v0, n) = plane(q, j);
                 let o = [ld::<W>(&p.org[0]), ld::<W>(&p.org[1]), ld::<W>(&p.org[2])];
                 let d = [ld::<W>(&p.dir[0]), ld::<W>(&p.dir[1]), ld::<W>(&p.dir[2])];
-                let t = W::distance(v0, n, o, d);
+                let t = W::distance(v0, n, o, d, fast);
                 let best = ld::<W>(&p.best_t);
                 let tri = q.tri[j];
                 let best_tri = W::load(p.best_tri.0.as_ptr() as *const f32);
@@ -1608,6 +1652,7 @@ mod tests {
                                 n,
                                 [ld(&o[0]), ld(&o[1]), ld(&o[2])],
                                 [ld(&d[0]), ld(&d[1]), ld(&d[2])],
+                                0xff,
                             )
                             .store(t.0.as_mut_ptr());
                         }
