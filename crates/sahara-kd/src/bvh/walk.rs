@@ -181,6 +181,7 @@ pub(crate) fn portable_step<const ORDERED: bool>(
 /// The closest-hit test of leaf `r`: lowers `best_t` and updates `best`;
 /// true if it found a hit.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn leaf_closest<C: Counters>(
     bvh: &Bvh,
     r: ChildRef,
