@@ -881,7 +881,7 @@ pub(crate) mod x86 {
     /// # Safety
     /// As [`trace`].
     #[inline(always)]
-    unsafe fn packet<W: Wide>(bvh: &Bvh, rays: &[Ray]) -> Packet {
+    pub(super) unsafe fn packet<W: Wide>(bvh: &Bvh, rays: &[Ray]) -> Packet {
         debug_assert!(rays.len() <= W::N);
         let z = Row([0.0; LANES]);
         // Origin, direction, tmin, tmax: eight rows.
@@ -1599,6 +1599,84 @@ mod tests {
         }); 16];
         empty.closest_hit_packet16(&rays, &mut out);
         assert!(out.iter().all(|h| h.is_none()));
+    }
+
+    /// Lane `l` of a packet holds its ray's single-ray set-up
+    /// (`BoxRay::new`, `RayShear::new`) bit for bit, and lanes without a
+    /// valid ray hold no ray.
+    fn assert_set_up(bvh: &Bvh, rays: &[Ray], p: &Packet, what: &str) {
+        use crate::bvh::walk::BoxRay;
+        use crate::isect::RayShear;
+        let b = |x: f32| x.to_bits();
+        for (l, ray) in rays.iter().enumerate() {
+            let valid = ray.is_valid() && ray.tmin <= ray.tmax;
+            assert_eq!(p.valid >> l & 1 == 1, valid, "{what} lane {l} {ray:?}");
+            if !valid {
+                assert_eq!(p.tmin.0[l], f32::INFINITY, "{what} lane {l}");
+                assert_eq!(p.best_t.0[l], f32::NEG_INFINITY, "{what} lane {l}");
+                assert!((0..3).all(|k| p.by_kz[k] >> l & 1 == 0), "{what} lane {l}");
+                continue;
+            }
+            let r = BoxRay::new(ray, bvh.scale);
+            let s = RayShear::from_ray(ray);
+            for a in 0..3 {
+                assert_eq!(b(p.inv[a].0[l]), b(r.inv[a]), "{what} lane {l} inv {a}");
+                let near = r.near_origin[a] * r.inv[a];
+                let far = r.far_origin[a] * r.inv[a];
+                assert_eq!(b(p.near_oinv[a].0[l]), b(near), "{what} lane {l} near {a}");
+                assert_eq!(b(p.far_oinv[a].0[l]), b(far), "{what} lane {l} far {a}");
+                assert_eq!(b(p.org[a].0[l]), b(ray.origin[a]), "{what} lane {l}");
+                assert_eq!(b(p.dir[a].0[l]), b(ray.dir[a]), "{what} lane {l}");
+                let o = ray.origin[s.k[a]];
+                assert_eq!(b(p.shear_o[a].0[l]), b(o), "{what} lane {l} shear o {a}");
+            }
+            assert_eq!(b(p.shear_s[0].0[l]), b(s.s.x), "{what} lane {l} shear x");
+            assert_eq!(b(p.shear_s[1].0[l]), b(s.s.y), "{what} lane {l} shear y");
+            assert_eq!(b(p.tmin.0[l]), b(ray.tmin), "{what} lane {l}");
+            assert_eq!(b(p.best_t.0[l]), b(ray.tmax), "{what} lane {l}");
+            assert_eq!(p.best_tri.0[l], u32::MAX, "{what} lane {l}");
+            assert_eq!(p.octant[l] as u32, r.octant, "{what} lane {l} octant");
+            assert_eq!(p.by_kz[s.k[2]] >> l & 1, 1, "{what} lane {l} kz");
+        }
+    }
+
+    /// The packet set-up, computed for all lanes at once, equals the
+    /// single-ray set-up of each lane's ray on every lane form: camera
+    /// tiles, rays in every octant, along the axes with zero and negative
+    /// zero components, invalid rays.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn packet_set_up_equals_each_rays_own() {
+        use std::arch::x86_64::{__m256, __m512};
+        if !crate::simd::has_avx2() {
+            return;
+        }
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn eight(bvh: &Bvh, rays: &[Ray]) -> Packet {
+            unsafe { x86::packet::<__m256>(bvh, rays) }
+        }
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn pair(bvh: &Bvh, rays: &[Ray]) -> Packet {
+            unsafe { x86::packet::<x86::Pair>(bvh, rays) }
+        }
+        #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+        unsafe fn sixteen(bvh: &Bvh, rays: &[Ray]) -> Packet {
+            unsafe { x86::packet::<__m512>(bvh, rays) }
+        }
+        let mut f = floats(77);
+        let tris = scene(&mut f);
+        let bvh = Bvh::build(tris.clone(), &BvhParams::default());
+        for p in 0..800 {
+            let rays = packet(&mut f, &tris, p);
+            // SAFETY (all three): the CPU has the instructions (checked).
+            for r in rays.chunks(8) {
+                assert_set_up(&bvh, r, &unsafe { eight(&bvh, r) }, "eight lanes");
+            }
+            assert_set_up(&bvh, &rays, &unsafe { pair(&bvh, &rays) }, "two halves");
+            if crate::simd::has_avx512() {
+                assert_set_up(&bvh, &rays, &unsafe { sixteen(&bvh, &rays) }, "sixteen");
+            }
+        }
     }
 
     /// The vectorised plane distance is `TrianglePlane::distance` bit for
