@@ -271,24 +271,19 @@ impl TriangleAccel {
         each!(self, t => t.any_hits_serial(rays, out))
     }
 
-    /// Closest hits of up to 8 coherent rays (a camera tile), by the
-    /// faster walk of each structure: the kd-tree's packet walk; the
-    /// hierarchy's single-ray walk, ray by ray, because its packet walk
-    /// ([`Bvh::closest_hit_packet`]) measures slower than its single rays on
-    /// every benchmark mesh (`docs/performance.md`).
+    /// Closest hits of up to 8 coherent rays (a camera tile) traced as one
+    /// packet by either structure's packet walk ([`KdTree::closest_hit_packet`],
+    /// [`Bvh::closest_hit_packet`]); the same answers as
+    /// [`TriangleAccel::closest_hit`], bit for bit. On the hierarchy, camera
+    /// tiles trace about twice as fast as packets as ray by ray
+    /// (`docs/performance.md`).
     pub fn closest_hit_packet(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        match self {
-            Self::Kd(t) => t.closest_hit_packet(rays, out),
-            Self::Bvh(t) => t.closest_hits_serial(rays, out),
-        }
+        each!(self, t => t.closest_hit_packet(rays, out))
     }
 
-    /// Closest hits of up to 16 coherent rays, as
-    /// [`TriangleAccel::closest_hit_packet`] chooses.
+    /// Closest hits of up to 16 coherent rays (a 4x4 camera tile) traced as
+    /// one packet, as [`TriangleAccel::closest_hit_packet`].
     pub fn closest_hit_packet16(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
-        match self {
-            Self::Kd(t) => t.closest_hit_packet16(rays, out),
-            Self::Bvh(t) => t.closest_hits_serial(rays, out),
-        }
+        each!(self, t => t.closest_hit_packet16(rays, out))
     }
 }

@@ -91,9 +91,9 @@ impl WideNode {
         let mut bounds = [[[f32::INFINITY; ARITY], [f32::NEG_INFINITY; ARITY]]; 3];
         let mut child = [EMPTY; ARITY];
         for (slot, (b, r)) in children.iter().enumerate() {
-            for axis in 0..3 {
-                bounds[axis][0][slot] = b.min[axis];
-                bounds[axis][1][slot] = b.max[axis];
+            for (axis, [lo, hi]) in bounds.iter_mut().enumerate() {
+                lo[slot] = b.min[axis];
+                hi[slot] = b.max[axis];
             }
             child[slot] = *r;
         }

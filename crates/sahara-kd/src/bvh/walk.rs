@@ -42,7 +42,7 @@ use crate::simd::level;
 pub(crate) const STACK: usize = 7 * super::build::MAX_BINARY_DEPTH + 16;
 
 /// The relative widening of the boxes (see the module's documentation).
-const PAD: f32 = 1.0 / (1 << 19) as f32;
+pub(crate) const PAD: f32 = 1.0 / (1 << 19) as f32;
 
 /// A ray prepared for the box tests.
 #[derive(Clone, Copy, Debug)]
@@ -181,6 +181,7 @@ pub(crate) fn portable_step<const ORDERED: bool>(
 /// The closest-hit test of leaf `r`: lowers `best_t` and updates `best`;
 /// true if it found a hit.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn leaf_closest<C: Counters>(
     bvh: &Bvh,
     r: ChildRef,
