@@ -12,8 +12,8 @@
 //! the single-ray walk's slab distances lane for lane
 //! ([`BoxRay`](super::walk::BoxRay): the same widened boxes, the same
 //! fused multiply-adds, the same NaN rules), so no ray misses a child that
-//! holds its hit. The children some ray enters are visited near to far by
-//! the smallest entry distance among the rays; those not visited next wait
+//! holds its hit. The children some ray enters are visited in the node's
+//! stored order for the packet's octant; those not visited next wait
 //! on a stack with each ray's entry distance, and a ray takes part in a
 //! child popped later only if it still enters it before its closest hit so
 //! far. A leaf is tested triangle by triangle for all its rays at once:
