@@ -98,7 +98,7 @@ pub fn decode_raw(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
     } else {
         decode_any(bytes, name)
     };
-    image.map_err(crate::one_line)
+    image.map_err(crate::error::one_line)
 }
 
 /// A KTX2 texture whose payload is Basis Universal (ETC1S or UASTC, with or

@@ -19,7 +19,7 @@ use std::borrow::Cow;
 use std::fs;
 use std::path::Path;
 
-use crate::Mesh;
+use sahara_kd::Mesh;
 use glam::Vec3;
 
 use crate::error::FormatError;

@@ -18,7 +18,7 @@ mod reader;
 use std::fs;
 use std::path::Path;
 
-use crate::Mesh;
+use sahara_kd::Mesh;
 use glam::{Vec2, Vec3};
 
 use crate::error::FormatError;

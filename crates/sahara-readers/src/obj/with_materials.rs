@@ -16,7 +16,7 @@ use std::collections::{HashMap, HashSet};
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use crate::Mesh;
+use sahara_kd::Mesh;
 use glam::{Vec2, Vec3};
 
 use super::{locate, obj_load_options, tobj_source};
