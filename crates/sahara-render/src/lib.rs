@@ -61,8 +61,8 @@ pub use scene::{Scene, ShapeInstance};
 pub use light::environment::{coordinates as environment_uv, direction as environment_direction};
 pub use light::{Environment, Light, LightKind, LightOf, AREA_SHAPES};
 pub use material::{
-    fresnel, metals, AlphaMode, Bsdf, Clearcoat, Distribution, Material, MaterialKind,
-    MaterialTextures, NormalMap, OcclusionMap,
+    fresnel, isotropic_mean, metals, roughness_from_alpha, AlphaMode, Bsdf, Clearcoat,
+    Distribution, Material, MaterialKind, MaterialTextures, NormalMap, OcclusionMap,
 };
 pub use medium::{
     CloudMedium, ColourGrid, ColourVolume, DensityGrid, GridCoefficients, GridMedium,

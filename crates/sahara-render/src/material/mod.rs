@@ -28,7 +28,7 @@ use fresnel::schlick;
 pub use kinds::MaterialKind;
 use layered::Layered;
 pub use maps::{Clearcoat, MaterialTextures, NormalMap, OcclusionMap};
-pub use microfacet::Distribution;
+pub use microfacet::{isotropic_mean, roughness_from_alpha, Distribution};
 use microfacet::Microfacet;
 
 /// The scattering model of a material.
