@@ -83,6 +83,28 @@ impl Light {
         }
     }
 
+    /// Light arriving at `p` from this light.
+    #[inline]
+    pub fn sample(&self, p: Vec3) -> Option<LightSample> {
+        match *self {
+            Light::Point {
+                position,
+                intensity,
+            } => point::sample(position, intensity, p),
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+            } => spot::sample(position, direction, intensity, cos_inner, cos_outer, p),
+            Light::Directional {
+                direction,
+                irradiance,
+            } => directional::sample(direction, irradiance),
+        }
+    }
+
     /// Emitted power (luminance), by which lights are chosen and a
     /// scene's own lights measured; a directional light's is what falls
     /// on a disc of `scene_radius`.
@@ -188,21 +210,7 @@ impl LightSource {
     /// Light arriving at `p` (sample `u` places it on area lights).
     pub fn sample(&self, p: Vec3, u: glam::Vec2) -> Option<LightSample> {
         match self {
-            LightSource::Explicit(Light::Point {
-                position,
-                intensity,
-            }) => point::sample(*position, *intensity, p),
-            LightSource::Explicit(Light::Spot {
-                position,
-                direction,
-                intensity,
-                cos_inner,
-                cos_outer,
-            }) => spot::sample(*position, *direction, *intensity, *cos_inner, *cos_outer, p),
-            LightSource::Explicit(Light::Directional {
-                direction,
-                irradiance,
-            }) => directional::sample(*direction, *irradiance),
+            LightSource::Explicit(l) => l.sample(p),
             LightSource::Area(a) => a.sample(p, u),
             LightSource::Environment(e) => e.sample(u),
         }
