@@ -1,10 +1,12 @@
 //! Lights: point, spot and directional lights given explicitly; area
-//! lights made from emissive geometry; the environment.
+//! lights made from emissive geometry; the environment; and the lights of
+//! a scene gathered once for its world ([`gather`]).
 
 pub mod area;
 pub mod directional;
 pub(crate) mod emission;
 pub mod environment;
+pub(crate) mod gather;
 mod kinds;
 pub mod point;
 pub mod spot;
