@@ -25,9 +25,9 @@ use std::collections::HashMap;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use sahara_kd::Mesh;
 use ::gltf::mesh::Mode;
 use glam::{Affine2, Mat4, Quat, Vec2, Vec3, Vec4};
+use sahara_kd::Mesh;
 use serde_json::Value;
 
 use crate::error::FormatError;

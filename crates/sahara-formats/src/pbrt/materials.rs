@@ -26,7 +26,9 @@
 
 use glam::Vec3;
 use sahara_readers::FormatError;
-use sahara_render::{isotropic_mean, roughness_from_alpha, AlphaMode, Bsdf, Distribution, Material};
+use sahara_render::{
+    isotropic_mean, roughness_from_alpha, AlphaMode, Bsdf, Distribution, Material,
+};
 
 use super::declarations::Entity;
 use super::params::SpectrumParam;

@@ -13,11 +13,11 @@ use std::collections::HashMap;
 use glam::{Affine3A, DMat4, DVec3, Vec3};
 use sahara_readers::vdb::VdbGrid;
 use sahara_readers::FormatError;
+use sahara_render::{isotropic_mean, roughness_from_alpha};
 use sahara_render::{
     CloudMedium, ColourGrid, ColourVolume, DensityGrid, GridCoefficients, GridMedium,
     HenyeyGreenstein, Material, Medium,
 };
-use sahara_render::{isotropic_mean, roughness_from_alpha};
 
 use super::declarations::{Entity, MediaDecl, MediumDecl};
 use super::measured_media::{measured, names};

@@ -89,11 +89,7 @@ impl EmissionTextures {
 /// A point of a mesh light's triangles, uniform by area (`u`): the
 /// triangle, the point's barycentrics `(b1, b2)`, the point and the
 /// triangle's front normal.
-fn mesh_point(
-    tris: &[[Vec3; 3]],
-    dist: &Distribution1D,
-    u: Vec2,
-) -> (usize, f32, f32, Vec3, Vec3) {
+fn mesh_point(tris: &[[Vec3; 3]], dist: &Distribution1D, u: Vec2) -> (usize, f32, f32, Vec3, Vec3) {
     let (x, _, i) = dist.sample_continuous(u.x);
     // Reuse the position within the chosen cell as a fresh uniform
     // number: it is uniform and independent of i.
