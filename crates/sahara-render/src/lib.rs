@@ -26,8 +26,10 @@
 //! `scene` (camera, meshes, shapes, instances); `film` (the image,
 //! reconstruction filters, exact sums, pixel windows) and `accel` (the
 //! instances' kd-trees); `world` (the scene prepared for tracing);
-//! `integrator` (light transport); `render` (the settings, the loop of
-//! passes and tiles, the frame digest). See `docs/renderer.md` for the
+//! `integrator` (light transport); `settings` (what a frame is, described
+//! once, and the layers of it a scene file or a caller gives); `render`
+//! (the render's settings, the loop of passes and tiles, the frame
+//! digest). See `docs/renderer.md` for the
 //! design.
 
 #![deny(missing_docs)]
@@ -45,6 +47,7 @@ mod names;
 mod render;
 mod sampler;
 mod scene;
+mod settings;
 mod texture;
 mod world;
 
@@ -82,8 +85,9 @@ pub use integrator::{
 };
 pub use keys::{Fallback, Key, KeyError, KeyType, Value, Values};
 pub use names::{one_of, Accepts, Named, Parameter, UnknownName};
-pub use render::{Adaptive, AdaptiveStats, RenderSettings, UNLIMITED_SPP};
+pub use render::{AdaptiveStats, RenderSettings, UNLIMITED_SPP};
 pub use sampler::SamplerKind;
+pub use settings::{Adaptive, AdaptiveChoice, Choice, FrameLayer, FrameSettings, Pick, Pickable};
 
 // Rendering, and what comes out: the image, its exact sums, pieces of a frame.
 pub use film::sums::{PixelSum, SumBuffer};
