@@ -17,9 +17,9 @@ use sahara_formats::{write_image, Pixels};
 use sahara_formats::{LoadOptions, Loaded};
 use sahara_kd::{BuildParams, Builder};
 use sahara_render::{
-    defaults, render_watched, Aov, AuxImages, Feature, Film, Filter, FilterKind, Integrator,
-    IntegratorKind, Named, PixelSum, Progress, RenderResult, RenderSettings, SamplerKind,
-    Scene as RenderScene, SettingsError, ToneMap,
+    defaults, render_watched, Aov, AuxImages, Feature, Film, Filter, FilterKind, FrameSettings,
+    Integrator, IntegratorKind, Named, PixelSum, Progress, RenderResult, RenderSettings,
+    SamplerKind, Scene as RenderScene, SettingsError, ToneMap,
 };
 
 use crate::pool::pool;
@@ -262,17 +262,19 @@ pub fn render<'py>(
     }
     let cancel = Arc::new(AtomicBool::new(false));
     let mut settings = RenderSettings {
-        width,
-        height,
-        spp,
-        pass_spp: pass_spp.unwrap_or(defaults::PASS_SPP).min(spp),
+        frame: FrameSettings {
+            width,
+            height,
+            spp,
+            pass_spp: pass_spp.unwrap_or(defaults::PASS_SPP).min(spp),
+            seed: seed.or(file.map(|f| f.seed)).unwrap_or(0),
+            sampler,
+            filter,
+            integrator,
+            adaptive: file.and_then(|f| f.adaptive),
+        },
         cancel: Some(cancel.clone()),
-        seed: seed.or(file.map(|f| f.seed)).unwrap_or(0),
-        sampler,
-        filter,
-        integrator,
         build,
-        adaptive: file.and_then(|f| f.adaptive),
         aovs: passes,
         ..Default::default()
     };

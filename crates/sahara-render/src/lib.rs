@@ -3,10 +3,11 @@
 //! as float buffers ([`Film`]) and exact per-pixel sums ([`SumBuffer`]).
 //!
 //! ```
-//! use sahara_render::{builtin, render, RenderSettings};
+//! use sahara_render::{builtin, render, FrameSettings, RenderSettings};
 //!
 //! let scene = builtin::cornell_box();
-//! let settings = RenderSettings { width: 16, height: 16, spp: 4, ..Default::default() };
+//! let frame = FrameSettings { width: 16, height: 16, spp: 4, ..Default::default() };
+//! let settings = RenderSettings::from(frame);
 //! let result = render(&scene, &settings, &|_| {})?;
 //! assert_eq!(result.film.pixels.len(), 256);
 //! assert_eq!(result.stats.nan_samples, 0);

@@ -17,8 +17,8 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Result};
 use sahara_formats::{read_part, read_part_info, PartInfo};
 use sahara_render::{
-    cost_maps, Aov, Aux, AuxImages, AuxSums, Film, Integrator, Named, RenderResult, RenderSettings,
-    RenderStats, SumBuffer,
+    cost_maps, Aov, Aux, AuxImages, AuxSums, Film, FrameSettings, Integrator, Named, RenderResult,
+    RenderSettings, RenderStats, SumBuffer,
 };
 use sahara_render::{tile, PixelWindow};
 
@@ -78,13 +78,13 @@ pub fn run(args: &MergeArgs) -> Result<()> {
         Some(d) => crate::denoise::apply(d, &mut result, first.noisy_guides)?,
         None => None,
     };
-    let settings = RenderSettings {
+    let settings = RenderSettings::from(FrameSettings {
         width: first.width,
         height: first.height,
         seed: first.seed,
         integrator: Integrator::from(first.integrator),
         ..Default::default()
-    };
+    });
     let out = Output {
         path: args.output.clone(),
         settings: &settings,

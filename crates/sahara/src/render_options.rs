@@ -9,7 +9,7 @@ use anyhow::{bail, Result};
 use sahara_formats::FileSettings;
 use sahara_kd::BuildParams;
 use sahara_render::UNLIMITED_SPP;
-use sahara_render::{Adaptive, Filter, Integrator, RenderSettings, ToneMap};
+use sahara_render::{Adaptive, Filter, FrameSettings, Integrator, RenderSettings, ToneMap};
 
 use crate::cli::RenderArgs;
 
@@ -95,20 +95,22 @@ pub fn resolve(
     };
     Ok(RenderOptions {
         settings: RenderSettings {
-            width,
-            height,
-            spp,
-            pass_spp: args.pass_spp.unwrap_or(PASS_SPP).min(spp),
+            frame: FrameSettings {
+                width,
+                height,
+                spp,
+                pass_spp: args.pass_spp.unwrap_or(PASS_SPP).min(spp),
+                seed,
+                sampler,
+                filter,
+                integrator,
+                adaptive,
+            },
             time_limit,
             cancel: Some(Arc::new(AtomicBool::new(false))),
-            seed,
-            sampler,
-            filter,
-            integrator,
             build: args
                 .builder
                 .map_or_else(BuildParams::default, BuildParams::new),
-            adaptive,
             ..Default::default()
         },
         exposure,

@@ -30,7 +30,7 @@ use sahara_formats::load_pbrt;
 use sahara_formats::load_rgb_f32;
 use sahara_formats::load_scene;
 use sahara_formats::FileSettings;
-use sahara_render::{render, RenderSettings, Scene};
+use sahara_render::{render, FrameSettings, RenderSettings, Scene};
 
 use crate::blocks::block_errors;
 
@@ -70,7 +70,7 @@ fn tolerance(name: &str) -> Tolerance {
 }
 
 fn render_image(scene: &Scene, s: &FileSettings) -> Vec<Vec3> {
-    let settings = RenderSettings {
+    let settings = RenderSettings::from(FrameSettings {
         width: s.width,
         height: s.height,
         spp: SPP,
@@ -79,8 +79,8 @@ fn render_image(scene: &Scene, s: &FileSettings) -> Vec<Vec3> {
         sampler: s.sampler,
         filter: s.filter,
         integrator: s.integrator,
-        ..RenderSettings::default()
-    };
+        ..Default::default()
+    });
     let result = render(scene, &settings, &|_| {}).unwrap();
     assert_eq!(result.stats.nan_samples, 0);
     result.film.pixels

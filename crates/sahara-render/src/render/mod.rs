@@ -25,7 +25,6 @@ use sahara_kd::BuildParams;
 
 use crate::accel::AccelLayout;
 use crate::cpu_time::process_cpu_time;
-use crate::film::filter::Filter;
 use crate::film::splat::{Pixels, SplatSums, Splatter};
 use crate::film::sums::{filter_margin, SumBuffer};
 use crate::film::window::PixelWindow;
@@ -37,28 +36,25 @@ use crate::integrator::wavefront::Wavefront;
 #[cfg(doc)]
 use crate::integrator::Supports;
 use crate::integrator::{
-    defaults, AuxSample, Context, Feature, Integrator, PathState, SettingsError, TraceStats,
+    AuxSample, Context, Feature, Integrator, PathState, SettingsError, TraceStats,
 };
 use crate::math::hash::hash2;
-use crate::sampler::{dims, PixelSampler, SampleId, SamplerKind};
+use crate::sampler::{dims, PixelSampler, SampleId};
 use crate::scene::Scene;
+use crate::settings::FrameSettings;
 use crate::world::World;
-pub use adaptive::{Adaptive, AdaptiveStats};
+pub use adaptive::AdaptiveStats;
 use adaptive::{Convergence, TileSums};
 pub use aux::{Aov, Aux, AuxImages, AuxSums};
 
-/// How to render.
+/// How to render: what the frame is ([`FrameSettings`], read as these
+/// settings' own fields) and how this render goes about it.
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels (the camera's aspect should be width/height).
-    pub height: u32,
-    /// Samples per pixel of the image.
-    pub spp: u32,
-    /// Samples per pixel of each progressive pass (at most `spp`); the last
-    /// pass takes what is left of `spp`.
-    pub pass_spp: u32,
+    /// What the frame is: size, samples per pixel and per pass, seed,
+    /// sampler, filter, integrator, adaptive sampling. With a time limit,
+    /// `spp` can be [`UNLIMITED_SPP`].
+    pub frame: FrameSettings,
     /// Stop starting passes after this long, even before `spp` samples; a
     /// pass under way when it runs out is abandoned (the first pass always
     /// completes). With a time limit, `spp` can be [`UNLIMITED_SPP`].
@@ -66,14 +62,6 @@ pub struct RenderSettings {
     /// Set to true (e.g. on Ctrl-C) to stop; the passes completed are kept,
     /// and if the first pass is under way, the pixels it has finished.
     pub cancel: Option<Arc<AtomicBool>>,
-    /// Seed of every random decision.
-    pub seed: u64,
-    /// Sample generator.
-    pub sampler: SamplerKind,
-    /// Reconstruction filter.
-    pub filter: Filter,
-    /// Light transport.
-    pub integrator: Integrator,
     /// Tile edge in pixels.
     pub tile_size: u32,
     /// Kd-tree build parameters for the meshes.
@@ -101,13 +89,55 @@ pub struct RenderSettings {
     pub part: bool,
     /// The render passes to make beside the beauty, the images a denoiser
     /// and compositing use ([`AuxImages`]; the integrators whose
-    /// [`Supports::aovs`] says so); empty: none.
+    /// [`Supports::aovs`] says so); empty: none. Adaptive sampling
+    /// ([`FrameSettings::adaptive`]) needs an integrator that supports it
+    /// ([`Supports::adaptive`]), and not with `samples` other than
+    /// `0..spp` (a pixel's decisions need all its samples).
     pub aovs: Vec<Aov>,
-    /// Adaptive sampling: pixels stop once their noise is low enough, and
-    /// `spp` is a cap (None: every pixel takes `spp`). Needs an integrator
-    /// that supports it ([`Supports::adaptive`]), and not with `samples`
-    /// other than `0..spp` (a pixel's decisions need all its samples).
-    pub adaptive: Option<Adaptive>,
+}
+
+/// The renderer reads the frame's settings as its own (`settings.spp`):
+/// they are the settings of every render, kept in one struct so that a
+/// scene file, a part file and a caller describe them once.
+impl std::ops::Deref for RenderSettings {
+    type Target = FrameSettings;
+
+    fn deref(&self) -> &FrameSettings {
+        &self.frame
+    }
+}
+
+impl std::ops::DerefMut for RenderSettings {
+    fn deref_mut(&mut self) -> &mut FrameSettings {
+        &mut self.frame
+    }
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            frame: FrameSettings::default(),
+            time_limit: None,
+            cancel: None,
+            tile_size: 32,
+            build: BuildParams::default(),
+            cost_scale: None,
+            window: None,
+            samples: None,
+            part: false,
+            aovs: Vec::new(),
+        }
+    }
+}
+
+impl From<FrameSettings> for RenderSettings {
+    /// A render of the whole frame `frame` with the defaults for the rest.
+    fn from(frame: FrameSettings) -> Self {
+        Self {
+            frame,
+            ..Default::default()
+        }
+    }
 }
 
 /// The `spp` of a render bounded by its time limit only.
@@ -164,31 +194,6 @@ impl RenderSettings {
             self.integrator.kind().require(Feature::Media)?;
         }
         Ok(())
-    }
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self {
-            width: 512,
-            height: 512,
-            spp: defaults::SPP,
-            pass_spp: defaults::PASS_SPP,
-            time_limit: None,
-            cancel: None,
-            seed: 0,
-            sampler: SamplerKind::Sobol,
-            filter: Filter::default(),
-            integrator: Integrator::default(),
-            tile_size: 32,
-            build: BuildParams::default(),
-            cost_scale: None,
-            window: None,
-            samples: None,
-            part: false,
-            aovs: Vec::new(),
-            adaptive: None,
-        }
     }
 }
 
