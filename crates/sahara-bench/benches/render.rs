@@ -78,7 +78,10 @@ fn kit(c: &mut Criterion) {
                 continue;
             }
         };
-        let file = assembled.settings.expect("a scene file's settings");
+        let file = assembled
+            .settings
+            .expect("a scene file's settings")
+            .frame_settings();
         let mut scene = assembled.scene;
         scene.camera.aspect = 1.0;
         let settings = RenderSettings::from(FrameSettings {

@@ -74,8 +74,8 @@ macro_rules! layered {
 
         impl $layer {
             /// This layer under `above`: every setting `above` gives
-            /// replaces (or, for a [`Choice`]($crate::Choice), combines
-            /// with) this one's.
+            /// replaces this one's (or, for a setting held as a `Choice`,
+            /// combines with it).
             pub fn apply(self, above: Self) -> Self {
                 Self {
                     $( $field: $crate::layered!(@over self.$field, above.$field $(, $choice)?), )*

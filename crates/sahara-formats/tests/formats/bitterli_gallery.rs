@@ -267,7 +267,7 @@ fn scene_file(case: &Case) -> Option<PathBuf> {
 /// Sahara's image of `a` as `sahara render FILE --width W --height H --spp N
 /// --seed 0` makes it.
 fn render_image(a: &AssembledScene, case: &Case) -> Vec<Vec3> {
-    let s = a.settings.as_ref().unwrap();
+    let s = a.settings.as_ref().unwrap().frame_settings();
     let mut scene = a.scene.clone();
     scene.camera.aspect = case.width as f32 / case.height as f32;
     let settings = RenderSettings::from(FrameSettings {

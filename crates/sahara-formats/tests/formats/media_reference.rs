@@ -49,7 +49,7 @@ fn errors(name: &str, text: &str, seed: u64) -> (Vec3, f32, f32) {
     };
     assert!(loaded.warnings.is_empty(), "{name}: {:?}", loaded.warnings);
     assert!(loaded.scene.has_media(), "{name}");
-    let s = loaded.settings.as_ref().unwrap();
+    let s = loaded.settings.as_ref().unwrap().frame_settings();
     assert_eq!((s.width, s.height), (w, h));
     let settings = RenderSettings::from(FrameSettings {
         width: s.width,

@@ -81,7 +81,7 @@ fn load(path: &Path, scenes: &Path) -> Loaded {
 /// Sahara's image of `a` at `spp` (the file's size, filter, sampler and
 /// integrator).
 fn render_image(a: &Loaded, spp: u32) -> Vec<Vec3> {
-    let s = a.settings.as_ref().unwrap();
+    let s = a.settings.as_ref().unwrap().frame_settings();
     let mut scene = a.scene.clone();
     scene.camera.aspect = s.width as f32 / s.height as f32;
     let settings = RenderSettings::from(FrameSettings {
