@@ -9,17 +9,12 @@
 mod bench;
 mod cli;
 mod demo_scene;
-mod denoise;
 mod human;
-mod id_names;
 mod input;
-mod memory;
 mod merge;
-mod output;
-mod part;
 mod render;
-mod render_options;
 mod scene_input;
+mod setting_args;
 mod stats;
 mod warnings;
 

@@ -112,34 +112,40 @@ class _Bar:
 def render(
     scene: Union[Scene, PathLike],
     *,
-    spp: Optional[int] = None,
-    width: Optional[int] = None,
-    height: Optional[int] = None,
-    integrator: Optional[str] = None,
-    seed: Optional[int] = None,
-    threads: Optional[int] = None,
-    aovs: Optional[Sequence[str]] = None,
-    denoise: bool = False,
     progress: Union[bool, Callable[[int, int], Any]] = True,
-    sampler: Optional[str] = None,
-    filter: Optional[str] = None,
-    pass_spp: Optional[int] = None,
-    builder: Optional[str] = None,
+    threads: Optional[int] = None,
+    **settings: Any,
 ) -> Union[np.ndarray, Tuple[np.ndarray, Dict[str, np.ndarray]]]:
-    """Renders a scene (a ``Scene`` or a file's path) as ``sahara render``
-    does: the arguments given override the file's settings, which override
-    the defaults (512 x 512, 64 spp, the path tracer, seed 0); the same
-    arguments give the same image, bit for bit, as the command line.
+    """Renders a scene (a ``Scene`` or a file's path) through the request
+    ``sahara render`` makes: the settings given override the file's
+    settings, which override the defaults (512 x 512, 64 spp, the path
+    tracer, seed 0); the same settings give the same image, bit for bit,
+    as the command line, and with ``output`` the same file.
 
-    Returns the linear RGB image, a float32 array (height, width, 3); with
-    ``aovs`` (any of ``albedo``, ``normal``, ``depth``, ``position``,
-    ``uv``, ``variance``, ``object``, ``material``) a pair ``(image,
-    passes)`` whose dict holds one array per pass. ``denoise`` runs Intel
-    Open Image Denoise (``pip install pyoidn``). ``progress``: a bar on
-    stderr (True), none (False), or a function called with (tiles done,
-    tiles in all). The GIL is released while rendering on ``threads``
-    threads (None: all); Ctrl-C stops the render after the tiles under way
-    and raises ``KeyboardInterrupt``.
+    The settings are the command line's render options as keywords
+    (``sahara.names()["setting"]`` lists them): ``spp``, ``width``,
+    ``height``, ``integrator``, ``sampler``, ``filter``, ``seed``,
+    ``pass_spp``, ``builder``; ``noise_threshold`` and ``min_spp``
+    (adaptive sampling); ``time_limit`` (seconds: without ``spp`` the
+    passes go on until it is up); ``aovs`` (any of ``albedo``, ``normal``,
+    ``depth``, ``position``, ``uv``, ``variance``, ``object``,
+    ``material``); ``denoise`` (Intel Open Image Denoise, ``pip install
+    pyoidn``); ``output`` (a ``.png`` or ``.exr`` file written as the
+    command line writes it, with ``exposure`` and ``tonemap``); ``part``
+    (``(i, n)``), ``split`` (``"tiles"`` or ``"samples"``), ``crop``
+    (``(x0, x1, y0, y1)``) and ``samples`` (``(start, end)``): a piece of
+    the frame, its ``output`` a part file for ``sahara merge``.
+
+    Returns the linear RGB image, a float32 array (height, width, 3), of
+    the crop window or piece if one is asked for; with ``aovs`` a pair
+    ``(image, passes)`` whose dict holds one array per pass.
+    ``progress``: a bar on stderr (True), none (False), or a function
+    called with (tiles done, tiles in all). The GIL is released while
+    rendering on ``threads`` threads (None: all); Ctrl-C stops the render
+    after the tiles under way and raises ``KeyboardInterrupt``. A setting
+    out of range raises ``ValueError``, of the wrong type ``TypeError``, a
+    render larger than the memory available ``MemoryError``, each naming
+    what is at fault.
     """
     if not isinstance(scene, Scene):
         scene = load(scene)
@@ -152,26 +158,11 @@ def render(
     else:
         callback = None
     try:
-        image, passes = _sahara.render(
-            scene,
-            spp=spp,
-            width=width,
-            height=height,
-            integrator=integrator,
-            seed=seed,
-            threads=threads,
-            aovs=list(aovs) if aovs else None,
-            denoise=denoise,
-            sampler=sampler,
-            filter=filter,
-            pass_spp=pass_spp,
-            builder=builder,
-            progress=callback,
-        )
+        image, passes = _sahara.render(scene, threads=threads, progress=callback, **settings)
     finally:
         if bar is not None:
             bar.close()
-    return (image, passes) if aovs else image
+    return (image, passes) if settings.get("aovs") else image
 
 
 def write(
