@@ -70,9 +70,7 @@ pub use assembly::camera::AUTO_VFOV_DEG;
 
 /// What a scene file (or a caller) asks of a render, one layer of
 /// settings; a file's crop; what lights a scene besides its own lights.
-pub use description::{
-    FileCrop, OutputLayer, OutputSettings, PieceLayer, SettingsLayer, Sky, Split,
-};
+pub use description::{FileCrop, PieceLayer, SettingsLayer, Sky, Split};
 
 // Mesh files.
 
@@ -120,10 +118,11 @@ pub use request::{
     RequestError, Setting, Spelling, Takes, Written, SETTINGS,
 };
 
-/// A rendered frame's image written out, the checks on its path, and the
-/// list of names of its id passes.
+/// How a rendered frame is written, its image written out, the checks on
+/// its path, and the list of names of its id passes.
 pub use output::frame::{
-    check_output, names_json, names_path, partial_path, write_names_beside, FrameImage,
+    check_output, names_path, partial_path, write_names_beside, FrameImage, OutputLayer,
+    OutputSettings,
 };
 
 /// Every error of this crate: one line naming the file and the place.

@@ -15,7 +15,7 @@ use std::ops::Range;
 use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
-use sahara_formats::request::denoise;
+use sahara_formats::request::{denoise, GUIDES};
 use sahara_formats::{check_output, read_part, read_part_info, write_names_beside, PartInfo};
 use sahara_formats::{Denoised, FrameImage};
 use sahara_render::{
@@ -40,8 +40,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     check_one_frame(&parts)?;
     let first = &parts[0].1;
     let denoise_it = args.denoise || first.output.denoise;
-    let guides = [Aov::Albedo, Aov::Normal];
-    if denoise_it && !guides.iter().all(|a| first.passes.contains(a)) {
+    if denoise_it && !GUIDES.iter().all(|a| first.passes.contains(a)) {
         bail!(
             "--denoise: the parts hold no albedo and normal for the denoiser: render them with \
              --denoise (or --aov albedo,normal)"
@@ -357,49 +356,9 @@ fn range(r: &Range<u32>) -> String {
 fn check_coverage(parts: &[(PathBuf, PartInfo)]) -> Result<u32> {
     let first = &parts[0].1;
     let (w, h, spp) = (first.frame.width, first.frame.height, first.frame.spp);
-    // The frame cut along every part's window edges: each cell is held by
-    // the same parts throughout.
-    let cuts = |edges: &mut Vec<u32>| {
-        edges.sort_unstable();
-        edges.dedup();
-    };
-    let held: Vec<usize> = (0..parts.len())
-        .filter(|&k| !parts[k].1.window.is_empty() && !parts[k].1.samples.is_empty())
-        .collect();
-    let mut xs = vec![0, w];
-    let mut ys = vec![0, h];
-    for &k in &held {
-        let win = parts[k].1.window;
-        xs.extend([win.x0, win.x1]);
-        ys.extend([win.y0, win.y1]);
-    }
-    cuts(&mut xs);
-    cuts(&mut ys);
+    let (xs, ys, cells) = cut_frame(parts, w, h);
     let (nx, ny) = (xs.len() - 1, ys.len() - 1);
-    let mut cells: Vec<Vec<usize>> = vec![Vec::new(); nx * ny];
-    for &k in &held {
-        let win = parts[k].1.window;
-        let ix0 = xs.binary_search(&win.x0).expect("an edge");
-        let ix1 = xs.binary_search(&win.x1).expect("an edge");
-        let iy0 = ys.binary_search(&win.y0).expect("an edge");
-        let iy1 = ys.binary_search(&win.y1).expect("an edge");
-        for iy in iy0..iy1 {
-            for ix in ix0..ix1 {
-                cells[iy * nx + ix].push(k);
-            }
-        }
-    }
-    // Tile grids the parts came from, to name a missing cell by its tile.
-    let mut grids: Vec<u32> = parts
-        .iter()
-        .filter_map(|(_, i)| {
-            let (_, rest) = i.part.split_once('/')?;
-            let (n, how) = rest.split_once(' ')?;
-            (how == "tiles").then(|| n.parse().ok()).flatten()
-        })
-        .collect();
-    grids.sort_unstable();
-    grids.dedup();
+    let grids = tile_grids(parts);
     let full = PixelWindow::full(w, h);
     let name_cell = |cell: &PixelWindow| {
         for &n in &grids {
@@ -463,6 +422,64 @@ fn check_coverage(parts: &[(PathBuf, PartInfo)]) -> Result<u32> {
         );
     }
     Ok(fewest)
+}
+
+/// The frame cut along every part's window edges, so that each cell is
+/// held by the same parts throughout: the cuts along x and y, and each
+/// cell's parts (rows of cells, top to bottom). Parts without pixels or
+/// samples hold none.
+fn cut_frame(
+    parts: &[(PathBuf, PartInfo)],
+    w: u32,
+    h: u32,
+) -> (Vec<u32>, Vec<u32>, Vec<Vec<usize>>) {
+    let cuts = |edges: &mut Vec<u32>| {
+        edges.sort_unstable();
+        edges.dedup();
+    };
+    let held: Vec<usize> = (0..parts.len())
+        .filter(|&k| !parts[k].1.window.is_empty() && !parts[k].1.samples.is_empty())
+        .collect();
+    let mut xs = vec![0, w];
+    let mut ys = vec![0, h];
+    for &k in &held {
+        let win = parts[k].1.window;
+        xs.extend([win.x0, win.x1]);
+        ys.extend([win.y0, win.y1]);
+    }
+    cuts(&mut xs);
+    cuts(&mut ys);
+    let nx = xs.len() - 1;
+    let mut cells: Vec<Vec<usize>> = vec![Vec::new(); nx * (ys.len() - 1)];
+    for &k in &held {
+        let win = parts[k].1.window;
+        let ix0 = xs.binary_search(&win.x0).expect("an edge");
+        let ix1 = xs.binary_search(&win.x1).expect("an edge");
+        let iy0 = ys.binary_search(&win.y0).expect("an edge");
+        let iy1 = ys.binary_search(&win.y1).expect("an edge");
+        for iy in iy0..iy1 {
+            for ix in ix0..ix1 {
+                cells[iy * nx + ix].push(k);
+            }
+        }
+    }
+    (xs, ys, cells)
+}
+
+/// The tile grids the parts came from (`I/N tiles`), to name a missing
+/// cell by its tile.
+fn tile_grids(parts: &[(PathBuf, PartInfo)]) -> Vec<u32> {
+    let mut grids: Vec<u32> = parts
+        .iter()
+        .filter_map(|(_, i)| {
+            let (_, rest) = i.part.split_once('/')?;
+            let (n, how) = rest.split_once(' ')?;
+            (how == "tiles").then(|| n.parse().ok()).flatten()
+        })
+        .collect();
+    grids.sort_unstable();
+    grids.dedup();
+    grids
 }
 
 /// The parts in groups whose windows overlap (transitively); parts without

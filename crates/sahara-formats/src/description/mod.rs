@@ -33,7 +33,7 @@ use sahara_render::{
     Camera, Environment, Light, Material, Medium, MediumInterface, SceneMesh, Shape, Srt,
 };
 
-pub use settings::{FileCrop, OutputLayer, OutputSettings, PieceLayer, SettingsLayer, Split};
+pub use settings::{FileCrop, PieceLayer, SettingsLayer, Split};
 
 /// A scene as a file describes it, before assembly.
 #[derive(Clone, Debug)]

@@ -10,30 +10,9 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use sahara_kd::Builder;
-use sahara_render::{layered, Aov, FrameLayer, FrameSettings, PixelWindow, ToneMap};
+use sahara_render::{FrameLayer, FrameSettings, PixelWindow};
 
-layered! {
-    /// How a frame is written out: the look of an 8-bit image, the render
-    /// passes beside it, and whether it is denoised. A render's output
-    /// and a farm's part files both carry it.
-    pub struct OutputSettings;
-    /// Some of how a frame is written, as a scene file or a caller gives
-    /// it (`None`: not given).
-    pub struct OutputLayer;
-    {
-        /// Exposure in stops for 8-bit output (pixels scaled by
-        /// `2^exposure`).
-        exposure: f32 = 0.0;
-        /// Tone map for 8-bit output.
-        tonemap: ToneMap = ToneMap::Clamp;
-        /// Render passes written beside the beauty, as layers of an EXR
-        /// (sorted, each once, once decided by the request).
-        aovs: Vec<Aov> = Vec::new();
-        /// Denoise the image with Intel Open Image Denoise, guided by the
-        /// albedo and normal of what each pixel sees.
-        denoise: bool = false;
-    }
-}
+use crate::output::frame::OutputLayer;
 
 /// The settings of a render as one layer gives them: the scene file's,
 /// the caller's (the command line's options, Python's keyword arguments)

@@ -1,8 +1,8 @@
-//! A rendered frame written out: the image (PNG or EXR, atomically, with
-//! its metadata and render passes as layers), the checks on its path
-//! made before anything is loaded or rendered, the rule that keeps a
-//! complete image from being replaced by a partial one, and the list of
-//! names beside the `object` and `material` passes. `sahara render`,
+//! A rendered frame written out: how ([`OutputSettings`]), the image (PNG
+//! or EXR, atomically, with its metadata and render passes as layers),
+//! the checks on its path made before anything is loaded or rendered, the
+//! rule that keeps a complete image from being replaced by a partial one,
+//! and the list of names beside the `object` and `material` passes. `sahara render`,
 //! `sahara merge` and the Python package's `render` write through here.
 
 use std::io::Write;
@@ -10,12 +10,34 @@ use std::path::{Path, PathBuf};
 
 use sahara_readers::FormatError;
 use sahara_render::{Aov, AuxImages, FrameSettings, Integrator, Named, RenderResult};
-use serde_json::{Map, Value};
+
+use sahara_render::{layered, ToneMap};
 
 use super::atomic::{check_writable, write_atomically};
 use super::image::{write_exr_layers, write_image, ExrLayer, ImageFormat, Pixels};
-use crate::assembly::SceneNames;
-use crate::description::OutputSettings;
+
+layered! {
+    /// How a frame is written out: the look of an 8-bit image, the render
+    /// passes beside it, and whether it is denoised. A render's output
+    /// and a farm's part files both carry it.
+    pub struct OutputSettings;
+    /// Some of how a frame is written, as a scene file or a caller gives
+    /// it (`None`: not given).
+    pub struct OutputLayer;
+    {
+        /// Exposure in stops for 8-bit output (pixels scaled by
+        /// `2^exposure`).
+        exposure: f32 = 0.0;
+        /// Tone map for 8-bit output.
+        tonemap: ToneMap = ToneMap::Clamp;
+        /// Render passes written beside the beauty, as layers of an EXR
+        /// (sorted, each once, once decided by the request).
+        aovs: Vec<Aov> = Vec::new();
+        /// Denoise the image with Intel Open Image Denoise, guided by the
+        /// albedo and normal of what each pixel sees.
+        denoise: bool = false;
+    }
+}
 
 /// Checks, before anything is loaded or rendered, that `path` names an
 /// image Sahara writes (`.png` or `.exr`, or `.exr` only for a part) in a
@@ -271,52 +293,6 @@ fn depth_to_gray8(rgb: &[f32], range: Option<(f32, f32)>) -> Vec<u8> {
         .collect()
 }
 
-/// The list of names of the `object` and `material` passes among `aovs`
-/// (None: neither asked for): a JSON file next to the image
-/// (`frame.exr` -> `frame.names.json`) that says what each id is,
-///
-/// ```json
-/// { "object": { "1": "bunny.ply", "2": "sphere 3" }, "material": { "1": "gold" } }
-/// ```
-///
-/// Ids are the scene's instance and material index + 1 (0, nothing hit,
-/// is not listed). Pure ASCII: other characters are written as JSON
-/// escapes, so the text also fits an EXR header (a part file carries it,
-/// and `merge` writes it beside the merged frame).
-pub fn names_json(names: &SceneNames, aovs: &[Aov]) -> Option<String> {
-    let table = |list: &[String]| {
-        let map: Map<String, Value> = list
-            .iter()
-            .enumerate()
-            .map(|(k, n)| ((k + 1).to_string(), Value::String(n.clone())))
-            .collect();
-        Value::Object(map)
-    };
-    let mut out = Map::new();
-    if aovs.contains(&Aov::Object) {
-        out.insert("object".into(), table(&names.objects));
-    }
-    if aovs.contains(&Aov::Material) {
-        out.insert("material".into(), table(&names.materials));
-    }
-    if out.is_empty() {
-        return None;
-    }
-    let text = serde_json::to_string_pretty(&Value::Object(out)).expect("JSON of strings");
-    let mut ascii = String::with_capacity(text.len());
-    for c in text.chars() {
-        if c.is_ascii() {
-            ascii.push(c);
-        } else {
-            let mut units = [0u16; 2];
-            for u in c.encode_utf16(&mut units) {
-                ascii += &format!("\\u{u:04x}");
-            }
-        }
-    }
-    Some(ascii + "\n")
-}
-
 /// Where the list of names of the image `image` goes.
 pub fn names_path(image: &Path) -> PathBuf {
     let stem = image
@@ -369,25 +345,6 @@ mod tests {
         let none = image(4, 4, |_, _| 0.0);
         assert_eq!(depth_range(&none, 4, 4), None);
         assert!(depth_to_gray8(&none, None).iter().all(|&v| v == 0));
-    }
-
-    #[test]
-    fn ids_count_from_one_and_the_text_is_ascii() {
-        let names = SceneNames {
-            objects: vec!["bunny.ply".into(), "tête".into()],
-            materials: vec!["gold".into()],
-        };
-        let text = names_json(&names, &[Aov::Object]).unwrap();
-        assert!(text.is_ascii(), "{text}");
-        let v: Value = serde_json::from_str(&text).unwrap();
-        assert_eq!(v["object"]["1"], "bunny.ply");
-        assert_eq!(v["object"]["2"], "tête");
-        assert!(v.get("material").is_none());
-        assert_eq!(names_json(&names, &[Aov::Depth]), None);
-        assert_eq!(
-            names_path(Path::new("out/frame.exr")),
-            Path::new("out/frame.names.json")
-        );
     }
 
     #[test]

@@ -33,8 +33,8 @@ use sahara_render::{
     Named, Parameter, PixelSum, PixelWindow, SumBuffer,
 };
 
-use crate::description::OutputSettings;
 use crate::output::atomic::write_atomically;
+use crate::output::frame::OutputSettings;
 
 /// The value of `sahara:format` in a part file.
 const FORMAT: &str = "sahara render part 2";

@@ -38,9 +38,9 @@ use crate::common::mesh::smooth_normals;
 use crate::common::tint::with_opacity;
 use crate::common::warnings::Warnings;
 use crate::description::{
-    CameraRequest, FileCrop, Geometry, Object, ObjectPlacement, OutputLayer, SceneDescription,
-    SettingsLayer,
+    CameraRequest, FileCrop, Geometry, Object, ObjectPlacement, SceneDescription, SettingsLayer,
 };
+use crate::output::frame::OutputLayer;
 
 /// Deepest chain of `mix` materials followed.
 const MAX_MIX_DEPTH: usize = 16;

@@ -5,9 +5,13 @@
 use std::time::Instant;
 
 use sahara_denoise::{Aux, Denoiser, Image};
-use sahara_render::{RenderResult, Scene};
+use sahara_render::{Aov, RenderResult, Scene};
 
 use crate::output::frame::flat;
+
+/// The render passes that guide the denoiser: a denoised render makes
+/// them, and a farm's parts carry them for `sahara merge` to denoise.
+pub const GUIDES: [Aov; 2] = [Aov::Albedo, Aov::Normal];
 
 /// True where a pixel's samples see different surfaces beyond its edges:
 /// through a lens that blurs (depth of field) or while things move

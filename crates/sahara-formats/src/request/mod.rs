@@ -28,6 +28,7 @@
 mod denoise;
 mod error;
 pub mod memory;
+mod names;
 mod piece;
 mod table;
 
@@ -38,19 +39,20 @@ use std::sync::Arc;
 use sahara_denoise::Denoiser;
 use sahara_kd::BuildParams;
 use sahara_render::{
-    frame_digest, Aov, Feature, Filter, FilterKind, Pick, RenderResult, RenderSettings, Scene,
-    SettingsError, UNLIMITED_SPP,
+    frame_digest, Feature, Filter, FilterKind, FrameSettings, Pick, PixelWindow, RenderResult,
+    RenderSettings, Scene, SettingsError, UNLIMITED_SPP,
 };
 
-pub use denoise::{denoise, guides_are_noisy, Denoised};
+pub use denoise::{denoise, guides_are_noisy, Denoised, GUIDES};
 pub use error::{Asked, RequestError, Spelling};
 pub use piece::{existing_part_differs, Piece};
 pub use table::{Given, Refused, Setting, Takes, MAX_SIDE, MAX_SPP, SETTINGS};
 
-use crate::description::{OutputSettings, SettingsLayer, Split};
+use crate::description::{SettingsLayer, Split};
 use crate::load::Loaded;
-use crate::output::frame::FrameImage;
-use crate::output::frame::{check_output, is_exr, names_json, partial_path, write_names_beside};
+use crate::output::frame::{check_output, is_exr, partial_path, write_names_beside};
+use crate::output::frame::{FrameImage, OutputSettings};
+pub use names::names_json;
 
 /// What a caller asks of a loaded scene.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -169,35 +171,8 @@ impl Request {
         let layer = SettingsLayer::default()
             .apply(file.unwrap_or_default())
             .apply(caller.clone());
-        let mut frame = layer.frame.clone().decided();
-        frame.pass_spp = frame.pass_spp.min(frame.spp);
-        if let Some(a) = layer.frame.adaptive.filter(|a| a.threshold.is_none()) {
-            if a.min_spp.is_some() {
-                return Err(RequestError::refused(
-                    Asked::Caller("min_spp", None),
-                    "needs a noise threshold (noise_threshold) to ask for adaptive sampling",
-                ));
-            }
-        }
-        let mut output = layer.output.clone().decided();
-        output.aovs.sort();
-        output.aovs.dedup();
-        let file_window = match layer.crop_window {
-            None => None,
-            Some(c) => {
-                let w = c.window(frame.width, frame.height);
-                if w.is_empty() {
-                    return Err(RequestError::refused(
-                        Asked::File("crop window"),
-                        format!(
-                            "holds no pixel of the {}x{} image",
-                            frame.width, frame.height
-                        ),
-                    ));
-                }
-                Some(w)
-            }
-        };
+        let (mut frame, output) = decide(&layer)?;
+        let file_window = file_window(&layer, &frame)?;
         let piece = piece::plan(
             &layer.piece,
             (frame.width, frame.height, frame.spp),
@@ -210,7 +185,7 @@ impl Request {
         }
         let mut aovs = output.aovs.clone();
         if output.denoise {
-            aovs.extend([Aov::Albedo, Aov::Normal]);
+            aovs.extend(GUIDES);
         }
         aovs.sort();
         aovs.dedup();
@@ -401,6 +376,49 @@ impl Plan {
         }
         Ok(Written::Image(path, said))
     }
+}
+
+/// The frame's and the output's settings the folded `layer` decides: the
+/// defaults where no layer gave one, passes of at most `spp` samples, the
+/// passes written sorted, each once. A minimum of samples without a noise
+/// threshold asks for nothing: refused.
+fn decide(layer: &SettingsLayer) -> Result<(FrameSettings, OutputSettings), RequestError> {
+    if let Some(a) = layer.frame.adaptive.filter(|a| a.threshold.is_none()) {
+        if a.min_spp.is_some() {
+            return Err(RequestError::refused(
+                Asked::Caller("min_spp", None),
+                "needs a noise threshold (noise_threshold) to ask for adaptive sampling",
+            ));
+        }
+    }
+    let mut frame = layer.frame.clone().decided();
+    frame.pass_spp = frame.pass_spp.min(frame.spp);
+    let mut output = layer.output.clone().decided();
+    output.aovs.sort();
+    output.aovs.dedup();
+    Ok((frame, output))
+}
+
+/// The pixels of the scene file's crop window in `frame`, if it has one:
+/// a plain render is an image of those pixels, as pbrt writes it.
+fn file_window(
+    layer: &SettingsLayer,
+    frame: &FrameSettings,
+) -> Result<Option<PixelWindow>, RequestError> {
+    let Some(crop) = layer.crop_window else {
+        return Ok(None);
+    };
+    let w = crop.window(frame.width, frame.height);
+    if w.is_empty() {
+        return Err(RequestError::refused(
+            Asked::File("crop window"),
+            format!(
+                "holds no pixel of the {}x{} image",
+                frame.width, frame.height
+            ),
+        ));
+    }
+    Ok(Some(w))
 }
 
 /// Render passes are layers of an EXR: refused for any other output.

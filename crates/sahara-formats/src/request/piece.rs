@@ -9,7 +9,8 @@ use sahara_render::{crop, sample_range, tile, PixelWindow};
 use sahara_render::{Aov, Aux, AuxImages, RenderResult, RenderSettings, SumBuffer};
 
 use super::error::{Asked, RequestError};
-use crate::description::{OutputSettings, PieceLayer, Split};
+use crate::description::{PieceLayer, Split};
+use crate::output::frame::OutputSettings;
 use crate::output::part::{read_part_info, write_part, PartInfo, PartSums};
 
 /// A piece of a frame: its pixels and its samples.

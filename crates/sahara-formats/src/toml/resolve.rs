@@ -14,7 +14,8 @@ use toml::Spanned;
 
 use super::file::*;
 use super::raw::*;
-use crate::description::{OutputLayer, SettingsLayer, Sky};
+use crate::description::{SettingsLayer, Sky};
+use crate::output::frame::OutputLayer;
 use crate::output::image::ImageFormat;
 
 mod kinds;

@@ -10,7 +10,8 @@ use sahara_render::{
     ToneMap,
 };
 
-use crate::description::{OutputLayer, SettingsLayer};
+use crate::description::SettingsLayer;
+use crate::output::frame::OutputLayer;
 
 use super::test_helpers::TempDir;
 
