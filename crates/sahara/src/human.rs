@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use sahara_bench::report::{BenchReport, StatsReport};
+use sahara_bench::report::{BenchReport, SetReport, StatsReport};
 
 /// `1234567` as `1,234,567`.
 pub fn thousands(n: u64) -> String {
@@ -55,6 +55,19 @@ batch: the whole set in one batch call on 1 thread; packets: 8- or 16-ray
 /// The header and one table row per set.
 pub fn bench_report(r: &BenchReport) -> String {
     let mut s = String::new();
+    bench_header(&mut s, r);
+    let _ = writeln!(s);
+    let entries = r.sets.entries();
+    bench_table(&mut s, r, &entries);
+    let _ = writeln!(s);
+    let _ = writeln!(s, "{}", BENCH_LEGEND.trim_end());
+    bench_counters(&mut s, &entries);
+    // Columns left empty (one thread) leave no trailing blanks.
+    s.lines().map(|l| l.trim_end().to_owned() + "\n").collect()
+}
+
+/// The report's header: the mesh, the camera, the tree and how it was timed.
+fn bench_header(s: &mut String, r: &BenchReport) {
     let _ = writeln!(s, "mesh       {}", r.mesh);
     let _ = writeln!(s, "triangles  {}", thousands(r.triangles as u64));
     if let Some(c) = &r.camera {
@@ -90,7 +103,10 @@ pub fn bench_report(r: &BenchReport) -> String {
         count(r.runs, "run"),
         count(r.threads, "thread")
     );
-    let _ = writeln!(s);
+}
+
+/// One row per set (and its batch and packet rows).
+fn bench_table(s: &mut String, r: &BenchReport, entries: &[(&str, &SetReport)]) {
     // With one thread the all-threads column would repeat the first.
     let many = r.threads > 1;
     let all = if many {
@@ -111,8 +127,7 @@ pub fn bench_report(r: &BenchReport) -> String {
         }
     };
     let dash = if many { "-" } else { "" };
-    let entries = r.sets.entries();
-    for (name, e) in &entries {
+    for (name, e) in entries {
         let _ = writeln!(
             s,
             "{:<8} {:>11} {:>11} {:>22.6} {:>11.3} {:>11.3} {}",
@@ -158,8 +173,11 @@ pub fn bench_report(r: &BenchReport) -> String {
             }
         }
     }
-    let _ = writeln!(s);
-    let _ = writeln!(s, "{}", BENCH_LEGEND.trim_end());
+}
+
+/// The traversal work per ray of the sets that counted it, beside the
+/// SAH's expectation.
+fn bench_counters(s: &mut String, entries: &[(&str, &SetReport)]) {
     if entries.iter().any(|(_, e)| e.counters.is_some()) {
         let _ = writeln!(s);
         let _ = writeln!(
@@ -171,7 +189,7 @@ pub fn bench_report(r: &BenchReport) -> String {
             "{:<8} {:>7} {:>17} {:>17} {:>19}",
             "set", "root %", "inner (SAH)", "leaves (SAH)", "triangles (SAH)"
         );
-        for (name, e) in &entries {
+        for (name, e) in entries {
             if let Some(c) = &e.counters {
                 let (i, l, t) = c.per_root_ray();
                 let _ = writeln!(
@@ -189,8 +207,6 @@ pub fn bench_report(r: &BenchReport) -> String {
             }
         }
     }
-    // Columns left empty (one thread) leave no trailing blanks.
-    s.lines().map(|l| l.trim_end().to_owned() + "\n").collect()
 }
 
 /// The statistics, one per line.
