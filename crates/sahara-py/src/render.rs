@@ -4,6 +4,7 @@
 //! defaults; interruptible from Python; images written by the same
 //! writer.
 
+use std::ffi::CString;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{mpsc, Arc};
@@ -12,13 +13,13 @@ use std::time::Duration;
 use glam::Vec3;
 use numpy::{PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::exceptions::{
-    PyFileNotFoundError, PyMemoryError, PyRuntimeError, PyTypeError, PyValueError,
+    PyFileNotFoundError, PyMemoryError, PyRuntimeError, PyTypeError, PyUserWarning, PyValueError,
 };
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use sahara_formats::{write_image, Pixels};
 use sahara_formats::{Given, Plan, Refused, Request, RequestError, Setting, SettingsLayer};
-use sahara_formats::{LoadOptions, Loaded, SceneNames, Spelling, SETTINGS};
+use sahara_formats::{LoadOptions, Loaded, Note, SceneNames, Spelling, SETTINGS};
 use sahara_render::{
     render_watched, Aov, AuxImages, Film, FilterKind, IntegratorKind, Named, Progress,
     RenderResult, SamplerKind, Scene as RenderScene, ToneMap,
@@ -237,6 +238,14 @@ pub fn render<'py>(
     request.check().map_err(request_error)?;
     let loaded = scene.loaded();
     let plan = py.detach(|| request.plan(loaded)).map_err(request_error)?;
+    // A setting that will not do what it seems to ask is a Python warning;
+    // what the plan decided goes unsaid, as a library says nothing.
+    for note in &plan.notes {
+        if let Note::Warning(line) = note {
+            let line = CString::new(line.as_str())?;
+            PyErr::warn(py, &py.get_type::<PyUserWarning>(), &line, 1)?;
+        }
+    }
     let mut result = run(py, &plan, threads, progress)?;
     let denoised = py
         .detach(|| plan.denoise(&mut result))

@@ -194,3 +194,9 @@ def test_an_exception_in_the_progress_function_stops_the_render():
 
     with pytest.raises(RuntimeError, match="stop here"):
         sahara.render(sahara.cornell_box(), width=128, height=128, spp=100000, progress=fail)
+
+
+def test_a_setting_that_cannot_do_what_it_asks_is_a_warning():
+    with pytest.warns(UserWarning, match="adaptive: every pixel takes all 4 samples"):
+        sahara.render(sahara.cornell_box(), width=8, height=8, spp=4, noise_threshold=0.1,
+                      progress=False)
