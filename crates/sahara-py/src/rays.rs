@@ -177,7 +177,8 @@ impl RayScene {
         out: Option<&Bound<'py, PyAny>>,
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (rays, snap) = self.rays_and_tree(py, origins, directions, tmin, tmax, threads)?;
+        let rays = RayArgs::extract(origins, directions, tmin, tmax)?;
+        let snap = self.snapshot(py, threads)?;
         let n = rays.n;
         let (dict, arrays) = match out {
             Some(o) if !o.is_none() => {
@@ -252,7 +253,8 @@ impl RayScene {
         tmax: Option<&Bound<'py, PyAny>>,
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyArray1<bool>>> {
-        let (rays, snap) = self.rays_and_tree(py, origins, directions, tmin, tmax, threads)?;
+        let rays = RayArgs::extract(origins, directions, tmin, tmax)?;
+        let snap = self.snapshot(py, threads)?;
         let out = PyArray1::<bool>::zeros(py, rays.n, false);
         {
             // SAFETY: as in `cast_rays`.
@@ -281,7 +283,8 @@ impl RayScene {
         tmax: Option<&Bound<'py, PyAny>>,
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyArray1<i32>>> {
-        let (rays, snap) = self.rays_and_tree(py, origins, directions, tmin, tmax, threads)?;
+        let rays = RayArgs::extract(origins, directions, tmin, tmax)?;
+        let snap = self.snapshot(py, threads)?;
         let out = PyArray1::<i32>::zeros(py, rays.n, false);
         {
             // SAFETY: as in `cast_rays`.
@@ -315,7 +318,8 @@ impl RayScene {
         max_hits: Option<usize>,
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (rays, snap) = self.rays_and_tree(py, origins, directions, tmin, tmax, threads)?;
+        let rays = RayArgs::extract(origins, directions, tmin, tmax)?;
+        let snap = self.snapshot(py, threads)?;
         let cap = max_hits.unwrap_or(usize::MAX);
         let view = rays.view();
         let n = rays.n;
@@ -469,22 +473,6 @@ impl RayScene {
         self.geometry
             .lock()
             .map_err(|_| PyRuntimeError::new_err("the scene was left broken by an earlier error"))
-    }
-
-    /// A query's rays, read from its arguments, and the tree to ask
-    /// ([`RayScene::snapshot`]).
-    #[allow(clippy::too_many_arguments)]
-    fn rays_and_tree<'py>(
-        &self,
-        py: Python<'py>,
-        origins: &Bound<'py, PyAny>,
-        directions: &Bound<'py, PyAny>,
-        tmin: Option<&Bound<'py, PyAny>>,
-        tmax: Option<&Bound<'py, PyAny>>,
-        threads: Option<usize>,
-    ) -> PyResult<(RayArgs<'py>, Snapshot)> {
-        let rays = RayArgs::extract(origins, directions, tmin, tmax)?;
-        Ok((rays, self.snapshot(py, threads)?))
     }
 
     /// `each(first, chunk)` for every chunk of a query of [`CHUNK`] rays

@@ -146,7 +146,7 @@ impl Request {
             ));
         }
         if let Some(path) = &c.path {
-            check_output(path, piece)?;
+            output_writable(path, piece)?;
             check_passes_output(c, path)?;
         }
         Ok(())
@@ -257,7 +257,7 @@ impl Request {
             .path
             .clone()
             .unwrap_or_else(|| PathBuf::from(format!("{name}.png")));
-        check_output(&path, piece)?;
+        output_writable(&path, piece)?;
         check_passes_output(&self.caller, &path)?;
         Ok(Some(path))
     }
@@ -419,6 +419,12 @@ fn file_window(
         ));
     }
     Ok(Some(w))
+}
+
+/// Refuses an output that cannot be written ([`check_output`]).
+fn output_writable(path: &std::path::Path, piece: bool) -> Result<(), RequestError> {
+    check_output(path, piece)
+        .map_err(|e| RequestError::File(format!("cannot write the output image: {e}")))
 }
 
 /// Render passes are layers of an EXR: refused for any other output.

@@ -34,12 +34,6 @@ pub(crate) fn plan(
     file_window: Option<PixelWindow>,
 ) -> Result<Option<Piece>, RequestError> {
     if !asked.is_piece() {
-        if let Some(how) = asked.split {
-            return Err(RequestError::refused(
-                Asked::Caller("split", Some(how.name())),
-                "applies to a part (with part)",
-            ));
-        }
         return Ok(None);
     }
     let mut window = match asked.crop {
