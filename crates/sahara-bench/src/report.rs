@@ -217,6 +217,10 @@ pub struct StatsReport {
     pub build_ms: f64,
     /// Builds timed.
     pub build_runs: usize,
+    /// Of the triangles given to the build ([`TreeStats::triangles`]),
+    /// those no ray can hit (a non-finite corner or zero area), which the
+    /// tree leaves out.
+    pub skipped_triangles: usize,
     /// The tree's statistics.
     #[serde(flatten)]
     pub tree: TreeStats,

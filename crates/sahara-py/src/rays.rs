@@ -315,9 +315,10 @@ impl RayScene {
         directions: &Bound<'py, PyAny>,
         tmin: Option<&Bound<'py, PyAny>>,
         tmax: Option<&Bound<'py, PyAny>>,
-        max_hits: Option<usize>,
+        max_hits: Option<&Bound<'py, PyAny>>,
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let max_hits = whole("max_hits", max_hits)?;
         let rays = RayArgs::extract(origins, directions, tmin, tmax)?;
         let snap = self.snapshot(py, threads)?;
         let cap = max_hits.unwrap_or(usize::MAX);
@@ -817,4 +818,28 @@ impl RayView<'_> {
             *r = self.ray(start + j);
         }
     }
+}
+
+/// `value` as a count (None stays None): what is not a whole number is a
+/// `TypeError`, a negative or too large one a `ValueError`, each naming
+/// the argument `name` (rather than the conversion's `OverflowError`).
+fn whole(name: &str, value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
+    let Some(v) = value.filter(|v| !v.is_none()) else {
+        return Ok(None);
+    };
+    if v.is_instance_of::<pyo3::types::PyBool>() || !v.hasattr("__index__")? {
+        return Err(PyTypeError::new_err(format!(
+            "{name} must be a whole number, not {}",
+            v.get_type().name()?
+        )));
+    }
+    let n = v.call_method0("__index__")?;
+    if n.lt(0)? {
+        return Err(PyValueError::new_err(format!(
+            "{name} must be at least 0, not {n}"
+        )));
+    }
+    n.extract::<usize>().map(Some).map_err(|_| {
+        PyValueError::new_err(format!("{name} must be at most {}, not {n}", usize::MAX))
+    })
 }

@@ -213,6 +213,9 @@ fn named<T: Named>(value: &str) -> PyResult<T> {
     T::from_name(value).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
+/// Most threads a render takes (the command line's `--threads` limit).
+const MAX_THREADS: i64 = 1024;
+
 /// Renders `scene` through the request `sahara render` makes: keyword
 /// arguments (the request's settings, `SETTINGS`) over the file's
 /// settings over the defaults, the same image for the same seed; with
@@ -227,10 +230,19 @@ fn named<T: Named>(value: &str) -> PyResult<T> {
 pub fn render<'py>(
     py: Python<'py>,
     scene: &Scene,
-    threads: Option<usize>,
+    threads: Option<i64>,
     progress: Option<Bound<'py, PyAny>>,
     settings: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<(Bound<'py, PyArray3<f32>>, Bound<'py, PyDict>)> {
+    let threads = match threads {
+        None => None,
+        Some(t @ 0..=MAX_THREADS) => Some(t as usize),
+        Some(t) => {
+            return Err(PyValueError::new_err(format!(
+                "threads: {t} is not in 0..={MAX_THREADS}"
+            )))
+        }
+    };
     let request = Request {
         caller: caller_settings(settings)?,
         write_by_default: false,
@@ -304,7 +316,7 @@ fn given(v: &Bound<'_, PyAny>) -> Result<Given, &'static str> {
         return Ok(Given::Flag(b.is_true()));
     }
     if let Ok(s) = v.cast::<PyString>() {
-        return Ok(Given::Text(s.to_string()));
+        return Ok(Given::Str(s.to_string()));
     }
     if let Ok(n) = v.extract::<i128>() {
         return Ok(Given::Whole(n));
@@ -313,7 +325,7 @@ fn given(v: &Bound<'_, PyAny>) -> Result<Given, &'static str> {
         return Ok(Given::Number(x));
     }
     if let Ok(p) = v.extract::<PathBuf>() {
-        return Ok(Given::Text(p.display().to_string()));
+        return Ok(Given::Str(p.display().to_string()));
     }
     if let Ok(items) = v.extract::<Vec<Bound<'_, PyAny>>>() {
         let items = items.iter().map(given).collect::<Result<_, _>>()?;

@@ -29,9 +29,9 @@
 //! instances' kd-trees); `world` (the scene prepared for tracing);
 //! `integrator` (light transport); `settings` (what a frame is, described
 //! once, and the layers of it a scene file or a caller gives); `render`
-//! (the render's settings, the loop of passes and tiles, the frame
-//! digest). See `docs/renderer.md` for the
-//! design.
+//! (the render's settings, the loop of passes, tiles and strips with the
+//! sample loops that trace a strip's samples, the frame digest). See
+//! `docs/renderer.md` for the design.
 
 #![deny(missing_docs)]
 

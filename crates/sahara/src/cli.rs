@@ -15,7 +15,8 @@ pub const DEFAULT_RUNS: usize = 3;
 /// Sahara: a ray tracer built around an SAH kd-tree.
 ///
 /// With no subcommand, renders the built-in Cornell box to
-/// `cornell_box.png` in the working folder (as `sahara render` would).
+/// `cornell_box.png` in the working folder (as `sahara render` would);
+/// options with no subcommand are `render`'s (`sahara -o out.png --spp 4`).
 #[derive(Debug, Parser)]
 #[command(name = "sahara", version, propagate_version = true)]
 pub struct Cli {

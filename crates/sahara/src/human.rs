@@ -209,6 +209,22 @@ fn bench_counters(s: &mut String, entries: &[(&str, &SetReport)]) {
     }
 }
 
+/// The triangles the trees hold: `given` less `skipped`, then `what` they
+/// are, and if any were skipped, how many of how many (`1 (1 of 2
+/// skipped: no ray can hit them)`).
+pub fn kept_triangles(given: u64, skipped: u64, what: &str) -> String {
+    let kept = thousands(given.saturating_sub(skipped));
+    if skipped == 0 {
+        format!("{kept}{what}")
+    } else {
+        format!(
+            "{kept}{what} ({} of {} skipped: no ray can hit them)",
+            thousands(skipped),
+            thousands(given)
+        )
+    }
+}
+
 /// The statistics, one per line.
 pub fn stats_report(r: &StatsReport) -> String {
     let t = &r.tree;
@@ -224,7 +240,10 @@ pub fn stats_report(r: &StatsReport) -> String {
                 count(r.build_runs, "build")
             ),
         ),
-        ("triangles", thousands(t.triangles as u64)),
+        (
+            "triangles",
+            kept_triangles(t.triangles as u64, r.skipped_triangles as u64, ""),
+        ),
         ("nodes", thousands(t.nodes as u64)),
         ("inner", thousands(t.inner as u64)),
         (

@@ -76,8 +76,10 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     let mut result = merged.result(first, spp);
     let denoised = match &denoiser {
         Some(d) => {
-            let done = denoise(d, &mut result, first.noisy_guides)
-                .map_err(|e| anyhow!("--denoise: {e}"))?;
+            let denoising = crate::status::Step::start("denoising");
+            let done = denoise(d, &mut result, first.noisy_guides);
+            drop(denoising);
+            let done = done.map_err(|e| anyhow!("--denoise: {e}"))?;
             if let Denoised::Done { seconds, .. } = &done {
                 eprintln!(
                     "denoised with Open Image Denoise {} in {seconds:.2} s, from {}",

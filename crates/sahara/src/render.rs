@@ -13,7 +13,7 @@
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -21,8 +21,9 @@ use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use sahara_formats::{existing_part_differs, Denoised, Note, Plan, Request, RequestError};
 use sahara_formats::{Spelling, Written};
+use sahara_render::internals::{render_world, World};
 use sahara_render::UNLIMITED_SPP;
-use sahara_render::{render_watched, Preview, Progress, RenderResult, RenderSettings};
+use sahara_render::{Preview, Progress, RenderResult, RenderSettings};
 
 use crate::cli::RenderArgs;
 use crate::scene_input::load_input;
@@ -81,7 +82,13 @@ pub fn run(args: &RenderArgs) -> Result<Finish> {
         return Ok(Finish::Done);
     }
     let mut result = render_frame(args, &plan)?;
-    let denoised = plan.denoise(&mut result).map_err(refused)?;
+    let denoising = plan
+        .denoiser
+        .is_some()
+        .then(|| crate::status::Step::start("denoising"));
+    let denoised = plan.denoise(&mut result);
+    drop(denoising);
+    let denoised = denoised.map_err(refused)?;
     match &denoised {
         Some(Denoised::Skipped) => eprintln!(
             "denoise: skipped, the first pass was stopped before every pixel was finished"
@@ -168,9 +175,19 @@ fn render_frame(args: &RenderArgs, plan: &Plan) -> Result<RenderResult> {
         .build()
         .context("cannot start the render threads")?;
     say_what_renders(plan, pool.current_num_threads());
+    // The trees and light tables, built before the bar is drawn so that a
+    // long build is said as such (a scene of millions of triangles takes
+    // seconds).
+    let start = Instant::now();
+    let mut world = pool.install(|| {
+        let _building = crate::status::Step::start("building the trees and light tables");
+        World::new(&plan.scene, &settings.build)
+    });
+    let build_time = start.elapsed();
     // Started after the lines above, so that it does not draw over them.
     let bar = progress_bar(settings);
-    let on_progress = progress_reporter(&bar, settings);
+    let said_progress = AtomicBool::new(false);
+    let on_progress = progress_reporter(&bar, settings, &said_progress);
     let preview_path = plan.path_for(true);
     let mut show_preview = |r: &RenderResult| {
         // A preview that cannot be written is a warning: the render goes on.
@@ -184,8 +201,25 @@ fn render_frame(args: &RenderArgs, plan: &Plan) -> Result<RenderResult> {
         every: Duration::from_secs_f64(t),
         show: &mut show_preview,
     });
-    let result = pool.install(|| render_watched(&plan.scene, settings, &on_progress, preview));
+    let result = pool.install(|| {
+        render_world(
+            &mut world,
+            settings,
+            &on_progress,
+            preview,
+            start,
+            build_time,
+        )
+    });
     bar.finish_and_clear();
+    if let (true, Ok(r)) = (said_progress.load(Ordering::Relaxed), &result) {
+        // The lines come every few seconds: the last of them may be short
+        // of the end, and a log should not end on `95.8% done`.
+        eprintln!(
+            "{}",
+            plain_closing_line(r.stats.passes, start.elapsed(), interrupted(plan, r))
+        );
+    }
     // The settings were checked by the plan.
     Ok(result?)
 }
@@ -233,10 +267,12 @@ fn say_what_renders(plan: &Plan, threads: usize) {
 }
 
 /// What the render calls after each tile: the bar moved, and where stderr
-/// is not a terminal (no bar is drawn there) a plain line now and then.
+/// is not a terminal (no bar is drawn there) a plain line now and then;
+/// `said` becomes true once one is printed.
 fn progress_reporter<'a>(
     bar: &'a ProgressBar,
     settings: &'a RenderSettings,
+    said: &'a AtomicBool,
 ) -> impl Fn(Progress) + Sync + 'a {
     let unlimited = settings.spp == UNLIMITED_SPP;
     let plain = !std::io::stderr().is_terminal();
@@ -258,6 +294,7 @@ fn progress_reporter<'a>(
             let mut last = last_line.lock().unwrap_or_else(|e| e.into_inner());
             if last.elapsed() >= every {
                 *last = Instant::now();
+                said.store(true, Ordering::Relaxed);
                 eprintln!(
                     "{}",
                     plain_progress_line(&p, unlimited, settings.time_limit)
@@ -494,6 +531,20 @@ fn plain_progress_line(p: &Progress, unlimited: bool, time_limit: Option<Duratio
     )
 }
 
+/// The plain progress line that closes a render's plain lines: `progress:
+/// 100.0% done, 00:01:05 elapsed, finished (4 passes)`, or for a render a
+/// signal stopped, `progress: stopped, 00:00:40 elapsed, 2 passes complete`.
+fn plain_closing_line(passes: u32, elapsed: Duration, interrupted: bool) -> String {
+    let s = elapsed.as_secs_f64().round() as u64;
+    let hms = format!("{:02}:{:02}:{:02}", s / 3600, s / 60 % 60, s % 60);
+    let passes_word = if passes == 1 { "pass" } else { "passes" };
+    if interrupted {
+        format!("progress: stopped, {hms} elapsed, {passes} {passes_word} complete")
+    } else {
+        format!("progress: 100.0% done, {hms} elapsed, finished ({passes} {passes_word})")
+    }
+}
+
 /// The time left, from the average rate since the start (`HH:MM:SS`), or
 /// `--:--:--` until 5% of the work or 3 seconds have passed. indicatif's
 /// own estimate follows the rate of the last few tiles, and the first
@@ -513,7 +564,7 @@ fn eta_text(pos: u64, len: Option<u64>, elapsed: Duration) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::{eta_text, plain_progress_line};
+    use super::{eta_text, plain_closing_line, plain_progress_line};
     use sahara_render::Progress;
     use std::time::Duration;
 
@@ -542,6 +593,18 @@ mod tests {
             plain_progress_line(&p, true, Some(Duration::from_secs(60))),
             "progress: 20.0% done, 00:00:12 elapsed, eta 00:00:48, 3.0 Mrays/s \
              (pass 2, tile 130/260 of this pass)"
+        );
+    }
+
+    #[test]
+    fn the_plain_lines_close_with_the_whole_render_done_or_stopped() {
+        assert_eq!(
+            plain_closing_line(4, Duration::from_secs(65), false),
+            "progress: 100.0% done, 00:01:05 elapsed, finished (4 passes)"
+        );
+        assert_eq!(
+            plain_closing_line(1, Duration::from_secs(40), true),
+            "progress: stopped, 00:00:40 elapsed, 1 pass complete"
         );
     }
 

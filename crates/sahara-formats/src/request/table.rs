@@ -19,8 +19,12 @@ use crate::description::{SettingsLayer, Split};
 /// Python value.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Given {
-    /// Text (every command-line value, a Python `str` or path).
+    /// Text a person typed (every command-line value): read as the
+    /// setting's kind, a number from its digits.
     Text(String),
+    /// A Python `str` or path: a name, a path or a value spelled as text
+    /// (a part `1/4`), but not a number (`spp="16"` is of the wrong kind).
+    Str(String),
     /// A whole number.
     Whole(i128),
     /// A number.
@@ -467,6 +471,7 @@ fn adaptive(l: &mut SettingsLayer) -> &mut AdaptiveChoice {
 fn kind_of(g: &Given) -> &'static str {
     match g {
         Given::Text(_) => "text",
+        Given::Str(_) => "str",
         Given::Whole(_) => "a whole number",
         Given::Number(_) => "a number",
         Given::Flag(_) => "a truth value",
@@ -477,7 +482,7 @@ fn kind_of(g: &Given) -> &'static str {
 /// Text.
 fn text(g: &Given) -> Result<&str, Refused> {
     match g {
-        Given::Text(t) => Ok(t),
+        Given::Text(t) | Given::Str(t) => Ok(t),
         other => Err(Refused::Type(format!(
             "expected text, got {}",
             kind_of(other)
@@ -531,7 +536,7 @@ fn named<T: Named>(g: &Given) -> Result<T, Refused> {
 /// Names of `T`'s table: a comma-separated text, or a list of names.
 fn names<T: Named>(g: &Given) -> Result<Vec<T>, Refused> {
     match g {
-        Given::Text(t) => t
+        Given::Text(t) | Given::Str(t) => t
             .split(',')
             .map(str::trim)
             .filter(|n| !n.is_empty())
@@ -559,7 +564,7 @@ fn switch(g: &Given) -> Result<bool, Refused> {
 /// The numbers of a list (or of a text split at `sep`).
 fn numbers(g: &Given, sep: &str) -> Option<Vec<f64>> {
     match g {
-        Given::Text(t) => t.split(sep).map(|p| p.trim().parse().ok()).collect(),
+        Given::Text(t) | Given::Str(t) => t.split(sep).map(|p| p.trim().parse().ok()).collect(),
         Given::List(items) => items.iter().map(|i| number(i).ok()).collect(),
         _ => None,
     }
@@ -619,7 +624,7 @@ fn sample_range(g: &Given) -> Result<Range<u32>, Refused> {
 /// A value as a message shows it.
 fn shown(g: &Given) -> String {
     match g {
-        Given::Text(t) => t.clone(),
+        Given::Text(t) | Given::Str(t) => t.clone(),
         Given::Whole(v) => v.to_string(),
         Given::Number(v) => v.to_string(),
         Given::Flag(b) => b.to_string(),

@@ -15,7 +15,10 @@ use std::time::Instant;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::{finish, Previews, Progress, RenderResult, RenderSettings, RenderStats};
+use super::result::{develop, RenderResult};
+use super::settings::RenderSettings;
+use super::stats::RenderStats;
+use super::watch::{Previews, Progress};
 use crate::cpu_time::process_cpu_time;
 use crate::film::sums::SumBuffer;
 use crate::film::window::PixelWindow;
@@ -89,7 +92,7 @@ pub(crate) fn render(
                 snapshot.spp = done;
                 snapshot.render_time = render_start.elapsed();
                 snapshot.stopped_early = true;
-                finish(
+                develop(
                     sppm.sums(&pixels, done),
                     None,
                     None,
@@ -104,7 +107,7 @@ pub(crate) fn render(
     stats.spp = done;
     stats.render_time = render_start.elapsed();
     stats.render_cpu_time = process_cpu_time().saturating_sub(cpu_start);
-    finish(sppm.sums(&pixels, done), None, None, stats, settings, None)
+    develop(sppm.sums(&pixels, done), None, None, stats, settings, None)
 }
 
 /// What every iteration of an SPPM render uses.
@@ -286,5 +289,5 @@ impl<'a, 'w> Iterations<'a, 'w> {
 /// A NaN or infinite value is zeroed and counted, a negative component
 /// clamped and counted (as the render loop does for samples).
 fn guard(v: Vec3, stats: &mut RenderStats) -> Vec3 {
-    super::guard(v, &mut stats.nan_samples, &mut stats.negative_samples)
+    super::tile::guard(v, &mut stats.nan_samples, &mut stats.negative_samples)
 }

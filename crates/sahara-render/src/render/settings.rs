@@ -1,0 +1,166 @@
+//! How to render: [`RenderSettings`], and their check against what the
+//! integrator supports and the scene holds.
+
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::Duration;
+
+use sahara_kd::BuildParams;
+
+use super::aux::Aov;
+use crate::film::window::PixelWindow;
+#[cfg(doc)]
+use crate::integrator::Supports;
+use crate::integrator::{Feature, SettingsError};
+use crate::scene::Scene;
+use crate::settings::FrameSettings;
+
+/// How to render: what the frame is ([`FrameSettings`], read as these
+/// settings' own fields) and how this render goes about it.
+#[derive(Clone, Debug)]
+pub struct RenderSettings {
+    /// What the frame is: size, samples per pixel and per pass, seed,
+    /// sampler, filter, integrator, adaptive sampling. With a time limit,
+    /// `spp` can be [`UNLIMITED_SPP`].
+    pub frame: FrameSettings,
+    /// Stop starting passes after this long, even before `spp` samples; a
+    /// pass under way when it runs out is abandoned (the first pass always
+    /// completes). With a time limit, `spp` can be [`UNLIMITED_SPP`].
+    pub time_limit: Option<Duration>,
+    /// Set to true (e.g. on Ctrl-C) to stop; the passes completed are kept,
+    /// and if the first pass is under way, the pixels it has finished.
+    pub cancel: Option<Arc<AtomicBool>>,
+    /// Tile edge in pixels.
+    pub tile_size: u32,
+    /// Kd-tree build parameters for the meshes.
+    pub build: BuildParams,
+    /// Full scale of the `cost` heat map in work units per camera ray
+    /// (None: the image's maximum).
+    pub cost_scale: Option<f32>,
+    /// The pixels whose sums the render produces (None: the whole image).
+    /// Every sample whose filter footprint reaches them is rendered, so a
+    /// window's sums are those of the whole frame's render over it, where
+    /// the integrator splits by pixels ([`Supports::pixel_parts`]); the
+    /// light-tracing integrators render a window as a crop, whose own
+    /// pixels' light subpaths stand for the whole frame's.
+    pub window: Option<PixelWindow>,
+    /// The sample indices of every pixel to render, counted over all
+    /// passes: sample `k` is index `k % pass_spp` of pass `k / pass_spp`
+    /// (None: `0..spp`). The passes rendered are those the range meets.
+    /// A range other than `0..spp` needs an integrator that splits by
+    /// samples ([`Supports::sample_ranges`]).
+    pub samples: Option<std::ops::Range<u32>>,
+    /// True when the render is a part of a frame whose parts' sums are
+    /// added up afterwards (a render farm's): its `window` must then be a
+    /// part by pixels the integrator supports ([`Supports::pixel_parts`]).
+    /// False: the window is a crop, an image of those pixels.
+    pub part: bool,
+    /// The render passes to make beside the beauty, the images a denoiser
+    /// and compositing use ([`AuxImages`](super::AuxImages); the integrators whose
+    /// [`Supports::aovs`] says so); empty: none. Adaptive sampling
+    /// ([`FrameSettings::adaptive`]) needs an integrator that supports it
+    /// ([`Supports::adaptive`]), and not with `samples` other than
+    /// `0..spp` (a pixel's decisions need all its samples).
+    pub aovs: Vec<Aov>,
+}
+
+/// The renderer reads the frame's settings as its own (`settings.spp`):
+/// they are the settings of every render, kept in one struct so that a
+/// scene file, a part file and a caller describe them once.
+impl std::ops::Deref for RenderSettings {
+    type Target = FrameSettings;
+
+    fn deref(&self) -> &FrameSettings {
+        &self.frame
+    }
+}
+
+impl std::ops::DerefMut for RenderSettings {
+    fn deref_mut(&mut self) -> &mut FrameSettings {
+        &mut self.frame
+    }
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            frame: FrameSettings::default(),
+            time_limit: None,
+            cancel: None,
+            tile_size: 32,
+            build: BuildParams::default(),
+            cost_scale: None,
+            window: None,
+            samples: None,
+            part: false,
+            aovs: Vec::new(),
+        }
+    }
+}
+
+impl From<FrameSettings> for RenderSettings {
+    /// A render of the whole frame `frame` with the defaults for the rest.
+    fn from(frame: FrameSettings) -> Self {
+        Self {
+            frame,
+            ..Default::default()
+        }
+    }
+}
+
+/// The `spp` of a render bounded by its time limit only.
+pub const UNLIMITED_SPP: u32 = u32::MAX;
+
+impl RenderSettings {
+    /// Samples per pixel of each pass: `pass_spp`, at least 1, at most `spp`.
+    pub fn pass_size(&self) -> u32 {
+        self.pass_spp.clamp(1, self.spp.max(1))
+    }
+
+    /// The most passes the render takes: `spp` in passes of [`Self::pass_size`].
+    pub fn passes(&self) -> u32 {
+        self.spp.max(1).div_ceil(self.pass_size())
+    }
+
+    /// Refuses what the integrator cannot honour, as its kind declares
+    /// ([`IntegratorKind::supports`]): a sample range, a part by pixels,
+    /// adaptive sampling (and adaptive sampling with a sample range, which
+    /// no integrator takes), render passes. Every render runs this first.
+    ///
+    /// [`IntegratorKind::supports`]: crate::IntegratorKind::supports
+    pub fn check(&self) -> Result<(), SettingsError> {
+        let kind = self.integrator.kind();
+        let sample_range = self.samples.as_ref().filter(|r| **r != (0..self.spp));
+        if sample_range.is_some() {
+            kind.require(Feature::SampleRanges)?;
+        }
+        let (w, h) = (self.width.max(1), self.height.max(1));
+        let full = PixelWindow::full(w, h);
+        if self.part && self.window.is_some_and(|win| win.intersect(&full) != full) {
+            kind.require(Feature::PixelParts)?;
+        }
+        if self.adaptive.is_some() {
+            kind.require(Feature::Adaptive)?;
+            if let Some(r) = sample_range {
+                return Err(SettingsError::AdaptiveSampleRange {
+                    samples: r.clone(),
+                    spp: self.spp,
+                });
+            }
+        }
+        if !self.aovs.is_empty() {
+            kind.require(Feature::Aovs)?;
+        }
+        Ok(())
+    }
+
+    /// [`RenderSettings::check`], and refuses what the integrator cannot
+    /// honour in this scene: participating media.
+    pub fn check_for(&self, scene: &Scene) -> Result<(), SettingsError> {
+        self.check()?;
+        if scene.has_media() {
+            self.integrator.kind().require(Feature::Media)?;
+        }
+        Ok(())
+    }
+}

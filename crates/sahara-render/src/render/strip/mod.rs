@@ -1,0 +1,240 @@
+//! A strip of a tile's rows, and the sample loops that trace its samples.
+//!
+//! A tile is rendered a strip of rows at a time ([`rows`]). A strip's
+//! samples have fixed places, their slots ([`Slots`]): pixel by pixel,
+//! rows top to bottom, each pixel's samples of the round in the order of
+//! their numbers. A sample loop traces the samples in whatever order and
+//! grouping suits it, and leaves each one's film position, radiance and
+//! auxiliary values in its slot ([`Slots::slot`]); the tile then reads the
+//! slots in order (`super::tile`).
+//!
+//! The loops, chosen by the integrator ([`SampleLoop::of`]):
+//! - `single`: one sample at a time, from camera ray to end
+//!   ([`Integrator::li_splats`]): the debug views, ambient occlusion, and
+//!   the path tracers in a scene with media;
+//! - `stepped`: the wavefront, every path of the strip a step at a time,
+//!   in camera-packet order (`path` and `distribution`);
+//! - `bidirectional`: camera and light subpaths in batches (`bdpt`,
+//!   `lightpath`).
+//!
+//! What every loop keeps, and with it the image's bits for a seed:
+//! - a sample's random numbers come from [`CameraSamples::at`] for its
+//!   pixel and number;
+//! - a sample's result depends on that sample alone, never on which
+//!   samples share its batch (or its packet, or its vector lanes), how
+//!   many there are, or the order they are traced in;
+//! - the result goes to the sample's slot, and the light it adds to other
+//!   pixels to [`Slots::splats`] (added to exact sums, so in any order).
+//!
+//! A new way of tracing a strip (paths as SIMD lanes, say) is a module
+//! beside these and a variant of [`SampleLoop`], held to the same.
+
+mod bidirectional;
+mod single;
+mod stepped;
+
+use glam::{Vec2, Vec3};
+
+use super::samples::{CameraSamples, RoundSamples};
+use super::settings::RenderSettings;
+use crate::integrator::bdpt::{Splat, Strategies};
+use crate::integrator::laps::Laps;
+use crate::integrator::{AuxSample, Integrator, TraceStats};
+use crate::world::World;
+
+/// Rows of a tile whose samples are traced as one batch by the stepped
+/// and the bidirectional integrators: 4x4 pixel blocks make the camera
+/// packets.
+const STRIP_ROWS: u32 = 4;
+
+/// The rows of a strip for `integrator`: [`STRIP_ROWS`] for those that
+/// trace their samples in batches, one for the others.
+pub(super) fn rows(integrator: &Integrator) -> u32 {
+    let batched = integrator.is_stepped() || integrator.bidirectional().is_some();
+    if batched {
+        STRIP_ROWS
+    } else {
+        1
+    }
+}
+
+thread_local! {
+    /// This thread's strip buffers, reused by every tile it renders (fresh
+    /// ones per tile cost page faults of their own).
+    static STRIP: std::cell::RefCell<Strip> = std::cell::RefCell::new(Strip::default());
+}
+
+/// A strip's buffers: the slots of its samples, and each sample loop's
+/// own.
+#[derive(Default)]
+pub(super) struct Strip {
+    /// The samples of the strip last rendered.
+    pub(super) slots: Slots,
+    stepped: stepped::Stepped,
+    bidirectional: bidirectional::Bidirectional,
+}
+
+/// The pixels `[x0, x1) x [y0, y1)` of a strip.
+#[derive(Clone, Copy)]
+pub(super) struct StripPixels {
+    pub(super) x0: u32,
+    pub(super) x1: u32,
+    pub(super) y0: u32,
+    pub(super) y1: u32,
+}
+
+impl StripPixels {
+    /// The pixels, rows top to bottom.
+    fn iter(self) -> impl Iterator<Item = (u32, u32)> {
+        (self.y0..self.y1).flat_map(move |y| (self.x0..self.x1).map(move |x| (x, y)))
+    }
+}
+
+/// What a sample loop traces: the round's samples of a strip's pixels.
+#[derive(Clone, Copy)]
+struct StripRound<'a> {
+    settings: &'a RenderSettings,
+    pixels: StripPixels,
+    samples: RoundSamples<'a>,
+    cameras: &'a CameraSamples<'a>,
+}
+
+impl StripRound<'_> {
+    /// The image's size in pixels.
+    fn film(&self) -> Vec2 {
+        Vec2::new(
+            self.settings.width.max(1) as f32,
+            self.settings.height.max(1) as f32,
+        )
+    }
+
+    /// True when the settings ask for render passes.
+    fn aux(&self) -> bool {
+        !self.settings.aovs.is_empty()
+    }
+}
+
+/// A strip's samples in their slots: pixel by pixel (rows top to bottom),
+/// each pixel's samples in the order of their numbers.
+#[derive(Default)]
+pub(super) struct Slots {
+    /// Where each pixel's samples start; a pixel has the slots up to the
+    /// next pixel's start.
+    pub(super) first: Vec<u32>,
+    /// Each sample's film position.
+    pub(super) pos: Vec<Vec2>,
+    /// Each sample's radiance.
+    pub(super) radiance: Vec<Vec3>,
+    /// Each sample's auxiliary values (when the settings ask for them).
+    pub(super) aux: Vec<AuxSample>,
+    /// Light the samples add elsewhere on the film.
+    pub(super) splats: Vec<Splat>,
+}
+
+impl Slots {
+    /// Sizes the slots for the round's samples of its pixels, and notes
+    /// where each pixel's samples start.
+    fn lay_out(&mut self, round: &StripRound) {
+        self.first.clear();
+        let mut n = 0usize;
+        for (x, y) in round.pixels.iter() {
+            self.first.push(n as u32);
+            n += round.samples.of(x, y).len();
+        }
+        self.pos.clear();
+        self.pos.resize(n, Vec2::ZERO);
+        self.radiance.clear();
+        self.radiance.resize(n, Vec3::ZERO);
+        self.aux.clear();
+        if round.aux() {
+            self.aux.resize(n, AuxSample::default());
+        }
+    }
+
+    /// The slot of sample `g` of pixel `(x, y)`.
+    #[inline]
+    fn slot(&self, round: &StripRound, x: u32, y: u32, g: u32) -> usize {
+        let p = round.pixels;
+        let start = round.samples.of(x, y).start;
+        (self.first[((y - p.y0) * (p.x1 - p.x0) + (x - p.x0)) as usize] + g - start) as usize
+    }
+}
+
+/// How a strip's samples are traced, by integrator.
+#[derive(Clone, Copy)]
+enum SampleLoop {
+    /// Camera and light subpaths in batches ([`bidirectional`]).
+    Bidirectional {
+        max_depth: u32,
+        strategies: Strategies,
+    },
+    /// The wavefront, a step of every path at a time ([`stepped`]).
+    Stepped,
+    /// One sample at a time ([`single`]).
+    Single,
+}
+
+impl SampleLoop {
+    /// The loop of `integrator` in `world`.
+    fn of(integrator: &Integrator, world: &World) -> Self {
+        if let Some((max_depth, strategies)) = integrator.bidirectional() {
+            Self::Bidirectional {
+                max_depth,
+                strategies,
+            }
+        } else if integrator.is_stepped() && !world.has_media() {
+            // A scene with media takes the volumetric path tracer, one
+            // path at a time.
+            Self::Stepped
+        } else {
+            Self::Single
+        }
+    }
+}
+
+impl Strip {
+    /// Runs `f` with this thread's strip.
+    pub(super) fn with<R>(f: impl FnOnce(&mut Strip) -> R) -> R {
+        STRIP.with_borrow_mut(f)
+    }
+
+    /// Renders the round's `samples` of `pixels`: lays out the slots, then
+    /// traces the samples with the integrator's loop, leaving each in its
+    /// slot.
+    pub(super) fn render(
+        &mut self,
+        world: &World,
+        s: &RenderSettings,
+        pixels: StripPixels,
+        samples: RoundSamples,
+        stats: &mut TraceStats,
+    ) {
+        let cameras = CameraSamples::new(s, &world.scene.camera);
+        let round = StripRound {
+            settings: s,
+            pixels,
+            samples,
+            cameras: &cameras,
+        };
+        let slots = &mut self.slots;
+        slots.lay_out(&round);
+        match SampleLoop::of(&s.integrator, world) {
+            SampleLoop::Bidirectional {
+                max_depth,
+                strategies,
+            } => self
+                .bidirectional
+                .trace(slots, world, &round, max_depth, strategies, stats),
+            SampleLoop::Stepped => self.stepped.trace(slots, world, &round, stats),
+            SampleLoop::Single => single::trace(slots, world, &round, stats),
+        }
+    }
+
+    /// The time the batched loops spent tracing and shading since last
+    /// asked.
+    pub(super) fn take_times(&mut self) -> Laps {
+        let mut laps = self.stepped.take_times();
+        laps += self.bidirectional.take_times();
+        laps
+    }
+}

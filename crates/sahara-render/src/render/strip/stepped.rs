@@ -1,0 +1,80 @@
+//! The stepped integrators' sample loop (`path`, `distribution`): the
+//! wavefront ([`Wavefront`]) traces every path of the strip a step at a
+//! time, each step's rays as one batch.
+
+use super::{Slots, StripPixels, StripRound};
+use crate::integrator::laps::Laps;
+use crate::integrator::wavefront::Wavefront;
+use crate::integrator::{PathState, TraceStats};
+use crate::world::World;
+
+/// The stepped loop's buffers, kept from strip to strip.
+#[derive(Default)]
+pub(super) struct Stepped {
+    /// The strip's paths, in camera-packet order.
+    paths: Vec<PathState>,
+    /// Each path's slot.
+    slot: Vec<u32>,
+    wavefront: Wavefront,
+}
+
+impl Stepped {
+    /// Traces the round's paths as batches, in camera-packet order: 4x4
+    /// pixel blocks, the pixels of a block in Morton order (2x2 blocks of
+    /// 2x2), each pixel's samples together. A run of 16 paths is then 16
+    /// samples of one pixel, or the samples of a 2x2 block's pixels when a
+    /// pixel takes 4: their camera rays, shadow rays and bounces start close
+    /// together and share the tree's cells (figures in
+    /// docs/performance.md, "What a packet of one pixel's samples would
+    /// share"). The order changes no path's arithmetic; each path's
+    /// radiance goes to its slot.
+    pub(super) fn trace(
+        &mut self,
+        slots: &mut Slots,
+        world: &World,
+        round: &StripRound,
+        stats: &mut TraceStats,
+    ) {
+        let aux = round.aux();
+        let StripPixels { x0, x1, y0, y1 } = round.pixels;
+        self.paths.clear();
+        self.slot.clear();
+        for (bx, by) in (y0..y1)
+            .step_by(4)
+            .flat_map(|by| (x0..x1).step_by(4).map(move |bx| (bx, by)))
+        {
+            for m in 0..16u32 {
+                // De-interleave the Morton index's bits.
+                let dx = (m & 1) | (m >> 1 & 2);
+                let dy = (m >> 1 & 1) | (m >> 2 & 2);
+                let (x, y) = (bx + dx, by + dy);
+                if x >= x1 || y >= y1 {
+                    continue;
+                }
+                for g in round.samples.of(x, y) {
+                    let (sampler, pos, ray, time) = round.cameras.at(x, y, g);
+                    let k = slots.slot(round, x, y, g);
+                    slots.pos[k] = pos;
+                    self.slot.push(k as u32);
+                    self.paths
+                        .push(PathState::new(ray, time, sampler).with_aux(aux));
+                }
+            }
+        }
+        self.wavefront
+            .trace(&round.settings.integrator, world, stats, &mut self.paths);
+        for (p, &k) in self.paths.iter().zip(&self.slot) {
+            slots.radiance[k as usize] = p.l;
+        }
+        if aux {
+            for (p, &k) in self.paths.iter().zip(&self.slot) {
+                slots.aux[k as usize] = p.aux;
+            }
+        }
+    }
+
+    /// The wavefront's time tracing and shading since last asked.
+    pub(super) fn take_times(&mut self) -> Laps {
+        self.wavefront.take_times()
+    }
+}
