@@ -32,7 +32,9 @@ def cli(sahara_bin, args, check=True):
 
 def keywords(args):
     """The keyword arguments of `sahara.render` for command-line options:
-    the same names, `--aov` as `aovs`; a switch is True."""
+    the same names, `--aov` as `aovs`; a switch is True; values as the
+    command line's text (`as_python` makes the numbers numbers, which
+    Python requires)."""
     out, i = {}, 0
     while i < len(args):
         name = args[i][2:].replace("-", "_")
@@ -46,8 +48,9 @@ def keywords(args):
 
 
 def as_python(args):
-    """The same settings as Python values where Python has its own (numbers,
-    tuples), to hold the translation of each as well."""
+    """The same settings as Python values where Python has its own: numbers
+    (a number given as a str is a TypeError) and tuples, to hold the
+    translation of each as well."""
     kw = keywords(args)
     for k in ("spp", "pass_spp", "width", "height", "seed", "min_spp"):
         if k in kw:
@@ -139,7 +142,7 @@ def test_the_same_denoised_file(tmp_path, sahara_bin):
         args = ["--spp", "4", "--denoise"] + SIZE
         r = cli(sahara_bin, args + ["-o", str(theirs)])
         assert "denoise: box filter" in r.stderr
-        image = sahara.render(sahara.cornell_box(), progress=False, output=ours, **keywords(args))
+        image = sahara.render(sahara.cornell_box(), progress=False, output=ours, **as_python(args))
         assert ours.read_bytes() == theirs.read_bytes(), ext
         assert image.shape == (30, 40, 3)
 
