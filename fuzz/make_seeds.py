@@ -327,8 +327,11 @@ def image_seeds():
     put("image", "grey16.png", png(3, 1, 0, 16, [struct.pack(">3H", 0, 30000, 65535)]))
     put("image", "rgba.png", png(1, 2, 6, 8, [bytes([1, 2, 3, 4]), bytes([5, 6, 7, 8])]))
     put("image", "tiny.hdr", b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 2\n" + bytes([128, 64, 32, 129]) * 4)
-    # KTX2 with Basis Universal payloads (UASTC with Zstandard, ETC1S).
-    for name in ["quad_uastc.ktx2", "quad_etc1s.ktx2"]:
+    # KTX2 with Basis Universal payloads (UASTC with Zstandard, ETC1S), and
+    # plain formats (8-bit with Zstandard, half floats with zlib, 16-bit
+    # stored as is, a packed float format).
+    for name in ["quad_uastc.ktx2", "quad_etc1s.ktx2", "plain_rgb8_zstd.ktx2", "plain_rgba16f_zlib.ktx2",
+                 "plain_rgb16_none.ktx2", "plain_e5b9g9r9_none.ktx2"]:
         put("image", name, (REPO / "crates/sahara-readers/tests/data" / name).read_bytes())
     for rel in ["sponza/textures/00_skap.jpg"]:
         data = read(rel)

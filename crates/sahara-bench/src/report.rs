@@ -230,6 +230,9 @@ pub struct StatsReport {
     pub build_ms: f64,
     /// Builds timed.
     pub build_runs: usize,
+    /// Of the triangles given to the build, those no ray can hit (a
+    /// non-finite corner or zero area), which the structure leaves out.
+    pub skipped_triangles: usize,
     /// The structure's statistics.
     #[serde(flatten)]
     pub tree: StructureStats,

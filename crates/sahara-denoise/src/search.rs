@@ -226,20 +226,27 @@ pub(crate) fn find_and_load(roots: &SearchRoots) -> Result<Loaded, DenoiseError>
         let place = format!("pyoidn in {}", venv.display());
         places.push((place, Box::new(|| pyoidn_in_prefix(venv))));
     }
-    if let Some(python) = &roots.python {
+    // Each place once: the interpreter asked first may be the one on PATH,
+    // and an activated virtual environment is also a prefix on PATH.
+    if let Some(python) = roots
+        .python
+        .as_ref()
+        .filter(|p| roots.python_first.as_ref() != Some(*p))
+    {
         let place = format!("pyoidn for {}", python.to_string_lossy());
         places.push((place, Box::new(|| ask_python(python))));
     }
-    if !roots.prefixes.is_empty() {
-        let list: Vec<String> = roots
-            .prefixes
-            .iter()
-            .map(|p| p.display().to_string())
-            .collect();
+    let prefixes: Vec<&PathBuf> = roots
+        .prefixes
+        .iter()
+        .filter(|p| !roots.venvs.iter().any(|v| same_folder(v, p)))
+        .collect();
+    if !prefixes.is_empty() {
+        let list: Vec<String> = prefixes.iter().map(|p| p.display().to_string()).collect();
         let place = format!("pyoidn in {}", list.join(", "));
         places.push((
             place,
-            Box::new(|| roots.prefixes.iter().find_map(|p| pyoidn_in_prefix(p))),
+            Box::new(move || prefixes.iter().find_map(|p| pyoidn_in_prefix(p))),
         ));
     }
     for (place, package) in places {
@@ -254,6 +261,11 @@ pub(crate) fn find_and_load(roots: &SearchRoots) -> Result<Loaded, DenoiseError>
     }
 
     Err(failure.unwrap_or(DenoiseError::NotFound { searched }))
+}
+
+/// True if `a` and `b` name the same folder (as written, or once resolved).
+fn same_folder(a: &Path, b: &Path) -> bool {
+    a == b || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
 }
 
 /// A way to find the `pyoidn` package's folder.
@@ -475,6 +487,28 @@ mod tests {
                 "(looked in OIDN_DIR=/nonexistent/oidn, \
                  pyoidn for SAHARA_PYTHON=/nonexistent/python, pyoidn in /nonexistent/venv, \
                  pyoidn for /nonexistent/python3, pyoidn in /nonexistent/a, /nonexistent/b)"
+            ),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn the_not_found_message_names_each_place_once() {
+        // SAHARA_PYTHON is the python3 on PATH, and the virtual environment
+        // is activated (its bin on PATH, so a prefix too).
+        let venv = PathBuf::from("/nonexistent/venv");
+        let roots = SearchRoots {
+            python_first: Some(OsString::from("python3")),
+            venvs: vec![venv.clone()],
+            python: Some(OsString::from("python3")),
+            prefixes: vec![venv, PathBuf::from("/nonexistent/usr")],
+            ..SearchRoots::default()
+        };
+        let message = find_and_load(&roots).err().unwrap().to_string();
+        assert!(
+            message.contains(
+                "(looked in pyoidn for SAHARA_PYTHON=python3, pyoidn in /nonexistent/venv, \
+                 pyoidn in /nonexistent/usr)"
             ),
             "{message}"
         );

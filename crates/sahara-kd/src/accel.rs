@@ -14,8 +14,8 @@ use crate::math::{Aabb, Ray, Triangle};
 pub enum AccelKind {
     /// The SAH kd-tree.
     Kd,
-    /// The eight-wide bounding volume hierarchy (the default: faster on
-    /// every query measured; see `docs/performance.md`).
+    /// The eight-wide bounding volume hierarchy, the default (which
+    /// structure is faster where: `docs/accelerator.md`).
     #[default]
     Bvh,
 }

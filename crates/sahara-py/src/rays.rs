@@ -176,8 +176,8 @@ impl RayScene {
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let rays = RayArgs::extract(origins, directions, tmin, tmax)?;
-        let n = rays.n;
         let snap = self.snapshot(py, threads)?;
+        let n = rays.n;
         let (dict, arrays) = match out {
             Some(o) if !o.is_none() => {
                 let d = o.cast::<PyDict>().map_err(|_| {
@@ -194,53 +194,46 @@ impl RayScene {
             let mut w = arrays.borrow()?;
             let (ts, tris, meshes, us, vs, ns) = w.slices()?;
             let view = rays.view();
-            let threads = threads.or(self.threads);
-            py.detach(|| {
-                run_on(threads, || {
-                    (
-                        ts.par_chunks_mut(CHUNK),
-                        tris.par_chunks_mut(CHUNK),
-                        meshes.par_chunks_mut(CHUNK),
-                        us.par_chunks_mut(CHUNK),
-                        vs.par_chunks_mut(CHUNK),
-                        ns.par_chunks_mut(3 * CHUNK),
-                    )
-                        .into_par_iter()
-                        .with_max_len(1)
-                        .enumerate()
-                        .for_each(|(c, (t, tri, mesh, u, v, nrm))| {
-                            let mut rays = [Ray::new(Vec3::ZERO, Vec3::ZERO); CHUNK];
-                            let mut hits = [None; CHUNK];
-                            let k = t.len();
-                            view.fill(c * CHUNK, &mut rays[..k]);
-                            snap.tree.closest_hits_serial(&rays[..k], &mut hits[..k]);
-                            for (j, h) in hits[..k].iter().enumerate() {
-                                match h {
-                                    Some(h) => {
-                                        let (m, local) = Geometry::locate(&snap.starts, h.tri);
-                                        t[j] = h.t;
-                                        tri[j] = local;
-                                        mesh[j] = m;
-                                        u[j] = h.u;
-                                        v[j] = h.v;
-                                    }
-                                    None => {
-                                        t[j] = f32::INFINITY;
-                                        tri[j] = -1;
-                                        mesh[j] = -1;
-                                        u[j] = 0.0;
-                                        v[j] = 0.0;
-                                    }
-                                }
-                            }
-                            // The normals in a loop of their own: its loads,
-                            // scattered over the mesh, overlap.
-                            for (h, n) in hits[..k].iter().zip(nrm.chunks_exact_mut(3)) {
-                                let v = h.map_or(Vec3::ZERO, |h| snap.normal(h.tri));
-                                n.copy_from_slice(&v.to_array());
-                            }
-                        })
-                })
+            let chunks = (
+                ts.par_chunks_mut(CHUNK),
+                tris.par_chunks_mut(CHUNK),
+                meshes.par_chunks_mut(CHUNK),
+                us.par_chunks_mut(CHUNK),
+                vs.par_chunks_mut(CHUNK),
+                ns.par_chunks_mut(3 * CHUNK),
+            )
+                .into_par_iter();
+            self.in_chunks(py, threads, chunks, |first, (t, tri, mesh, u, v, nrm)| {
+                let mut rays = [Ray::new(Vec3::ZERO, Vec3::ZERO); CHUNK];
+                let mut hits = [None; CHUNK];
+                let k = t.len();
+                view.fill(first, &mut rays[..k]);
+                snap.tree.closest_hits_serial(&rays[..k], &mut hits[..k]);
+                for (j, h) in hits[..k].iter().enumerate() {
+                    match h {
+                        Some(h) => {
+                            let (m, local) = Geometry::locate(&snap.starts, h.tri);
+                            t[j] = h.t;
+                            tri[j] = local;
+                            mesh[j] = m;
+                            u[j] = h.u;
+                            v[j] = h.v;
+                        }
+                        None => {
+                            t[j] = f32::INFINITY;
+                            tri[j] = -1;
+                            mesh[j] = -1;
+                            u[j] = 0.0;
+                            v[j] = 0.0;
+                        }
+                    }
+                }
+                // The normals in a loop of their own: its loads,
+                // scattered over the mesh, overlap.
+                for (h, n) in hits[..k].iter().zip(nrm.chunks_exact_mut(3)) {
+                    let v = h.map_or(Vec3::ZERO, |h| snap.normal(h.tri));
+                    n.copy_from_slice(&v.to_array());
+                }
             })?;
         }
         Ok(dict)
@@ -265,18 +258,11 @@ impl RayScene {
             // SAFETY: as in `cast_rays`.
             let o = unsafe { out.as_slice_mut()? };
             let view = rays.view();
-            py.detach(|| {
-                run_on(threads.or(self.threads), || {
-                    o.par_chunks_mut(CHUNK)
-                        .with_max_len(1)
-                        .enumerate()
-                        .for_each(|(c, o)| {
-                            let mut rays = [Ray::new(Vec3::ZERO, Vec3::ZERO); CHUNK];
-                            let k = o.len();
-                            view.fill(c * CHUNK, &mut rays[..k]);
-                            snap.tree.any_hits_serial(&rays[..k], o);
-                        })
-                })
+            self.in_chunks(py, threads, o.par_chunks_mut(CHUNK), |first, o| {
+                let mut rays = [Ray::new(Vec3::ZERO, Vec3::ZERO); CHUNK];
+                let k = o.len();
+                view.fill(first, &mut rays[..k]);
+                snap.tree.any_hits_serial(&rays[..k], o);
             })?;
         }
         Ok(out)
@@ -302,19 +288,12 @@ impl RayScene {
             // SAFETY: as in `cast_rays`.
             let o = unsafe { out.as_slice_mut()? };
             let view = rays.view();
-            py.detach(|| {
-                run_on(threads.or(self.threads), || {
-                    o.par_chunks_mut(CHUNK)
-                        .with_max_len(1)
-                        .enumerate()
-                        .for_each(|(c, o)| {
-                            let mut hits = Vec::new();
-                            for (j, slot) in o.iter_mut().enumerate() {
-                                snap.tree.all_hits(&view.ray(c * CHUNK + j), &mut hits);
-                                *slot = hits.len().min(i32::MAX as usize) as i32;
-                            }
-                        })
-                })
+            self.in_chunks(py, threads, o.par_chunks_mut(CHUNK), |first, o| {
+                let mut hits = Vec::new();
+                for (j, slot) in o.iter_mut().enumerate() {
+                    snap.tree.all_hits(&view.ray(first + j), &mut hits);
+                    *slot = hits.len().min(i32::MAX as usize) as i32;
+                }
             })?;
         }
         Ok(out)
@@ -334,30 +313,24 @@ impl RayScene {
         directions: &Bound<'py, PyAny>,
         tmin: Option<&Bound<'py, PyAny>>,
         tmax: Option<&Bound<'py, PyAny>>,
-        max_hits: Option<usize>,
+        max_hits: Option<&Bound<'py, PyAny>>,
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let max_hits = whole("max_hits", max_hits)?;
         let rays = RayArgs::extract(origins, directions, tmin, tmax)?;
         let snap = self.snapshot(py, threads)?;
         let cap = max_hits.unwrap_or(usize::MAX);
         let view = rays.view();
         let n = rays.n;
-        let parts: Vec<Vec<(u32, Hit)>> = py.detach(|| {
-            run_on(threads.or(self.threads), || {
-                (0..n.div_ceil(CHUNK))
-                    .into_par_iter()
-                    .with_max_len(1)
-                    .map(|c| {
-                        let mut hits = Vec::new();
-                        let mut out = Vec::new();
-                        for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
-                            snap.tree.all_hits(&view.ray(i), &mut hits);
-                            out.extend(hits.iter().take(cap).map(|h| (i as u32, *h)));
-                        }
-                        out
-                    })
-                    .collect()
-            })
+        let chunks = (0..n.div_ceil(CHUNK)).into_par_iter();
+        let parts: Vec<Vec<(u32, Hit)>> = self.in_chunks(py, threads, chunks, |first, _| {
+            let mut hits = Vec::new();
+            let mut out = Vec::new();
+            for i in first..(first + CHUNK).min(n) {
+                snap.tree.all_hits(&view.ray(i), &mut hits);
+                out.extend(hits.iter().take(cap).map(|h| (i as u32, *h)));
+            }
+            out
         })?;
         let total: usize = parts.iter().map(Vec::len).sum();
         let ray = PyArray1::<i64>::zeros(py, total, false);
@@ -425,30 +398,23 @@ impl RayScene {
             let o = unsafe { out.as_slice_mut()? };
             let view = points.view();
             let bounds = snap.tree.bounds();
-            py.detach(|| {
-                run_on(threads.or(self.threads), || {
-                    o.par_chunks_mut(CHUNK)
-                        .with_max_len(1)
-                        .enumerate()
-                        .for_each(|(c, o)| {
-                            let mut hits = Vec::new();
-                            for (j, slot) in o.iter_mut().enumerate() {
-                                let p = view.get(c * CHUNK + j);
-                                // Outside the root cell: outside the mesh.
-                                if !(p.cmpge(bounds.min).all() && p.cmple(bounds.max).all()) {
-                                    continue;
-                                }
-                                let odd = DIRECTIONS[..samples]
-                                    .iter()
-                                    .filter(|&&d| {
-                                        snap.tree.all_hits(&Ray::new(p, Vec3::from(d)), &mut hits);
-                                        hits.len() % 2 == 1
-                                    })
-                                    .count();
-                                *slot = 2 * odd > samples;
-                            }
+            self.in_chunks(py, threads, o.par_chunks_mut(CHUNK), |first, o| {
+                let mut hits = Vec::new();
+                for (j, slot) in o.iter_mut().enumerate() {
+                    let p = view.get(first + j);
+                    // Outside the root cell: outside the mesh.
+                    if !(p.cmpge(bounds.min).all() && p.cmple(bounds.max).all()) {
+                        continue;
+                    }
+                    let odd = DIRECTIONS[..samples]
+                        .iter()
+                        .filter(|&&d| {
+                            snap.tree.all_hits(&Ray::new(p, Vec3::from(d)), &mut hits);
+                            hits.len() % 2 == 1
                         })
-                })
+                        .count();
+                    *slot = 2 * odd > samples;
+                }
             })?;
         }
         Ok(out)
@@ -510,6 +476,32 @@ impl RayScene {
         self.geometry
             .lock()
             .map_err(|_| PyRuntimeError::new_err("the scene was left broken by an earlier error"))
+    }
+
+    /// `each(first, chunk)` for every chunk of a query of [`CHUNK`] rays
+    /// (`first`: the index of its first ray), every chunk its own job, on
+    /// the scene's threads (or `threads`) without the GIL; the results in
+    /// the chunks' order.
+    fn in_chunks<C, R>(
+        &self,
+        py: Python<'_>,
+        threads: Option<usize>,
+        chunks: C,
+        each: impl Fn(usize, C::Item) -> R + Sync + Send,
+    ) -> PyResult<Vec<R>>
+    where
+        C: IndexedParallelIterator,
+        R: Send,
+    {
+        py.detach(|| {
+            run_on(threads.or(self.threads), || {
+                chunks
+                    .with_max_len(1)
+                    .enumerate()
+                    .map(|(c, chunk)| each(c * CHUNK, chunk))
+                    .collect()
+            })
+        })
     }
 
     /// The tree (built now, without the GIL, if the meshes changed) and
@@ -828,4 +820,28 @@ impl RayView<'_> {
             *r = self.ray(start + j);
         }
     }
+}
+
+/// `value` as a count (None stays None): what is not a whole number is a
+/// `TypeError`, a negative or too large one a `ValueError`, each naming
+/// the argument `name` (rather than the conversion's `OverflowError`).
+fn whole(name: &str, value: Option<&Bound<'_, PyAny>>) -> PyResult<Option<usize>> {
+    let Some(v) = value.filter(|v| !v.is_none()) else {
+        return Ok(None);
+    };
+    if v.is_instance_of::<pyo3::types::PyBool>() || !v.hasattr("__index__")? {
+        return Err(PyTypeError::new_err(format!(
+            "{name} must be a whole number, not {}",
+            v.get_type().name()?
+        )));
+    }
+    let n = v.call_method0("__index__")?;
+    if n.lt(0)? {
+        return Err(PyValueError::new_err(format!(
+            "{name} must be at least 0, not {n}"
+        )));
+    }
+    n.extract::<usize>().map(Some).map_err(|_| {
+        PyValueError::new_err(format!("{name} must be at most {}, not {n}", usize::MAX))
+    })
 }

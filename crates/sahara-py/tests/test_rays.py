@@ -91,6 +91,10 @@ def test_one_origin_or_direction_is_broadcast_and_intervals_apply():
         (lambda: sahara.RayScene(SQUARE_V, SQUARE_F).cast_rays(np.zeros((3, 4)), np.zeros((3, 3))), "origins: expected an array of shape (N, 3) or (3,)"),
         (lambda: sahara.RayScene(SQUARE_V, SQUARE_F).occluded(np.zeros((3, 3)), [0, 0, 1], tmax=np.ones(2)), "tmax: expected a number or an array of shape (3,)"),
         (lambda: sahara.RayScene(SQUARE_V, SQUARE_F).contains(np.zeros((2, 3)), samples=0), "samples: expected 1..=7"),
+        # A count out of range is a ValueError naming it, not the
+        # conversion's OverflowError.
+        (lambda: sahara.RayScene(SQUARE_V, SQUARE_F).all_hits([0, 0, 0], [0, 0, 1], max_hits=-1), "max_hits must be at least 0, not -1"),
+        (lambda: sahara.RayScene(SQUARE_V, SQUARE_F).all_hits([0, 0, 0], [0, 0, 1], max_hits=2**70), "max_hits must be at most"),
     ],
 )
 def test_bad_inputs_are_value_errors_that_say_what(make, message):

@@ -1,11 +1,11 @@
 //! Image readers: PNG, JPEG, Radiance HDR, OpenEXR, TGA, PFM and KTX2
-//! (Basis Universal), as the values the file stores.
+//! (plain formats and Basis Universal), as the values the file stores.
 //!
 //! [`decode_raw`] (and [`load_raw`]) give a [`RawImage`]: 8-bit PNG, JPEG
-//! and TGA images as their 8-bit codes, KTX2 textures transcoded to 8-bit
-//! codes, 16-bit PNG as floats in `[0, 1]`
-//! still encoded as the file encodes them, and Radiance HDR, OpenEXR and
-//! PFM as linear floats ([`Pixels`] says which). Nothing is converted to
+//! and TGA images and 8-bit KTX2 textures (Basis Universal ones transcoded
+//! to 8 bits) as their 8-bit codes, 16-bit PNG and KTX2 as floats in
+//! `[0, 1]` still encoded as the file encodes them, and Radiance HDR,
+//! OpenEXR, PFM and float KTX2 as linear floats ([`Pixels`] says which). Nothing is converted to
 //! linear colour here: what the codes mean (sRGB colours, or data such as
 //! normals and roughness) depends on the image's use, which the caller
 //! knows (`sahara-formats` decodes them for the renderer).
@@ -15,6 +15,7 @@
 //! RGB. The size in the header is checked against [`MAX_IMAGE_SIDE`] and
 //! [`MAX_IMAGE_PIXELS`] before any pixel memory is allocated.
 
+mod ktx2;
 mod pfm;
 mod tga;
 
@@ -45,8 +46,9 @@ pub enum ImageFormat {
     Tga,
     /// Portable Float Map.
     Pfm,
-    /// KTX2 with a Basis Universal payload (ETC1S or UASTC), as glTF's
-    /// `KHR_texture_basisu` stores textures.
+    /// KTX2: a plain 8-bit, 16-bit or float format, or a Basis Universal
+    /// payload (ETC1S or UASTC), as glTF's `KHR_texture_basisu` stores
+    /// textures.
     Ktx2,
 }
 
@@ -98,144 +100,7 @@ pub fn decode_raw(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
     } else {
         decode_any(bytes, name)
     };
-    image.map_err(crate::one_line)
-}
-
-/// A KTX2 texture whose payload is Basis Universal (ETC1S or UASTC, with or
-/// without Zstandard supercompression), transcoded to 8-bit RGBA with the
-/// `basisu` crate: its first mip level, first layer and face. Colour codes
-/// stay as stored (sRGB for colour textures), as for an 8-bit PNG.
-fn decode_ktx2(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
-    use basisu::{DecodeFlags, Error, SourceFormat, TargetFormat, Transcoder};
-    let why = |e: Error| match e {
-        Error::InvalidData => "it is not a Basis Universal texture or it is corrupt (only \
-                               KTX2 files with an ETC1S or UASTC payload are read; convert the \
-                               texture to PNG or JPEG)"
-            .to_owned(),
-        Error::Truncated => "the file is truncated".to_owned(),
-        Error::Unsupported {
-            source: SourceFormat::UastcHdr4x4 | SourceFormat::AstcHdr6x6 | SourceFormat::UastcHdr6x6,
-            ..
-        } => "it is an HDR texture, which Sahara does not read from KTX2; convert it to EXR"
-            .to_owned(),
-        Error::Unsupported { source, .. } => {
-            format!("its {source:?} payload cannot be transcoded to 8-bit colour")
-        }
-        Error::UnsupportedFeature(what) => format!("unsupported: {what}"),
-        Error::VideoRequiresState => "it is a video, not a texture".to_owned(),
-        Error::InvalidImageOrLevel => "it holds no image".to_owned(),
-        Error::ZstdRequired => "its Zstandard supercompression cannot be read".to_owned(),
-        e => format!("{e:?}"),
-    };
-    let fail =
-        |e: Error| FormatError::in_file(name, format!("cannot read the KTX2 texture: {}", why(e)));
-    ktx2_sound(bytes).map_err(|what| {
-        FormatError::in_file(
-            name,
-            format!("cannot read the KTX2 texture: its {what} is corrupt"),
-        )
-    })?;
-    let texture = Transcoder::new(bytes).map_err(fail)?;
-    let (width, height) = texture.base_dimensions();
-    check_size(name, width, height)?;
-    let rgba = texture
-        .transcode_image(0, 0, 0, TargetFormat::Rgba32, DecodeFlags::NONE)
-        .map_err(fail)?;
-    if rgba.len() != 4 * width as usize * height as usize {
-        return Err(FormatError::in_file(
-            name,
-            "cannot read the KTX2 texture: its first level is not one 2D image",
-        ));
-    }
-    let alpha = texture.has_alpha().then(|| alpha_fractions(&rgba));
-    Ok(RawImage {
-        width,
-        height,
-        format: ImageFormat::Ktx2,
-        pixels: Pixels::Rgba8(rgba),
-        alpha,
-    })
-}
-
-/// Checks what `basisu` 0.1 trusts in a KTX2 header: Zstandard-compressed
-/// levels whose stated uncompressed size is beyond what their blocks can
-/// take would have it allocate that much (up to exabytes, an abort), and a
-/// key/value entry that ends past the key/value data would have it read
-/// out of bounds (a panic). `Err` names the part that is wrong.
-fn ktx2_sound(bytes: &[u8]) -> Result<(), &'static str> {
-    let u32_at = |at: usize| -> Option<u64> {
-        Some(u64::from(u32::from_le_bytes(
-            bytes.get(at..at + 4)?.try_into().ok()?,
-        )))
-    };
-    let u64_at = |at: usize| -> Option<u64> {
-        Some(u64::from_le_bytes(bytes.get(at..at + 8)?.try_into().ok()?))
-    };
-    let header = (|| {
-        Some((
-            [u32_at(20)?, u32_at(24)?, u32_at(32)?, u32_at(36)?],
-            u32_at(40)?,
-            u32_at(44)?,
-            (u32_at(56)?, u32_at(60)?),
-        ))
-    })();
-    // A file too short for its header is left to the transcoder, which
-    // says it is truncated.
-    let Some(([width, height, layers, faces], levels, scheme, (kvd_at, kvd_len))) = header else {
-        return Ok(());
-    };
-    // A level's byte offset plus its length past 2^64 (the transcoder adds
-    // them unchecked).
-    for level in 0..levels.clamp(1, 32) {
-        let at = 80 + 24 * level as usize;
-        let (Some(offset), Some(length)) = (u64_at(at), u64_at(at + 8)) else {
-            break;
-        };
-        if offset.checked_add(length).is_none() {
-            return Err("level index");
-        }
-    }
-    const ZSTANDARD: u64 = 2;
-    if scheme == ZSTANDARD {
-        // 16 bytes per 4 x 4 block (UASTC and ASTC blocks), for each layer
-        // and face of the level; the whole stack within Sahara's pixel
-        // limit.
-        let stack = layers.max(1).saturating_mul(faces.max(1));
-        if width.saturating_mul(height).saturating_mul(stack) > MAX_IMAGE_PIXELS {
-            return Err("size");
-        }
-        for level in 0..levels.clamp(1, 32) {
-            let Some(stated) = u64_at(80 + 24 * level as usize + 16) else {
-                return Ok(());
-            };
-            let side = |s: u64| (s >> level).max(1).div_ceil(4);
-            if stated > 16 * side(width) * side(height) * stack {
-                // (At most 2^4 x 2^26 x 2^4: the pixel limit bounds each.)
-                return Err("level index");
-            }
-        }
-    }
-    // Key/value entries: a length, that many bytes, padding to a multiple
-    // of 4 (from the file's start); the transcoder walks them as long as
-    // more than 4 bytes remain, stopping at a length that does not fit.
-    let (start, end) = (kvd_at, kvd_at + kvd_len);
-    if kvd_len == 0 || end > bytes.len() as u64 {
-        return Ok(());
-    }
-    let mut p = start;
-    while end - p > 4 {
-        let length = u32_at(p as usize).ok_or("key/value data")?;
-        p += 4;
-        if length < 2 || end - p < length {
-            return Ok(());
-        }
-        p += length;
-        p += (4 - (p & 3)) & 3;
-        if p > end {
-            return Err("key/value data");
-        }
-    }
-    Ok(())
+    image.map_err(crate::error::one_line)
 }
 
 fn decode_any(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
@@ -250,7 +115,7 @@ fn decode_any(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
         });
     }
     if bytes.starts_with(&[0xAB, b'K', b'T', b'X', b' ', b'2', b'0', 0xBB]) {
-        return decode_ktx2(bytes, name);
+        return ktx2::decode(bytes, name);
     }
     if bytes.len() >= 12 && &bytes[..4] == b"RIFF" && &bytes[8..12] == b"WEBP" {
         return Err(FormatError::in_file(

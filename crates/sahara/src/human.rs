@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use sahara_bench::report::{BenchReport, StatsReport, StructureStats};
+use sahara_bench::report::{BenchReport, SetReport, StatsReport, StructureStats};
 
 /// `1234567` as `1,234,567`.
 pub fn thousands(n: u64) -> String {
@@ -55,6 +55,19 @@ batch: the whole set in one batch call on 1 thread; packets: 8- or 16-ray
 /// The header and one table row per set.
 pub fn bench_report(r: &BenchReport) -> String {
     let mut s = String::new();
+    bench_header(&mut s, r);
+    let _ = writeln!(s);
+    let entries = r.sets.entries();
+    bench_table(&mut s, r, &entries);
+    let _ = writeln!(s);
+    let _ = writeln!(s, "{}", BENCH_LEGEND.trim_end());
+    bench_counters(&mut s, &entries);
+    // Columns left empty (one thread) leave no trailing blanks.
+    s.lines().map(|l| l.trim_end().to_owned() + "\n").collect()
+}
+
+/// The report's header: the mesh, the camera, the tree and how it was timed.
+fn bench_header(s: &mut String, r: &BenchReport) {
     let _ = writeln!(s, "mesh       {}", r.mesh);
     let _ = writeln!(s, "triangles  {}", thousands(r.triangles as u64));
     if let Some(c) = &r.camera {
@@ -90,7 +103,10 @@ pub fn bench_report(r: &BenchReport) -> String {
         count(r.runs, "run"),
         count(r.threads, "thread")
     );
-    let _ = writeln!(s);
+}
+
+/// One row per set (and its batch and packet rows).
+fn bench_table(s: &mut String, r: &BenchReport, entries: &[(&str, &SetReport)]) {
     // With one thread the all-threads column would repeat the first.
     let many = r.threads > 1;
     let all = if many {
@@ -111,8 +127,7 @@ pub fn bench_report(r: &BenchReport) -> String {
         }
     };
     let dash = if many { "-" } else { "" };
-    let entries = r.sets.entries();
-    for (name, e) in &entries {
+    for (name, e) in entries {
         let _ = writeln!(
             s,
             "{:<8} {:>11} {:>11} {:>22.6} {:>11.3} {:>11.3} {}",
@@ -158,8 +173,11 @@ pub fn bench_report(r: &BenchReport) -> String {
             }
         }
     }
-    let _ = writeln!(s);
-    let _ = writeln!(s, "{}", BENCH_LEGEND.trim_end());
+}
+
+/// The traversal work per ray of the sets that counted it, beside the
+/// SAH's expectation.
+fn bench_counters(s: &mut String, entries: &[(&str, &SetReport)]) {
     if entries.iter().any(|(_, e)| e.counters.is_some()) {
         let _ = writeln!(s);
         let _ = writeln!(
@@ -171,7 +189,7 @@ pub fn bench_report(r: &BenchReport) -> String {
             "{:<8} {:>7} {:>17} {:>17} {:>19}",
             "set", "root %", "inner (SAH)", "leaves (SAH)", "triangles (SAH)"
         );
-        for (name, e) in &entries {
+        for (name, e) in entries {
             if let Some(c) = &e.counters {
                 let (i, l, t) = c.per_root_ray();
                 let _ = writeln!(
@@ -189,8 +207,22 @@ pub fn bench_report(r: &BenchReport) -> String {
             }
         }
     }
-    // Columns left empty (one thread) leave no trailing blanks.
-    s.lines().map(|l| l.trim_end().to_owned() + "\n").collect()
+}
+
+/// The triangles the trees hold: `given` less `skipped`, then `what` they
+/// are, and if any were skipped, how many of how many (`1 (1 of 2
+/// skipped: no ray can hit them)`).
+pub fn kept_triangles(given: u64, skipped: u64, what: &str) -> String {
+    let kept = thousands(given.saturating_sub(skipped));
+    if skipped == 0 {
+        format!("{kept}{what}")
+    } else {
+        format!(
+            "{kept}{what} ({} of {} skipped: no ray can hit them)",
+            thousands(skipped),
+            thousands(given)
+        )
+    }
 }
 
 /// The statistics, one per line.
@@ -209,8 +241,8 @@ pub fn stats_report(r: &StatsReport) -> String {
         ),
     ];
     match &r.tree {
-        StructureStats::Kd(t) => lines.extend(kd_lines(t)),
-        StructureStats::Bvh(b) => lines.extend(bvh_lines(b)),
+        StructureStats::Kd(t) => lines.extend(kd_lines(t, r.skipped_triangles)),
+        StructureStats::Bvh(b) => lines.extend(bvh_lines(b, r.skipped_triangles)),
     }
     for (k, v) in lines {
         let _ = writeln!(s, "{k:<11} {v}");
@@ -245,9 +277,12 @@ pub fn stats_report(r: &StatsReport) -> String {
 }
 
 /// A kd-tree's statistics, as `stats_report` lines.
-fn kd_lines(t: &sahara_kd::TreeStats) -> Vec<(&'static str, String)> {
+fn kd_lines(t: &sahara_kd::TreeStats, skipped: usize) -> Vec<(&'static str, String)> {
     vec![
-        ("triangles", thousands(t.triangles as u64)),
+        (
+            "triangles",
+            kept_triangles(t.triangles as u64, skipped as u64, ""),
+        ),
         ("nodes", thousands(t.nodes as u64)),
         ("inner", thousands(t.inner as u64)),
         (
@@ -298,9 +333,12 @@ fn kd_lines(t: &sahara_kd::TreeStats) -> Vec<(&'static str, String)> {
 }
 
 /// A hierarchy's statistics, as `stats_report` lines.
-fn bvh_lines(b: &sahara_kd::BvhStats) -> Vec<(&'static str, String)> {
+fn bvh_lines(b: &sahara_kd::BvhStats, skipped: usize) -> Vec<(&'static str, String)> {
     vec![
-        ("triangles", thousands(b.triangles as u64)),
+        (
+            "triangles",
+            kept_triangles(b.triangles as u64, skipped as u64, ""),
+        ),
         (
             "nodes",
             format!(

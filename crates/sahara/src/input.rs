@@ -14,7 +14,10 @@ use sahara_render::Mesh;
 pub fn load_mesh(path: &Path) -> Result<Mesh> {
     // A `FormatError`'s message already holds its cause: flatten it so the
     // cause is not printed twice by `{:#}`.
-    let (mesh, mut warnings) = sahara_formats::load_mesh_with_warnings(path)
+    let loading = crate::status::Step::start(format!("loading {}", path.display()));
+    let loaded = sahara_formats::load_mesh_with_warnings(path);
+    drop(loading);
+    let (mesh, mut warnings) = loaded
         .map_err(|e| anyhow!("{e}"))
         .with_context(|| format!("cannot load mesh {}", path.display()))?;
     let skipped = mesh.unhittable_count();

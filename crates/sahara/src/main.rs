@@ -9,18 +9,14 @@
 mod bench;
 mod cli;
 mod demo_scene;
-mod denoise;
 mod human;
-mod id_names;
 mod input;
-mod memory;
 mod merge;
-mod output;
-mod part;
 mod render;
-mod render_options;
 mod scene_input;
+mod setting_args;
 mod stats;
+mod status;
 mod warnings;
 
 use std::process::ExitCode;
@@ -36,7 +32,7 @@ use render::Finish;
 const INTERRUPTED: u8 = 130;
 
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let cli = match Cli::try_parse_from(with_render_implied(std::env::args_os())) {
         Ok(cli) => cli,
         Err(e) => return argument_error(e),
     };
@@ -55,6 +51,24 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The arguments, with `render` put before them when they start with an
+/// option other than help and version: the bare command takes `render`'s
+/// options (`sahara -o out.png`, `sahara --spp 4`) as it renders what
+/// `sahara render` renders.
+fn with_render_implied(
+    args: impl IntoIterator<Item = std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    let mut args: Vec<_> = args.into_iter().collect();
+    let renders = args
+        .get(1)
+        .and_then(|a| a.to_str())
+        .is_some_and(|a| a.starts_with('-') && !["-h", "--help", "-V", "--version"].contains(&a));
+    if renders {
+        args.insert(1, "render".into());
+    }
+    args
 }
 
 /// Help and version as clap prints them; any other command-line error as

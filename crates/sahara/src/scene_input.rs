@@ -8,7 +8,10 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Result};
 use sahara_formats::{load, load_builtin, LoadOptions, Loaded};
 
-/// A scene to render, with what its file says about rendering it.
+/// A scene to render, with what its file says about rendering it. Its
+/// problems, those of the finished scene among them (triangles skipped, no
+/// light), are [`Loaded::problems`]: every command that loads a scene says
+/// them.
 pub(crate) type Input = Loaded;
 
 /// The scene to render: the built-in Cornell box, a scene file or a mesh
@@ -29,11 +32,16 @@ pub(crate) fn load_input(
         defines: defines.to_vec(),
     };
     // A `FormatError`'s message already names the file and place.
-    let input = match path {
+    let loading = crate::status::Step::start(match path {
+        Some(path) => format!("loading {}", path.display()),
+        None => "loading the built-in scene".to_owned(),
+    });
+    let loaded = match path {
         Some(path) => load(path, &options),
         None => load_builtin(&options),
-    }
-    .map_err(|e| anyhow!("{e}"))?;
+    };
+    drop(loading);
+    let input = loaded.map_err(|e| anyhow!("{e}"))?;
     if let Some(framing) = &input.framing {
         eprintln!("{framing}");
     }

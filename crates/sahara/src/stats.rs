@@ -22,6 +22,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         return run_scene(args);
     }
     let mesh = args.tree.select(load_mesh(&args.mesh)?);
+    let skipped_triangles = mesh.unhittable_count();
     let threads = args
         .threads
         .map_or_else(Pools::available_threads, usize::from);
@@ -48,6 +49,7 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         builder: params.builder_name(),
         build_ms,
         build_runs: args.runs,
+        skipped_triangles,
         tree: match &tree {
             TriangleAccel::Kd(t) => StructureStats::Kd(t.stats()),
             TriangleAccel::Bvh(b) => StructureStats::Bvh(b.stats()),
@@ -124,6 +126,9 @@ pub struct SceneStatsReport {
     /// Triangles of all instances (an instanced mesh counted once per
     /// instance).
     pub instanced_triangles: u64,
+    /// Of those, the ones no ray can hit (a non-finite corner or zero
+    /// area), which the trees leave out.
+    pub skipped_triangles: u64,
     /// Bytes held by the trees.
     pub memory_bytes: usize,
 }
@@ -134,7 +139,7 @@ fn run_scene(args: &StatsArgs) -> Result<()> {
         bail!("--subset applies to meshes, not to scene files");
     }
     let input = crate::scene_input::load_input(Some(&args.mesh), None, None, &[])?;
-    crate::warnings::print(&input.warnings);
+    crate::warnings::print(&input.problems());
     let threads = args
         .threads
         .map_or_else(Pools::available_threads, usize::from);
@@ -173,6 +178,19 @@ fn run_scene(args: &StatsArgs) -> Result<()> {
             .iter()
             .map(|i| scene.meshes[i.mesh as usize].mesh.triangle_count() as u64)
             .sum(),
+        skipped_triangles: {
+            // Counted once per mesh, however many instances show it.
+            let skipped: Vec<u64> = scene
+                .meshes
+                .iter()
+                .map(|m| m.mesh.unhittable_count() as u64)
+                .collect();
+            scene
+                .instances
+                .iter()
+                .map(|i| skipped[i.mesh as usize])
+                .sum()
+        },
         memory_bytes: accel.tree_bytes(),
     };
     if args.json {
@@ -218,8 +236,8 @@ fn scene_stats_report(r: &SceneStatsReport, threads: usize) -> String {
     };
     let _ = writeln!(
         s,
-        "triangles  {} (instanced)",
-        human::thousands(r.instanced_triangles)
+        "triangles  {}",
+        human::kept_triangles(r.instanced_triangles, r.skipped_triangles, " instanced")
     );
     let _ = writeln!(s, "builder    {}", r.builder);
     let _ = writeln!(

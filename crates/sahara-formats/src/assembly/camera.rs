@@ -1,5 +1,6 @@
-//! The automatic camera: the whole scene seen from above, the front and
-//! the right.
+//! The automatic camera: the scene's subject seen from above, the front
+//! and the right, or for models whose format says where their front is
+//! (glTF: +Z), from the front and a little above.
 
 use glam::Vec3;
 use sahara_readers::FormatError;
@@ -22,6 +23,26 @@ pub(crate) fn has_finite_triangles(scene: &Scene) -> bool {
 /// in the frame.
 const GROUND_DWARFS: f32 = 4.0;
 
+/// How much larger than the subject a flat or emissive object must be for
+/// the automatic camera to leave it out of the framing (though not out of
+/// the light, which [`GROUND_DWARFS`] decides): a floor twice the subject's
+/// size would make the subject small in the frame.
+const FRAME_DWARFS: f32 = 2.0;
+
+/// Where the automatic camera stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum View {
+    /// Above, in front (+Z) and to the right (+X): a three-quarter view
+    /// that shows a mesh of unknown orientation in depth.
+    ThreeQuarter,
+    /// In front (+Z) and a little above ([`FRONT_ELEVATION_DEG`]), as glTF
+    /// viewers show a model: glTF models face +Z with +Y up.
+    Front,
+}
+
+/// How far above the horizontal the [`View::Front`] camera looks down.
+const FRONT_ELEVATION_DEG: f32 = 15.0;
+
 /// Thickness, relative to its largest extent, below which an object is flat:
 /// a plane, or a sea or terrain whose waves or hills are low beside its size.
 const FLAT: f32 = 0.05;
@@ -29,13 +50,14 @@ const FLAT: f32 = 0.05;
 /// A camera that sees the scene (see [`auto_camera_framing`]).
 #[cfg(test)]
 fn auto_camera(scene: &Scene, name: &str) -> Result<Camera, FormatError> {
-    auto_camera_framing(scene, name).map(|(c, _)| c)
+    auto_camera_framing(scene, name, View::ThreeQuarter).map(|(c, _)| c)
 }
 
 /// What the automatic camera frames and what it leaves out as context.
 pub(crate) struct Grounds {
     /// Per instance: context, not subject (a flat or emissive object at
-    /// least [`GROUND_DWARFS`] times the size of the subject).
+    /// least so many times the size of the subject: [`GROUND_DWARFS`] for
+    /// the light, [`FRAME_DWARFS`] for the framing).
     pub(crate) context: Vec<bool>,
     /// Per instance: flat (its thickness at most [`FLAT`] of its size).
     pub(crate) flat: Vec<bool>,
@@ -57,9 +79,14 @@ impl Grounds {
 /// at least [`GROUND_DWARFS`] times the diagonal of the other objects'
 /// bounds (those that are not candidates; if every object is one, all but
 /// the largest) is context. The automatic camera frames what is not
-/// context, and `auto` lighting does not count a ground's glow as the
-/// scene's light.
+/// context (with [`FRAME_DWARFS`] in place of [`GROUND_DWARFS`]), and
+/// `auto` lighting does not count a ground's glow as the scene's light.
 pub(crate) fn grounds(scene: &Scene) -> Grounds {
+    grounds_at(scene, GROUND_DWARFS)
+}
+
+/// [`grounds`], with context `dwarfs` times the subject's size or more.
+fn grounds_at(scene: &Scene, dwarfs: f32) -> Grounds {
     let n = scene.instances.len();
     let bounds: Vec<Option<(Vec3, Vec3)>> = scene
         .instances
@@ -102,7 +129,7 @@ pub(crate) fn grounds(scene: &Scene) -> Grounds {
     let diagonal = measure.map(|(lo, hi)| (hi - lo).length());
     let context: Vec<bool> = (0..n)
         .map(|i| match (bounds[i], diagonal) {
-            (Some(b), Some(d)) if candidate[i] && d.is_finite() => size(&b) >= GROUND_DWARFS * d,
+            (Some(b), Some(d)) if candidate[i] && d.is_finite() => size(&b) >= dwarfs * d,
             _ => false,
         })
         .collect();
@@ -225,18 +252,50 @@ fn mark_triangle(grid: &mut [bool], t: [glam::Vec2; 3]) {
     }
 }
 
+/// How far from the centre of the box `lo..hi`, looking at it from the
+/// direction `from` (with +Y up), every corner of the box is within the
+/// field of view (`half_fov` either side, across and up: any image at
+/// least as wide as it is tall shows it all), with a 5 % margin. Tighter
+/// than the bounding sphere, which leaves a model long along the line of
+/// sight (a fox seen from the front) small in the frame.
+fn front_distance(lo: Vec3, hi: Vec3, from: Vec3, half_fov: f32) -> f32 {
+    let right = Vec3::Y.cross(from).normalize();
+    let up = from.cross(right);
+    let (c, tan) = (0.5 * (lo + hi), half_fov.tan());
+    let (mut d, mut nearest) = (0.0f32, 0.0f32);
+    for k in 0..8 {
+        let corner = Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        ) - c;
+        // The corner's offset towards the eye shortens its depth.
+        let nearer = corner.dot(from);
+        let across = corner.dot(right).abs().max(corner.dot(up).abs());
+        d = d.max(across / tan + nearer);
+        nearest = nearest.max(nearer);
+    }
+    let r = (0.5 * (hi - lo).length()).max(1e-6);
+    // Never so close that the box reaches the eye.
+    1.05 * d.max(nearest + 0.1 * r)
+}
+
 /// A camera that sees the scene's objects: looking at the centre of their
-/// bounds from above, the front (+Z) and the right (+X), at the distance
-/// where their bounding sphere fills the vertical field of view; with the
-/// log's words for how it chose. Context ([`grounds`]: flat or emissive
-/// objects at least [`GROUND_DWARFS`] times the size of everything else,
-/// such as a ground plane or a sea) is left out of the framing (it still
-/// renders), so that the subject fills the frame rather than the plane it
-/// stands on. Objects that enclose a room open on one side (a Cornell box)
+/// bounds from where `view` says (above, the front (+Z) and the right
+/// (+X); or the front and a little above), at the distance where their
+/// bounding sphere fills the vertical field of view; with the log's words
+/// for how it chose. Context ([`grounds`]: flat or emissive objects at
+/// least [`FRAME_DWARFS`] times the size of everything else, such as a
+/// ground plane or a sea) is left out of the framing (it still renders),
+/// so that the subject fills the frame rather than the plane it stands on. Objects that enclose a room open on one side (a Cornell box)
 /// are looked into through that side, the opening filling the frame, not
 /// at from outside its walls.
-pub fn auto_camera_framing(scene: &Scene, name: &str) -> Result<(Camera, String), FormatError> {
-    let g = grounds(scene);
+pub(crate) fn auto_camera_framing(
+    scene: &Scene,
+    name: &str,
+    view: View,
+) -> Result<(Camera, String), FormatError> {
+    let g = grounds_at(scene, FRAME_DWARFS);
     let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     let (mut framed, mut left_out) = (0, 0);
     let mut in_frame = vec![false; scene.instances.len()];
@@ -277,10 +336,17 @@ pub fn auto_camera_framing(scene: &Scene, name: &str) -> Result<(Camera, String)
             let up = if axis == 1 { Vec3::NEG_Z } else { Vec3::Y };
             (face + out * d, up)
         }
-        None => (
-            c + Vec3::new(0.3, 0.5, 1.0).normalize() * (r / half_fov.sin()),
-            Vec3::Y,
-        ),
+        None => match view {
+            View::ThreeQuarter => {
+                let from = Vec3::new(0.3, 0.5, 1.0).normalize();
+                (c + from * (r / half_fov.sin()), Vec3::Y)
+            }
+            View::Front => {
+                let (sin, cos) = FRONT_ELEVATION_DEG.to_radians().sin_cos();
+                let from = Vec3::new(0.0, sin, cos);
+                (c + from * front_distance(lo, hi, from, half_fov), Vec3::Y)
+            }
+        },
     };
     // Coordinates near the float range put the eye at infinity, and
     // coordinates far from the origin beside a tiny mesh leave no room
@@ -300,7 +366,7 @@ pub fn auto_camera_framing(scene: &Scene, name: &str) -> Result<(Camera, String)
         0 => format!("auto (framing all {framed} objects"),
         n => format!(
             "auto (framing {framed} object{}; {n} flat or emissive object{} at least \
-             {GROUND_DWARFS} times their size, a ground, sea or backdrop, left out of the framing",
+             {FRAME_DWARFS} times their size, a ground, sea or backdrop, left out of the framing",
             objects(framed),
             objects(n)
         ),
@@ -362,7 +428,8 @@ mod tests {
 
     #[test]
     fn a_ground_plane_that_dwarfs_the_subject_is_left_out_of_the_framing() {
-        let (c, how) = auto_camera_framing(&sphere_on_ground(1000.0), "t").unwrap();
+        let (c, how) =
+            auto_camera_framing(&sphere_on_ground(1000.0), "t", View::ThreeQuarter).unwrap();
         // Framed on the sphere (radius 1): the eye is a few radii away,
         // not hundreds.
         assert!(c.eye.length() < 5.0, "{}", c.eye);
@@ -437,7 +504,7 @@ mod tests {
         palm_island(&mut scene);
         // Waves of 2 units over 392: five times the old flatness bound.
         wavy_sea(&mut scene, 2.0, 1.0);
-        let (c, how) = auto_camera_framing(&scene, "t").unwrap();
+        let (c, how) = auto_camera_framing(&scene, "t", View::ThreeQuarter).unwrap();
         assert!(
             how.contains("framing 6 objects; 1 flat or emissive object"),
             "{how}"
@@ -486,7 +553,7 @@ mod tests {
     fn a_room_open_on_one_side_is_looked_into_through_it() {
         let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
         cornell_room(&mut scene, false);
-        let (c, how) = auto_camera_framing(&scene, "t").unwrap();
+        let (c, how) = auto_camera_framing(&scene, "t", View::ThreeQuarter).unwrap();
         assert!(how.contains("a room open on its +z side"), "{how}");
         // On the opening's axis, outside it, looking straight in, level.
         let centre = Vec3::new(-278.0, 274.0, 279.5);
@@ -500,16 +567,85 @@ mod tests {
         // Closed on all six sides, it is no room with an opening.
         let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
         cornell_room(&mut scene, true);
-        let (_, how) = auto_camera_framing(&scene, "t").unwrap();
+        let (_, how) = auto_camera_framing(&scene, "t", View::ThreeQuarter).unwrap();
         assert_eq!(how, "auto (framing all 7 objects)");
         // Nor is a sphere on a floor.
-        let (_, how) = auto_camera_framing(&sphere_on_ground(3.0), "t").unwrap();
+        let (_, how) =
+            auto_camera_framing(&sphere_on_ground(3.0), "t", View::ThreeQuarter).unwrap();
         assert!(!how.contains("room"), "{how}");
     }
 
     #[test]
+    fn a_gltf_model_is_seen_from_its_front_a_little_above() {
+        let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
+        let m = scene.add_material(Material::default());
+        scene.add_shape(
+            sahara_render::Shape::Box {
+                min: Vec3::new(1.0, 0.0, -1.0),
+                max: Vec3::new(3.0, 4.0, 1.0),
+            },
+            m,
+        );
+        let (c, _) = auto_camera_framing(&scene, "t", View::Front).unwrap();
+        let from = (c.eye - Vec3::new(2.0, 2.0, 0.0)).normalize();
+        // Straight in front (+Z), 15 degrees above, looking at the centre.
+        assert!(from.x.abs() < 1e-6, "{from}");
+        assert!((from.y - 15f32.to_radians().sin()).abs() < 1e-5, "{from}");
+        assert!((c.forward + from).length() < 1e-5, "{}", c.forward);
+        // The three-quarter view of other meshes: from the right and
+        // higher.
+        let (c, _) = auto_camera_framing(&scene, "t", View::ThreeQuarter).unwrap();
+        let from = (c.eye - Vec3::new(2.0, 2.0, 0.0)).normalize();
+        assert!(from.x > 0.2 && from.y > 0.4, "{from}");
+    }
+
+    #[test]
+    fn a_model_long_along_the_line_of_sight_still_fills_the_front_view() {
+        // A box 1 wide, 1 tall and 6 deep (a fox seen from the front): every
+        // corner in the frame, the outermost near its edge (the bounding
+        // sphere would leave it a third of the frame).
+        let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
+        let m = scene.add_material(Material::default());
+        let (lo, hi) = (Vec3::new(-0.5, 0.0, -3.0), Vec3::new(0.5, 1.0, 3.0));
+        scene.add_shape(sahara_render::Shape::Box { min: lo, max: hi }, m);
+        let (c, _) = auto_camera_framing(&scene, "t", View::Front).unwrap();
+        let tan = (0.5 * AUTO_VFOV_DEG.to_radians()).tan();
+        let right = c.forward.cross(Vec3::Y).normalize();
+        let up = right.cross(c.forward);
+        let mut widest = 0.0f32;
+        for k in 0..8 {
+            let p = Vec3::new(
+                [lo.x, hi.x][k & 1],
+                [lo.y, hi.y][(k >> 1) & 1],
+                [lo.z, hi.z][(k >> 2) & 1],
+            ) - c.eye;
+            let depth = p.dot(c.forward);
+            assert!(depth > 0.0, "corner {k} behind the eye");
+            let fill = p.dot(right).abs().max(p.dot(up).abs()) / (depth * tan);
+            assert!(fill <= 1.0, "corner {k} out of the frame: {fill}");
+            widest = widest.max(fill);
+        }
+        assert!(widest > 0.9, "{widest}");
+    }
+
+    #[test]
+    fn a_floor_a_few_times_the_subjects_size_does_not_decide_the_framing() {
+        // A chair on a floor 3.8 times its size (Bevy's
+        // MixedLightingExample): the chair is framed, the floor left out;
+        // the light's ground rule (four times) still counts the floor.
+        let (c, how) = auto_camera_framing(&sphere_on_ground(13.2), "t", View::Front).unwrap();
+        assert!(
+            how.contains("1 flat or emissive object at least 2 times"),
+            "{how}"
+        );
+        assert!(c.eye.length() < 5.0, "{}", c.eye);
+        assert!(!grounds(&sphere_on_ground(13.2)).context.contains(&true));
+    }
+
+    #[test]
     fn a_floor_of_the_subjects_size_is_framed_with_it() {
-        let (c, how) = auto_camera_framing(&sphere_on_ground(3.0), "t").unwrap();
+        let (c, how) =
+            auto_camera_framing(&sphere_on_ground(3.0), "t", View::ThreeQuarter).unwrap();
         assert_eq!(how, "auto (framing all 2 objects)");
         // Farther than the sphere alone needs (sqrt(3) / sin(22.5 deg) =
         // 4.5): the floor's corners are in the frame too (6.1).

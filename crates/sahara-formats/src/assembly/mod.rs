@@ -36,14 +36,14 @@ use sahara_readers::gltf::GltfCamera;
 use sahara_render::{Camera, Instance, MediumInterface, Placement, Scene, SceneMesh, Shape, Srt};
 
 use crate::description::{
-    CameraRequest, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
+    CameraRequest, Geometry, Object, ObjectPlacement, SceneDescription, SettingsLayer,
 };
 use crate::gltf::{gltf_camera, gltf_light};
 use crate::mesh::library::{file_key, MeshLibrary};
 use camera::has_finite_triangles;
 use sky::SkyUsed;
 
-use camera::{auto_camera_framing, AUTO_VFOV_DEG};
+use camera::{auto_camera_framing, View, AUTO_VFOV_DEG};
 use sahara_readers::FormatError;
 
 /// A scene ready to render, with what assembling it decided.
@@ -54,7 +54,7 @@ pub struct AssembledScene {
     /// size).
     pub scene: Scene,
     /// How the file asks to be rendered, if it says.
-    pub settings: Option<FileSettings>,
+    pub settings: Option<SettingsLayer>,
     /// Where the camera came from: the description's source for a given
     /// camera, a glTF camera (`file: camera 'name'`), or `auto`.
     pub camera_source: String,
@@ -121,6 +121,7 @@ pub fn assemble(mut desc: SceneDescription) -> Result<AssembledScene, FormatErro
         own: shown_with_own_materials(&desc.objects),
         interfaces: desc.medium_interfaces.iter().copied().collect(),
         filled: HashSet::new(),
+        faces_z: None,
     };
     let mut moving_emitters = 0;
     // The file's media come first (the objects' interfaces name them by
@@ -150,8 +151,18 @@ pub fn assemble(mut desc: SceneDescription) -> Result<AssembledScene, FormatErro
         scene.environment = Some(env);
     }
     scene.generate_tangents();
-    let (camera, camera_source) =
-        choose_camera(desc.camera, &objects.cameras, &scene, &name, &mut warnings)?;
+    let view = match objects.faces_z {
+        Some(true) => View::Front,
+        _ => View::ThreeQuarter,
+    };
+    let (camera, camera_source) = choose_camera(
+        desc.camera,
+        &objects.cameras,
+        &scene,
+        &name,
+        view,
+        &mut warnings,
+    )?;
     scene.camera = camera;
     let (sky, sky_share) = sky::apply(&mut scene, &desc.sky)
         .map_err(|e| FormatError::in_file(&name, format!("sky: {e}")))?;
@@ -188,6 +199,9 @@ struct Objects {
     interfaces: BTreeMap<u32, MediumInterface>,
     /// Instances whose glTF material fills them with a medium.
     filled: HashSet<u32>,
+    /// Whether all the geometry so far comes from files whose models face
+    /// +Z (glTF); `None` before any.
+    faces_z: Option<bool>,
 }
 
 impl Objects {
@@ -200,6 +214,9 @@ impl Objects {
         o: &Object,
         name: &str,
     ) -> Result<bool, FormatError> {
+        if !matches!(o.geometry, Geometry::File(_)) {
+            self.faces_z = Some(false);
+        }
         Ok(match &o.geometry {
             Geometry::File(path) => self.add_file(scene, k, o, path, name)?,
             Geometry::Shape(shape) => {
@@ -238,6 +255,7 @@ impl Objects {
         if self.library.file_count() > first {
             self.cameras.extend(f.cameras.iter().cloned());
         }
+        self.faces_z = Some(self.faces_z.unwrap_or(true) && f.faces_z);
         for part in &f.parts {
             let instance = scene.add_instance(Instance {
                 mesh: part.mesh,
@@ -331,12 +349,14 @@ fn material_names(
 
 /// The camera the description asks for, and where it came from: the given
 /// one, a named camera of its mesh files (`cameras`), or the files' first
-/// camera, else the automatic one framing `scene`.
+/// camera, else the automatic one framing `scene` from the side `view`
+/// says.
 fn choose_camera(
     request: CameraRequest,
     cameras: &[GltfCamera],
     scene: &Scene,
     name: &str,
+    view: View,
     warnings: &mut Vec<String>,
 ) -> Result<(Camera, String), FormatError> {
     Ok(match request {
@@ -382,7 +402,7 @@ fn choose_camera(
                     "auto (nothing to frame)".into(),
                 )
             }
-            None => auto_camera_framing(scene, name)?,
+            None => auto_camera_framing(scene, name, view)?,
         },
     })
 }

@@ -67,7 +67,23 @@ impl std::fmt::Display for SkyUsed {
 /// automatic camera's `grounds`) does not count: it is context, lighting
 /// the subject from below, and cannot stand in for a sky above it.
 pub fn own_power(scene: &Scene, radius: f32) -> f32 {
+    own_power_by(scene, radius, &mut |t| luminance(t.mean()))
+}
+
+/// [`own_power`], with `texture_luminance` giving an emission texture's
+/// mean luminance. It is asked once per emissive material with a texture,
+/// whatever the number of triangles wearing it: the work is linear in the
+/// scene's triangles plus its emission textures' texels (the tests count
+/// the asking).
+fn own_power_by(
+    scene: &Scene,
+    radius: f32,
+    texture_luminance: &mut dyn FnMut(&Texture) -> f32,
+) -> f32 {
     let grounds = super::camera::grounds(scene);
+    // Per material, its emission texture's mean luminance (1 without one),
+    // found when a triangle first wears it.
+    let mut texture_means: Vec<Option<f32>> = vec![None; scene.materials.len()];
     let mut power = 0.0f64;
     for (i, inst) in scene.instances.iter().enumerate() {
         if grounds.is_ground(i) {
@@ -76,10 +92,8 @@ pub fn own_power(scene: &Scene, radius: f32) -> f32 {
         let mesh = &scene.meshes[inst.mesh as usize];
         let xf = inst.placement.at(0.0);
         for (t, idx) in mesh.mesh.indices.iter().enumerate() {
-            let Some(m) = scene
-                .materials
-                .get(scene.material_of(i as u32, t as u32) as usize)
-            else {
+            let id = scene.material_of(i as u32, t as u32) as usize;
+            let Some(m) = scene.materials.get(id) else {
                 continue;
             };
             if !m.is_emissive() {
@@ -89,11 +103,12 @@ pub fn own_power(scene: &Scene, radius: f32) -> f32 {
             let area = 0.5 * (b - a).cross(c - a).length();
             if area.is_finite() {
                 let faces = if m.two_sided_emission { 2.0 } else { 1.0 };
-                let texture = m
-                    .textures
-                    .emission
-                    .as_ref()
-                    .map_or(1.0, |t| luminance(t.texture.mean()));
+                let texture = *texture_means[id].get_or_insert_with(|| {
+                    m.textures
+                        .emission
+                        .as_ref()
+                        .map_or(1.0, |t| texture_luminance(&t.texture))
+                });
                 power +=
                     (area * std::f32::consts::PI * luminance(m.emission) * texture * faces) as f64;
             }
@@ -224,6 +239,59 @@ mod tests {
             scene.add_light(*l);
         }
         scene
+    }
+
+    /// A strip of `n` emissive triangles (each of area 1/2) wearing
+    /// material 0, which has a `side` x `side` emission texture, and as
+    /// many wearing material 1, with another.
+    fn glowing_strips(n: u32, side: u32) -> Scene {
+        let mut scene = Scene::new(Camera::look_at(Vec3::Z, Vec3::ZERO, Vec3::Y, 45.0, 1.0));
+        for grey in [0.5, 0.25] {
+            let texels = vec![Vec3::splat(grey); (side * side) as usize];
+            let map = sahara_render::TextureMap::new(Arc::new(Texture::new(side, side, texels)));
+            let mut m = Material::diffuse(Vec3::splat(0.5)).with_emission(Vec3::ONE);
+            m.textures.emission = Some(map);
+            let id = scene.add_material(m);
+            let y = id as f32 * 2.0;
+            let positions = (0..=n)
+                .flat_map(|i| {
+                    [
+                        Vec3::new(i as f32, y, 0.0),
+                        Vec3::new(i as f32, y + 1.0, 0.0),
+                    ]
+                })
+                .collect();
+            let indices = (0..n).map(|i| [2 * i, 2 * i + 2, 2 * i + 1]).collect();
+            scene.add_object(
+                sahara_render::Mesh { positions, indices },
+                glam::Affine3A::IDENTITY,
+                id,
+            );
+        }
+        scene
+    }
+
+    #[test]
+    fn each_emission_texture_is_averaged_once_however_many_triangles_wear_it() {
+        // The work counted: texels averaged. It was once a pass over the
+        // whole texture per emissive triangle (a glTF model of 15,452
+        // triangles with a 2048 x 2048 emission map took minutes).
+        for n in [10, 10_000] {
+            let scene = glowing_strips(n, 256);
+            let (mut asked, mut texels) = (0, 0u64);
+            let power = own_power_by(&scene, 1.0, &mut |t| {
+                asked += 1;
+                texels += u64::from(t.width * t.height);
+                luminance(t.mean())
+            });
+            assert_eq!(asked, 2, "{n} triangles");
+            assert_eq!(texels, 2 * 256 * 256, "{n} triangles");
+            // Radiance 1 times the texture's grey, over n triangles of
+            // area 1/2 each, pi per unit, one face each.
+            let want = std::f32::consts::PI * 0.5 * n as f32 * (0.5 + 0.25);
+            assert!((power - want).abs() <= 1e-4 * want, "{power} vs {want}");
+            assert_eq!(power, own_power(&scene, 1.0));
+        }
     }
 
     #[test]

@@ -43,6 +43,10 @@ pub struct LoadedFile {
     pub material: Option<u32>,
     /// True if a material of the file emits light.
     pub emissive: bool,
+    /// True if the file's format says where a model's front is: glTF's
+    /// models face +Z (with +Y up), and the automatic camera shows them
+    /// from the front, as glTF viewers do.
+    pub faces_z: bool,
     /// The file's cameras (glTF), placed in the file's space.
     pub cameras: Vec<GltfCamera>,
     /// The file's lights (glTF `KHR_lights_punctual`), placed in the
@@ -130,6 +134,7 @@ impl MeshLibrary {
                     part_names: vec![None],
                     material: Some(self.default_material(scene)),
                     emissive: false,
+                    faces_z: false,
                     cameras: Vec::new(),
                     lights: Vec::new(),
                     volumes: HashMap::new(),
@@ -187,6 +192,7 @@ impl MeshLibrary {
             part_names: vec![None],
             material,
             emissive,
+            faces_z: false,
             cameras: Vec::new(),
             lights: Vec::new(),
             volumes: HashMap::new(),
@@ -266,6 +272,7 @@ impl MeshLibrary {
                 .collect(),
             material,
             emissive,
+            faces_z: true,
             cameras: g.cameras,
             lights: g.lights,
             volumes,

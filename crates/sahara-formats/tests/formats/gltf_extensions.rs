@@ -375,9 +375,16 @@ fn triangles_with_non_finite_corners_are_skipped_and_framing_ignores_them() {
     let dir = TempDir::new("gltf-inf");
     let path = dir.write("inf.gltf", json);
     let s = load_mesh_scene(&path).unwrap();
-    // Framed on the finite triangle: the camera looks at its bounds' centre.
+    // Framed on the finite triangle: the camera looks at its bounds' centre,
+    // from the front (+Z, glTF's front) and a little above, as glTF
+    // viewers show a model.
     let centre = Vec3::new(0.5, 0.5, 0.0);
     assert!(((centre - s.scene.camera.eye).normalize() - s.scene.camera.forward).length() < 1e-5);
+    let from = (s.scene.camera.eye - centre).normalize();
+    assert!(
+        from.x.abs() < 1e-5 && (from.y - 15f32.to_radians().sin()).abs() < 1e-5,
+        "{from}"
+    );
     assert_eq!(
         s.scene.diagnostics(),
         ["1 of 2 triangles skipped (1 with a NaN or infinite corner)"]
@@ -389,6 +396,10 @@ fn triangles_with_non_finite_corners_are_skipped_and_framing_ignores_them() {
     );
     let s = load_mesh_scene(&obj).unwrap();
     assert!(((centre - s.scene.camera.eye).normalize() - s.scene.camera.forward).length() < 1e-5);
+    // An OBJ says nothing of its front: the three-quarter view, from the
+    // right and above.
+    let from = (s.scene.camera.eye - centre).normalize();
+    assert!(from.x > 0.2 && from.y > 0.4, "{from}");
     assert_eq!(
         s.scene.diagnostics(),
         ["1 of 2 triangles skipped (1 with a NaN or infinite corner)"]

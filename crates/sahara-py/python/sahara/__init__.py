@@ -16,9 +16,11 @@ See docs/python.md in the repository.
 
 from __future__ import annotations
 
+import errno
 import os
 import sys
 import time
+import warnings
 from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -62,6 +64,14 @@ def load(
     ``FileNotFoundError``, or ``sahara.FormatError`` (a ``ValueError``)
     with the command line's one-line message naming the file and line.
     """
+    if more_defines and not os.fspath(path).lower().endswith(".xml"):
+        # Only a Mitsuba scene takes parameters: anything else is a
+        # mistyped keyword, said as Python says one.
+        raise TypeError(
+            f"load() got an unexpected keyword argument {next(iter(more_defines))!r} "
+            "(keyword arguments other than camera, sky and defines are the parameters "
+            "of a Mitsuba scene, .xml)"
+        )
     d = {str(k): _define(v) for k, v in dict(defines or {}, **more_defines).items()}
     return _sahara.load(os.fspath(path), camera=camera, sky=sky, defines=list(d.items()) or None)
 
@@ -76,16 +86,27 @@ def _define(v: Any) -> str:
 
 class _Bar:
     """A progress bar on stderr: tqdm's (notebook-aware) when installed,
-    else one line rewritten in place."""
+    else one line rewritten in place on a terminal, and plain lines now and
+    then elsewhere (a log, a notebook's captured stderr), as the command
+    line prints them."""
+
+    #: Seconds between plain lines where stderr is not a terminal.
+    EVERY = 10.0
 
     def __init__(self, label: str):
         self.label, self.bar, self.start = label, None, time.monotonic()
+        self.last_line = None
         try:
             from tqdm.auto import tqdm
 
             self.tqdm = tqdm
         except ImportError:
             self.tqdm = None
+        try:
+            self.terminal = sys.stderr.isatty()
+        except (AttributeError, ValueError):
+            self.terminal = False
+        self.drawn = False
 
     def __call__(self, done: int, total: int) -> None:
         if self.tqdm is not None:
@@ -95,52 +116,77 @@ class _Bar:
             self.bar.n = done
             self.bar.refresh()
             return
+        percent = 100 * done // max(total, 1)
+        elapsed = time.monotonic() - self.start
+        if not self.terminal:
+            # No line rewritten in place where stderr is not a terminal:
+            # a plain line now and then.
+            now = time.monotonic()
+            if self.last_line is None or now - self.last_line >= self.EVERY:
+                self.last_line = now
+                sys.stderr.write(f"{self.label}: {percent}% done, {elapsed:.0f} s\n")
+                sys.stderr.flush()
+            return
         width = 30
         filled = width * done // max(total, 1)
-        line = f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] {100 * done // max(total, 1):3d}% {time.monotonic() - self.start:.0f} s"
+        line = f"\r{self.label} [{'#' * filled}{'.' * (width - filled)}] {percent:3d}% {elapsed:.0f} s"
         sys.stderr.write(line)
         sys.stderr.flush()
+        self.drawn = True
 
-    def close(self) -> None:
+    def close(self, finished: bool = True) -> None:
         if self.bar is not None:
             self.bar.close()
-        elif self.tqdm is None:
-            sys.stderr.write("\r" + " " * 60 + "\r")
+        elif self.tqdm is None and self.terminal:
+            if self.drawn:
+                sys.stderr.write("\r" + " " * 60 + "\r")
+                sys.stderr.flush()
+        elif self.tqdm is None and self.last_line is not None:
+            # The plain lines end on the render's end, each on its own line.
+            elapsed = time.monotonic() - self.start
+            end = "100% done, finished" if finished else "stopped"
+            sys.stderr.write(f"{self.label}: {end}, {elapsed:.0f} s\n")
             sys.stderr.flush()
 
 
 def render(
     scene: Union[Scene, PathLike],
     *,
-    spp: Optional[int] = None,
-    width: Optional[int] = None,
-    height: Optional[int] = None,
-    integrator: Optional[str] = None,
-    seed: Optional[int] = None,
-    threads: Optional[int] = None,
-    aovs: Optional[Sequence[str]] = None,
-    denoise: bool = False,
     progress: Union[bool, Callable[[int, int], Any]] = True,
-    sampler: Optional[str] = None,
-    filter: Optional[str] = None,
-    pass_spp: Optional[int] = None,
-    accel: Optional[str] = None,
-    builder: Optional[str] = None,
+    threads: Optional[int] = None,
+    **settings: Any,
 ) -> Union[np.ndarray, Tuple[np.ndarray, Dict[str, np.ndarray]]]:
-    """Renders a scene (a ``Scene`` or a file's path) as ``sahara render``
-    does: the arguments given override the file's settings, which override
-    the defaults (512 x 512, 64 spp, the path tracer, seed 0); the same
-    arguments give the same image, bit for bit, as the command line.
+    """Renders a scene (a ``Scene`` or a file's path) through the request
+    ``sahara render`` makes: the settings given override the file's
+    settings, which override the defaults (512 x 512, 64 spp, the path
+    tracer, seed 0); the same settings give the same image, bit for bit,
+    as the command line, and with ``output`` the same file.
 
-    Returns the linear RGB image, a float32 array (height, width, 3); with
-    ``aovs`` (any of ``albedo``, ``normal``, ``depth``, ``position``,
-    ``uv``, ``variance``, ``object``, ``material``) a pair ``(image,
-    passes)`` whose dict holds one array per pass. ``denoise`` runs Intel
-    Open Image Denoise (``pip install pyoidn``). ``progress``: a bar on
-    stderr (True), none (False), or a function called with (tiles done,
-    tiles in all). The GIL is released while rendering on ``threads``
-    threads (None: all); Ctrl-C stops the render after the tiles under way
-    and raises ``KeyboardInterrupt``.
+    The settings are the command line's render options as keywords
+    (``sahara.names()["setting"]`` lists them): ``spp``, ``width``,
+    ``height``, ``integrator``, ``sampler``, ``filter``, ``seed``,
+    ``pass_spp``, ``accel``, ``builder``; ``noise_threshold`` and ``min_spp``
+    (adaptive sampling); ``time_limit`` (seconds: without ``spp`` the
+    passes go on until it is up); ``aovs`` (any of ``albedo``, ``normal``,
+    ``depth``, ``position``, ``uv``, ``variance``, ``object``,
+    ``material``; one name or a sequence of names); ``denoise`` (Intel Open Image Denoise, ``pip install
+    pyoidn``); ``output`` (a ``.png`` or ``.exr`` file written as the
+    command line writes it, with ``exposure`` and ``tonemap``); ``part``
+    (``(i, n)``), ``split`` (``"tiles"`` or ``"samples"``), ``crop``
+    (``(x0, x1, y0, y1)``) and ``samples`` (``(start, end)``): a piece of
+    the frame, its ``output`` a part file for ``sahara merge``.
+
+    Returns the linear RGB image, a float32 array (height, width, 3), of
+    the crop window or piece if one is asked for; with ``aovs`` a pair
+    ``(image, passes)`` whose dict holds one array per pass.
+    ``progress``: a bar on stderr (True), none (False), or a function
+    called with (tiles done, tiles in all). The GIL is released while
+    rendering on ``threads`` threads (None or 0: all, at most 1024);
+    Ctrl-C stops the render after the tiles under way and raises
+    ``KeyboardInterrupt``. A setting out of range raises ``ValueError``, of
+    the wrong type (``spp=2.5``, ``spp="16"``) ``TypeError``, a render
+    larger than the memory available ``MemoryError``, each naming the
+    argument at fault.
     """
     if not isinstance(scene, Scene):
         scene = load(scene)
@@ -152,28 +198,14 @@ def render(
         callback = progress
     else:
         callback = None
+    finished = False
     try:
-        image, passes = _sahara.render(
-            scene,
-            spp=spp,
-            width=width,
-            height=height,
-            integrator=integrator,
-            seed=seed,
-            threads=threads,
-            aovs=list(aovs) if aovs else None,
-            denoise=denoise,
-            sampler=sampler,
-            filter=filter,
-            pass_spp=pass_spp,
-            accel=accel,
-            builder=builder,
-            progress=callback,
-        )
+        image, passes = _sahara.render(scene, threads=threads, progress=callback, **settings)
+        finished = True
     finally:
         if bar is not None:
-            bar.close()
-    return (image, passes) if aovs else image
+            bar.close(finished)
+    return (image, passes) if settings.get("aovs") else image
 
 
 def write(
@@ -188,6 +220,45 @@ def write(
     writes its output: ``.exr`` as linear 32-bit floats, ``.png`` as 8-bit
     sRGB after ``exposure`` (stops) and ``tonemap`` (``clamp`` or
     ``filmic``); ``metadata``'s entries as the file's text attributes.
-    The file is written beside the target and renamed over it."""
+    The file is written beside the target and renamed over it.
+
+    Float images are linear. ``uint8`` and ``uint16`` images are read as
+    PIL and imageio give them, sRGB-encoded codes (0 to 255, 0 to 65535),
+    and decoded to linear first (so an 8-bit image read with PIL is
+    written back to the same PNG codes); other integer types are a
+    ``TypeError``. NaN values are written as black (PNG) or NaN (EXR),
+    with a ``RuntimeWarning`` that counts them. A folder is an
+    ``IsADirectoryError``."""
+    target = os.fspath(path)
+    if os.path.isdir(target):
+        raise IsADirectoryError(
+            errno.EISDIR, "is a folder; give a file name ending in .png or .exr", target
+        )
+    image = _linear_image(image, target)
     items = [(str(k), str(v)) for k, v in (metadata or {}).items()]
-    _sahara.write(os.fspath(path), image, exposure=exposure, tonemap=tonemap, metadata=items or None)
+    _sahara.write(target, image, exposure=exposure, tonemap=tonemap, metadata=items or None)
+
+
+def _linear_image(image: Any, target: str) -> Any:
+    """An image for ``write`` as linear floats: 8-bit and 16-bit unsigned
+    codes decoded from sRGB; NaN counted and warned of."""
+    a = np.asarray(image)
+    if a.dtype == np.uint8 or a.dtype == np.uint16:
+        c = a.astype(np.float64) / float(np.iinfo(a.dtype).max)
+        linear = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+        return linear.astype(np.float32)
+    if a.dtype.kind in "biu":
+        raise TypeError(
+            f"image: {a.dtype} pixels cannot be written; give linear floats, or uint8 or "
+            "uint16 sRGB-encoded codes (as PIL and imageio read images)"
+        )
+    if a.dtype.kind == "f":
+        nan = int(np.count_nonzero(np.isnan(a)))
+        if nan:
+            written = "NaN" if target.lower().endswith(".exr") else "black"
+            warnings.warn(
+                f"image: {nan} of {a.size} values are NaN; they are written as {written}",
+                RuntimeWarning,
+                stacklevel=3,
+            )
+    return image

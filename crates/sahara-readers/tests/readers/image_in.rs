@@ -108,6 +108,205 @@ fn ktx2_textures_decode_to_their_colours_within_the_codecs_error() {
     }
 }
 
+/// Texel `i` of the plain KTX2 test image (`tests/data/make_ktx2_plain.py`)
+/// as 8-bit codes (R, G, B, A).
+fn plain_codes(i: usize) -> [u8; 4] {
+    let i = i as u32;
+    [32 * i + 3, 255 - 30 * i, (7 * i * i) % 256, 255 - 20 * i].map(|c| c as u8)
+}
+
+/// Texel `i` of the plain KTX2 test image as 16-bit values over 65535.
+fn plain_unorm16(i: usize) -> [f32; 4] {
+    plain_codes(i).map(|c| (257 * u32::from(c) + i as u32) as f32 / 65535.0)
+}
+
+/// Texel `i` of the plain KTX2 test image as floats.
+fn plain_floats(i: usize) -> [f32; 4] {
+    let i = i as f32;
+    [i / 2.0 + 0.25, 2.0 - i / 8.0, 16.0 * i, i / 8.0]
+}
+
+#[test]
+fn plain_ktx2_textures_read_to_their_texels() {
+    // Each file holds the 4 x 2 test image in its base level's first layer
+    // (and other values in a second level or layer, which must not be
+    // read). Values are exact: 8-bit codes as stored, 16-bit over 65535,
+    // floats as stored (the test image's fit every float format exactly).
+    let rgb = |rgba: [f32; 4], channels: usize| {
+        let mut v = [rgba[0], rgba[1], rgba[2]];
+        v[channels.min(3)..].fill(0.0);
+        v
+    };
+    for (file, channels) in [
+        ("plain_rgb8_zstd.ktx2", 3),
+        ("plain_rgba8_srgb_zlib.ktx2", 4),
+        ("plain_bgra8_none.ktx2", 4),
+        ("plain_rg8_zstd.ktx2", 2),
+    ] {
+        let i = decode_raw(&ktx2(file), file).unwrap();
+        assert_eq!(
+            (i.width, i.height, i.format),
+            (4, 2, ImageFormat::Ktx2),
+            "{file}"
+        );
+        let want: Vec<u8> = (0..8)
+            .flat_map(|k| {
+                let c = plain_codes(k);
+                match channels {
+                    2 => [c[0], c[1], 0, 255],
+                    3 => [c[0], c[1], c[2], 255],
+                    _ => c,
+                }
+            })
+            .collect();
+        assert_eq!(i.pixels, Pixels::Rgba8(want), "{file}");
+        let alpha = (channels == 4).then(|| {
+            (0..8)
+                .map(|k| f32::from(plain_codes(k)[3]) / 255.0)
+                .collect::<Vec<_>>()
+        });
+        assert_eq!(i.alpha, alpha, "{file}");
+    }
+    // One channel, shown as grey by its KTXswizzle (rrr1).
+    let i = decode_raw(&ktx2("plain_r8_rrr1.ktx2"), "r8").unwrap();
+    let want: Vec<u8> = (0..8)
+        .flat_map(|k| {
+            let r = plain_codes(k)[0];
+            [r, r, r, 255]
+        })
+        .collect();
+    assert_eq!((i.pixels, i.alpha), (Pixels::Rgba8(want), None));
+    for (file, channels) in [("plain_rgba16_zstd.ktx2", 4), ("plain_rgb16_none.ktx2", 3)] {
+        let i = decode_raw(&ktx2(file), file).unwrap();
+        let want = (0..8)
+            .flat_map(|k| rgb(plain_unorm16(k), channels))
+            .collect();
+        assert_eq!(i.pixels, Pixels::EncodedRgbF32(want), "{file}");
+        let alpha = (channels == 4).then(|| (0..8).map(|k| plain_unorm16(k)[3]).collect());
+        assert_eq!(i.alpha, alpha, "{file}");
+    }
+    for (file, channels) in [
+        ("plain_rgba16f_zlib.ktx2", 4),
+        ("plain_rgb32f_zstd.ktx2", 3),
+        ("plain_r32f_none.ktx2", 1),
+        ("plain_e5b9g9r9_none.ktx2", 3),
+        ("plain_b10g11r11_zstd.ktx2", 3),
+    ] {
+        let i = decode_raw(&ktx2(file), file).unwrap();
+        assert_eq!((i.width, i.height), (4, 2), "{file}");
+        let want: Vec<f32> = (0..8)
+            .flat_map(|k| rgb(plain_floats(k), channels))
+            .collect();
+        let Pixels::LinearRgbF32(got) = &i.pixels else {
+            panic!("{file}: {:?}", i.pixels)
+        };
+        assert_eq!(got.len(), want.len(), "{file}");
+        for (k, (g, w)) in got.chunks(3).zip(want.chunks(3)).enumerate() {
+            // E5B9G9R9 keeps 9 bits under the texel's largest channel's
+            // exponent: within half a step of 2^(e + 1 - 9). The other
+            // formats hold the test image's values exactly.
+            let step = if file.contains("e5b9g9r9") {
+                2f32.powi(w[2].max(w[0]).log2().floor() as i32 + 1 - 9)
+            } else {
+                0.0
+            };
+            for c in 0..3 {
+                assert!(
+                    (g[c] - w[c]).abs() <= step / 2.0,
+                    "{file} texel {k}: {g:?} for {w:?}"
+                );
+            }
+        }
+        let alpha = (channels == 4).then(|| (0..8).map(|k| plain_floats(k)[3]).collect());
+        assert_eq!(i.alpha, alpha, "{file}");
+    }
+}
+
+#[test]
+fn ktx2_formats_sahara_does_not_read_are_said_to_be_not_supported() {
+    // vkFormat 146 (BC7_SRGB_BLOCK), 38 (R8G8B8A8_SNORM), 124 (D16_UNORM),
+    // and a scheme that does not exist: "not supported", naming what, and
+    // never "corrupt".
+    let with = |at: usize, value: u32| {
+        let mut bytes = ktx2("plain_rgba8_srgb_zlib.ktx2");
+        bytes[at..at + 4].copy_from_slice(&value.to_le_bytes());
+        decode_raw(&bytes, "t.ktx2").unwrap_err().to_string()
+    };
+    for (vk, kind) in [
+        (146, "BC1 to BC7 block-compressed"),
+        (38, "8-bit signed, scaled or integer"),
+        (124, "depth or stencil"),
+        (1_000_054_000, "PVRTC"),
+    ] {
+        let e = with(12, vk);
+        assert!(
+            e.starts_with(&format!(
+                "t.ktx2: cannot read the KTX2 texture: its format, vkFormat {vk} (a"
+            )) && e.contains(kind)
+                && e.contains("is not supported")
+                && !e.contains("corrupt"),
+            "{e}"
+        );
+    }
+    let e = with(44, 7);
+    assert!(
+        e.contains("supercompression scheme 7 is not supported") && !e.contains("corrupt"),
+        "{e}"
+    );
+    // vkFormat 0 whose data format is not Basis Universal's.
+    let mut bytes = ktx2("plain_rgba8_srgb_zlib.ktx2");
+    bytes[12..16].copy_from_slice(&0u32.to_le_bytes());
+    let e = decode_raw(&bytes, "t.ktx2").unwrap_err().to_string();
+    assert!(
+        e.contains("vkFormat 0 with data format model 1, is not supported")
+            && !e.contains("corrupt"),
+        "{e}"
+    );
+}
+
+#[test]
+fn plain_ktx2_files_whose_sizes_disagree_are_corrupt_and_never_read_past_their_end() {
+    let good = ktx2("plain_rgb8_zstd.ktx2");
+    // Level 0 stated to unpack to more or less than a 4 x 2 RGB8 image.
+    for unpacked in [23u64, 25, 1 << 40] {
+        let mut bytes = good.clone();
+        bytes[96..104].copy_from_slice(&unpacked.to_le_bytes());
+        let e = decode_raw(&bytes, "t.ktx2").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            format!(
+                "t.ktx2: cannot read the KTX2 texture: it is corrupt: its level 0 says it unpacks \
+                 to {unpacked} bytes, where one 4x2 R8G8B8_UNORM image takes 24"
+            )
+        );
+    }
+    // Cut anywhere, or any byte changed: an image or a one-line error,
+    // never a panic.
+    for file in [
+        "plain_rgb8_zstd.ktx2",
+        "plain_rgba16f_zlib.ktx2",
+        "plain_bgra8_none.ktx2",
+    ] {
+        let good = ktx2(file);
+        for len in 12..good.len() {
+            let e = decode_raw(&good[..len], "t.ktx2").unwrap_err().to_string();
+            assert!(
+                e.starts_with("t.ktx2: cannot read the KTX2 texture: "),
+                "{e}"
+            );
+        }
+        for at in 12..good.len() {
+            for flip in [0x01, 0x80, 0xFF] {
+                let mut bytes = good.clone();
+                bytes[at] ^= flip;
+                if let Err(e) = decode_raw(&bytes, "t.ktx2") {
+                    assert!(!e.to_string().contains('\n'), "{e}");
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn bad_ktx2_data_is_a_one_line_error_naming_the_file() {
     let check = |bytes: &[u8], what: &str| match decode_raw(bytes, "bad.ktx2") {
@@ -166,8 +365,7 @@ fn bad_ktx2_data_is_a_one_line_error_naming_the_file() {
         e,
         "kvd.ktx2: cannot read the KTX2 texture: its key/value data is corrupt"
     );
-    // Only the signature, and a KTX2 file whose payload is not Basis
-    // Universal (vkFormat R8G8B8A8_UNORM, no supercompression).
+    // Only the signature.
     let e = decode_raw(&ktx2("quad_uastc.ktx2")[..12], "bad.ktx2")
         .unwrap_err()
         .to_string();
@@ -175,13 +373,14 @@ fn bad_ktx2_data_is_a_one_line_error_naming_the_file() {
         e.starts_with("bad.ktx2: cannot read the KTX2 texture"),
         "{e}"
     );
+    // The UASTC file's data taken for R8G8B8A8_UNORM: its level's size
+    // disagrees.
     let mut raw = ktx2("quad_uastc.ktx2");
     raw[12..16].copy_from_slice(&37u32.to_le_bytes());
     let e = decode_raw(&raw, "raw.ktx2").unwrap_err().to_string();
     assert_eq!(
         e,
-        "raw.ktx2: cannot read the KTX2 texture: it is not a Basis Universal texture or it is \
-         corrupt (only KTX2 files with an ETC1S or UASTC payload are read; convert the texture \
-         to PNG or JPEG)"
+        "raw.ktx2: cannot read the KTX2 texture: it is corrupt: its level 0 says it unpacks to \
+         64 bytes, where one 8x8 R8G8B8A8_UNORM image takes 256"
     );
 }

@@ -354,30 +354,6 @@ impl Integrator {
         }
         self
     }
-
-    /// The integrator of a render that names `asked` (or nothing) over a
-    /// scene file's integrator `file` (or none): a kind asked for takes its
-    /// default parameters, unless the file names the same kind (then the
-    /// file's parameters hold); between `path`, `bdpt`, `lightpath` and
-    /// `sppm`, which count a path's length alike, the file's length holds
-    /// too, so that switching the estimator renders the same image. Nothing
-    /// asked: the file's, else the default. The command line's
-    /// `--integrator` and the Python package's `integrator=` both use it.
-    pub fn chosen(asked: Option<IntegratorKind>, file: Option<Integrator>) -> Integrator {
-        match (asked, file) {
-            (Some(kind), Some(f)) if f.kind() == kind => f,
-            (Some(kind), Some(f)) => {
-                let new = Integrator::from(kind);
-                match (f.path_length(), new.path_length()) {
-                    (Some(n), Some(_)) => new.with_path_length(n),
-                    _ => new,
-                }
-            }
-            (Some(kind), None) => Integrator::from(kind),
-            (None, Some(f)) => f,
-            (None, None) => Integrator::default(),
-        }
-    }
 }
 
 /// Work counted while tracing.

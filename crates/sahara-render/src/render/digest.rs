@@ -147,27 +147,17 @@ mod tests {
             ..base.clone()
         };
         assert_eq!(frame_digest(&scene, &same), d);
+        let with = |change: fn(&mut RenderSettings)| {
+            let mut s = base.clone();
+            change(&mut s);
+            s
+        };
         for other in [
-            RenderSettings {
-                seed: 1,
-                ..base.clone()
-            },
-            RenderSettings {
-                width: 511,
-                ..base.clone()
-            },
-            RenderSettings {
-                spp: 16,
-                ..base.clone()
-            },
-            RenderSettings {
-                pass_spp: 4,
-                ..base.clone()
-            },
-            RenderSettings {
-                filter: crate::Filter::from(crate::FilterKind::Tent),
-                ..base.clone()
-            },
+            with(|s| s.seed = 1),
+            with(|s| s.width = 511),
+            with(|s| s.spp = 16),
+            with(|s| s.pass_spp = 4),
+            with(|s| s.filter = crate::Filter::from(crate::FilterKind::Tent)),
         ] {
             assert_ne!(frame_digest(&scene, &other), d);
         }

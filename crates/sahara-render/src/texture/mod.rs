@@ -48,6 +48,10 @@ pub struct Texture {
     /// Levels 1 and up, each half the size of the one before (rounded
     /// down, at least 1), built on first use.
     pyramid: OnceLock<Vec<Level>>,
+    /// The mean of the level-0 texels, computed on first use: callers ask
+    /// for it once per triangle or per material, and each asking must not
+    /// cost a pass over the texels.
+    mean: OnceLock<Vec3>,
 }
 
 impl PartialEq for Texture {
@@ -95,6 +99,7 @@ impl Texture {
             height: base.height,
             base,
             pyramid: OnceLock::new(),
+            mean: OnceLock::new(),
         }
     }
 
@@ -122,12 +127,15 @@ impl Texture {
         (0..self.base.len()).map(|i| self.base.get(i))
     }
 
-    /// The mean linear RGB of the texels.
+    /// The mean linear RGB of the texels, computed the first time it is
+    /// asked for and kept.
     pub fn mean(&self) -> Vec3 {
-        let sum = self
-            .texels()
-            .fold(glam::DVec3::ZERO, |s, t| s + t.as_dvec3());
-        (sum / self.base.len() as f64).as_vec3()
+        *self.mean.get_or_init(|| {
+            let sum = self
+                .texels()
+                .fold(glam::DVec3::ZERO, |s, t| s + t.as_dvec3());
+            (sum / self.base.len() as f64).as_vec3()
+        })
     }
 
     /// Bytes the texels take (the pyramid included once built).

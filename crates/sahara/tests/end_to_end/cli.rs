@@ -394,9 +394,41 @@ fn every_command_warns_about_skipped_triangles() {
         );
         assert!(err.contains("1 warning while loading"), "{args:?}: {err}");
     }
-    // The JSON on stdout stays one object.
+    // The count after skipping, and how many were skipped; the JSON on
+    // stdout stays one object.
+    let out = sahara(&["stats", obj]);
+    assert!(
+        String::from_utf8_lossy(&out.stdout)
+            .contains("triangles   1 (1 of 2 skipped: no ray can hit them)\n"),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
     let out = sahara(&["stats", obj, "--json"]);
     assert_eq!(stdout_json(&out)["triangles"], 2);
+    assert_eq!(stdout_json(&out)["skipped_triangles"], 1);
+    // A scene file: the same warning as render, and the count after skipping.
+    let scene = dir.join("nan.toml");
+    fs::write(
+        &scene,
+        "[camera]\neye = [0, 0, 3]\ntarget = [0, 0, 0]\nvfov = 40\n\n\
+         [film]\nwidth = 8\nheight = 8\n\n[[object]]\ntype = \"mesh\"\nfile = \"nan.obj\"\n",
+    )
+    .unwrap();
+    let out = sahara(&["stats", scene.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("nan.toml: 1 of 2 triangles skipped (1 with a NaN or infinite corner)"),
+        "{err}"
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("triangles  1 instanced (1 of 2 skipped: no ray can hit them)\n"),
+        "{text}"
+    );
+    let out = sahara(&["stats", scene.to_str().unwrap(), "--json"]);
+    assert_eq!(stdout_json(&out)["instanced_triangles"], 2);
+    assert_eq!(stdout_json(&out)["skipped_triangles"], 1);
     fs::remove_dir_all(dir).unwrap();
 }
 

@@ -347,8 +347,8 @@ fn a_log_that_is_not_a_terminal_gets_plain_progress_lines() {
         .lines()
         .filter(|l| l.starts_with("progress: "))
         .collect();
-    assert!(!lines.is_empty(), "{err}");
-    for line in &lines {
+    assert!(lines.len() > 1, "{err}");
+    for line in &lines[..lines.len() - 1] {
         assert!(
             line.contains("% done, ")
                 && line.contains(" elapsed, eta ")
@@ -359,8 +359,95 @@ fn a_log_that_is_not_a_terminal_gets_plain_progress_lines() {
     }
     assert!(err.contains("(pass 1/2, tile "), "{err}");
     assert!(err.contains("(pass 2/2, tile "), "{err}");
-    // The last tile of the last pass is the whole render.
-    assert!(err.contains("progress: 100.0% done"), "{err}");
+    // The last line says the render is finished, whatever the last tile's
+    // line said.
+    assert!(
+        lines.last().unwrap().starts_with("progress: 100.0% done, ")
+            && lines
+                .last()
+                .unwrap()
+                .ends_with(" elapsed, finished (2 passes)"),
+        "{err}"
+    );
+    // A line every hour: none is printed, nor the closing one.
+    let o = std::process::Command::new(crate::common::SAHARA)
+        .args(["render", "--width", "40", "--height", "40", "--spp", "4"])
+        .args(["-o", out.to_str().unwrap()])
+        .env("SAHARA_PROGRESS_EVERY", "3600")
+        .output()
+        .unwrap();
+    assert!(!stderr(&o).contains("progress: "), "{}", stderr(&o));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn steps_that_take_a_while_say_what_they_are_doing() {
+    // With SAHARA_STATUS_AFTER=0 every step is said, however short; in a
+    // log, a line when it is said and one with its time when it ends.
+    let dir = temp_dir("status-lines");
+    let out = dir.join("s.png");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/bunny_dof.toml");
+    let o = std::process::Command::new(crate::common::SAHARA)
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ])
+        .args(["--spp", "1", "-o", out.to_str().unwrap()])
+        .env("SAHARA_STATUS_AFTER", "0")
+        .output()
+        .unwrap();
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    for step in [
+        format!("loading {}", scene.display()),
+        "building the trees and light tables".to_owned(),
+    ] {
+        assert!(err.contains(&format!("{step}...\n")), "{step}: {err}");
+        assert!(err.contains(&format!("{step}: done in ")), "{step}: {err}");
+    }
+    // By default a step of less than a second says nothing.
+    let o = sahara(&[
+        "render",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!stderr(&o).contains("..."), "{}", stderr(&o));
+    let _ = fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_bare_command_takes_renders_options() {
+    // `sahara -o out.png --spp 1 ...` renders the built-in scene as
+    // `sahara render` does with them.
+    let dir = temp_dir("bare");
+    let (bare, render) = (dir.join("bare.png"), dir.join("render.png"));
+    let size = ["--width", "24", "--height", "16", "--spp", "1"];
+    let out = sahara(&[&["-o", bare.to_str().unwrap()][..], &size].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = sahara(&[&["render", "-o", render.to_str().unwrap()][..], &size].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(fs::read(&bare).unwrap(), fs::read(&render).unwrap());
+    // A mistake in them is said as render says it.
+    let out = sahara(&["--spp", "0"]);
+    assert!(!out.status.success());
+    assert!(
+        stderr(&out).contains("0 is not in 1..="),
+        "{}",
+        stderr(&out)
+    );
+    // Help and version stay the tool's.
+    let out = sahara(&["--version"]);
+    assert!(String::from_utf8_lossy(&out.stdout).starts_with("sahara "));
     let _ = fs::remove_dir_all(&dir);
 }
 
@@ -1315,7 +1402,7 @@ fn render_passes_need_an_exr_and_a_path_tracer() {
     let out = sahara(&["render", "--aov", "albedo", "-o", png.to_str().unwrap()]);
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("is not one (use -o NAME.exr)"),
+        stderr(&out).contains("is not one (name a .exr file)"),
         "{}",
         stderr(&out)
     );
