@@ -97,7 +97,7 @@ fn bench_json_matches_a_brute_force_count() {
         assert!(j.get(key).is_some(), "missing {key} in {j}");
     }
     assert_eq!(j["triangles"], 2);
-    assert_eq!(j["builder"], "sah");
+    assert_eq!(j["builder"], "kd-tree (sah)");
     assert_eq!(j["threads"], 2);
     assert_eq!(j["camera"]["vfov_deg"], 90.0);
     let sets = &j["sets"];
