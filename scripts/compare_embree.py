@@ -8,8 +8,13 @@ and prints markdown tables: hits and t-sums with the protocol's agreement
 check, Mrays/s of both and the ratio Sahara / Embree (best of all rounds),
 build times and memory.
 
-Usage: scripts/compare_embree.py [--rounds N] [--runs N] [--builder B]
+Usage: scripts/compare_embree.py [--rounds N] [--runs N] [--accel kd,bvh]
+                                 [--builder B] [--bvh-builder B]
                                  [--meshes a,b,...] [--no-embree]
+
+With several structures (`--accel kd,bvh`, the default) each round runs
+Embree, then Sahara's kd-tree, then its hierarchy, so every ratio is taken
+at the same moment; the tables put the structures side by side.
 Run from the repository root after `cargo build --release`.
 """
 import argparse
@@ -66,21 +71,23 @@ def run_embree(exe, mesh, runs):
     return r
 
 
-def same_rays_check(exe, mesh, builder):
+def same_rays_check(exe, mesh, accel, builder, bvh_builder):
     """Secondary sets start at each tracer's own primary hits, so a few ulps
     of difference in a primary t move them. Trace Sahara's shadow and
     diffuse sets from Embree's primary hits instead: bit-identical rays."""
     hits = os.path.join(ROOT, "target", "embree", "primary.hits")
     subprocess.run([exe, mesh, "--runs", "1", "--no-build-times", "--sets", "primary",
                     "--dump", "primary", hits], check=True, capture_output=True)
-    out = subprocess.run([SAHARA, "bench", mesh, "--json", "--runs", "1", "--builder", builder,
+    out = subprocess.run([SAHARA, "bench", mesh, "--json", "--runs", "1", "--accel", accel,
+                          "--builder", builder, "--bvh-builder", bvh_builder,
                           "--sets", "shadow,diffuse", "--primary-hits", hits],
                          check=True, capture_output=True, text=True).stdout
     return json.loads(out)["sets"]
 
 
-def run_sahara(mesh, runs, builder):
-    out = subprocess.run([SAHARA, "bench", mesh, "--json", "--runs", str(runs), "--builder", builder],
+def run_sahara(mesh, runs, accel, builder, bvh_builder):
+    out = subprocess.run([SAHARA, "bench", mesh, "--json", "--runs", str(runs), "--accel", accel,
+                          "--builder", builder, "--bvh-builder", bvh_builder],
                          check=True, capture_output=True, text=True).stdout
     return json.loads(out)
 
@@ -108,14 +115,21 @@ def agree(s, e):
     return hits_ok and t_ok
 
 
+def ratio(a, b):
+    return f"{a:.2f} ({a / b:.2f})" if b else f"{a:.2f}"
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rounds", type=int, default=2)
     ap.add_argument("--runs", type=int, default=3)
-    ap.add_argument("--builder", default="sah")
+    ap.add_argument("--accel", default="kd,bvh", help="structures, in the order run: kd, bvh")
+    ap.add_argument("--builder", default="sah", help="the kd-tree's builder")
+    ap.add_argument("--bvh-builder", default="spatial", help="the hierarchy's builder")
     ap.add_argument("--meshes", default=",".join(MESHES))
     ap.add_argument("--no-embree", action="store_true")
     a = ap.parse_args()
+    accels = a.accel.split(",")
     exe = None if a.no_embree else build_embree()
     if exe is None and not a.no_embree:
         print("Embree is not installed (apt-get install libembree-dev): Sahara only.", file=sys.stderr)
@@ -126,59 +140,65 @@ def main():
         if not os.path.exists(path):
             print(f"skipping {path}: not found", file=sys.stderr)
             continue
-        s_best = e_best = None
+        s_best = {k: None for k in accels}
+        e_best = None
         for _ in range(a.rounds):
             if exe:
                 e_best = best(e_best, run_embree(exe, path, a.runs))
-            s_best = best(s_best, run_sahara(path, a.runs, a.builder))
+            for k in accels:
+                s_best[k] = best(s_best[k], run_sahara(path, a.runs, k, a.builder, a.bvh_builder))
         if e_best:
-            s_best["same_rays"] = same_rays_check(exe, path, a.builder)
+            for k in accels:
+                s_best[k]["same_rays"] = same_rays_check(exe, path, k, a.builder, a.bvh_builder)
         rows.append((os.path.basename(os.path.dirname(path)), s_best, e_best))
         print(f"done {m}", file=sys.stderr)
+    names = {k: ("kd-tree" if k == "kd" else "BVH") for k in accels}
     print(f"Load average at start: {' '.join(load)}; {a.rounds} rounds x best of {a.runs} runs; "
-          f"Sahara builder `{a.builder}`.\n")
-    print("1T: Mrays/s by the tracing thread's CPU time; batch 1T: Sahara's one batch call over "
-          "the set on one thread; 2T: wall clock.\n")
-    print("| mesh | set | rays | hits Sahara / Embree | t-sum Sahara / Embree | agree | "
-          "Mrays/s 1T Sahara / Embree (ratio) | batch 1T Sahara / Embree (ratio) | "
-          "Mrays/s 2T Sahara / Embree (ratio) |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for name, s, e in rows:
-        for k in SETS:
-            sv = s["sets"][k]
-            ev = e["sets"].get(k) if e else None
-            if ev:
-                print(f"| {name} | {k} | {sv['rays']:,} | {sv['hits']:,} / {ev['hits']:,} | "
-                      f"{sv['t_sum']:.6f} / {ev['t_sum']:.6f} | {'yes' if agree(sv, ev) else '**no**'} | "
-                      f"{sv['mrays_1t_cpu']:.2f} / {ev['mrays_1t_cpu']:.2f} ({sv['mrays_1t_cpu'] / ev['mrays_1t_cpu']:.2f}) | "
-                      f"{sv.get('mrays_batch_1t_cpu', 0):.2f} / {ev['mrays_1t_cpu']:.2f} ({sv.get('mrays_batch_1t_cpu', 0) / ev['mrays_1t_cpu']:.2f}) | "
-                      f"{sv['mrays_all']:.2f} / {ev['mrays_all']:.2f} ({sv['mrays_all'] / ev['mrays_all']:.2f}) |")
-            else:
-                print(f"| {name} | {k} | {sv['rays']:,} | {sv['hits']:,} | {sv['t_sum']:.6f} | - | "
-                      f"{sv['mrays_1t_cpu']:.2f} | {sv.get('mrays_batch_1t_cpu', 0):.2f} | "
-                      f"{sv['mrays_all']:.2f} |")
-        for k, sv in (s.get("same_rays") or {}).items():
-            if sv and e and not agree(s["sets"][k], e["sets"][k]):
-                ev = e["sets"][k]
-                print(f"| {name} | {k}, from Embree's primary hits | {sv['rays']:,} | "
-                      f"{sv['hits']:,} / {ev['hits']:,} | {sv['t_sum']:.6f} / {ev['t_sum']:.6f} | "
-                      f"{'yes' if agree(sv, ev) else '**no**'} | | | |")
-        prim = s["sets"]["primary"]
-        for sk, slabel in (("mrays_packet_1t_cpu", "8 (4x2)"), ("mrays_packet16_1t_cpu", "16 (4x4)")):
-            p = prim.get(sk)
-            for ek, label in (("prim_p8", "8"), ("prim_p16", "16")):
-                if e and ek in e["sets"] and p is not None:
-                    ev = e["sets"][ek]["mrays_1t_cpu"]
-                    print(f"| {name} | primary packets: Sahara {slabel} / Embree {label} | | | | | "
-                          f"{p:.2f} / {ev:.2f} ({p / ev:.2f}) | | |")
-    print("\n| mesh | triangles | Sahara build ms | Embree HIGH / MEDIUM build ms | "
-          "Sahara tree + triangles MB | Embree BVH MB (+ vertex/index buffers) | Sahara SAH cost |")
-    print("|---|---|---|---|---|---|---|")
-    for name, s, e in rows:
+          f"kd-tree builder `{a.builder}`, BVH builder `{a.bvh_builder}`.\n")
+    print("Mrays/s on one thread by the tracing thread's CPU time, with the ratio to Embree's "
+          "single rays of the same set in brackets; batch: one batch call over the set; "
+          "2T: wall clock on two threads, against Embree's on two.\n")
+    head = " | ".join(f"{names[k]} 1T | {names[k]} batch 1T | {names[k]} 2T" for k in accels)
+    print(f"| mesh | set | rays | hits (agree) | Embree 1T | Embree 2T | {head} |")
+    print("|---|---|---|---|---|---|" + "---|" * (3 * len(accels)))
+    for name, ss, e in rows:
+        for st in SETS:
+            ev = e["sets"].get(st) if e else None
+            first = ss[accels[0]]["sets"][st]
+            ok = all(agree(ss[k]["sets"][st], ev) or
+                     (ss[k].get("same_rays") or {}).get(st) is not None and agree(ss[k]["same_rays"][st], ev)
+                     for k in accels) if ev else None
+            cells = []
+            for k in accels:
+                sv = ss[k]["sets"][st]
+                b = ev["mrays_1t_cpu"] if ev else 0
+                b2 = ev["mrays_all"] if ev else 0
+                cells += [ratio(sv["mrays_1t_cpu"], b), ratio(sv.get("mrays_batch_1t_cpu", 0), b),
+                          ratio(sv["mrays_all"], b2)]
+            agree_cell = "-" if ok is None else ("yes" if ok else "**no**")
+            e1 = f"{ev['mrays_1t_cpu']:.2f}" if ev else "-"
+            e2 = f"{ev['mrays_all']:.2f}" if ev else "-"
+            print(f"| {name} | {st} | {first['rays']:,} | {first['hits']:,} ({agree_cell}) | {e1} | {e2} | "
+                  + " | ".join(cells) + " |")
+        for sk, slabel, ek in (("mrays_packet_1t_cpu", "8 (4x2)", "prim_p8"),
+                               ("mrays_packet16_1t_cpu", "16 (4x4)", "prim_p16")):
+            if not (e and ek in e["sets"]):
+                continue
+            ev = e["sets"][ek]["mrays_1t_cpu"]
+            cells = []
+            for k in accels:
+                p = ss[k]["sets"]["primary"].get(sk)
+                cells += [ratio(p, ev) if p is not None else "-", "", ""]
+            print(f"| {name} | primary in packets of {slabel} | | | {ev:.2f} | | " + " | ".join(cells) + " |")
+    print("\n| mesh | triangles | Embree HIGH / MEDIUM build ms | Embree BVH MB (+ buffers) | "
+          + " | ".join(f"{names[k]} build ms | {names[k]} MB" for k in accels) + " |")
+    print("|---|---|---|---|" + "---|" * (2 * len(accels)))
+    for name, ss, e in rows:
         eb = f"{e['build_ms']:.1f} / {e.get('build_medium_ms', float('nan')):.1f}" if e else "-"
         em = f"{e['memory_bytes'] / 1e6:.1f} (+{e.get('buffer_bytes', 0) / 1e6:.1f})" if e else "-"
-        print(f"| {name} | {s['triangles']:,} | {s['build_ms']:.1f} | {eb} | "
-              f"{s['memory_bytes'] / 1e6:.1f} | {em} | {s['sah_cost']:.1f} |")
+        first = ss[accels[0]]
+        print(f"| {name} | {first['triangles']:,} | {eb} | {em} | "
+              + " | ".join(f"{ss[k]['build_ms']:.1f} | {ss[k]['memory_bytes'] / 1e6:.1f}" for k in accels) + " |")
 
 
 if __name__ == "__main__":

@@ -10,7 +10,8 @@
 //! hit equals `sahara_kd::brute::any_hit` and "closest hit exists", so do
 //! batches (interleaved over the wide nodes and one by one), and the
 //! rays traced in packets of eight (grouped by direction signs) give the
-//! closest hits too.
+//! closest hits too. The eight-wide hierarchy, by each of its builds,
+//! answers single rays, batches and 8- and 16-ray packets as the oracle.
 #![no_main]
 
 use arbitrary::Arbitrary;
@@ -19,7 +20,7 @@ use libfuzzer_sys::fuzz_target;
 use sahara_kd::internals::BatchWalk;
 use sahara_kd::PACKET;
 use sahara_kd::validate;
-use sahara_kd::{brute, BuildParams, Builder, KdTree, Ray, Triangle};
+use sahara_kd::{brute, BuildParams, Builder, Bvh, BvhBuilder, BvhParams, KdTree, Ray, Triangle};
 
 #[derive(Arbitrary, Debug, Clone, Copy)]
 enum Coord {
@@ -158,6 +159,18 @@ fuzz_target!(|input: Input| {
             "brute force disagrees with itself on {ray:?}"
         );
     }
+    // Packets: the rays grouped by direction signs (so that most packets
+    // take the packet path; mixed ones fall back to single rays) and
+    // origins (so that packets from the eye are culled against their
+    // frustum), eight or sixteen at a time.
+    let sign = |r: &Ray| {
+        usize::from(r.dir.x.is_sign_negative())
+            | usize::from(r.dir.y.is_sign_negative()) << 1
+            | usize::from(r.dir.z.is_sign_negative()) << 2
+    };
+    let mut order: Vec<usize> = (0..rays.len()).collect();
+    // By signs, then by origin: rays from the eye share packets.
+    order.sort_by_key(|&i| (sign(&rays[i]), rays[i].origin.to_array().map(f32::to_bits)));
     let builders = Builder::ALL.into_iter().chain([Builder::Binned {
         bins: 2 + u32::from(input.bins % 63),
     }]);
@@ -210,18 +223,7 @@ fuzz_target!(|input: Input| {
                 );
             }
         }
-        // Packets: the rays grouped by direction signs (so that most packets
-        // take the packet path; mixed ones fall back to single rays) and
-        // origins (so that packets from the eye are culled against their
-        // frustum), eight at a time.
-        let sign = |r: &Ray| {
-            usize::from(r.dir.x.is_sign_negative())
-                | usize::from(r.dir.y.is_sign_negative()) << 1
-                | usize::from(r.dir.z.is_sign_negative()) << 2
-        };
-        let mut order: Vec<usize> = (0..rays.len()).collect();
-        // By signs, then by origin: rays from the eye share packets.
-        order.sort_by_key(|&i| (sign(&rays[i]), rays[i].origin.to_array().map(f32::to_bits)));
+        // Packets, eight at a time in `order`.
         for idx in order.chunks(PACKET) {
             let packet: Vec<Ray> = idx.iter().map(|&i| rays[i]).collect();
             let mut got = vec![None; packet.len()];
@@ -234,6 +236,53 @@ fuzz_target!(|input: Input| {
                     expected[i].0,
                     rays[i]
                 );
+            }
+        }
+    }
+    // The eight-wide hierarchy, by each of its builds: single rays,
+    // batches and 8- and 16-ray packets, bit for bit the oracle's.
+    for builder in [BvhBuilder::Binned, BvhBuilder::Spatial, BvhBuilder::FromKd] {
+        let mut params = BvhParams::new(builder);
+        params.parallel = false;
+        params.bins = 2 + usize::from(input.bins % 31);
+        params.kd.parallel = false;
+        let bvh = Bvh::build(triangles.clone(), &params);
+        let name = builder.name();
+        let mut hits = vec![None; rays.len()];
+        bvh.closest_hits_serial(&rays, &mut hits);
+        let mut occluded = vec![false; rays.len()];
+        bvh.any_hits_serial(&rays, &mut occluded);
+        for (k, (ray, &(closest, any))) in rays.iter().zip(&expected).enumerate() {
+            let got = bvh.closest_hit(ray);
+            assert!(
+                same(got, closest),
+                "bvh {name}: closest hit {got:?} but brute force gives {closest:?} for {ray:?}"
+            );
+            assert_eq!(bvh.any_hit(ray), any, "bvh {name}: any hit disagrees for {ray:?}");
+            assert!(
+                same(hits[k], closest),
+                "bvh {name} batch: closest hit {:?} but brute force gives {closest:?} for {ray:?}",
+                hits[k]
+            );
+            assert_eq!(occluded[k], any, "bvh {name} batch: any hit disagrees for {ray:?}");
+        }
+        for size in [8, 16] {
+            for idx in order.chunks(size) {
+                let packet: Vec<Ray> = idx.iter().map(|&i| rays[i]).collect();
+                let mut got = vec![None; packet.len()];
+                if size == 8 {
+                    bvh.closest_hit_packet(&packet, &mut got);
+                } else {
+                    bvh.closest_hit_packet16(&packet, &mut got);
+                }
+                for (&i, g) in idx.iter().zip(&got) {
+                    assert!(
+                        same(*g, expected[i].0),
+                        "bvh {name}: {size}-ray packet hit {g:?} but brute force gives {:?} for {:?}",
+                        expected[i].0,
+                        rays[i]
+                    );
+                }
             }
         }
     }

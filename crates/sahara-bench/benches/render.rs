@@ -21,7 +21,7 @@ use std::time::{Duration, Instant};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use sahara_formats::load_scene;
 use sahara_render::internals::{render_world, World};
-use sahara_render::{builtin, render, Integrator, RenderSettings};
+use sahara_render::{builtin, render, FrameSettings, Integrator, RenderSettings};
 
 const SIZE: u32 = 64;
 const SPP: u32 = 4;
@@ -36,13 +36,13 @@ fn cornell(c: &mut Criterion) {
     g.throughput(Throughput::Elements(u64::from(SIZE * SIZE * SPP)));
     g.sample_size(10);
     for name in ["path", "distribution", "ao"] {
-        let settings = RenderSettings {
+        let settings = RenderSettings::from(FrameSettings {
             width: SIZE,
             height: SIZE,
             spp: SPP,
             integrator: Integrator::named(name).expect("a known integrator"),
             ..Default::default()
-        };
+        });
         g.bench_function(BenchmarkId::from_parameter(name), |b| {
             b.iter(|| pool.install(|| black_box(render(&scene, &settings, &|_| {}).unwrap())))
         });
@@ -78,10 +78,13 @@ fn kit(c: &mut Criterion) {
                 continue;
             }
         };
-        let file = assembled.settings.expect("a scene file's settings");
+        let file = assembled
+            .settings
+            .expect("a scene file's settings")
+            .frame_settings();
         let mut scene = assembled.scene;
         scene.camera.aspect = 1.0;
-        let settings = RenderSettings {
+        let settings = RenderSettings::from(FrameSettings {
             width: SIZE,
             height: SIZE,
             spp: file.spp,
@@ -90,7 +93,7 @@ fn kit(c: &mut Criterion) {
             filter: file.filter,
             seed: file.seed,
             ..Default::default()
-        };
+        });
         let mut world = World::new(&scene, &settings.build);
         g.throughput(Throughput::Elements(u64::from(SIZE * SIZE * file.spp)));
         g.bench_function(BenchmarkId::from_parameter(name), |b| {

@@ -1,7 +1,7 @@
 //! What a benchmark reports, as plain structs whose serde form is the JSON
 //! layout of `sahara bench --json` and `sahara stats --json`.
 
-use sahara_kd::TreeStats;
+use sahara_kd::{AccelSummary, BvhStats, TreeStats};
 use serde::Serialize;
 
 use crate::protocol::{ProtocolCamera, SetKind};
@@ -168,17 +168,17 @@ pub struct CounterReport {
     pub mean_leaves: f64,
     /// Ray/triangle tests per ray.
     pub mean_triangles: f64,
-    /// [`TreeStats::expected_inner`].
+    /// [`AccelSummary::expected_inner`].
     pub expected_inner: f64,
-    /// [`TreeStats::expected_leaves`].
+    /// [`AccelSummary::expected_leaves`].
     pub expected_leaves: f64,
-    /// [`TreeStats::expected_triangles`].
+    /// [`AccelSummary::expected_triangles`].
     pub expected_triangles: f64,
 }
 
 impl CounterReport {
     /// The report of `totals` on a tree with statistics `stats`.
-    pub fn new(totals: &CountTotals, stats: &TreeStats) -> Self {
+    pub fn new(totals: &CountTotals, stats: &AccelSummary) -> Self {
         let n = totals.rays.max(1) as f64;
         Self {
             root_fraction: totals.rays_meeting_root as f64 / n,
@@ -206,22 +206,84 @@ impl CounterReport {
     }
 }
 
-/// The result of `sahara stats`: build time and every [`TreeStats`] field.
+/// A structure's own statistics.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum StructureStats {
+    /// A kd-tree's.
+    Kd(TreeStats),
+    /// An eight-wide hierarchy's.
+    Bvh(BvhStats),
+}
+
+/// The result of `sahara stats`: build time and every field of the
+/// structure's statistics, and with `--all` every structure side by side.
 #[derive(Clone, Debug, Serialize, PartialEq)]
 pub struct StatsReport {
     /// The mesh.
     pub mesh: String,
+    /// `kd` or `bvh`.
+    pub accel: String,
     /// Builder name.
     pub builder: String,
     /// Best build time, milliseconds.
     pub build_ms: f64,
     /// Builds timed.
     pub build_runs: usize,
-    /// Of the triangles given to the build ([`TreeStats::triangles`]),
-    /// those no ray can hit (a non-finite corner or zero area), which the
-    /// tree leaves out.
+    /// Of the triangles given to the build, those no ray can hit (a
+    /// non-finite corner or zero area), which the structure leaves out.
     pub skipped_triangles: usize,
-    /// The tree's statistics.
+    /// The structure's statistics.
     #[serde(flatten)]
-    pub tree: TreeStats,
+    pub tree: StructureStats,
+    /// With `--all`: every structure and builder, built the same way.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub structures: Vec<StructureRow>,
+}
+
+/// One structure of `sahara stats --all`.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct StructureRow {
+    /// As `kd-tree (sah)` or `bvh8 (spatial)`.
+    pub structure: String,
+    /// Best build time, milliseconds.
+    pub build_ms: f64,
+    /// The structure's summary: memory, references, the SAH's expected
+    /// work per ray.
+    #[serde(flatten)]
+    pub summary: AccelSummaryReport,
+}
+
+/// [`AccelSummary`] as reported.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct AccelSummaryReport {
+    /// Triangles given to the build.
+    pub triangles: usize,
+    /// Bytes of nodes, leaf data and indices.
+    pub memory_bytes: usize,
+    /// Triangle references in leaves.
+    pub references: usize,
+    /// The SAH cost in the structure's own units.
+    pub sah_cost: f64,
+    /// Inner nodes (wide nodes for the hierarchy) a ray meeting the root
+    /// visits by the SAH.
+    pub expected_inner: f64,
+    /// Leaves it visits.
+    pub expected_leaves: f64,
+    /// Triangle tests it makes.
+    pub expected_triangles: f64,
+}
+
+impl From<&AccelSummary> for AccelSummaryReport {
+    fn from(s: &AccelSummary) -> Self {
+        Self {
+            triangles: s.triangles,
+            memory_bytes: s.memory_bytes,
+            references: s.references,
+            sah_cost: s.sah_cost,
+            expected_inner: s.expected_inner,
+            expected_leaves: s.expected_leaves,
+            expected_triangles: s.expected_triangles,
+        }
+    }
 }

@@ -45,6 +45,7 @@ mod mesh;
 mod mitsuba;
 mod output;
 mod pbrt;
+pub mod request;
 mod toml;
 
 // Loading scenes: any file by its extension, or one format.
@@ -67,9 +68,9 @@ pub use assembly::sky::{SkyUsed, DEFAULT_SKY, DEFAULT_SUN, DEFAULT_SUN_DIRECTION
 /// The vertical field of view of the automatic camera, degrees.
 pub use assembly::camera::AUTO_VFOV_DEG;
 
-/// What a scene file asks of a render (and its crop), and what lights it
-/// besides its own lights.
-pub use description::{FileCrop, FileSettings, Sky};
+/// What a scene file (or a caller) asks of a render, one layer of
+/// settings; a file's crop; what lights a scene besides its own lights.
+pub use description::{FileCrop, PieceLayer, SettingsLayer, Sky, Split};
 
 // Mesh files.
 
@@ -108,6 +109,21 @@ pub use output::atomic::{check_writable, write_atomically};
 
 /// Render parts: a piece of a frame and its exact sums, as EXR.
 pub use output::part::{read_part, read_part_info, write_part, PartInfo, PartSums};
+
+/// The one front door: a loaded scene and a caller's settings as a plan
+/// of the render, the settings table both front ends offer, and the
+/// finishing of a render (denoising, writing).
+pub use request::{
+    existing_part_differs, Asked, Denoised, Given, Note, Piece, Plan, Refused, Request,
+    RequestError, Setting, Spelling, Takes, Written, SETTINGS,
+};
+
+/// How a rendered frame is written, its image written out, the checks on
+/// its path, and the list of names of its id passes.
+pub use output::frame::{
+    check_output, names_path, partial_path, write_names_beside, FrameImage, OutputLayer,
+    OutputSettings,
+};
 
 /// Every error of this crate: one line naming the file and the place.
 pub use sahara_readers::FormatError;

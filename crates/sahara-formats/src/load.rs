@@ -17,7 +17,7 @@ use sahara_readers::FormatError;
 use sahara_render::{builtin, Camera, Scene};
 
 use crate::assembly::{assemble, sky, AssembledScene, SceneNames};
-use crate::description::{FileSettings, SceneDescription, Sky};
+use crate::description::{SceneDescription, SettingsLayer, Sky};
 use crate::mesh::{read_mesh_scene, CameraChoice};
 use crate::toml::read_scene;
 
@@ -44,12 +44,14 @@ pub struct Loaded {
     /// chosen automatically: the caller sets it from the image size).
     pub scene: Scene,
     /// The render settings of a scene file (None: a mesh or the built-in scene).
-    pub settings: Option<FileSettings>,
+    pub settings: Option<SettingsLayer>,
     /// The scene's name: the file name without its extension
     /// (`scene.pbrt.gz` is `scene`), `cornell_box` for the built-in scene.
     pub name: String,
     /// What a log calls it: the path, or `the built-in Cornell box`.
     pub description: String,
+    /// The file it was read from (None: the built-in scene).
+    pub path: Option<std::path::PathBuf>,
     /// What the scene's objects and materials are called.
     pub names: SceneNames,
     /// Problems that did not stop loading, one line each, naming the file.
@@ -58,6 +60,25 @@ pub struct Loaded {
     /// where the camera and the light came from, one line for the log
     /// (`camera: auto; light: default sky and sun ...`).
     pub framing: Option<String>,
+}
+
+impl Loaded {
+    /// Its problems, one line each: those found reading it, then those of
+    /// the finished scene (triangles skipped, lights that light nothing),
+    /// named after its file.
+    pub fn problems(&self) -> Vec<String> {
+        let mut out = self.warnings.clone();
+        out.extend(
+            self.scene
+                .diagnostics()
+                .into_iter()
+                .map(|d| match &self.path {
+                    Some(p) => format!("{}: {d}", p.display()),
+                    None => d,
+                }),
+        );
+        out
+    }
 }
 
 /// The file kinds [`load`] reads, for messages.
@@ -168,6 +189,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, FormatError> {
         settings: a.settings,
         name: stem(path),
         description: path.display().to_string(),
+        path: Some(path.to_path_buf()),
         names: a.names,
         warnings: a.warnings,
         framing,
@@ -194,6 +216,7 @@ pub fn load_builtin(options: &LoadOptions) -> Result<Loaded, FormatError> {
         settings: None,
         name: "cornell_box".into(),
         description: "the built-in Cornell box".into(),
+        path: None,
         warnings: Vec::new(),
         framing,
     })

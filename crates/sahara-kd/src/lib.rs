@@ -1,21 +1,27 @@
 //! `sahara-kd`: Sahara's accelerator.
 //!
-//! Kd-trees over triangle soups, built by the surface area heuristic (an
-//! exact O(N log N) event sweep with split clipping, or binned) or by the
-//! naive baselines; front-to-back traversal with early exit for closest-hit
-//! and any-hit queries, for single rays, 8- and 16-ray packets and parallel
-//! batches, over leaves whose triangles sit in 8-wide blocks; tree
-//! statistics; a structural validator; and the brute-force oracle the tests
-//! hold the tree to. No I/O, no rendering.
+//! Two structures over triangle soups, both built by the surface area
+//! heuristic: kd-trees (an exact O(N log N) event sweep with split
+//! clipping, binned, or the naive baselines), and eight-wide bounding volume
+//! hierarchies (binned, with spatial splits, or collapsed from the
+//! kd-tree). Closest-hit and any-hit queries for single rays, 8- and 16-ray
+//! packets and parallel batches; [`TriangleAccel`] holds either structure
+//! behind one set of queries. Statistics; a structural validator; and the
+//! brute-force oracle both structures are held to, bit for bit. No I/O, no
+//! rendering.
 //!
 //! ```
 //! use glam::Vec3;
-//! use sahara_kd::{BuildParams, KdTree, Ray, Triangle};
+//! use sahara_kd::{AccelParams, BuildParams, KdTree, Ray, Triangle, TriangleAccel};
 //!
 //! let tris = vec![Triangle::new(Vec3::new(-1.0, -1.0, 5.0), Vec3::new(1.0, -1.0, 5.0), Vec3::new(0.0, 1.0, 5.0))];
-//! let tree = KdTree::build(tris, &BuildParams::default());
-//! let hit = tree.closest_hit(&Ray::new(Vec3::ZERO, Vec3::Z)).unwrap();
+//! let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+//! let tree = KdTree::build(tris.clone(), &BuildParams::default());
+//! let hit = tree.closest_hit(&ray).unwrap();
 //! assert_eq!((hit.t, hit.tri), (5.0, 0));
+//! // The eight-wide hierarchy (the default structure), same answer.
+//! let accel = TriangleAccel::build(tris, &AccelParams::default());
+//! assert_eq!(accel.closest_hit(&ray), Some(hit));
 //! ```
 //!
 //! The crate's parts, each importing only those before it in this list:
@@ -23,13 +29,16 @@
 //! (instruction-set levels and dispatch); `isect` (the watertight test and
 //! hit records); `leaf` (leaf storage and the leaf tests) and `build` (the
 //! builders); `kd` (the tree, its node, walks, queries, batches and
-//! packets); then `stats`, `validate` and `brute`. See
-//! `docs/accelerator.md` for the design.
+//! packets); `bvh` (the hierarchy: its node, leaves of four, builds, walks,
+//! packets); `accel` (either structure); then `stats`, `validate` and
+//! `brute`. See `docs/accelerator.md` for the design.
 
 #![deny(missing_docs)]
 
+mod accel;
 pub mod brute;
 mod build;
+mod bvh;
 mod isect;
 mod kd;
 mod leaf;
@@ -40,7 +49,9 @@ mod stats;
 mod test_support;
 mod validate;
 
+pub use accel::{AccelKind, AccelParams, AccelSummary, TriangleAccel};
 pub use build::{AxisRule, BuildParams, Builder, PositionRule, Primitive, MAX_DEPTH};
+pub use bvh::{Bvh, BvhBuilder, BvhParams, BvhStats, MAX_LEAF as BVH_MAX_LEAF};
 pub use isect::{intersect_ray_triangle, Hit, TriangleHit};
 pub use kd::{
     BoxTree, Counters, KdTree, LeafStorage, NoCounters, Node, TraversalCounters, PACKET, PACKET16,

@@ -11,7 +11,7 @@ use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
-use sahara_kd::{BuildParams, Builder, Hit, KdTree, Ray, Triangle};
+use sahara_kd::{AccelParams, Hit, Ray, Triangle, TriangleAccel};
 
 use crate::arrays::{PerRay, PerRayView, Rows3, Rows3View};
 use crate::pool::run_on;
@@ -45,7 +45,7 @@ impl Geometry {
 /// the tree, kept while the meshes do not change.
 #[derive(Clone)]
 struct Snapshot {
-    tree: Arc<KdTree>,
+    tree: Arc<TriangleAccel>,
     /// The unit geometric normal of each face (one load per hit, rather
     /// than three vertices found through the face).
     normals: Arc<[Vec3]>,
@@ -53,16 +53,18 @@ struct Snapshot {
     starts: Arc<[u32]>,
 }
 
-/// Triangle meshes in one kd-tree, for ray queries on numpy arrays.
+/// Triangle meshes in one acceleration structure (the eight-wide BVH, or
+/// a kd-tree), for ray queries on numpy arrays.
 ///
-/// `RayScene(vertices, faces, builder="sah", threads=None)` holds one mesh;
+/// `RayScene(vertices, faces, accel="bvh", builder=None, threads=None)`
+/// holds one mesh;
 /// `add_mesh` adds more (each with its id: 0, 1, ...), and the tree over
 /// all of them is built at the next query. Every query releases the GIL
 /// and runs on `threads` threads (None: all of the machine's).
 #[pyclass(module = "sahara._sahara", frozen)]
 pub struct RayScene {
     geometry: Mutex<GeometryState>,
-    params: BuildParams,
+    params: AccelParams,
     threads: Option<usize>,
 }
 
@@ -75,20 +77,16 @@ struct GeometryState {
 #[pymethods]
 impl RayScene {
     #[new]
-    #[pyo3(signature = (vertices=None, faces=None, *, builder="sah", threads=None))]
+    #[pyo3(signature = (vertices=None, faces=None, *, accel="bvh", builder=None, threads=None))]
     fn new(
         py: Python<'_>,
         vertices: Option<&Bound<'_, PyAny>>,
         faces: Option<&Bound<'_, PyAny>>,
-        builder: &str,
+        accel: &str,
+        builder: Option<&str>,
         threads: Option<usize>,
     ) -> PyResult<Self> {
-        let Some(b) = Builder::parse(builder) else {
-            return Err(PyValueError::new_err(format!(
-                "builder: unknown builder '{builder}' (expected sah, binned, binnedN with N in \
-                 2..=1024, rr-middle, rr-median, largest-middle, largest-median)"
-            )));
-        };
+        let params = AccelParams::from_names(accel, builder).map_err(PyValueError::new_err)?;
         let scene = RayScene {
             geometry: Mutex::new(GeometryState {
                 geometry: Geometry {
@@ -98,7 +96,7 @@ impl RayScene {
                 },
                 shared: None,
             }),
-            params: BuildParams::new(b),
+            params,
             threads: threads.filter(|&t| t > 0),
         };
         match (vertices, faces) {
@@ -178,8 +176,8 @@ impl RayScene {
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let rays = RayArgs::extract(origins, directions, tmin, tmax)?;
-        let n = rays.n;
         let snap = self.snapshot(py, threads)?;
+        let n = rays.n;
         let (dict, arrays) = match out {
             Some(o) if !o.is_none() => {
                 let d = o.cast::<PyDict>().map_err(|_| {
@@ -196,53 +194,46 @@ impl RayScene {
             let mut w = arrays.borrow()?;
             let (ts, tris, meshes, us, vs, ns) = w.slices()?;
             let view = rays.view();
-            let threads = threads.or(self.threads);
-            py.detach(|| {
-                run_on(threads, || {
-                    (
-                        ts.par_chunks_mut(CHUNK),
-                        tris.par_chunks_mut(CHUNK),
-                        meshes.par_chunks_mut(CHUNK),
-                        us.par_chunks_mut(CHUNK),
-                        vs.par_chunks_mut(CHUNK),
-                        ns.par_chunks_mut(3 * CHUNK),
-                    )
-                        .into_par_iter()
-                        .with_max_len(1)
-                        .enumerate()
-                        .for_each(|(c, (t, tri, mesh, u, v, nrm))| {
-                            let mut rays = [Ray::new(Vec3::ZERO, Vec3::ZERO); CHUNK];
-                            let mut hits = [None; CHUNK];
-                            let k = t.len();
-                            view.fill(c * CHUNK, &mut rays[..k]);
-                            snap.tree.closest_hits_serial(&rays[..k], &mut hits[..k]);
-                            for (j, h) in hits[..k].iter().enumerate() {
-                                match h {
-                                    Some(h) => {
-                                        let (m, local) = Geometry::locate(&snap.starts, h.tri);
-                                        t[j] = h.t;
-                                        tri[j] = local;
-                                        mesh[j] = m;
-                                        u[j] = h.u;
-                                        v[j] = h.v;
-                                    }
-                                    None => {
-                                        t[j] = f32::INFINITY;
-                                        tri[j] = -1;
-                                        mesh[j] = -1;
-                                        u[j] = 0.0;
-                                        v[j] = 0.0;
-                                    }
-                                }
-                            }
-                            // The normals in a loop of their own: its loads,
-                            // scattered over the mesh, overlap.
-                            for (h, n) in hits[..k].iter().zip(nrm.chunks_exact_mut(3)) {
-                                let v = h.map_or(Vec3::ZERO, |h| snap.normal(h.tri));
-                                n.copy_from_slice(&v.to_array());
-                            }
-                        })
-                })
+            let chunks = (
+                ts.par_chunks_mut(CHUNK),
+                tris.par_chunks_mut(CHUNK),
+                meshes.par_chunks_mut(CHUNK),
+                us.par_chunks_mut(CHUNK),
+                vs.par_chunks_mut(CHUNK),
+                ns.par_chunks_mut(3 * CHUNK),
+            )
+                .into_par_iter();
+            self.in_chunks(py, threads, chunks, |first, (t, tri, mesh, u, v, nrm)| {
+                let mut rays = [Ray::new(Vec3::ZERO, Vec3::ZERO); CHUNK];
+                let mut hits = [None; CHUNK];
+                let k = t.len();
+                view.fill(first, &mut rays[..k]);
+                snap.tree.closest_hits_serial(&rays[..k], &mut hits[..k]);
+                for (j, h) in hits[..k].iter().enumerate() {
+                    match h {
+                        Some(h) => {
+                            let (m, local) = Geometry::locate(&snap.starts, h.tri);
+                            t[j] = h.t;
+                            tri[j] = local;
+                            mesh[j] = m;
+                            u[j] = h.u;
+                            v[j] = h.v;
+                        }
+                        None => {
+                            t[j] = f32::INFINITY;
+                            tri[j] = -1;
+                            mesh[j] = -1;
+                            u[j] = 0.0;
+                            v[j] = 0.0;
+                        }
+                    }
+                }
+                // The normals in a loop of their own: its loads,
+                // scattered over the mesh, overlap.
+                for (h, n) in hits[..k].iter().zip(nrm.chunks_exact_mut(3)) {
+                    let v = h.map_or(Vec3::ZERO, |h| snap.normal(h.tri));
+                    n.copy_from_slice(&v.to_array());
+                }
             })?;
         }
         Ok(dict)
@@ -267,18 +258,11 @@ impl RayScene {
             // SAFETY: as in `cast_rays`.
             let o = unsafe { out.as_slice_mut()? };
             let view = rays.view();
-            py.detach(|| {
-                run_on(threads.or(self.threads), || {
-                    o.par_chunks_mut(CHUNK)
-                        .with_max_len(1)
-                        .enumerate()
-                        .for_each(|(c, o)| {
-                            let mut rays = [Ray::new(Vec3::ZERO, Vec3::ZERO); CHUNK];
-                            let k = o.len();
-                            view.fill(c * CHUNK, &mut rays[..k]);
-                            snap.tree.any_hits_serial(&rays[..k], o);
-                        })
-                })
+            self.in_chunks(py, threads, o.par_chunks_mut(CHUNK), |first, o| {
+                let mut rays = [Ray::new(Vec3::ZERO, Vec3::ZERO); CHUNK];
+                let k = o.len();
+                view.fill(first, &mut rays[..k]);
+                snap.tree.any_hits_serial(&rays[..k], o);
             })?;
         }
         Ok(out)
@@ -304,19 +288,12 @@ impl RayScene {
             // SAFETY: as in `cast_rays`.
             let o = unsafe { out.as_slice_mut()? };
             let view = rays.view();
-            py.detach(|| {
-                run_on(threads.or(self.threads), || {
-                    o.par_chunks_mut(CHUNK)
-                        .with_max_len(1)
-                        .enumerate()
-                        .for_each(|(c, o)| {
-                            let mut hits = Vec::new();
-                            for (j, slot) in o.iter_mut().enumerate() {
-                                snap.tree.all_hits(&view.ray(c * CHUNK + j), &mut hits);
-                                *slot = hits.len().min(i32::MAX as usize) as i32;
-                            }
-                        })
-                })
+            self.in_chunks(py, threads, o.par_chunks_mut(CHUNK), |first, o| {
+                let mut hits = Vec::new();
+                for (j, slot) in o.iter_mut().enumerate() {
+                    snap.tree.all_hits(&view.ray(first + j), &mut hits);
+                    *slot = hits.len().min(i32::MAX as usize) as i32;
+                }
             })?;
         }
         Ok(out)
@@ -345,22 +322,15 @@ impl RayScene {
         let cap = max_hits.unwrap_or(usize::MAX);
         let view = rays.view();
         let n = rays.n;
-        let parts: Vec<Vec<(u32, Hit)>> = py.detach(|| {
-            run_on(threads.or(self.threads), || {
-                (0..n.div_ceil(CHUNK))
-                    .into_par_iter()
-                    .with_max_len(1)
-                    .map(|c| {
-                        let mut hits = Vec::new();
-                        let mut out = Vec::new();
-                        for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
-                            snap.tree.all_hits(&view.ray(i), &mut hits);
-                            out.extend(hits.iter().take(cap).map(|h| (i as u32, *h)));
-                        }
-                        out
-                    })
-                    .collect()
-            })
+        let chunks = (0..n.div_ceil(CHUNK)).into_par_iter();
+        let parts: Vec<Vec<(u32, Hit)>> = self.in_chunks(py, threads, chunks, |first, _| {
+            let mut hits = Vec::new();
+            let mut out = Vec::new();
+            for i in first..(first + CHUNK).min(n) {
+                snap.tree.all_hits(&view.ray(i), &mut hits);
+                out.extend(hits.iter().take(cap).map(|h| (i as u32, *h)));
+            }
+            out
         })?;
         let total: usize = parts.iter().map(Vec::len).sum();
         let ray = PyArray1::<i64>::zeros(py, total, false);
@@ -428,30 +398,23 @@ impl RayScene {
             let o = unsafe { out.as_slice_mut()? };
             let view = points.view();
             let bounds = snap.tree.bounds();
-            py.detach(|| {
-                run_on(threads.or(self.threads), || {
-                    o.par_chunks_mut(CHUNK)
-                        .with_max_len(1)
-                        .enumerate()
-                        .for_each(|(c, o)| {
-                            let mut hits = Vec::new();
-                            for (j, slot) in o.iter_mut().enumerate() {
-                                let p = view.get(c * CHUNK + j);
-                                // Outside the root cell: outside the mesh.
-                                if !(p.cmpge(bounds.min).all() && p.cmple(bounds.max).all()) {
-                                    continue;
-                                }
-                                let odd = DIRECTIONS[..samples]
-                                    .iter()
-                                    .filter(|&&d| {
-                                        snap.tree.all_hits(&Ray::new(p, Vec3::from(d)), &mut hits);
-                                        hits.len() % 2 == 1
-                                    })
-                                    .count();
-                                *slot = 2 * odd > samples;
-                            }
+            self.in_chunks(py, threads, o.par_chunks_mut(CHUNK), |first, o| {
+                let mut hits = Vec::new();
+                for (j, slot) in o.iter_mut().enumerate() {
+                    let p = view.get(first + j);
+                    // Outside the root cell: outside the mesh.
+                    if !(p.cmpge(bounds.min).all() && p.cmple(bounds.max).all()) {
+                        continue;
+                    }
+                    let odd = DIRECTIONS[..samples]
+                        .iter()
+                        .filter(|&&d| {
+                            snap.tree.all_hits(&Ray::new(p, Vec3::from(d)), &mut hits);
+                            hits.len() % 2 == 1
                         })
-                })
+                        .count();
+                    *slot = 2 * odd > samples;
+                }
             })?;
         }
         Ok(out)
@@ -462,9 +425,11 @@ impl RayScene {
     /// traversal work it predicts, and the builder.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let snap = self.snapshot(py, None)?;
-        let stats = py.detach(|| snap.tree.stats());
-        let value = serde_json::to_value(stats)
-            .map_err(|e| PyRuntimeError::new_err(format!("statistics: {e}")))?;
+        let value = py.detach(|| match &*snap.tree {
+            TriangleAccel::Kd(t) => serde_json::to_value(t.stats()),
+            TriangleAccel::Bvh(b) => serde_json::to_value(b.stats()),
+        });
+        let value = value.map_err(|e| PyRuntimeError::new_err(format!("statistics: {e}")))?;
         let d = PyDict::new(py);
         if let serde_json::Value::Object(map) = value {
             for (k, v) in map {
@@ -477,17 +442,19 @@ impl RayScene {
                 }
             }
         }
-        d.set_item("builder", self.params.builder.name())?;
+        d.set_item("accel", self.params.kind.name())?;
+        d.set_item("builder", self.params.builder_name())?;
         Ok(d)
     }
 
     fn __repr__(&self) -> PyResult<String> {
         let s = self.lock()?;
         Ok(format!(
-            "RayScene({} meshes, {} triangles, builder '{}')",
+            "RayScene({} meshes, {} triangles, accel '{}', builder '{}')",
             s.geometry.starts.len() - 1,
             s.geometry.faces.len(),
-            self.params.builder.name()
+            self.params.kind.name(),
+            self.params.builder_name()
         ))
     }
 }
@@ -511,6 +478,32 @@ impl RayScene {
             .map_err(|_| PyRuntimeError::new_err("the scene was left broken by an earlier error"))
     }
 
+    /// `each(first, chunk)` for every chunk of a query of [`CHUNK`] rays
+    /// (`first`: the index of its first ray), every chunk its own job, on
+    /// the scene's threads (or `threads`) without the GIL; the results in
+    /// the chunks' order.
+    fn in_chunks<C, R>(
+        &self,
+        py: Python<'_>,
+        threads: Option<usize>,
+        chunks: C,
+        each: impl Fn(usize, C::Item) -> R + Sync + Send,
+    ) -> PyResult<Vec<R>>
+    where
+        C: IndexedParallelIterator,
+        R: Send,
+    {
+        py.detach(|| {
+            run_on(threads.or(self.threads), || {
+                chunks
+                    .with_max_len(1)
+                    .enumerate()
+                    .map(|(c, chunk)| each(c * CHUNK, chunk))
+                    .collect()
+            })
+        })
+    }
+
     /// The tree (built now, without the GIL, if the meshes changed) and
     /// the arrays a query reads.
     fn snapshot(&self, py: Python<'_>, threads: Option<usize>) -> PyResult<Snapshot> {
@@ -527,7 +520,7 @@ impl RayScene {
                 .map(|t| t.normal().normalize_or_zero())
                 .collect();
             let params = &self.params;
-            let tree = Arc::new(run_on(threads, || KdTree::build(tris, params))?);
+            let tree = Arc::new(run_on(threads, || TriangleAccel::build(tris, params))?);
             let snap = Snapshot {
                 tree,
                 normals,

@@ -1,7 +1,10 @@
-//! Scenes loaded as the command line loads them, rendered with its
-//! settings rules (keyword arguments over the file's settings over the
-//! defaults), interruptible from Python, and images written by its writer.
+//! Scenes loaded as the command line loads them and rendered through the
+//! same request (`sahara_formats::Request`): keyword arguments are the
+//! request's settings table's, over the file's settings over the
+//! defaults; interruptible from Python; images written by the same
+//! writer.
 
+use std::ffi::CString;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{mpsc, Arc};
@@ -9,17 +12,17 @@ use std::time::Duration;
 
 use glam::Vec3;
 use numpy::{PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray3, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyFileNotFoundError, PyMemoryError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyMemoryError, PyRuntimeError, PyTypeError, PyUserWarning, PyValueError,
+};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
-use sahara_formats::FileSettings;
+use pyo3::types::{PyBool, PyDict, PyList, PyString};
 use sahara_formats::{write_image, Pixels};
-use sahara_formats::{LoadOptions, Loaded};
-use sahara_kd::{BuildParams, Builder};
+use sahara_formats::{Given, Plan, Refused, Request, RequestError, Setting, SettingsLayer};
+use sahara_formats::{LoadOptions, Loaded, Note, SceneNames, Spelling, SETTINGS};
 use sahara_render::{
-    defaults, render_watched, Aov, AuxImages, Feature, Film, Filter, FilterKind, Integrator,
-    IntegratorKind, Named, PixelSum, Progress, RenderResult, RenderSettings, SamplerKind,
-    Scene as RenderScene, SettingsError, ToneMap,
+    render_watched, Aov, AuxImages, Film, FilterKind, IntegratorKind, Named, Progress,
+    RenderResult, SamplerKind, Scene as RenderScene, ToneMap,
 };
 
 use crate::pool::pool;
@@ -36,11 +39,27 @@ fn format_error(e: sahara_formats::FormatError) -> PyErr {
     FormatError::new_err(e.to_string())
 }
 
+/// A refused request as the Python exception a caller expects: a
+/// `MemoryError` for a render beyond the machine, a `RuntimeError` for
+/// the denoiser, `sahara.FormatError` for a file, else a `ValueError`
+/// naming the keyword argument.
+fn request_error(e: RequestError) -> PyErr {
+    let message = e.message(Spelling::Python);
+    match e {
+        RequestError::Memory(_) => PyMemoryError::new_err(message),
+        RequestError::Denoiser { .. } => PyRuntimeError::new_err(message),
+        RequestError::File(_) => FormatError::new_err(message),
+        RequestError::Refused { .. } => PyValueError::new_err(message),
+    }
+}
+
 /// A scene loaded from a file (or the built-in Cornell box), ready to render.
 #[pyclass(module = "sahara._sahara", frozen)]
 pub struct Scene {
     scene: Arc<RenderScene>,
-    settings: Option<FileSettings>,
+    settings: Option<SettingsLayer>,
+    path: Option<PathBuf>,
+    names: SceneNames,
     /// The scene's name (the file name without its extension).
     #[pyo3(get)]
     name: String,
@@ -50,52 +69,54 @@ pub struct Scene {
     /// Problems that did not stop loading, one line each, naming the file.
     #[pyo3(get)]
     warnings: Vec<String>,
-    /// What the scene's objects are called, by id - 1 (the `object` pass).
-    #[pyo3(get)]
-    object_names: Vec<String>,
-    /// What the scene's materials are called, by id - 1 (the `material` pass).
-    #[pyo3(get)]
-    material_names: Vec<String>,
     /// Where a mesh file's camera and light came from (None for a scene file).
     #[pyo3(get)]
     framing: Option<String>,
 }
 
 impl Scene {
-    /// The loaded scene; its problems named after the file they come
-    /// from (`from_file`), as the command line names them.
-    fn from_loaded(l: Loaded, from_file: bool) -> Self {
-        let mut warnings = l.warnings;
-        let from = l.description.clone();
-        warnings.extend(l.scene.diagnostics().into_iter().map(|d| {
-            if from_file {
-                format!("{from}: {d}")
-            } else {
-                d
-            }
-        }));
+    /// The loaded scene, with its problems as the command line says them.
+    fn from_loaded(l: Loaded) -> Self {
         Scene {
+            warnings: l.problems(),
             scene: Arc::new(l.scene),
             settings: l.settings,
+            path: l.path,
+            names: l.names,
             name: l.name,
             description: l.description,
-            warnings,
-            object_names: l.names.objects,
-            material_names: l.names.materials,
             framing: l.framing,
+        }
+    }
+
+    /// The scene as loaded, for a request (its problems were said when it
+    /// was loaded).
+    fn loaded(&self) -> Loaded {
+        Loaded {
+            scene: (*self.scene).clone(),
+            settings: self.settings.clone(),
+            name: self.name.clone(),
+            description: self.description.clone(),
+            path: self.path.clone(),
+            names: self.names.clone(),
+            warnings: Vec::new(),
+            framing: self.framing.clone(),
         }
     }
 }
 
 #[pymethods]
 impl Scene {
-    /// The render settings the file asks for (a dict), or None (a mesh
-    /// file, the built-in scene).
+    /// The render settings of the file (over the defaults: what a render
+    /// without arguments uses), a dict; None for a mesh file or the
+    /// built-in scene.
     #[getter]
     fn file_settings<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let Some(f) = &self.settings else {
+        let Some(file) = &self.settings else {
             return Ok(None);
         };
+        let layer = SettingsLayer::default().apply(file.clone());
+        let (f, o) = (layer.frame_settings(), layer.output.clone().decided());
         let d = PyDict::new(py);
         d.set_item("integrator", f.integrator.name())?;
         d.set_item("sampler", f.sampler.name())?;
@@ -104,11 +125,25 @@ impl Scene {
         d.set_item("filter", f.filter.kind().name())?;
         d.set_item("width", f.width)?;
         d.set_item("height", f.height)?;
-        d.set_item("exposure", f.exposure)?;
-        d.set_item("tonemap", f.tonemap.name())?;
-        d.set_item("output", f.output.as_ref().map(|p| p.display().to_string()))?;
-        d.set_item("denoise", f.denoise)?;
+        d.set_item("noise_threshold", f.adaptive.map(|a| a.threshold))?;
+        d.set_item("min_spp", f.adaptive.map(|a| a.min_spp))?;
+        d.set_item("exposure", o.exposure)?;
+        d.set_item("tonemap", o.tonemap.name())?;
+        d.set_item("output", layer.path.map(|p| p.display().to_string()))?;
+        d.set_item("denoise", o.denoise)?;
         Ok(Some(d))
+    }
+
+    /// What the scene's objects are called, by id - 1 (the `object` pass).
+    #[getter]
+    fn object_names(&self) -> Vec<String> {
+        self.names.objects.clone()
+    }
+
+    /// What the scene's materials are called, by id - 1 (the `material` pass).
+    #[getter]
+    fn material_names(&self) -> Vec<String> {
+        self.names.materials.clone()
     }
 
     /// The number of triangles over the scene's meshes.
@@ -156,7 +191,7 @@ pub fn load(
     let loaded = py
         .detach(|| sahara_formats::load(&path, &options))
         .map_err(format_error)?;
-    Ok(Scene::from_loaded(loaded, true))
+    Ok(Scene::from_loaded(loaded))
 }
 
 /// The built-in Cornell box, seen by `camera` (a sidecar file) and lit as
@@ -170,7 +205,7 @@ pub fn cornell_box(camera: Option<String>, sky: Option<String>) -> PyResult<Scen
         defines: Vec::new(),
     };
     let loaded = sahara_formats::load_builtin(&options).map_err(format_error)?;
-    Ok(Scene::from_loaded(loaded, false))
+    Ok(Scene::from_loaded(loaded))
 }
 
 /// A name of a setting table, or a ValueError listing the names.
@@ -178,196 +213,125 @@ fn named<T: Named>(value: &str) -> PyResult<T> {
     T::from_name(value).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
-/// Renders `scene` as `sahara render` does with the same settings:
-/// keyword arguments over the file's settings over the defaults, the
-/// same image for the same seed. Releases the GIL; Ctrl-C (or any
-/// exception a signal handler raises) stops the render after the tiles
-/// under way and re-raises. `progress(done, total)` is called now and then
-/// from the calling thread. Returns the linear RGB image (height, width, 3)
-/// float32 and a dict of the `aovs` asked for.
+/// Most threads a render takes (the command line's `--threads` limit).
+const MAX_THREADS: i64 = 1024;
+
+/// Renders `scene` through the request `sahara render` makes: keyword
+/// arguments (the request's settings, `SETTINGS`) over the file's
+/// settings over the defaults, the same image for the same seed; with
+/// `output`, the same file. Releases the GIL; Ctrl-C (or any exception a
+/// signal handler raises) stops the render after the tiles under way and
+/// re-raises. `progress(done, total)` is called now and then from the
+/// calling thread. Returns the linear RGB image (height, width, 3)
+/// float32 (of the crop or piece, if one is asked for) and a dict of the
+/// `aovs` asked for.
 #[pyfunction]
-#[pyo3(signature = (scene, *, spp=None, width=None, height=None, integrator=None, seed=None,
-    threads=None, aovs=None, denoise=false, sampler=None, filter=None, pass_spp=None,
-    builder=None, progress=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (scene, *, threads=None, progress=None, **settings))]
 pub fn render<'py>(
     py: Python<'py>,
     scene: &Scene,
-    spp: Option<u32>,
-    width: Option<u32>,
-    height: Option<u32>,
-    integrator: Option<String>,
-    seed: Option<u64>,
-    threads: Option<usize>,
-    aovs: Option<Vec<String>>,
-    denoise: bool,
-    sampler: Option<String>,
-    filter: Option<String>,
-    pass_spp: Option<u32>,
-    builder: Option<String>,
+    threads: Option<i64>,
     progress: Option<Bound<'py, PyAny>>,
+    settings: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<(Bound<'py, PyArray3<f32>>, Bound<'py, PyDict>)> {
-    let file = scene.settings.as_ref();
-    check_sizes(spp, width, height, pass_spp)?;
-    let integrator = Integrator::chosen(
-        integrator
-            .as_deref()
-            .map(named::<IntegratorKind>)
-            .transpose()?,
-        file.map(|f| f.integrator),
-    );
-    let sampler = match sampler {
-        Some(s) => named::<SamplerKind>(&s)?,
-        None => file.map(|f| f.sampler).unwrap_or_default(),
-    };
-    let filter_kind = filter.as_deref().map(named::<FilterKind>).transpose()?;
-    let mut filter = match (filter_kind, file) {
-        (Some(kind), Some(f)) if f.filter.kind() == kind => f.filter,
-        (Some(kind), _) => Filter::from(kind),
-        (None, Some(f)) => f.filter,
-        (None, None) => Filter::default(),
-    };
-    let build = match builder {
-        None => BuildParams::default(),
-        Some(b) => BuildParams::new(
-            Builder::parse(&b)
-                .ok_or_else(|| PyValueError::new_err(format!("builder: unknown builder '{b}'")))?,
-        ),
-    };
-    let spp = spp.or(file.map(|f| f.spp)).unwrap_or(defaults::SPP);
-    let width = width.or(file.map(|f| f.width)).unwrap_or(512);
-    let height = height.or(file.map(|f| f.height)).unwrap_or(512);
-    let mut passes: Vec<Aov> = aovs
-        .unwrap_or_default()
-        .iter()
-        .map(|a| named::<Aov>(a))
-        .collect::<PyResult<_>>()?;
-    let asked = passes.clone();
-    let denoise = denoise || file.is_some_and(|f| f.denoise);
-    if denoise {
-        passes.extend([Aov::Albedo, Aov::Normal]);
-        if filter_kind.is_none() {
-            // As the command line: a wider filter correlates the noise of
-            // neighbouring pixels, which the denoiser keeps.
-            filter = Filter::from(FilterKind::Box);
-        }
-    }
-    passes.sort();
-    passes.dedup();
-    if denoise {
-        integrator
-            .kind()
-            .require(Feature::Denoise)
-            .map_err(|e| PyValueError::new_err(format!("denoise: {e}")))?;
-    }
-    let cancel = Arc::new(AtomicBool::new(false));
-    let mut settings = RenderSettings {
-        width,
-        height,
-        spp,
-        pass_spp: pass_spp.unwrap_or(defaults::PASS_SPP).min(spp),
-        cancel: Some(cancel.clone()),
-        seed: seed.or(file.map(|f| f.seed)).unwrap_or(0),
-        sampler,
-        filter,
-        integrator,
-        build,
-        adaptive: file.and_then(|f| f.adaptive),
-        aovs: passes,
-        ..Default::default()
-    };
-    if let Some(c) = file.and_then(|f| f.crop) {
-        let w = c.window(width, height);
-        if w.is_empty() {
+    let threads = match threads {
+        None => None,
+        Some(t @ 0..=MAX_THREADS) => Some(t as usize),
+        Some(t) => {
             return Err(PyValueError::new_err(format!(
-                "the scene file's crop window holds no pixel of the {width}x{height} image"
-            )));
+                "threads: {t} is not in 0..={MAX_THREADS}"
+            )))
         }
-        settings.window = Some(w);
-    }
-    // What the integrator cannot honour (the renderer's rules), named by
-    // the argument or scene-file key that asked for it.
-    settings.check().map_err(|e| {
-        let asked = match &e {
-            SettingsError::Unsupported {
-                feature: Feature::Aovs,
-                ..
-            } => "aovs",
-            _ => "noise_threshold",
-        };
-        PyValueError::new_err(format!("{asked}: {e}"))
-    })?;
-    check_memory(width, height, settings.aovs.len())?;
-    let denoiser = if denoise {
-        Some(
-            sahara_denoise::Denoiser::load()
-                .map_err(|e| PyRuntimeError::new_err(format!("denoise: {e}")))?,
-        )
-    } else {
-        None
     };
-    let mut render_scene = (*scene.scene).clone();
-    render_scene.camera.aspect = width as f32 / height as f32;
-    render_scene
-        .validate()
-        .map_err(|e| PyValueError::new_err(format!("{}: invalid scene: {e}", scene.description)))?;
-    let mut result = run(py, render_scene, settings, threads, &cancel, progress)?;
-    if let Some(d) = &denoiser {
-        denoise_result(d, &mut result, &scene.scene)?;
+    let request = Request {
+        caller: caller_settings(settings)?,
+        write_by_default: false,
+    };
+    request.check().map_err(request_error)?;
+    let loaded = scene.loaded();
+    let plan = py.detach(|| request.plan(loaded)).map_err(request_error)?;
+    // A setting that will not do what it seems to ask is a Python warning;
+    // what the plan decided goes unsaid, as a library says nothing.
+    for note in &plan.notes {
+        if let Note::Warning(line) = note {
+            let line = CString::new(line.as_str())?;
+            PyErr::warn(py, &py.get_type::<PyUserWarning>(), &line, 1)?;
+        }
     }
+    let mut result = run(py, &plan, threads, progress)?;
+    let denoised = py
+        .detach(|| plan.denoise(&mut result))
+        .map_err(request_error)?;
+    py.detach(|| plan.write(&result, denoised.as_ref(), false))
+        .map_err(request_error)?;
     let (w, h) = (result.film.width as usize, result.film.height as usize);
     let image = PyArray3::<f32>::zeros(py, [h, w, 3], false);
     // SAFETY: made here, held by no one else.
     unsafe { image.as_slice_mut()? }.copy_from_slice(&result.film.to_rgb_f32());
     let out = match &result.aux {
-        Some(aux) => pass_arrays(py, &aux.images, &asked, w, h)?,
+        Some(aux) => pass_arrays(py, &aux.images, &plan.output.aovs, w, h)?,
         None => PyDict::new(py),
     };
     Ok((image, out))
 }
 
-/// Refuses a zero size or sample count, and sides beyond 65536.
-fn check_sizes(
-    spp: Option<u32>,
-    width: Option<u32>,
-    height: Option<u32>,
-    pass_spp: Option<u32>,
-) -> PyResult<()> {
-    for (what, v) in [
-        ("spp", spp),
-        ("width", width),
-        ("height", height),
-        ("pass_spp", pass_spp),
-    ] {
-        if v == Some(0) || v.is_some_and(|v| v > 65536 && what != "spp") {
-            return Err(PyValueError::new_err(format!(
-                "{what} must be {}",
-                if what == "spp" {
-                    "at least 1"
-                } else {
-                    "1..=65536"
-                }
+/// The caller's settings layer from `render`'s keyword arguments, each
+/// put by the settings table (None: not given). A keyword no setting
+/// has is a `TypeError`, as Python's own; a value of the wrong kind a
+/// `TypeError`, one the setting refuses a `ValueError`, both naming the
+/// keyword.
+fn caller_settings(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<SettingsLayer> {
+    let mut layer = SettingsLayer::default();
+    let Some(kwargs) = kwargs else {
+        return Ok(layer);
+    };
+    for (key, value) in kwargs.iter() {
+        let key: String = key.extract()?;
+        let Some(setting) = Setting::by_keyword(&key) else {
+            let known: Vec<&str> = SETTINGS.iter().map(|s| s.keyword).collect();
+            return Err(PyTypeError::new_err(format!(
+                "render() got an unexpected keyword argument '{key}' (it takes {} and threads, \
+                 progress)",
+                known.join(", ")
             )));
+        };
+        if value.is_none() {
+            continue;
         }
+        let given = given(&value)
+            .map_err(|what| PyTypeError::new_err(format!("{key}: expected {what}")))?;
+        setting.set(&mut layer, &given).map_err(|e| match e {
+            Refused::Type(m) => PyTypeError::new_err(format!("{key}: {m}")),
+            Refused::Value(m) => PyValueError::new_err(format!("{key}: {m}")),
+        })?;
     }
-    Ok(())
+    Ok(layer)
 }
 
-/// A MemoryError for a render beyond the machine. The film's sums, its
-/// image and the passes are allocated in the render's threads, where a
-/// failed allocation aborts the process: the memory is asked for here
-/// first.
-fn check_memory(width: u32, height: u32, passes: usize) -> PyResult<()> {
-    let pixels = width as usize * height as usize;
-    let per_pixel = std::mem::size_of::<PixelSum>() + 16 * (2 + passes);
-    let bytes = pixels.saturating_mul(per_pixel);
-    if Vec::<u8>::new().try_reserve_exact(bytes).is_err() {
-        return Err(PyMemoryError::new_err(format!(
-            "a {width}x{height} render needs about {:.1} GB, more than this machine gives",
-            bytes as f64 / 1e9
-        )));
+/// A Python value as the settings table takes it: `bool`, whole numbers
+/// (`int` and numpy's, anything with `__index__`), other numbers, `str`
+/// and paths, lists and tuples of these. Else what is expected.
+fn given(v: &Bound<'_, PyAny>) -> Result<Given, &'static str> {
+    if let Ok(b) = v.cast::<PyBool>() {
+        return Ok(Given::Flag(b.is_true()));
     }
-    Ok(())
+    if let Ok(s) = v.cast::<PyString>() {
+        return Ok(Given::Str(s.to_string()));
+    }
+    if let Ok(n) = v.extract::<i128>() {
+        return Ok(Given::Whole(n));
+    }
+    if let Ok(x) = v.extract::<f64>() {
+        return Ok(Given::Number(x));
+    }
+    if let Ok(p) = v.extract::<PathBuf>() {
+        return Ok(Given::Str(p.display().to_string()));
+    }
+    if let Ok(items) = v.extract::<Vec<Bound<'_, PyAny>>>() {
+        let items = items.iter().map(given).collect::<Result<_, _>>()?;
+        return Ok(Given::List(items));
+    }
+    Err("a number, text, a path, True or False, or a list of them")
 }
 
 /// The render passes `asked` for as numpy arrays of `h` x `w` pixels, by
@@ -426,118 +390,87 @@ fn pass_arrays<'py>(
     Ok(out)
 }
 
-/// Runs the render on its own thread (in the pool of `threads`), while
-/// this one waits without the GIL, checks for signals and reports
-/// progress. An exception from a signal handler (KeyboardInterrupt) stops
-/// the render at the next tile, waits for its threads and is returned.
+/// Runs the plan's render on a thread of its own (in the pool of
+/// `threads`), while this one waits without the GIL, checks for signals
+/// and reports progress. An exception from a signal handler
+/// (KeyboardInterrupt) or from `progress` stops the render at the next
+/// tile, waits for its threads and is returned.
 fn run(
     py: Python<'_>,
-    scene: RenderScene,
-    settings: RenderSettings,
+    plan: &Plan,
     threads: Option<usize>,
-    cancel: &Arc<AtomicBool>,
     progress: Option<Bound<'_, PyAny>>,
 ) -> PyResult<RenderResult> {
     let threads = threads.filter(|&t| t > 0).unwrap_or_else(|| {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
     let pool = pool(threads)?;
+    let cancel = plan.settings.cancel.clone().unwrap_or_default();
     let done = Arc::new(AtomicU64::new(0));
     let total = Arc::new(AtomicU64::new(0));
     let (tx, mut rx) = mpsc::channel();
     let (d, t) = (done.clone(), total.clone());
-    let worker = std::thread::Builder::new()
-        .name("sahara-render".into())
-        .spawn(move || {
-            let on_progress = |p: Progress| {
-                t.store(u64::from(p.passes) * p.tiles as u64, Ordering::Relaxed);
-                d.store(
-                    p.pass as u64 * p.tiles as u64 + p.tiles_done as u64,
-                    Ordering::Relaxed,
-                );
-            };
-            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                pool.install(|| render_watched(&scene, &settings, &on_progress, None))
-            }));
-            let _ = tx.send(r);
-        })
-        .map_err(|e| PyRuntimeError::new_err(format!("cannot start the render thread: {e}")))?;
-    let mut shown = (u64::MAX, u64::MAX);
-    let result = loop {
-        // The receiver goes into the wait and comes back (it is not Sync).
-        let (got, back) = py.detach(move || (rx.recv_timeout(Duration::from_millis(100)), rx));
-        rx = back;
-        let now = (done.load(Ordering::Relaxed), total.load(Ordering::Relaxed));
-        if let Some(cb) = &progress {
-            if now != shown && now.1 > 0 {
-                shown = now;
-                if let Err(e) = cb.call1(now) {
-                    cancel.store(true, Ordering::SeqCst);
-                    py.detach(|| worker.join()).ok();
-                    return Err(e);
-                }
-            }
-        }
-        match got {
-            Ok(r) => break r,
-            Err(mpsc::RecvTimeoutError::Disconnected) => {
-                return Err(PyRuntimeError::new_err("the render thread stopped"))
-            }
-            Err(mpsc::RecvTimeoutError::Timeout) => {}
-        }
-        if let Err(e) = py.check_signals() {
+    let (scene, settings) = (&plan.scene, &plan.settings);
+    std::thread::scope(|s| {
+        let worker = std::thread::Builder::new()
+            .name("sahara-render".into())
+            .spawn_scoped(s, move || {
+                let on_progress = |p: Progress| {
+                    t.store(u64::from(p.passes) * p.tiles as u64, Ordering::Relaxed);
+                    d.store(
+                        p.pass as u64 * p.tiles as u64 + p.tiles_done as u64,
+                        Ordering::Relaxed,
+                    );
+                };
+                let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    pool.install(|| render_watched(scene, settings, &on_progress, None))
+                }));
+                let _ = tx.send(r);
+            })
+            .map_err(|e| PyRuntimeError::new_err(format!("cannot start the render thread: {e}")))?;
+        let stop = |worker: std::thread::ScopedJoinHandle<'_, ()>, cancel: &AtomicBool| {
             cancel.store(true, Ordering::SeqCst);
             py.detach(|| worker.join()).ok();
-            return Err(e);
+        };
+        let mut shown = (u64::MAX, u64::MAX);
+        let result = loop {
+            // The receiver goes into the wait and comes back (it is not Sync).
+            let (got, back) = py.detach(move || (rx.recv_timeout(Duration::from_millis(100)), rx));
+            rx = back;
+            let now = (done.load(Ordering::Relaxed), total.load(Ordering::Relaxed));
+            if let Some(cb) = &progress {
+                if now != shown && now.1 > 0 {
+                    shown = now;
+                    if let Err(e) = cb.call1(now) {
+                        stop(worker, &cancel);
+                        return Err(e);
+                    }
+                }
+            }
+            match got {
+                Ok(r) => break r,
+                Err(mpsc::RecvTimeoutError::Disconnected) => {
+                    return Err(PyRuntimeError::new_err("the render thread stopped"))
+                }
+                Err(mpsc::RecvTimeoutError::Timeout) => {}
+            }
+            if let Err(e) = py.check_signals() {
+                stop(worker, &cancel);
+                return Err(e);
+            }
+        };
+        py.detach(|| worker.join()).ok();
+        let result = result
+            .map_err(|_| PyRuntimeError::new_err("the render failed (a panic)"))?
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        if let Some(cb) = &progress {
+            let t = total.load(Ordering::Relaxed);
+            if t > 0 && shown != (t, t) {
+                cb.call1((t, t))?;
+            }
         }
-    };
-    py.detach(|| worker.join()).ok();
-    let result = result
-        .map_err(|_| PyRuntimeError::new_err("the render failed (a panic)"))?
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    if let Some(cb) = &progress {
-        let t = total.load(Ordering::Relaxed);
-        if t > 0 && shown != (t, t) {
-            cb.call1((t, t))?;
-        }
-    }
-    Ok(result)
-}
-
-/// Denoises the image in place, as `sahara render --denoise` does.
-fn denoise_result(
-    denoiser: &sahara_denoise::Denoiser,
-    result: &mut RenderResult,
-    scene: &RenderScene,
-) -> PyResult<()> {
-    let aux = result
-        .aux
-        .as_ref()
-        .ok_or_else(|| PyRuntimeError::new_err("denoise: the render made no albedo and normal"))?;
-    let flat = |v: &[Vec3]| -> Vec<f32> { v.iter().flat_map(|p| p.to_array()).collect() };
-    let (albedo, normal) = (flat(&aux.images.albedo), flat(&aux.images.normal));
-    let noisy = result.film.to_rgb_f32();
-    let c = &scene.camera;
-    let noisy_guides = c.lens_radius > 0.0
-        || (c.shutter_close > c.shutter_open
-            && scene.instances.iter().any(|i| i.placement.is_moving()));
-    let image = sahara_denoise::Image {
-        width: result.film.width as usize,
-        height: result.film.height as usize,
-        color: &noisy,
-        hdr: true,
-    };
-    let guide = sahara_denoise::Aux {
-        prefilter_aux: noisy_guides,
-        ..sahara_denoise::Aux::albedo_normal(&albedo, &normal)
-    };
-    let clean = denoiser
-        .denoise(&image, guide)
-        .map_err(|e| PyRuntimeError::new_err(format!("denoise: {e}")))?;
-    for (p, c) in result.film.pixels.iter_mut().zip(clean.chunks_exact(3)) {
-        *p = Vec3::new(c[0], c[1], c[2]).max(Vec3::ZERO);
-    }
-    Ok(())
+        Ok(result)
+    })
 }
 
 /// Writes a linear RGB image, (height, width, 3) float32, as the command
@@ -614,10 +547,13 @@ fn write_rgb(
 }
 
 /// The names each setting takes: integrators, samplers, filters, render
-/// passes, tone maps and builders.
+/// passes and tone maps; and `setting`, the keyword arguments of
+/// `render` that are render settings.
 #[pyfunction]
 pub fn names(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
+    let keywords: Vec<&str> = SETTINGS.iter().map(|s| s.keyword).collect();
+    d.set_item("setting", PyList::new(py, keywords)?)?;
     d.set_item("integrator", PyList::new(py, IntegratorKind::names())?)?;
     d.set_item("sampler", PyList::new(py, SamplerKind::names())?)?;
     d.set_item("filter", PyList::new(py, FilterKind::names())?)?;

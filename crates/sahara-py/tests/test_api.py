@@ -37,7 +37,15 @@ def test_the_stubs_name_every_public_object_of_the_native_module():
 
 
 def runtime_parameters(obj):
-    return [p for p in inspect.signature(obj).parameters if p != "self"]
+    """The parameters of `obj`; its `**settings` are the render settings'
+    keywords, which the stub lists one by one for editors."""
+    names = []
+    for p in inspect.signature(obj).parameters.values():
+        if p.kind is p.VAR_KEYWORD:
+            names += native.names()["setting"]
+        elif p.name != "self":
+            names.append(p.name)
+    return names
 
 
 def test_the_stubs_signatures_are_the_native_modules():

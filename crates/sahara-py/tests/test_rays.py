@@ -85,6 +85,8 @@ def test_one_origin_or_direction_is_broadcast_and_intervals_apply():
         (lambda: sahara.RayScene(SQUARE_V.astype(str), SQUARE_F), "vertices: expected"),
         (lambda: sahara.RayScene(SQUARE_V), "give both vertices and faces"),
         (lambda: sahara.RayScene(SQUARE_V, SQUARE_F, builder="bvh"), "builder: unknown builder 'bvh'"),
+        (lambda: sahara.RayScene(SQUARE_V, SQUARE_F, accel="octree"), "accel: unknown structure 'octree'"),
+        (lambda: sahara.RayScene(SQUARE_V, SQUARE_F, accel="kd", builder="spatial"), "builder: unknown builder 'spatial'"),
         (lambda: sahara.RayScene(SQUARE_V, SQUARE_F).cast_rays(np.zeros((3, 3)), np.zeros((2, 3))), "origins and directions: 3 and 2 rows"),
         (lambda: sahara.RayScene(SQUARE_V, SQUARE_F).cast_rays(np.zeros((3, 4)), np.zeros((3, 3))), "origins: expected an array of shape (N, 3) or (3,)"),
         (lambda: sahara.RayScene(SQUARE_V, SQUARE_F).occluded(np.zeros((3, 3)), [0, 0, 1], tmax=np.ones(2)), "tmax: expected a number or an array of shape (3,)"),
@@ -218,10 +220,28 @@ def test_occluded_agrees_with_closest_hits_and_threads_give_the_same_answers():
     np.testing.assert_array_equal(s.occluded(o, d), one["triangle"] >= 0)
 
 
+@pytest.mark.parametrize("builder", ["spatial", "binned", "kd"])
+def test_every_structure_gives_the_kd_trees_answers_bit_for_bit(builder):
+    v, f = icosphere(3)
+    v = np.vstack([v, v * 0.5 + 0.2])
+    f = np.vstack([f, f + len(v) // 2])
+    o, d = random_rays(5000, spread=1.5)
+    kd = sahara.RayScene(v, f, accel="kd")
+    bvh = sahara.RayScene(v, f, accel="bvh", builder=builder)
+    a, b = kd.cast_rays(o, d), bvh.cast_rays(o, d)
+    assert (a["triangle"] >= 0).sum() > 1000
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k])
+    np.testing.assert_array_equal(kd.occluded(o, d), bvh.occluded(o, d))
+    np.testing.assert_array_equal(kd.count_intersections(o, d), bvh.count_intersections(o, d))
+
+
 def test_stats_report_the_tree():
     v, f = icosphere(3)
     st = sahara.RayScene(v, f, builder="binned").stats()
-    assert st["triangles"] == len(f) and st["builder"] == "binned"
+    assert st["triangles"] == len(f) and st["builder"] == "binned" and st["accel"] == "bvh"
+    st = sahara.RayScene(v, f, accel="kd", builder="sah").stats()
+    assert st["triangles"] == len(f) and st["builder"] == "sah" and st["accel"] == "kd"
     assert st["sah_cost"] > 0 and st["nodes"] == st["inner"] + st["leaves"]
     assert st["memory_bytes"] > 0
 

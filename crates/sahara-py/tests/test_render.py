@@ -67,6 +67,27 @@ def test_the_same_seed_gives_the_same_image_and_another_seed_another():
     assert not np.array_equal(a, c)
 
 
+def test_either_structure_gives_the_same_image():
+    s = sahara.cornell_box()
+    kd = sahara.render(s, width=24, height=24, spp=2, accel="kd", progress=False)
+    bvh = sahara.render(s, width=24, height=24, spp=2, accel="bvh", progress=False)
+    np.testing.assert_array_equal(kd, bvh)
+
+
+def test_the_path_loops_give_the_same_image_to_noise():
+    s = sahara.cornell_box()
+    images = {
+        loop: sahara.render(s, width=24, height=24, spp=64, path_loop=loop, progress=False)
+        for loop in ["scalar", "lanes", "lanes-no-refill", "auto"]
+    }
+    # The lanes round differently from the scalar loop, and auto takes the
+    # lanes on the Cornell box; refilling changes no lane's arithmetic.
+    np.testing.assert_array_equal(images["lanes"], images["auto"])
+    np.testing.assert_array_equal(images["lanes"], images["lanes-no-refill"])
+    scalar, lanes = images["scalar"].mean(), images["lanes"].mean()
+    assert abs(scalar - lanes) < 0.02 * scalar
+
+
 def test_file_settings_hold_unless_given():
     s = sahara.load(SCENES / "cornell_box.xml", spp=3)
     assert s.file_settings["spp"] == 3
@@ -93,9 +114,17 @@ def test_render_passes_come_as_arrays():
     [
         ({"integrator": "whitted"}, "unknown integrator 'whitted'"),
         ({"aovs": ["colour"]}, "unknown render pass 'colour'"),
-        ({"spp": 0}, "spp must be at least 1"),
-        ({"width": 0}, "width must be 1..=65536"),
+        ({"spp": 0}, "spp: 0 is not in 1..=1048576"),
+        ({"width": 0}, r"width: 0 is not in 1..=65536"),
+        ({"noise_threshold": -1}, r"noise_threshold: must be a positive number"),
+        ({"time_limit": 0}, "time_limit: must be a positive number of seconds"),
+        ({"part": (2, 2)}, r"part: '2, 2' is not a part I/N"),
+        ({"min_spp": 4}, r"min_spp: needs a noise threshold"),
+        ({"split": "samples"}, r'split="samples": applies to a part'),
+        ({"aovs": ["depth"], "output": "x.png"}, r"aovs: render passes are written as layers of an EXR"),
         ({"builder": "bvh"}, "builder: unknown builder 'bvh'"),
+        ({"accel": "octree"}, "accel: unknown structure 'octree'"),
+        ({"path_loop": "wide"}, "path_loop: unknown path loop 'wide'"),
     ],
 )
 def test_bad_settings_are_value_errors(kwargs, message):
@@ -103,25 +132,34 @@ def test_bad_settings_are_value_errors(kwargs, message):
         sahara.render(sahara.cornell_box(), progress=False, **kwargs)
 
 
+def test_settings_of_the_wrong_kind_are_type_errors():
+    for kwargs, message in [
+        ({"spp": 2.5}, "spp: expected a whole number, got a number"),
+        ({"spp": "16"}, "spp: expected a whole number, got str"),
+        ({"denoise": 1}, "denoise: expected True or False"),
+        ({"aovs": 3}, "aovs: expected a name or a list of names, got a whole number"),
+        ({"sppp": 4}, "unexpected keyword argument 'sppp'"),
+    ]:
+        with pytest.raises(TypeError, match=message):
+            sahara.render(sahara.cornell_box(), progress=False, **kwargs)
+
+
 @pytest.mark.parametrize(
-    "kwargs, error, message",
+    "kwargs, message",
     [
-        ({"spp": -1}, ValueError, "spp must be at least 1, not -1"),
-        ({"spp": 2**40}, ValueError, "spp must be at most 4294967295"),
-        ({"width": -5}, ValueError, "width must be 1..=65536, not -5"),
-        ({"height": 10**6}, ValueError, "height must be 1..=65536, not 1000000"),
-        ({"pass_spp": -2}, ValueError, "pass_spp must be at least 1, not -2"),
-        ({"seed": -1}, ValueError, "seed must be at least 0, not -1"),
-        ({"threads": -1}, ValueError, "threads must be 0..=1024, not -1"),
-        ({"spp": 2.5}, TypeError, "spp must be a whole number, not float"),
-        ({"spp": "16"}, TypeError, "spp must be a whole number, not str"),
-        ({"aovs": 3}, TypeError, "aovs must be a pass name or a sequence of names, not int"),
+        ({"spp": -1}, r"spp: -1 is not in 1..=1048576"),
+        ({"spp": 2**40}, r"spp: 1099511627776 is not in 1..=1048576"),
+        ({"width": -5}, r"width: -5 is not in 1..=65536"),
+        ({"height": 10**6}, r"height: 1000000 is not in 1..=65536"),
+        ({"pass_spp": -2}, r"pass_spp: -2 is not in 1..=1048576"),
+        ({"seed": -1}, r"seed: -1 is not in 0..="),
+        ({"threads": -1}, r"threads: -1 is not in 0..=1024"),
     ],
 )
-def test_arguments_out_of_range_name_the_argument(kwargs, error, message):
+def test_arguments_out_of_range_name_the_argument(kwargs, message):
     # Not the conversion's OverflowError: the exception a Python user
     # expects, naming the argument.
-    with pytest.raises(error, match=message):
+    with pytest.raises(ValueError, match=message):
         sahara.render(sahara.cornell_box(), progress=False, **kwargs)
 
 
@@ -199,17 +237,8 @@ def test_nan_pixels_are_counted_in_a_warning(tmp_path):
         sahara.write(tmp_path / "nan.exr", image)
 
 
-def overcommit_mode():
-    try:
-        return open("/proc/sys/vm/overcommit_memory").read().strip()
-    except OSError:
-        return None
-
-
-@pytest.mark.skipif(overcommit_mode() not in ("0", "2"),
-                    reason="where the system promises any amount of memory, the render would start")
 def test_a_render_beyond_the_machines_memory_is_a_memory_error():
-    with pytest.raises(MemoryError, match="a 65536x65536 render needs about"):
+    with pytest.raises(MemoryError, match=r"this render needs about 384.0 GiB \(32 triangles, a 65536x65536 film\)"):
         sahara.render(sahara.cornell_box(), width=65536, height=65536, spp=1, progress=False)
 
 
@@ -305,3 +334,9 @@ def test_an_exception_in_the_progress_function_stops_the_render():
 
     with pytest.raises(RuntimeError, match="stop here"):
         sahara.render(sahara.cornell_box(), width=128, height=128, spp=100000, progress=fail)
+
+
+def test_a_setting_that_cannot_do_what_it_asks_is_a_warning():
+    with pytest.warns(UserWarning, match="adaptive: every pixel takes all 4 samples"):
+        sahara.render(sahara.cornell_box(), width=8, height=8, spp=4, noise_threshold=0.1,
+                      progress=False)

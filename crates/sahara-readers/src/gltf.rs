@@ -25,9 +25,9 @@ use std::collections::HashMap;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use crate::Mesh;
 use ::gltf::mesh::Mode;
 use glam::{Affine2, Mat4, Quat, Vec2, Vec3, Vec4};
+use sahara_kd::Mesh;
 use serde_json::Value;
 
 use crate::error::FormatError;
@@ -284,7 +284,7 @@ pub enum GltfImage {
 
 /// Loads a `.gltf` or `.glb` file (the format is recognised by content).
 pub fn load_gltf(path: &Path) -> Result<GltfScene, FormatError> {
-    load(path).map_err(crate::one_line)
+    load(path).map_err(crate::error::one_line)
 }
 
 fn load(path: &Path) -> Result<GltfScene, FormatError> {

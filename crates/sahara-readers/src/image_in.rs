@@ -100,7 +100,7 @@ pub fn decode_raw(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {
     } else {
         decode_any(bytes, name)
     };
-    image.map_err(crate::one_line)
+    image.map_err(crate::error::one_line)
 }
 
 fn decode_any(bytes: &[u8], name: &str) -> Result<RawImage, FormatError> {

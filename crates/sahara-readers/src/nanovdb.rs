@@ -26,8 +26,8 @@ use std::path::Path;
 
 use nanovdb_rs::{GridType, NvdbFile, ReadAccessor, ValidatedFloatTree};
 
+use crate::error::FormatError;
 use crate::vdb::{check_size, panic_text, VdbGrid, MAX_VALUES};
-use crate::FormatError;
 
 /// Reads the float grid named `grid` from the `.nvdb` file at `path`.
 pub fn read_nanovdb(path: &Path, grid: &str) -> Result<VdbGrid, FormatError> {

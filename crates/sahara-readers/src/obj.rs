@@ -19,8 +19,8 @@ use std::borrow::Cow;
 use std::fs;
 use std::path::Path;
 
-use crate::Mesh;
 use glam::Vec3;
+use sahara_kd::Mesh;
 
 use crate::error::FormatError;
 use crate::fan::fan_triangulate;

@@ -18,8 +18,8 @@ mod reader;
 use std::fs;
 use std::path::Path;
 
-use crate::Mesh;
 use glam::{Vec2, Vec3};
+use sahara_kd::Mesh;
 
 use crate::error::FormatError;
 use crate::fan::fan_triangulate;

@@ -33,7 +33,7 @@ use std::path::Path;
 use glam::{Affine3A, DVec3, Quat, Vec3};
 use vdb_rs::{GridDescriptor, Map, MetadataValue, VdbLevel, VdbReader};
 
-use crate::FormatError;
+use crate::error::FormatError;
 
 /// The most voxels a dense grid read from a `.vdb` file may hold (2^28:
 /// one GiB of 32-bit floats).

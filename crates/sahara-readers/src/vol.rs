@@ -12,7 +12,7 @@
 use std::fs;
 use std::path::Path;
 
-use crate::FormatError;
+use crate::error::FormatError;
 
 /// A grid as the file holds it.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,7 +1,7 @@
 //! Renders the built-in Cornell box to a PPM: `cargo run --release -p
 //! sahara-render --example cornell -- OUT.ppm [SIZE] [SPP] [INTEGRATOR]`.
 
-use sahara_render::{builtin, render, Integrator, RenderSettings, ToneMap};
+use sahara_render::{builtin, render, FrameSettings, Integrator, RenderSettings, ToneMap};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
@@ -13,13 +13,13 @@ fn main() {
         .and_then(|s| Integrator::named(s).ok())
         .unwrap_or_default();
     let scene = builtin::cornell_box();
-    let settings = RenderSettings {
+    let settings = RenderSettings::from(FrameSettings {
         width: size,
         height: size,
         spp,
         integrator,
         ..Default::default()
-    };
+    });
     let r = render(&scene, &settings, &|_| {}).unwrap();
     let s = &r.stats;
     eprintln!(

@@ -3,10 +3,11 @@
 //! as float buffers ([`Film`]) and exact per-pixel sums ([`SumBuffer`]).
 //!
 //! ```
-//! use sahara_render::{builtin, render, RenderSettings};
+//! use sahara_render::{builtin, render, FrameSettings, RenderSettings};
 //!
 //! let scene = builtin::cornell_box();
-//! let settings = RenderSettings { width: 16, height: 16, spp: 4, ..Default::default() };
+//! let frame = FrameSettings { width: 16, height: 16, spp: 4, ..Default::default() };
+//! let settings = RenderSettings::from(frame);
 //! let result = render(&scene, &settings, &|_| {})?;
 //! assert_eq!(result.film.pixels.len(), 256);
 //! assert_eq!(result.stats.nan_samples, 0);
@@ -26,9 +27,11 @@
 //! `scene` (camera, meshes, shapes, instances); `film` (the image,
 //! reconstruction filters, exact sums, pixel windows) and `accel` (the
 //! instances' kd-trees); `world` (the scene prepared for tracing);
-//! `integrator` (light transport); `render` (the settings, the loop of
-//! passes, tiles and strips with the sample loops that trace a strip's
-//! samples, the frame digest). See `docs/renderer.md` for the design.
+//! `integrator` (light transport); `settings` (what a frame is, described
+//! once, and the layers of it a scene file or a caller gives); `render`
+//! (the render's settings, the loop of passes, tiles and strips with the
+//! sample loops that trace a strip's samples, the frame digest). See
+//! `docs/renderer.md` for the design.
 
 #![deny(missing_docs)]
 
@@ -45,6 +48,7 @@ mod names;
 mod render;
 mod sampler;
 mod scene;
+mod settings;
 mod texture;
 mod world;
 
@@ -61,8 +65,8 @@ pub use scene::{Scene, ShapeInstance};
 pub use light::environment::{coordinates as environment_uv, direction as environment_direction};
 pub use light::{Environment, Light, LightKind, LightOf, AREA_SHAPES};
 pub use material::{
-    fresnel, metals, AlphaMode, Bsdf, Clearcoat, Distribution, Material, MaterialKind,
-    MaterialTextures, NormalMap, OcclusionMap,
+    fresnel, isotropic_mean, metals, roughness_from_alpha, AlphaMode, Bsdf, Clearcoat,
+    Distribution, Material, MaterialKind, MaterialTextures, NormalMap, OcclusionMap,
 };
 pub use medium::{
     CloudMedium, ColourGrid, ColourVolume, DensityGrid, GridCoefficients, GridMedium,
@@ -83,8 +87,9 @@ pub use integrator::{
 };
 pub use keys::{Fallback, Key, KeyError, KeyType, Value, Values};
 pub use names::{one_of, Accepts, Named, Parameter, UnknownName};
-pub use render::{Adaptive, AdaptiveStats, PathLoop, RenderSettings, UNLIMITED_SPP};
+pub use render::{AdaptiveStats, PathLoop, RenderSettings, UNLIMITED_SPP};
 pub use sampler::SamplerKind;
+pub use settings::{Adaptive, AdaptiveChoice, Choice, FrameLayer, FrameSettings, Pick, Pickable};
 
 // Rendering, and what comes out: the image, its exact sums, pieces of a frame.
 pub use film::sums::{PixelSum, SumBuffer};

@@ -151,13 +151,13 @@ fn run(label: &str, mesh_path: Option<&Path>, mesh: &Mesh, opts: &BenchOptions) 
     };
 
     eprintln!(
-        "building the {} tree over {} triangles ({}, {})...",
-        opts.tree.builder.name(),
+        "building the {} over {} triangles ({}, {})...",
+        opts.tree.structure_name(),
         mesh.triangle_count(),
         human::count(sahara_bench::runner::BUILD_RUNS, "build"),
         human::count(threads, "thread")
     );
-    let bench = Bench::new(mesh, &opts.tree.params(), threads, opts.runs)
+    let bench = Bench::new(mesh, &opts.tree.accel_params(), threads, opts.runs)
         .context("cannot start the thread pools")?;
     eprintln!("built in {:.1} ms (best)", bench.build_ms());
 

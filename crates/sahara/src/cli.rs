@@ -2,14 +2,12 @@
 
 use std::path::PathBuf;
 
-use std::marker::PhantomData;
-
-use clap::builder::{PossibleValue, StringValueParser, TypedValueParser};
-use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
+use clap::{ArgAction, Args, Parser, Subcommand};
 use sahara_bench::SetKind;
-use sahara_kd::{BuildParams, Builder};
+use sahara_kd::{AccelKind, AccelParams, BuildParams, Builder, BvhBuilder, BvhParams};
 use sahara_render::Mesh;
-use sahara_render::{Aov, FilterKind, IntegratorKind, Named, PathLoop, SamplerKind, ToneMap};
+
+pub use crate::setting_args::SettingArgs;
 
 /// Default timed runs per set.
 pub const DEFAULT_RUNS: usize = 3;
@@ -42,16 +40,6 @@ pub enum Command {
     Merge(MergeArgs),
 }
 
-/// How `--part` divides a frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, ValueEnum)]
-pub enum Split {
-    /// Pixel regions of nearly equal pixel counts.
-    #[default]
-    Tiles,
-    /// Contiguous ranges of every pixel's sample indices.
-    Samples,
-}
-
 /// Options of `sahara merge`.
 #[derive(Debug, Args, Clone, PartialEq)]
 pub struct MergeArgs {
@@ -73,11 +61,11 @@ pub struct MergeArgs {
 
 /// Options of `sahara render`.
 ///
-/// Options a scene file can also set (`--spp`, `--width`, `--height`,
-/// `--integrator`, `--sampler`, `--filter`, `--seed`, `--exposure`,
-/// `--tonemap`, `--output`) are `None` unless given, so that the file's
-/// values hold unless overridden on the command line; the defaults in
-/// brackets apply when neither gives one.
+/// The render settings (`--spp`, `--width`, `--integrator`, `--denoise`,
+/// `--part`, ...) are the request's table's ([`SettingArgs`]): each holds
+/// only if given, over the scene file's value, over the default. The
+/// options here are the command line's own: what to load, on how many
+/// threads, and what the command does around the render.
 #[derive(Debug, Args, Clone, PartialEq, Default)]
 pub struct RenderArgs {
     /// What to render: a scene file (.toml, .pbrt, .pbrt.gz, Mitsuba .xml), or a mesh (.obj, .ply, .gltf,
@@ -86,64 +74,12 @@ pub struct RenderArgs {
     /// sun when its own lights are weak (see --sky); none for the built-in
     /// Cornell box.
     pub scene: Option<PathBuf>,
-    /// Output image; the format follows the extension (.png, .exr)
-    /// [default: the scene file's output, else <scene name>.png in the
-    /// working folder].
-    #[arg(short, long, value_name = "FILE")]
-    pub output: Option<PathBuf>,
-    /// Samples per pixel: exactly this many, the last pass shorter if need
-    /// be [default: the scene file's, else 64; with --time-limit, no cap].
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
-    pub spp: Option<u32>,
-    /// Adaptive sampling: a pixel stops taking samples once its estimated
-    /// noise is below T (relative to the square root of its brightness, as
-    /// Cycles' noise threshold: 0.01 is a good start, lower is cleaner),
-    /// and --spp becomes the cap; pixels are tested after each pass.
-    #[arg(long, value_name = "T", allow_negative_numbers = true)]
-    pub noise_threshold: Option<f32>,
-    /// With --noise-threshold: samples every pixel takes before it is
-    /// first tested [default: 16].
-    #[arg(long, value_name = "N", requires = "noise_threshold", value_parser = clap::value_parser!(u32).range(2..=1 << 20))]
-    pub min_spp: Option<u32>,
-    /// Samples per pixel in each progressive pass [default: min(spp, 8)].
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
-    pub pass_spp: Option<u32>,
-    /// Image width in pixels [default: the scene file's, else 512].
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub width: Option<u32>,
-    /// Image height in pixels [default: the scene file's, else 512].
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..=65536))]
-    pub height: Option<u32>,
-    /// Light transport, with its default parameters (or the scene file's,
-    /// if it names the same one; path, bdpt, lightpath and sppm keep the
-    /// file's max_depth of any of them) [default: the scene file's, else
-    /// path].
-    #[arg(long, value_name = "NAME", value_parser = NameParser::<IntegratorKind>::new())]
-    pub integrator: Option<IntegratorKind>,
-    /// Sample generator [default: the scene file's, else sobol].
-    #[arg(long, value_name = "NAME", value_parser = NameParser::<SamplerKind>::new())]
-    pub sampler: Option<SamplerKind>,
-    /// How the path tracer traces its samples: in SIMD lanes, refilled
-    /// as paths end or not, or the scalar reference; auto takes the lanes
-    /// where every material of the scene has a lane BSDF [default: auto].
-    #[arg(long, value_name = "NAME", value_parser = NameParser::<PathLoop>::new())]
-    pub path_loop: Option<PathLoop>,
-    /// Reconstruction filter, with its default parameters (or the scene
-    /// file's, if it names the same one) [default: the scene file's, else
-    /// gaussian].
-    #[arg(long, value_name = "NAME", value_parser = NameParser::<FilterKind>::new())]
-    pub filter: Option<FilterKind>,
+    /// The render settings.
+    #[command(flatten)]
+    pub settings: SettingArgs,
     /// Rendering threads [default: all hardware threads].
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u16).range(1..=1024))]
     pub threads: Option<u16>,
-    /// Seed of every random decision (same seed, same image, bit for bit)
-    /// [default: the scene file's, else 0].
-    #[arg(long, allow_negative_numbers = true)]
-    pub seed: Option<u64>,
-    /// Render progressive passes until this many seconds have passed (for
-    /// equal-time comparisons), or until --spp samples if it is given.
-    #[arg(long, value_name = "SECS")]
-    pub time_limit: Option<f64>,
     /// The camera of a mesh (or the built-in scene): a sidecar JSON file,
     /// or the name of one of a glTF file's cameras [default: the sidecar
     /// <dir>/<stem>.camera.json, else a glTF file's first camera, else the
@@ -162,131 +98,15 @@ pub struct RenderArgs {
     /// (repeatable).
     #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
     pub define: Vec<(String, String)>,
-    /// Kd-tree builder (as for `sahara bench`): a speed setting only, the
-    /// image is the same with any [default: sah].
-    #[arg(long, value_name = "NAME", value_parser = parse_builder)]
-    pub builder: Option<Builder>,
     /// During a progressive render, rewrite the output (atomically, marked
     /// partial) with the passes done so far at most every SECS seconds, to
     /// watch it in an image viewer; the final image replaces it.
     #[arg(long, value_name = "SECS")]
     pub preview_every: Option<f64>,
-    /// Exposure in stops, for PNG output [default: the scene file's, else 0].
-    #[arg(long, allow_negative_numbers = true)]
-    pub exposure: Option<f32>,
-    /// Tone map for PNG output [default: the scene file's, else clamp].
-    #[arg(long, value_name = "NAME", value_parser = NameParser::<ToneMap>::new())]
-    pub tonemap: Option<ToneMap>,
-    /// Render part I (0-based) of N of the frame, divided as --split says,
-    /// and write it as a part file (.exr) for `sahara merge`.
-    #[arg(long, value_name = "I/N", value_parser = parse_part)]
-    pub part: Option<(u32, u32)>,
-    /// How --part divides the frame: tiles (pixel regions) or samples
-    /// (ranges of every pixel's samples) [default: tiles].
-    #[arg(long, value_name = "HOW", requires = "part")]
-    pub split: Option<Split>,
-    /// Render only the crop window X0,X1,Y0,Y1, fractions of the image (y
-    /// from the top; pixel bounds rounded up, as pbrt-v4's); writes a part
-    /// file. With --part (and --split tiles), the tiles divide the crop
-    /// window.
-    #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = parse_crop)]
-    pub crop: Option<[f64; 4]>,
-    /// Render only sample indices START..END of every pixel (counted over
-    /// all passes, 0..spp); writes a part file. With --part samples, the
-    /// parts divide this range.
-    #[arg(long, value_name = "START..END", value_parser = parse_samples)]
-    pub samples: Option<std::ops::Range<u32>>,
     /// With a part: if the output already holds this part of this frame,
     /// complete, do not render it again (for retried farm tasks).
     #[arg(long)]
     pub skip_existing: bool,
-    /// Render passes to write as layers of the EXR beside the beauty,
-    /// comma-separated: albedo (albedo.R/G/B), normal (normal.X/Y/Z, world
-    /// space), depth (depth.Z, camera distance), position (position.X/Y/Z,
-    /// world space), uv (uv.U/V), variance (variance.R/G/B, of the pixel's
-    /// estimate); needs an .exr output.
-    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = NameParser::<Aov>::new())]
-    pub aov: Vec<Aov>,
-    /// Denoise the image with Intel Open Image Denoise, guided by the
-    /// albedo and normal of what each pixel sees (the library is loaded
-    /// when found: `pip install pyoidn`, or OIDN_DIR); an EXR keeps the
-    /// noisy image as the layer `noisy` (noisy.R/G/B).
-    #[arg(long)]
-    pub denoise: bool,
-}
-
-/// Parses a setting through the renderer's name table, so `--help` lists
-/// the names and a wrong one is refused with them.
-#[derive(Clone, Copy)]
-pub struct NameParser<T>(PhantomData<T>);
-
-impl<T> NameParser<T> {
-    /// The parser of `T`'s names.
-    pub fn new() -> Self {
-        NameParser(PhantomData)
-    }
-}
-
-impl<T: Named + Send + Sync> TypedValueParser for NameParser<T> {
-    type Value = T;
-
-    fn parse_ref(
-        &self,
-        cmd: &clap::Command,
-        arg: Option<&clap::Arg>,
-        value: &std::ffi::OsStr,
-    ) -> Result<T, clap::Error> {
-        StringValueParser::new()
-            .try_map(|name| T::from_name(&name))
-            .parse_ref(cmd, arg, value)
-    }
-
-    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
-        Some(Box::new(
-            T::ALL.iter().map(|v| PossibleValue::new(v.name())),
-        ))
-    }
-}
-
-/// `I/N` with I < N.
-fn parse_part(s: &str) -> Result<(u32, u32), String> {
-    let bad = || format!("'{s}' is not a part I/N with 0 <= I < N (I counts from 0)");
-    let (i, n) = s.split_once('/').ok_or_else(bad)?;
-    let (i, n): (u32, u32) = (i.parse().map_err(|_| bad())?, n.parse().map_err(|_| bad())?);
-    if i >= n {
-        return Err(bad());
-    }
-    Ok((i, n))
-}
-
-/// `x0,x1,y0,y1`, fractions with x0 <= x1 and y0 <= y1.
-fn parse_crop(s: &str) -> Result<[f64; 4], String> {
-    let bad = || {
-        format!(
-            "'{s}' is not a crop window x0,x1,y0,y1 of fractions in [0, 1] with x0 <= x1, y0 <= y1"
-        )
-    };
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|p| p.trim().parse::<f64>().map_err(|_| bad()))
-        .collect::<Result<_, _>>()?;
-    match v[..] {
-        [x0, x1, y0, y1] if v.iter().all(|f| (0.0..=1.0).contains(f)) && x0 <= x1 && y0 <= y1 => {
-            Ok([x0, x1, y0, y1])
-        }
-        _ => Err(bad()),
-    }
-}
-
-/// `START..END` with START <= END.
-fn parse_samples(s: &str) -> Result<std::ops::Range<u32>, String> {
-    let bad = || format!("'{s}' is not a sample range START..END with START <= END");
-    let (a, b) = s.split_once("..").ok_or_else(bad)?;
-    let (a, b): (u32, u32) = (a.parse().map_err(|_| bad())?, b.parse().map_err(|_| bad())?);
-    if a > b {
-        return Err(bad());
-    }
-    Ok(a..b)
 }
 
 const BENCH_ABOUT: &str = "\
@@ -435,11 +255,25 @@ pub struct StatsArgs {
     /// Print one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Also build the kd-tree and the hierarchy by each of its builders
+    /// (spatial, binned, kd) over the same triangles, and put their build
+    /// times, memory, references and expected work per ray side by side.
+    #[arg(long)]
+    pub all: bool,
 }
 
 /// Which tree to build over which triangles (shared by `bench` and `stats`).
 #[derive(Debug, Args, Clone, PartialEq)]
 pub struct TreeOptions {
+    /// The structure: `bvh` (the eight-wide hierarchy, the default) or
+    /// `kd` (the kd-tree).
+    #[arg(long, default_value = "bvh", value_parser = parse_accel)]
+    pub accel: AccelKind,
+    /// The hierarchy's build: spatial (SAH with spatial splits, the
+    /// default), binned (object splits only), kd (collapsed from the SAH
+    /// kd-tree).
+    #[arg(long, default_value = "spatial", value_name = "NAME", value_parser = parse_bvh_builder)]
+    pub bvh_builder: BvhBuilder,
     /// Tree builder: sah, binned, binnedN (N bins, 2..=1024), rr-middle,
     /// rr-median, largest-middle, largest-median, middle, median.
     #[arg(long, default_value = "sah", value_parser = parse_builder)]
@@ -490,6 +324,8 @@ pub struct TreeOptions {
 impl Default for TreeOptions {
     fn default() -> Self {
         Self {
+            accel: AccelKind::Bvh,
+            bvh_builder: BvhBuilder::Spatial,
             builder: Builder::Sah,
             traversal_cost: None,
             intersection_cost: None,
@@ -507,7 +343,28 @@ impl Default for TreeOptions {
 }
 
 impl TreeOptions {
-    /// The build parameters these options ask for.
+    /// The structure and build parameters these options ask for.
+    pub fn accel_params(&self) -> AccelParams {
+        let kd = self.params();
+        AccelParams {
+            kind: self.accel,
+            kd,
+            bvh: BvhParams {
+                kd,
+                ..BvhParams::new(self.bvh_builder)
+            },
+        }
+    }
+
+    /// A name for what is built, as `bvh8 (spatial)` or `kd-tree (sah)`.
+    pub fn structure_name(&self) -> String {
+        match self.accel {
+            AccelKind::Bvh => format!("bvh8 ({})", self.bvh_builder.name()),
+            AccelKind::Kd => format!("kd-tree ({})", self.builder.name()),
+        }
+    }
+
+    /// The kd-tree's build parameters these options ask for.
     pub fn params(&self) -> BuildParams {
         let mut p = BuildParams::new(self.builder);
         p.traversal_cost = self.traversal_cost.unwrap_or(p.traversal_cost);
@@ -559,6 +416,17 @@ fn parse_subset(s: &str) -> Result<f64, String> {
         Ok(v) if v > 0.0 && v <= 1.0 => Ok(v),
         _ => Err(format!("'{s}' is not a fraction in (0, 1]")),
     }
+}
+
+/// A structure by name.
+fn parse_accel(s: &str) -> Result<AccelKind, String> {
+    AccelKind::parse(s).ok_or_else(|| format!("unknown structure '{s}'; expected bvh or kd"))
+}
+
+/// A hierarchy builder by name.
+fn parse_bvh_builder(s: &str) -> Result<BvhBuilder, String> {
+    BvhBuilder::parse(s)
+        .ok_or_else(|| format!("unknown hierarchy builder '{s}'; expected spatial, binned or kd"))
 }
 
 /// A builder by name, with the list of names in the error.

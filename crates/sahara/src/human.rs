@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use sahara_bench::report::{BenchReport, StatsReport};
+use sahara_bench::report::{BenchReport, SetReport, StatsReport, StructureStats};
 
 /// `1234567` as `1,234,567`.
 pub fn thousands(n: u64) -> String {
@@ -55,6 +55,19 @@ batch: the whole set in one batch call on 1 thread; packets: 8- or 16-ray
 /// The header and one table row per set.
 pub fn bench_report(r: &BenchReport) -> String {
     let mut s = String::new();
+    bench_header(&mut s, r);
+    let _ = writeln!(s);
+    let entries = r.sets.entries();
+    bench_table(&mut s, r, &entries);
+    let _ = writeln!(s);
+    let _ = writeln!(s, "{}", BENCH_LEGEND.trim_end());
+    bench_counters(&mut s, &entries);
+    // Columns left empty (one thread) leave no trailing blanks.
+    s.lines().map(|l| l.trim_end().to_owned() + "\n").collect()
+}
+
+/// The report's header: the mesh, the camera, the tree and how it was timed.
+fn bench_header(s: &mut String, r: &BenchReport) {
     let _ = writeln!(s, "mesh       {}", r.mesh);
     let _ = writeln!(s, "triangles  {}", thousands(r.triangles as u64));
     if let Some(c) = &r.camera {
@@ -90,7 +103,10 @@ pub fn bench_report(r: &BenchReport) -> String {
         count(r.runs, "run"),
         count(r.threads, "thread")
     );
-    let _ = writeln!(s);
+}
+
+/// One row per set (and its batch and packet rows).
+fn bench_table(s: &mut String, r: &BenchReport, entries: &[(&str, &SetReport)]) {
     // With one thread the all-threads column would repeat the first.
     let many = r.threads > 1;
     let all = if many {
@@ -111,8 +127,7 @@ pub fn bench_report(r: &BenchReport) -> String {
         }
     };
     let dash = if many { "-" } else { "" };
-    let entries = r.sets.entries();
-    for (name, e) in &entries {
+    for (name, e) in entries {
         let _ = writeln!(
             s,
             "{:<8} {:>11} {:>11} {:>22.6} {:>11.3} {:>11.3} {}",
@@ -158,8 +173,11 @@ pub fn bench_report(r: &BenchReport) -> String {
             }
         }
     }
-    let _ = writeln!(s);
-    let _ = writeln!(s, "{}", BENCH_LEGEND.trim_end());
+}
+
+/// The traversal work per ray of the sets that counted it, beside the
+/// SAH's expectation.
+fn bench_counters(s: &mut String, entries: &[(&str, &SetReport)]) {
     if entries.iter().any(|(_, e)| e.counters.is_some()) {
         let _ = writeln!(s);
         let _ = writeln!(
@@ -171,7 +189,7 @@ pub fn bench_report(r: &BenchReport) -> String {
             "{:<8} {:>7} {:>17} {:>17} {:>19}",
             "set", "root %", "inner (SAH)", "leaves (SAH)", "triangles (SAH)"
         );
-        for (name, e) in &entries {
+        for (name, e) in entries {
             if let Some(c) = &e.counters {
                 let (i, l, t) = c.per_root_ray();
                 let _ = writeln!(
@@ -189,8 +207,6 @@ pub fn bench_report(r: &BenchReport) -> String {
             }
         }
     }
-    // Columns left empty (one thread) leave no trailing blanks.
-    s.lines().map(|l| l.trim_end().to_owned() + "\n").collect()
 }
 
 /// The triangles the trees hold: `given` less `skipped`, then `what` they
@@ -211,11 +227,10 @@ pub fn kept_triangles(given: u64, skipped: u64, what: &str) -> String {
 
 /// The statistics, one per line.
 pub fn stats_report(r: &StatsReport) -> String {
-    let t = &r.tree;
     let mut s = String::new();
-    let lines: Vec<(&str, String)> = vec![
+    let mut lines: Vec<(&str, String)> = vec![
         ("mesh", r.mesh.clone()),
-        ("builder", r.builder.clone()),
+        ("builder", format!("{} ({})", r.builder, r.accel)),
         (
             "build",
             format!(
@@ -224,9 +239,49 @@ pub fn stats_report(r: &StatsReport) -> String {
                 count(r.build_runs, "build")
             ),
         ),
+    ];
+    match &r.tree {
+        StructureStats::Kd(t) => lines.extend(kd_lines(t, r.skipped_triangles)),
+        StructureStats::Bvh(b) => lines.extend(bvh_lines(b, r.skipped_triangles)),
+    }
+    for (k, v) in lines {
+        let _ = writeln!(s, "{k:<11} {v}");
+    }
+    if !r.structures.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n{:<18} {:>10} {:>10} {:>11} {:>9} {:>8} {:>10}",
+            "structure", "build ms", "MiB", "references", "inner", "leaves", "triangles"
+        );
+        for row in &r.structures {
+            let m = &row.summary;
+            let _ = writeln!(
+                s,
+                "{:<18} {:>10.1} {:>10.2} {:>11} {:>9.2} {:>8.2} {:>10.2}",
+                row.structure,
+                row.build_ms,
+                m.memory_bytes as f64 / (1 << 20) as f64,
+                thousands(m.references as u64),
+                m.expected_inner,
+                m.expected_leaves,
+                m.expected_triangles
+            );
+        }
+        let _ = writeln!(
+            s,
+            "inner, leaves, triangles: what the SAH expects a ray meeting the root to visit and test \
+             (inner: binary kd nodes, or eight-wide nodes)"
+        );
+    }
+    s
+}
+
+/// A kd-tree's statistics, as `stats_report` lines.
+fn kd_lines(t: &sahara_kd::TreeStats, skipped: usize) -> Vec<(&'static str, String)> {
+    vec![
         (
             "triangles",
-            kept_triangles(t.triangles as u64, r.skipped_triangles as u64, ""),
+            kept_triangles(t.triangles as u64, skipped as u64, ""),
         ),
         ("nodes", thousands(t.nodes as u64)),
         ("inner", thousands(t.inner as u64)),
@@ -274,11 +329,52 @@ pub fn stats_report(r: &StatsReport) -> String {
                 t.expected_inner, t.expected_leaves, t.expected_triangles, t.expected_leaf_tests
             ),
         ),
-    ];
-    for (k, v) in lines {
-        let _ = writeln!(s, "{k:<11} {v}");
-    }
-    s
+    ]
+}
+
+/// A hierarchy's statistics, as `stats_report` lines.
+fn bvh_lines(b: &sahara_kd::BvhStats, skipped: usize) -> Vec<(&'static str, String)> {
+    vec![
+        (
+            "triangles",
+            kept_triangles(b.triangles as u64, skipped as u64, ""),
+        ),
+        (
+            "nodes",
+            format!(
+                "{} eight-wide, {:.2} children each",
+                thousands(b.nodes as u64),
+                b.mean_children
+            ),
+        ),
+        (
+            "leaves",
+            format!(
+                "{}, {:.2} triangles each (at most {})",
+                thousands(b.leaves as u64),
+                b.mean_leaf_triangles,
+                sahara_kd::BVH_MAX_LEAF
+            ),
+        ),
+        ("depth", format!("max {}", b.max_depth)),
+        (
+            "references",
+            format!(
+                "{} ({:.3} per triangle)",
+                thousands(b.references as u64),
+                b.duplication
+            ),
+        ),
+        ("memory", bytes(b.memory_bytes)),
+        ("SAH cost", format!("{:.3}", b.sah_cost)),
+        (
+            "expected",
+            format!(
+                "{:.2} nodes, {:.2} leaves, {:.2} triangles per ray meeting the root",
+                b.expected_nodes, b.expected_leaves, b.expected_triangles
+            ),
+        ),
+    ]
 }
 
 #[cfg(test)]

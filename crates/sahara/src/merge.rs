@@ -15,22 +15,23 @@ use std::ops::Range;
 use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
-use sahara_formats::{read_part, read_part_info, PartInfo};
+use sahara_formats::request::{denoise, GUIDES};
+use sahara_formats::{check_output, read_part, read_part_info, write_names_beside, PartInfo};
+use sahara_formats::{Denoised, FrameImage};
 use sahara_render::{
-    cost_maps, Aov, Aux, AuxImages, AuxSums, Film, Integrator, Named, RenderResult, RenderSettings,
-    RenderStats, SumBuffer,
+    cost_maps, Aov, Aux, AuxImages, AuxSums, Film, Integrator, Named, RenderResult, RenderStats,
+    SumBuffer,
 };
 use sahara_render::{tile, PixelWindow};
 
 use crate::cli::MergeArgs;
-use crate::output::{check_output, Output};
 
 /// Entries of the list of what is missing shown in full.
 const MISSING_SHOWN: usize = 8;
 
 /// `sahara merge PARTS... -o OUT`.
 pub fn run(args: &MergeArgs) -> Result<()> {
-    check_output(&args.output, false)?;
+    check_output(&args.output, false).map_err(|e| anyhow!("{e}"))?;
     let mut parts: Vec<(PathBuf, PartInfo)> = Vec::with_capacity(args.parts.len());
     for path in &args.parts {
         let info = read_part_info(path).map_err(|e| anyhow!("{e}"))?;
@@ -38,17 +39,16 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     }
     check_one_frame(&parts)?;
     let first = &parts[0].1;
-    let denoise = args.denoise || first.denoise;
-    let guides = [Aov::Albedo, Aov::Normal];
-    if denoise && !guides.iter().all(|a| first.passes.contains(a)) {
+    let denoise_it = args.denoise || first.output.denoise;
+    if denoise_it && !GUIDES.iter().all(|a| first.passes.contains(a)) {
         bail!(
             "--denoise: the parts hold no albedo and normal for the denoiser: render them with \
              --denoise (or --aov albedo,normal)"
         );
     }
     // The library is found before any pixel is read.
-    let denoiser = if denoise {
-        Some(crate::denoise::load()?)
+    let denoiser = if denoise_it {
+        Some(sahara_denoise::Denoiser::load().map_err(|e| anyhow!("--denoise: {e}"))?)
     } else {
         None
     };
@@ -74,36 +74,52 @@ pub fn run(args: &MergeArgs) -> Result<()> {
     }
     let merged = add_up(&parts)?;
     let mut result = merged.result(first, spp);
-    let noisy = match &denoiser {
-        Some(d) => crate::denoise::apply(d, &mut result, first.noisy_guides)?,
+    let denoised = match &denoiser {
+        Some(d) => {
+            let denoising = crate::status::Step::start("denoising");
+            let done = denoise(d, &mut result, first.noisy_guides);
+            drop(denoising);
+            let done = done.map_err(|e| anyhow!("--denoise: {e}"))?;
+            if let Denoised::Done { seconds, .. } = &done {
+                eprintln!(
+                    "denoised with Open Image Denoise {} in {seconds:.2} s, from {}",
+                    d.version(),
+                    d.location()
+                );
+            }
+            Some(done)
+        }
         None => None,
     };
-    let settings = RenderSettings {
-        width: first.width,
-        height: first.height,
-        seed: first.seed,
-        integrator: Integrator::from(first.integrator),
-        ..Default::default()
+    let noisy = match &denoised {
+        Some(Denoised::Done { noisy, .. }) => Some(noisy.as_slice()),
+        _ => None,
     };
-    let out = Output {
+    // The merged frame is written as the frame rendered whole: its
+    // settings are the parts'.
+    let out = FrameImage {
         path: args.output.clone(),
-        settings: &settings,
-        exposure: first.exposure,
-        tonemap: first.tonemap,
-        aovs: &first.aovs,
-        noisy: noisy.as_deref(),
+        frame: &first.frame,
+        look: &first.output,
+        noisy,
     };
-    out.write(&result, !partial.is_empty(), true)?;
+    let said = out
+        .write(&result, !partial.is_empty())
+        .map_err(|e| anyhow!("cannot write the output image: {e}"))?;
+    if let Some(said) = said {
+        eprintln!("{said}");
+    }
     if !first.names.is_empty() {
-        crate::id_names::write_beside(&args.output, &first.names)?;
+        write_names_beside(&args.output, &first.names)
+            .map_err(|e| anyhow!("cannot write the list of object and material names: {e}"))?;
     }
     eprintln!(
         "wrote {}{}: {} parts, {}x{}, {} spp",
         if partial.is_empty() { "" } else { "PARTIAL " },
         args.output.display(),
         parts.len(),
-        first.width,
-        first.height,
+        first.frame.width,
+        first.frame.height,
         spp
     );
     Ok(())
@@ -114,10 +130,7 @@ pub fn run(args: &MergeArgs) -> Result<()> {
 fn check_one_frame(parts: &[(PathBuf, PartInfo)]) -> Result<()> {
     let (first_path, first) = &parts[0];
     for (path, info) in &parts[1..] {
-        let same = info.digest == first.digest
-            && (info.width, info.height, info.spp, info.seed)
-                == (first.width, first.height, first.spp, first.seed)
-            && info.integrator == first.integrator;
+        let same = info.digest == first.digest && info.frame == first.frame;
         if !same {
             bail!(
                 "{}: a part of another frame than {} (digest {} vs {}): another scene or other settings",
@@ -127,13 +140,8 @@ fn check_one_frame(parts: &[(PathBuf, PartInfo)]) -> Result<()> {
                 short(&first.digest)
             );
         }
-        let same_passes = (&info.passes, &info.aovs, info.denoise, info.sample_counts)
-            == (
-                &first.passes,
-                &first.aovs,
-                first.denoise,
-                first.sample_counts,
-            );
+        let same_passes = (&info.passes, &info.output.aovs, info.output.denoise)
+            == (&first.passes, &first.output.aovs, first.output.denoise);
         if !same_passes {
             bail!(
                 "{}: rendered with other render passes than {} ({} vs {}): render every part \
@@ -160,7 +168,7 @@ impl Merged {
     /// The frame as a render's result of `spp` samples.
     fn result(self, first: &PartInfo, spp: u32) -> RenderResult {
         let mut film = self.film;
-        let integrator = Integrator::from(first.integrator);
+        let integrator = first.frame.integrator;
         let cost = matches!(integrator, Integrator::Cost).then(|| cost_maps(&mut film, None));
         RenderResult {
             film,
@@ -184,11 +192,11 @@ impl Merged {
 /// group's sums in memory at a time.
 fn add_up(parts: &[(PathBuf, PartInfo)]) -> Result<Merged> {
     let first = &parts[0].1;
-    let (w, h) = (first.width, first.height);
+    let (w, h) = (first.frame.width, first.frame.height);
     let mut merged = Merged {
         film: Film::new(w, h),
         passes: FramePasses::new(&first.passes, w, h),
-        samples: first.sample_counts.then(|| vec![0u32; (w * h) as usize]),
+        samples: first.sample_counts().then(|| vec![0u32; (w * h) as usize]),
     };
     for group in groups(parts) {
         let bounds = group
@@ -327,8 +335,12 @@ fn passes_said(info: &PartInfo) -> String {
     };
     format!(
         "passes {}{}",
-        list(&info.aovs),
-        if info.denoise { ", denoised" } else { "" }
+        list(&info.output.aovs),
+        if info.output.denoise {
+            ", denoised"
+        } else {
+            ""
+        }
     )
 }
 
@@ -345,50 +357,10 @@ fn range(r: &Range<u32>) -> String {
 /// (`spp` unless partial parts are merged).
 fn check_coverage(parts: &[(PathBuf, PartInfo)]) -> Result<u32> {
     let first = &parts[0].1;
-    let (w, h, spp) = (first.width, first.height, first.spp);
-    // The frame cut along every part's window edges: each cell is held by
-    // the same parts throughout.
-    let cuts = |edges: &mut Vec<u32>| {
-        edges.sort_unstable();
-        edges.dedup();
-    };
-    let held: Vec<usize> = (0..parts.len())
-        .filter(|&k| !parts[k].1.window.is_empty() && !parts[k].1.samples.is_empty())
-        .collect();
-    let mut xs = vec![0, w];
-    let mut ys = vec![0, h];
-    for &k in &held {
-        let win = parts[k].1.window;
-        xs.extend([win.x0, win.x1]);
-        ys.extend([win.y0, win.y1]);
-    }
-    cuts(&mut xs);
-    cuts(&mut ys);
+    let (w, h, spp) = (first.frame.width, first.frame.height, first.frame.spp);
+    let (xs, ys, cells) = cut_frame(parts, w, h);
     let (nx, ny) = (xs.len() - 1, ys.len() - 1);
-    let mut cells: Vec<Vec<usize>> = vec![Vec::new(); nx * ny];
-    for &k in &held {
-        let win = parts[k].1.window;
-        let ix0 = xs.binary_search(&win.x0).expect("an edge");
-        let ix1 = xs.binary_search(&win.x1).expect("an edge");
-        let iy0 = ys.binary_search(&win.y0).expect("an edge");
-        let iy1 = ys.binary_search(&win.y1).expect("an edge");
-        for iy in iy0..iy1 {
-            for ix in ix0..ix1 {
-                cells[iy * nx + ix].push(k);
-            }
-        }
-    }
-    // Tile grids the parts came from, to name a missing cell by its tile.
-    let mut grids: Vec<u32> = parts
-        .iter()
-        .filter_map(|(_, i)| {
-            let (_, rest) = i.part.split_once('/')?;
-            let (n, how) = rest.split_once(' ')?;
-            (how == "tiles").then(|| n.parse().ok()).flatten()
-        })
-        .collect();
-    grids.sort_unstable();
-    grids.dedup();
+    let grids = tile_grids(parts);
     let full = PixelWindow::full(w, h);
     let name_cell = |cell: &PixelWindow| {
         for &n in &grids {
@@ -452,6 +424,64 @@ fn check_coverage(parts: &[(PathBuf, PartInfo)]) -> Result<u32> {
         );
     }
     Ok(fewest)
+}
+
+/// The frame cut along every part's window edges, so that each cell is
+/// held by the same parts throughout: the cuts along x and y, and each
+/// cell's parts (rows of cells, top to bottom). Parts without pixels or
+/// samples hold none.
+fn cut_frame(
+    parts: &[(PathBuf, PartInfo)],
+    w: u32,
+    h: u32,
+) -> (Vec<u32>, Vec<u32>, Vec<Vec<usize>>) {
+    let cuts = |edges: &mut Vec<u32>| {
+        edges.sort_unstable();
+        edges.dedup();
+    };
+    let held: Vec<usize> = (0..parts.len())
+        .filter(|&k| !parts[k].1.window.is_empty() && !parts[k].1.samples.is_empty())
+        .collect();
+    let mut xs = vec![0, w];
+    let mut ys = vec![0, h];
+    for &k in &held {
+        let win = parts[k].1.window;
+        xs.extend([win.x0, win.x1]);
+        ys.extend([win.y0, win.y1]);
+    }
+    cuts(&mut xs);
+    cuts(&mut ys);
+    let nx = xs.len() - 1;
+    let mut cells: Vec<Vec<usize>> = vec![Vec::new(); nx * (ys.len() - 1)];
+    for &k in &held {
+        let win = parts[k].1.window;
+        let ix0 = xs.binary_search(&win.x0).expect("an edge");
+        let ix1 = xs.binary_search(&win.x1).expect("an edge");
+        let iy0 = ys.binary_search(&win.y0).expect("an edge");
+        let iy1 = ys.binary_search(&win.y1).expect("an edge");
+        for iy in iy0..iy1 {
+            for ix in ix0..ix1 {
+                cells[iy * nx + ix].push(k);
+            }
+        }
+    }
+    (xs, ys, cells)
+}
+
+/// The tile grids the parts came from (`I/N tiles`), to name a missing
+/// cell by its tile.
+fn tile_grids(parts: &[(PathBuf, PartInfo)]) -> Vec<u32> {
+    let mut grids: Vec<u32> = parts
+        .iter()
+        .filter_map(|(_, i)| {
+            let (_, rest) = i.part.split_once('/')?;
+            let (n, how) = rest.split_once(' ')?;
+            (how == "tiles").then(|| n.parse().ok()).flatten()
+        })
+        .collect();
+    grids.sort_unstable();
+    grids.dedup();
+    grids
 }
 
 /// The parts in groups whose windows overlap (transitively); parts without

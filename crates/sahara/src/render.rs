@@ -1,35 +1,32 @@
 //! `sahara render`: a scene to a PNG or EXR, with a progress bar, Ctrl-C
 //! handling and a summary.
 //!
-//! [`run`] is a handful of steps: every option that can be checked alone is
-//! checked before anything is loaded ([`check_args`]); the scene is loaded
-//! ([`load_input`]); the frame is planned and everything the render needs
-//! is checked before it starts ([`plan`]); the frame is rendered
-//! ([`render_frame`]); the image or part file is written ([`save`]). An
-//! interrupted render comes back as [`Finish::Interrupted`], which `main`
-//! turns into exit code 130.
+//! [`run`] is a handful of steps, each the request's but the log's: the
+//! options are checked before anything is loaded ([`check_args`]); the
+//! scene is loaded ([`load_input`]); the request plans the frame and
+//! checks everything the render needs before it starts
+//! ([`Request::plan`]); the frame is rendered with progress on stderr
+//! ([`render_frame`]); the plan denoises it and writes the image or part
+//! file, and the log says what was written ([`save`]). An interrupted
+//! render comes back as [`Finish::Interrupted`], which `main` turns into
+//! exit code 130.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use sahara_formats::{existing_part_differs, Denoised, Note, Plan, Request, RequestError};
+use sahara_formats::{Spelling, Written};
 use sahara_render::internals::{render_world, World};
 use sahara_render::UNLIMITED_SPP;
-use sahara_render::{
-    Aov, Feature, Filter, FilterKind, Preview, Progress, RenderResult, RenderSettings,
-    SettingsError, ToneMap,
-};
+use sahara_render::{Preview, Progress, RenderResult, RenderSettings};
 
 use crate::cli::RenderArgs;
-use crate::memory;
-use crate::output::{check_output, partial_path, Output};
-use crate::part::{self, Piece};
-use crate::render_options::{resolve, RenderOptions};
-use crate::scene_input::{load_input, Input};
+use crate::scene_input::load_input;
 
 /// How a render ended.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -55,326 +52,109 @@ fn plain_progress_every() -> Duration {
         .map_or(PLAIN_PROGRESS_EVERY, Duration::from_secs_f64)
 }
 
+/// A request's refusal as the command line spells it.
+fn refused(e: RequestError) -> anyhow::Error {
+    anyhow!(e.message(Spelling::CommandLine))
+}
+
 /// `sahara render ...` (and `sahara` with no subcommand).
 pub fn run(args: &RenderArgs) -> Result<Finish> {
-    check_args(args)?;
+    let request = Request {
+        caller: args.settings.0.clone(),
+        write_by_default: true,
+    };
+    check_args(args, &request)?;
     let input = load_input(
         args.scene.as_deref(),
         args.camera.as_deref(),
         args.sky.as_deref(),
         &args.define,
     )?;
-    let Some(job) = plan(args, input)? else {
-        return Ok(Finish::Done);
-    };
-    let mut result = render_frame(args, &job)?;
-    let noisy = match &job.denoiser {
-        Some(d) => {
-            let noisy_guides = crate::denoise::guides_are_noisy(&job.scene);
-            crate::denoise::apply(d, &mut result, noisy_guides)?
-        }
-        None => None,
-    };
-    save(&job, &result, noisy.as_deref())
-}
-
-/// Checks the options that need no scene, before anything is loaded: a
-/// mistake found after a long load (or a render) would cost the user that
-/// time.
-fn check_args(args: &RenderArgs) -> Result<()> {
-    if let Some(t) = args.time_limit {
-        if !(t > 0.0 && t.is_finite()) {
-            bail!("--time-limit must be a positive number of seconds");
+    let plan = request.plan(input).map_err(refused)?;
+    crate::warnings::print(&plan.warnings);
+    for note in &plan.notes {
+        match note {
+            Note::Said(line) => eprintln!("{line}"),
+            Note::Warning(line) => eprintln!("warning: {line}"),
         }
     }
+    if args.skip_existing && already_rendered(&plan) {
+        return Ok(Finish::Done);
+    }
+    let mut result = render_frame(args, &plan)?;
+    let denoising = plan
+        .denoiser
+        .is_some()
+        .then(|| crate::status::Step::start("denoising"));
+    let denoised = plan.denoise(&mut result);
+    drop(denoising);
+    let denoised = denoised.map_err(refused)?;
+    match &denoised {
+        Some(Denoised::Skipped) => eprintln!(
+            "denoise: skipped, the first pass was stopped before every pixel was finished"
+        ),
+        Some(Denoised::Done { seconds, .. }) => {
+            if let Some(d) = &plan.denoiser {
+                eprintln!(
+                    "denoised with Open Image Denoise {} in {seconds:.2} s, from {}",
+                    d.version(),
+                    d.location()
+                );
+            }
+        }
+        None => {}
+    }
+    save(&plan, &result, denoised.as_ref())
+}
+
+/// Checks the options before anything is loaded: the request's settings
+/// alone, and the command line's own options. A mistake found after a
+/// long load (or a render) would cost the user that time.
+fn check_args(args: &RenderArgs, request: &Request) -> Result<()> {
     if let Some(t) = args.preview_every {
         if !(t >= 0.0 && t.is_finite()) {
             bail!("--preview-every must be a number of seconds >= 0");
         }
     }
-    if args.exposure.is_some_and(|e| !e.is_finite()) {
-        bail!("--exposure must be a finite number of stops");
+    let piece = request.caller.piece.is_piece();
+    if piece && args.preview_every.is_some() {
+        bail!("--preview-every does not apply to a part");
     }
-    if let Some(t) = args.noise_threshold {
-        if !(t > 0.0 && t.is_finite()) {
-            bail!("--noise-threshold must be a positive number (0.01 is a good start)");
-        }
+    if !piece && args.skip_existing {
+        bail!("--skip-existing applies to parts (--part, --crop or --samples)");
     }
-    part::check_args(args)?;
-    if let Some(output) = &args.output {
-        check_output(output, part::is_part(args))?;
-        check_aov_output(args, output)?;
-    }
-    Ok(())
+    request.check().map_err(refused)
 }
 
-/// The renderer's refusal of settings the integrator cannot honour in
-/// `scene` ([`RenderSettings::check_for`]; `sahara_render::IntegratorKind::supports`
-/// declares what each integrator supports), as one line naming the option
-/// or scene-file key that asked for it. `denoise`: the render is to be
-/// denoised.
-fn check_settings(
-    args: &RenderArgs,
-    scene: &sahara_render::Scene,
-    settings: &RenderSettings,
-    denoise: bool,
-) -> Result<()> {
-    let asked_by = |e: &SettingsError| -> &'static str {
-        match e {
-            SettingsError::Unsupported {
-                feature: Feature::Denoise,
-                ..
-            } if args.denoise => "--denoise",
-            SettingsError::Unsupported {
-                feature: Feature::Denoise,
-                ..
-            } => "the scene file's `denoise`",
-            SettingsError::Unsupported {
-                feature: Feature::Aovs,
-                ..
-            } => "--aov",
-            SettingsError::Unsupported {
-                feature: Feature::Adaptive,
-                ..
-            }
-            | SettingsError::AdaptiveSampleRange { .. }
-                if args.noise_threshold.is_some() =>
-            {
-                "--noise-threshold"
-            }
-            SettingsError::Unsupported {
-                feature: Feature::Adaptive,
-                ..
-            }
-            | SettingsError::AdaptiveSampleRange { .. } => "the scene file's noise_threshold",
-            SettingsError::Unsupported {
-                feature: Feature::PixelParts,
-                ..
-            } if args.crop.is_some() => "--crop",
-            SettingsError::Unsupported {
-                feature: Feature::PixelParts,
-                ..
-            } if args.part.is_some() && args.split != Some(crate::cli::Split::Samples) => {
-                "--split tiles"
-            }
-            SettingsError::Unsupported {
-                feature: Feature::PixelParts,
-                ..
-            } => "the scene file's crop window",
-            SettingsError::Unsupported {
-                feature: Feature::SampleRanges,
-                ..
-            } if args.samples.is_some() => "--samples",
-            SettingsError::Unsupported {
-                feature: Feature::SampleRanges,
-                ..
-            } => "--split samples",
-            SettingsError::Unsupported {
-                feature: Feature::Media,
-                ..
-            } if args.integrator.is_some() => "--integrator (the scene has participating media)",
-            SettingsError::Unsupported {
-                feature: Feature::Media,
-                ..
-            } => "the scene's integrator (the scene has participating media)",
-        }
+/// True if the part's file already holds this part of this frame,
+/// complete (`--skip-existing`): said, and not rendered again.
+fn already_rendered(plan: &Plan) -> bool {
+    let (Some((piece, digest)), Some(path)) = (&plan.piece, &plan.path) else {
+        return false;
     };
-    let named = |e: SettingsError| anyhow!("{}: {e}", asked_by(&e));
-    if denoise {
-        settings
-            .integrator
-            .kind()
-            .require(Feature::Denoise)
-            .map_err(named)?;
-    }
-    settings.check_for(scene).map_err(named)
-}
-
-/// Render passes are layers of an EXR: refused for any other output.
-fn check_aov_output(args: &RenderArgs, output: &std::path::Path) -> Result<()> {
-    if !args.aov.is_empty()
-        && !output
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
-    {
-        bail!(
-            "--aov writes render passes as layers of an EXR file: the output {} is not one \
-             (use -o NAME.exr)",
-            output.display()
-        );
-    }
-    Ok(())
-}
-
-/// A frame ready to render: the scene, its settings and where it goes.
-struct Job {
-    scene: sahara_render::Scene,
-    description: String,
-    settings: RenderSettings,
-    exposure: f32,
-    tonemap: ToneMap,
-    output: PathBuf,
-    /// Whether a file was at `output` before the render: a partial image
-    /// then goes beside it.
-    output_existed: bool,
-    /// The piece of the frame a part renders, with the frame's digest.
-    piece: Option<(Piece, String)>,
-    /// Render passes written beside the beauty.
-    aovs: Vec<sahara_render::Aov>,
-    /// True with `--denoise` (or the scene file's `denoise`).
-    denoise: bool,
-    /// The list of names of the object and material passes (JSON), if
-    /// asked for.
-    names: Option<String>,
-    /// The denoiser, with `--denoise` (None for a part: `merge` denoises).
-    denoiser: Option<sahara_denoise::Denoiser>,
-}
-
-/// Settles the settings (command line over scene file over defaults) and
-/// checks everything the render needs: the output, the crop, the part, the
-/// memory, the scene. `None`: nothing to render (`--skip-existing` found
-/// the part done).
-fn plan(args: &RenderArgs, input: Input) -> Result<Option<Job>> {
-    let Input {
-        mut scene,
-        settings: file,
-        name,
-        description,
-        warnings,
-        names,
-        ..
-    } = input;
-    crate::warnings::print(&warnings);
-    let RenderOptions {
-        mut settings,
-        exposure,
-        tonemap,
-        output,
-    } = resolve(args, file.as_ref(), &name)?;
-    // The scene file's crop (pbrt's film `cropwindow` / `pixelbounds`):
-    // a plain render is an image of those pixels, as pbrt writes it.
-    let file_window = file
-        .as_ref()
-        .and_then(|f| f.crop)
-        .map(|c| c.window(settings.width, settings.height));
-    if file_window.is_some_and(|w| w.is_empty()) {
-        bail!(
-            "the scene file's crop window holds no pixel of the {}x{} image",
-            settings.width,
-            settings.height
-        );
-    }
-    let piece = part::plan(args, &settings, file_window)?;
-    if piece.is_none() {
-        settings.window = file_window;
-    }
-    // The output named by the scene file (the command line's was checked
-    // by `check_args`).
-    if args.output.is_none() {
-        check_output(&output, piece.is_some())?;
-        check_aov_output(args, &output)?;
-    }
-    // The scene file may ask for adaptive sampling and denoising too.
-    let file_denoise = !args.denoise && file.as_ref().is_some_and(|f| f.denoise);
-    let denoise = args.denoise || file_denoise;
-    settings.aovs = args.aov.clone();
-    if denoise {
-        settings.aovs.extend([Aov::Albedo, Aov::Normal]);
-    }
-    settings.aovs.sort();
-    settings.aovs.dedup();
-    if let Some(p) = &piece {
-        settings.part = true;
-        settings.window = Some(p.window);
-        settings.samples = Some(p.samples.clone());
-    }
-    check_settings(args, &scene, &settings, denoise)?;
-    // A filter wider than a pixel shares each sample between neighbours:
-    // their noise is then correlated, which the denoiser (trained on
-    // independent pixels) takes for detail and keeps. Figures in
-    // docs/clean-image.md.
-    if denoise {
-        match args.filter {
-            None => {
-                settings.filter = Filter::from(FilterKind::Box);
-                eprintln!(
-                    "denoise: box filter (a wider one correlates the noise of neighbouring \
-                     pixels, which the denoiser then keeps; --filter chooses another)"
-                );
-            }
-            Some(kind) if kind != FilterKind::Box => eprintln!(
-                "warning: --denoise with the {kind} filter: its noise is correlated between \
-                 pixels, which the denoiser keeps (the box filter denoises best)"
-            ),
-            Some(_) => {}
+    match existing_part_differs(path, digest, piece) {
+        None => {
+            eprintln!(
+                "{}: already holds this part, complete: not rendered again",
+                path.display()
+            );
+            true
+        }
+        Some(why) => {
+            eprintln!("{}: rendering the part: {why}", path.display());
+            false
         }
     }
-    // The library is found before the render, not after it. A part is
-    // never denoised alone: it carries the albedo and normal, and `merge`
-    // denoises the whole frame (so a farm's nodes need no denoiser).
-    let denoiser = if denoise && piece.is_none() {
-        Some(crate::denoise::load()?)
-    } else {
-        None
-    };
-    // Refuse a render that would not fit, with what it would need.
-    let triangles: u64 = scene
-        .meshes
-        .iter()
-        .map(|m| m.mesh.indices.len() as u64)
-        .sum();
-    let (film_w, film_h) = match (&piece, settings.window) {
-        (Some(p), _) => (p.window.width().max(1), p.window.height().max(1)),
-        (None, Some(w)) => (w.width(), w.height()),
-        (None, None) => (settings.width, settings.height),
-    };
-    memory::check_fits(triangles, film_w, film_h, memory::available_bytes())?;
-    // Any aspect ratio: the vertical field of view is kept.
-    scene.camera.aspect = settings.width as f32 / settings.height as f32;
-    scene.validate().map_err(|e| match &args.scene {
-        Some(p) => anyhow!("{}: invalid scene: {e}", p.display()),
-        None => anyhow!("invalid scene: {e}"),
-    })?;
-    let piece = match piece {
-        None => None,
-        Some(p) => {
-            let digest = sahara_render::frame_digest(&scene, &settings);
-            if args.skip_existing {
-                match part::existing_differs(&output, &digest, &p) {
-                    None => {
-                        eprintln!(
-                            "{}: already holds this part, complete: not rendered again",
-                            output.display()
-                        );
-                        return Ok(None);
-                    }
-                    Some(why) => eprintln!("{}: rendering the part: {why}", output.display()),
-                }
-            }
-            Some((p, digest))
-        }
-    };
-    Ok(Some(Job {
-        scene,
-        description,
-        settings,
-        exposure,
-        tonemap,
-        output_existed: output.exists(),
-        output,
-        piece,
-        names: crate::id_names::json(&names, &args.aov),
-        aovs: args.aov.clone(),
-        denoise,
-        denoiser,
-    }))
 }
 
 /// Renders the frame on `--threads` threads with progress on stderr,
 /// stopping early on SIGINT, SIGTERM or SIGHUP.
-fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
-    let settings = &job.settings;
-    let cancel = settings.cancel.clone().expect("settings set a cancel flag");
+fn render_frame(args: &RenderArgs, plan: &Plan) -> Result<RenderResult> {
+    let settings = &plan.settings;
+    let cancel = settings
+        .cancel
+        .clone()
+        .expect("the plan sets a cancel flag");
     // SIGINT, SIGTERM and SIGHUP (ctrlc's `termination` feature): a batch
     // system's kill is handled like Ctrl-C.
     ctrlc::set_handler(move || {
@@ -394,7 +174,61 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
         .num_threads(threads)
         .build()
         .context("cannot start the render threads")?;
-    if let Some((p, _)) = &job.piece {
+    say_what_renders(plan, pool.current_num_threads());
+    // The trees and light tables, built before the bar is drawn so that a
+    // long build is said as such (a scene of millions of triangles takes
+    // seconds).
+    let start = Instant::now();
+    let mut world = pool.install(|| {
+        let _building = crate::status::Step::start("building the trees and light tables");
+        World::new(&plan.scene, &settings.build)
+    });
+    let build_time = start.elapsed();
+    // Started after the lines above, so that it does not draw over them.
+    let bar = progress_bar(settings);
+    let said_progress = AtomicBool::new(false);
+    let on_progress = progress_reporter(&bar, settings, &said_progress);
+    let preview_path = plan.path_for(true);
+    let mut show_preview = |r: &RenderResult| {
+        // A preview that cannot be written is a warning: the render goes on.
+        if let Some(path) = &preview_path {
+            if let Err(e) = plan.image(path.clone(), None).write(r, true) {
+                bar.suspend(|| eprintln!("warning: preview not written: {e}"));
+            }
+        }
+    };
+    let preview = args.preview_every.map(|t| Preview {
+        every: Duration::from_secs_f64(t),
+        show: &mut show_preview,
+    });
+    let result = pool.install(|| {
+        render_world(
+            &mut world,
+            settings,
+            &on_progress,
+            preview,
+            start,
+            build_time,
+        )
+    });
+    bar.finish_and_clear();
+    if let (true, Ok(r)) = (said_progress.load(Ordering::Relaxed), &result) {
+        // The lines come every few seconds: the last of them may be short
+        // of the end, and a log should not end on `95.8% done`.
+        eprintln!(
+            "{}",
+            plain_closing_line(r.stats.passes, start.elapsed(), interrupted(plan, r))
+        );
+    }
+    // The settings were checked by the plan.
+    Ok(result?)
+}
+
+/// The log's line of what is rendered, and how: the part, the size, the
+/// integrator and sampler, the samples, adaptive sampling, the threads.
+fn say_what_renders(plan: &Plan, threads: usize) {
+    let settings = &plan.settings;
+    if let Some((p, _)) = &plan.piece {
         eprintln!(
             "part{}: pixels {} ({} of them), samples {}..{}",
             if p.label.is_empty() {
@@ -408,17 +242,9 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
             p.samples.end
         );
     }
-    if let (None, Some(w)) = (&job.piece, settings.window) {
-        eprintln!(
-            "crop window of the scene file: pixels {w}, written as a {}x{} image",
-            w.width(),
-            w.height()
-        );
-    }
-    let threads = pool.current_num_threads();
     eprintln!(
         "rendering {} at {}x{}, {} ({}), {} spp in passes of {}{}, {threads} thread{}",
-        job.description,
+        plan.description,
         settings.width,
         settings.height,
         settings.integrator.name(),
@@ -438,34 +264,21 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
             .unwrap_or_default(),
         plural(threads as u64),
     );
-    if let Some(a) = settings.adaptive {
-        if settings.spp != UNLIMITED_SPP && a.min_spp >= settings.spp {
-            eprintln!(
-                "warning: adaptive: every pixel takes all {spp} samples, as at least {min} are \
-                 taken before the noise is tested; raise --spp (the cap) above {min}, or lower \
-                 --min-spp, for pixels to stop early",
-                spp = settings.spp,
-                min = a.min_spp
-            );
-        }
-    }
-    // The trees and light tables, built before the bar is drawn so that a
-    // long build is said as such (a scene of millions of triangles takes
-    // seconds).
-    let start = Instant::now();
-    let mut world = pool.install(|| {
-        let _building = crate::status::Step::start("building the trees and light tables");
-        World::new(&job.scene, &settings.build)
-    });
-    let build_time = start.elapsed();
-    // Started after the line above, so that it does not draw over it.
-    let bar = progress_bar(settings);
+}
+
+/// What the render calls after each tile: the bar moved, and where stderr
+/// is not a terminal (no bar is drawn there) a plain line now and then;
+/// `said` becomes true once one is printed.
+fn progress_reporter<'a>(
+    bar: &'a ProgressBar,
+    settings: &'a RenderSettings,
+    said: &'a AtomicBool,
+) -> impl Fn(Progress) + Sync + 'a {
     let unlimited = settings.spp == UNLIMITED_SPP;
     let plain = !std::io::stderr().is_terminal();
     let every = plain_progress_every();
-    // When the last plain line was printed, and whether one was.
-    let last_line = Mutex::new((Instant::now(), false));
-    let on_progress = |p: Progress| {
+    let last_line = Mutex::new(Instant::now());
+    move |p: Progress| {
         if !unlimited {
             bar.set_length(u64::from(p.passes) * u64::from(p.tiles));
         }
@@ -478,10 +291,10 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
         };
         let message = format!("pass {}{of} {mrays:.1} Mrays/s", p.pass + 1);
         if plain {
-            // No bar is drawn where stderr is not a terminal: a line now and then.
             let mut last = last_line.lock().unwrap_or_else(|e| e.into_inner());
-            if last.0.elapsed() >= every {
-                *last = (Instant::now(), true);
+            if last.elapsed() >= every {
+                *last = Instant::now();
+                said.store(true, Ordering::Relaxed);
                 eprintln!(
                     "{}",
                     plain_progress_line(&p, unlimited, settings.time_limit)
@@ -489,126 +302,37 @@ fn render_frame(args: &RenderArgs, job: &Job) -> Result<RenderResult> {
             }
         }
         bar.set_message(message);
-    };
-    let preview_output = job.output_at(true);
-    let mut show_preview = |r: &RenderResult| {
-        // A preview that cannot be written is a warning: the render goes on.
-        if let Err(e) = preview_output.write(r, true, false) {
-            bar.suspend(|| eprintln!("warning: preview not written: {e:#}"));
-        }
-    };
-    let preview = args.preview_every.map(|t| Preview {
-        every: Duration::from_secs_f64(t),
-        show: &mut show_preview,
-    });
-    let result = pool.install(|| {
-        render_world(
-            &mut world,
-            settings,
-            &on_progress,
-            preview,
-            start,
-            build_time,
-        )
-    });
-    bar.finish_and_clear();
-    let said_progress = last_line.lock().unwrap_or_else(|e| e.into_inner()).1;
-    if let (true, Ok(r)) = (said_progress, &result) {
-        // The lines come every few seconds: the last of them may be short
-        // of the end, and a log should not end on `95.8% done`.
-        eprintln!(
-            "{}",
-            plain_closing_line(r.stats.passes, start.elapsed(), job.interrupted(r))
-        );
     }
-    // The settings were checked before the render (`check_settings`).
-    Ok(result?)
 }
 
-impl Job {
-    /// Where the image goes: the output, or beside it for a partial image
-    /// when a file was there before the render.
-    fn output_at(&self, partial: bool) -> Output<'_> {
-        let path = if partial {
-            partial_path(&self.output, self.output_existed)
-        } else {
-            self.output.clone()
-        };
-        Output {
-            path,
-            settings: &self.settings,
-            exposure: self.exposure,
-            tonemap: self.tonemap,
-            aovs: &self.aovs,
-            noisy: None,
-        }
-    }
-
-    /// True if a signal stopped the render.
-    fn interrupted(&self, result: &RenderResult) -> bool {
-        result.stats.stopped_early
-            && self
-                .settings
-                .cancel
-                .as_ref()
-                .is_some_and(|c| c.load(Ordering::SeqCst))
-    }
+/// True if a signal stopped the render.
+fn interrupted(plan: &Plan, result: &RenderResult) -> bool {
+    result.stats.stopped_early
+        && plan
+            .settings
+            .cancel
+            .as_ref()
+            .is_some_and(|c| c.load(Ordering::SeqCst))
 }
 
 /// Writes the image (or the part file) and says what was written.
-fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finish> {
+fn save(plan: &Plan, result: &RenderResult, denoised: Option<&Denoised>) -> Result<Finish> {
     let s = &result.stats;
-    let partial = job.interrupted(result);
+    let partial = interrupted(plan, result);
     let finish = if partial {
         Finish::Interrupted
     } else {
         Finish::Done
     };
-    if let Some((p, digest)) = &job.piece {
-        let record = part::PartRecord {
-            piece: p,
-            digest,
-            exposure: job.exposure,
-            tonemap: job.tonemap,
-            aovs: &job.aovs,
-            denoise: job.denoise,
-            noisy_guides: crate::denoise::guides_are_noisy(&job.scene),
-            names: job.names.as_deref(),
-            interrupted: partial,
-        };
-        let path = if partial {
-            partial_path(&job.output, job.output_existed)
-        } else {
-            job.output.clone()
-        };
-        let done = part::write(&path, &record, &job.settings, result)?;
-        eprintln!(
-            "{} {}: samples {}..{} of {}..{}, {:.2} s render (+{:.0} ms tree builds), {}, {} rays",
-            if partial {
-                "wrote PARTIAL part"
-            } else {
-                "wrote part"
-            },
-            where_is(&path).display(),
-            done.start,
-            done.end,
-            p.samples.start,
-            p.samples.end,
-            s.render_time.as_secs_f64(),
-            s.build_time.as_secs_f64() * 1e3,
-            s.layout,
-            s.rays()
-        );
-        return Ok(finish);
-    }
-    if s.passes == 0 && s.first_pass_pixels == 0 {
+    let output = plan.path.clone().unwrap_or_default();
+    if plan.piece.is_none() && s.passes == 0 && s.first_pass_pixels == 0 {
         if partial {
             // Stopped by a signal: the exit code says interrupted (130), as
             // for any stopped render, not failed.
             eprintln!(
                 "interrupted before the first pixel was finished: no image written{}",
-                if job.output_existed {
-                    format!(" ({} left as it was)", job.output.display())
+                if plan.path_existed {
+                    format!(" ({} left as it was)", output.display())
                 } else {
                     String::new()
                 }
@@ -617,19 +341,49 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
         }
         bail!("stopped before the first pixel was finished: no image written");
     }
-    let mut output = job.output_at(partial);
-    output.noisy = noisy;
-    output.write(result, partial, true)?;
-    if let Some(names) = &job.names {
-        crate::id_names::write_beside(&output.path, names)?;
-    }
-    if !partial {
-        // A preview written beside the earlier image is stale now.
-        let beside = partial_path(&job.output, job.output_existed);
-        if beside != job.output && beside.exists() {
-            let _ = std::fs::remove_file(&beside);
+    match plan.write(result, denoised, partial).map_err(refused)? {
+        Written::Nothing => {}
+        Written::Part(path, done) => {
+            let p = &plan.piece.as_ref().expect("a part has a piece").0;
+            eprintln!(
+                "{} {}: samples {}..{} of {}..{}, {:.2} s render (+{:.0} ms tree builds), {}, {} rays",
+                if partial {
+                    "wrote PARTIAL part"
+                } else {
+                    "wrote part"
+                },
+                where_is(&path).display(),
+                done.start,
+                done.end,
+                p.samples.start,
+                p.samples.end,
+                s.render_time.as_secs_f64(),
+                s.build_time.as_secs_f64() * 1e3,
+                s.layout,
+                s.rays()
+            );
+            return Ok(finish);
+        }
+        Written::Image(path, said) => {
+            if let Some(said) = said {
+                eprintln!("{said}");
+            }
+            say_what_was_written(&path, result, partial);
         }
     }
+    if partial && plan.path_existed {
+        eprintln!(
+            "{}: left as it was (the partial image is beside it)",
+            output.display()
+        );
+    }
+    Ok(finish)
+}
+
+/// The log's lines of an image written: where, its passes, samples,
+/// times and rays; what adaptive sampling did.
+fn say_what_was_written(path: &std::path::Path, result: &RenderResult, partial: bool) {
+    let s = &result.stats;
     let secs = s.render_time.as_secs_f64();
     let pixels = u64::from(result.film.width) * u64::from(result.film.height);
     eprintln!(
@@ -639,7 +393,7 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
         } else {
             "wrote"
         },
-        where_is(&output.path).display(),
+        where_is(path).display(),
         if s.passes == 0 {
             format!(
                 "first pass interrupted, {} of {pixels} pixels finished (the rest black)",
@@ -697,13 +451,6 @@ fn save(job: &Job, result: &RenderResult, noisy: Option<&[f32]>) -> Result<Finis
             100.0 * a.converged as f64 / a.pixels.max(1) as f64
         );
     }
-    if partial && job.output_existed {
-        eprintln!(
-            "{}: left as it was (the partial image is beside it)",
-            job.output.display()
-        );
-    }
-    Ok(finish)
 }
 
 /// Where `path` is, for the log: a relative path with the working folder

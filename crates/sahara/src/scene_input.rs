@@ -8,7 +8,10 @@ use std::path::Path;
 use anyhow::{anyhow, bail, Result};
 use sahara_formats::{load, load_builtin, LoadOptions, Loaded};
 
-/// A scene to render, with what its file says about rendering it.
+/// A scene to render, with what its file says about rendering it. Its
+/// problems, those of the finished scene among them (triangles skipped, no
+/// light), are [`Loaded::problems`]: every command that loads a scene says
+/// them.
 pub(crate) type Input = Loaded;
 
 /// The scene to render: the built-in Cornell box, a scene file or a mesh
@@ -38,17 +41,7 @@ pub(crate) fn load_input(
         None => load_builtin(&options),
     };
     drop(loading);
-    let mut input = loaded.map_err(|e| anyhow!("{e}"))?;
-    // The finished scene's problems (triangles skipped, no light), named
-    // after the file they come from: every command that loads the scene
-    // says them.
-    let diagnostics = input.scene.diagnostics().into_iter();
-    match path {
-        Some(p) => input
-            .warnings
-            .extend(diagnostics.map(|d| format!("{}: {d}", p.display()))),
-        None => input.warnings.extend(diagnostics),
-    }
+    let input = loaded.map_err(|e| anyhow!("{e}"))?;
     if let Some(framing) = &input.framing {
         eprintln!("{framing}");
     }

@@ -5,9 +5,10 @@ use std::fmt::Write;
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use sahara_bench::report::StatsReport;
+use sahara_bench::report::{StatsReport, StructureRow, StructureStats};
 use sahara_bench::runner::{build_timed, Pools};
 use sahara_formats::is_scene_file;
+use sahara_kd::{AccelParams, BvhBuilder, BvhParams, TriangleAccel};
 use sahara_render::internals::World;
 use serde::Serialize;
 
@@ -27,24 +28,33 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         .map_or_else(Pools::available_threads, usize::from);
     let pools = Pools::new(threads).context("cannot start the thread pool")?;
     eprintln!(
-        "building the {} tree over {} triangles ({})...",
-        args.tree.builder.name(),
+        "building the {} over {} triangles ({})...",
+        args.tree.structure_name(),
         mesh.triangle_count(),
         human::count(args.runs, "build")
     );
-    let (tree, build_ms) = build_timed(
-        &mesh.triangles(),
-        &args.tree.params(),
-        args.runs,
-        &pools.all,
-    );
+    let params = args.tree.accel_params();
+    let tris = mesh.triangles();
+    let (tree, build_ms) = build_timed(&tris, args.runs, &pools.all, |t| {
+        TriangleAccel::build(t, &params)
+    });
+    let structures = if args.all {
+        every_structure(&tris, &args.tree, args.runs, &pools)
+    } else {
+        Vec::new()
+    };
     let report = StatsReport {
         mesh: args.mesh.display().to_string(),
-        builder: args.tree.builder.name(),
+        accel: params.kind.name().to_owned(),
+        builder: params.builder_name(),
         build_ms,
         build_runs: args.runs,
         skipped_triangles,
-        tree: tree.stats(),
+        tree: match &tree {
+            TriangleAccel::Kd(t) => StructureStats::Kd(t.stats()),
+            TriangleAccel::Bvh(b) => StructureStats::Bvh(b.stats()),
+        },
+        structures,
     };
     if args.json {
         println!(
@@ -55,6 +65,38 @@ pub fn run(args: &StatsArgs) -> Result<()> {
         print!("{}", human::stats_report(&report));
     }
     Ok(())
+}
+
+/// `sahara stats --all`: the kd-tree and the hierarchy by each of its
+/// builders, over the same triangles, each built `runs` times.
+fn every_structure(
+    tris: &[sahara_kd::Triangle],
+    tree: &crate::cli::TreeOptions,
+    runs: usize,
+    pools: &Pools,
+) -> Vec<StructureRow> {
+    let kd = AccelParams::kd(tree.params());
+    let bvh = [BvhBuilder::Spatial, BvhBuilder::Binned, BvhBuilder::FromKd].map(|b| AccelParams {
+        bvh: BvhParams {
+            kd: tree.params(),
+            ..BvhParams::new(b)
+        },
+        ..AccelParams::bvh(b)
+    });
+    std::iter::once(kd)
+        .chain(bvh)
+        .map(|p| {
+            let (t, build_ms) =
+                build_timed(tris, runs, &pools.all, |t| TriangleAccel::build(t, &p));
+            let summary = t.summary();
+            eprintln!("  {}: {build_ms:.1} ms", summary.structure);
+            StructureRow {
+                structure: summary.structure.clone(),
+                build_ms,
+                summary: (&summary).into(),
+            }
+        })
+        .collect()
 }
 
 /// What `sahara stats` says of a scene: how its acceleration structure
@@ -76,7 +118,7 @@ pub struct SceneStatsReport {
     /// Instances traced in two levels (shared meshes, moving instances,
     /// analytic emitters).
     pub two_level_instances: usize,
-    /// Kd-trees built: the world tree, if any, and one per mesh of the
+    /// Trees built: the world tree, if any, and one per mesh of the
     /// two-level instances.
     pub trees: usize,
     /// Triangles in the world tree.
@@ -97,16 +139,16 @@ fn run_scene(args: &StatsArgs) -> Result<()> {
         bail!("--subset applies to meshes, not to scene files");
     }
     let input = crate::scene_input::load_input(Some(&args.mesh), None, None, &[])?;
-    crate::warnings::print(&input.warnings);
+    crate::warnings::print(&input.problems());
     let threads = args
         .threads
         .map_or_else(Pools::available_threads, usize::from);
     let pools = Pools::new(threads).context("cannot start the thread pool")?;
-    let params = args.tree.params();
+    let params = args.tree.accel_params();
     let scene = &input.scene;
     eprintln!(
         "building the {} trees of {} ({})...",
-        args.tree.builder.name(),
+        args.tree.structure_name(),
         input.description,
         human::count(args.runs, "build")
     );
@@ -123,7 +165,7 @@ fn run_scene(args: &StatsArgs) -> Result<()> {
     let layout = accel.layout();
     let report = SceneStatsReport {
         scene: args.mesh.display().to_string(),
-        builder: args.tree.builder.name(),
+        builder: args.tree.structure_name(),
         build_ms: best,
         build_runs: args.runs.max(1),
         instances: layout.instances,

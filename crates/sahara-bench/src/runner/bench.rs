@@ -2,7 +2,7 @@
 
 use rayon::ThreadPoolBuildError;
 use sahara_kd::Mesh;
-use sahara_kd::{BuildParams, KdTree, Ray, TreeStats};
+use sahara_kd::{AccelParams, AccelSummary, Ray, TriangleAccel};
 
 use super::build::{build_timed, BUILD_RUNS};
 use super::counters::count_set;
@@ -14,9 +14,8 @@ use crate::report::{BenchReport, CameraReport, CounterReport, SetReport, SetRepo
 
 /// A tree built for benchmarking, with the pools that trace on it.
 pub struct Bench {
-    tree: KdTree,
-    stats: TreeStats,
-    params: BuildParams,
+    tree: TriangleAccel,
+    stats: AccelSummary,
     build_ms: f64,
     pools: Pools,
     runs: usize,
@@ -30,17 +29,18 @@ impl Bench {
     /// [`crate::protocol::frame::check_mesh`]).
     pub fn new(
         mesh: &Mesh,
-        params: &BuildParams,
+        params: &AccelParams,
         threads: usize,
         runs: usize,
     ) -> Result<Self, ThreadPoolBuildError> {
         let pools = Pools::new(threads)?;
-        let (tree, build_ms) = build_timed(&mesh.triangles(), params, BUILD_RUNS, &pools.all);
-        let stats = tree.stats();
+        let (tree, build_ms) = build_timed(&mesh.triangles(), BUILD_RUNS, &pools.all, |t| {
+            TriangleAccel::build(t, params)
+        });
+        let stats = tree.summary();
         Ok(Self {
             tree,
             stats,
-            params: *params,
             build_ms,
             pools,
             runs: runs.max(1),
@@ -48,12 +48,12 @@ impl Bench {
     }
 
     /// The tree.
-    pub fn tree(&self) -> &KdTree {
+    pub fn tree(&self) -> &TriangleAccel {
         &self.tree
     }
 
     /// The tree's statistics.
-    pub fn stats(&self) -> &TreeStats {
+    pub fn stats(&self) -> &AccelSummary {
         &self.stats
     }
 
@@ -135,13 +135,13 @@ impl Bench {
         BenchReport {
             mesh: mesh.to_owned(),
             triangles: self.stats.triangles,
-            builder: self.params.builder.name(),
+            builder: self.stats.structure.clone(),
             build_ms: self.build_ms,
             memory_bytes: self.stats.memory_bytes,
             sah_cost: self.stats.sah_cost,
             threads: self.pools.threads,
             runs: self.runs,
-            tree_depth: self.stats.max_depth,
+            tree_depth: self.stats.depth,
             leaves: self.stats.leaves,
             camera,
             sets,

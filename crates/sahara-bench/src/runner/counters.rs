@@ -1,7 +1,7 @@
 //! Traversal work per ray, next to what the SAH predicts.
 
 use rayon::prelude::*;
-use sahara_kd::{KdTree, Ray, TraversalCounters};
+use sahara_kd::{Ray, TraversalCounters, TriangleAccel};
 
 use super::trace::{Query, CHUNK};
 
@@ -28,10 +28,10 @@ impl std::ops::Add for CountTotals {
 
 /// True if the traversal enters the root cell for `ray` (it returns at once
 /// otherwise).
-fn meets_root(tree: &KdTree, ray: &Ray) -> bool {
+fn meets_root(tree: &TriangleAccel, ray: &Ray) -> bool {
     ray.is_valid()
         && ray.tmin <= ray.tmax
-        && !tree.nodes().is_empty()
+        && !tree.bounds().is_empty()
         && tree
             .bounds()
             .intersect_ray(ray.origin, glam::Vec3::ONE / ray.dir, ray.tmin, ray.tmax)
@@ -39,7 +39,7 @@ fn meets_root(tree: &KdTree, ray: &Ray) -> bool {
 }
 
 /// Count the traversal work of `rays` on the current rayon pool.
-pub fn count_set(tree: &KdTree, rays: &[Ray], query: Query) -> CountTotals {
+pub fn count_set(tree: &TriangleAccel, rays: &[Ray], query: Query) -> CountTotals {
     rays.par_chunks(CHUNK)
         .with_max_len(1) // one job per chunk, as in `trace_into`
         .map(|chunk| {
@@ -67,10 +67,10 @@ pub fn count_set(tree: &KdTree, rays: &[Ray], query: Query) -> CountTotals {
 mod tests {
     use super::*;
     use glam::Vec3;
-    use sahara_kd::{BuildParams, Triangle};
+    use sahara_kd::{AccelParams, Triangle};
 
     #[test]
-    fn counts_add_up_and_misses_of_the_root_do_no_work() {
+    fn counts_add_up_and_misses_of_the_root_test_no_triangle() {
         let tris: Vec<Triangle> = (0..50)
             .map(|i| {
                 let z = 2.0 + i as f32;
@@ -81,16 +81,26 @@ mod tests {
                 )
             })
             .collect();
-        let tree = KdTree::build(tris, &BuildParams::default());
-        let hit = Ray::new(Vec3::new(0.0, -0.5, 0.0), Vec3::Z);
-        let away = Ray::new(Vec3::new(0.0, -0.5, 0.0), Vec3::NEG_Z);
-        let t = count_set(&tree, &[hit, away], Query::ClosestHit);
-        assert_eq!((t.rays, t.rays_meeting_root), (2, 1));
-        let mut one = TraversalCounters::default();
-        tree.closest_hit_counted(&hit, &mut one);
-        assert_eq!(t.work, one);
-        assert!(one.triangles >= 1 && one.leaves >= 1);
-        let any = count_set(&tree, &[hit], Query::AnyHit);
-        assert!(any.work.triangles <= one.triangles);
+        for params in [AccelParams::default(), AccelParams::kd(Default::default())] {
+            let tree = TriangleAccel::build(tris.clone(), &params);
+            let hit = Ray::new(Vec3::new(0.0, -0.5, 0.0), Vec3::Z);
+            let away = Ray::new(Vec3::new(0.0, -0.5, 0.0), Vec3::NEG_Z);
+            let t = count_set(&tree, &[hit, away], Query::ClosestHit);
+            assert_eq!((t.rays, t.rays_meeting_root), (2, 1));
+            let mut one = TraversalCounters::default();
+            tree.closest_hit_counted(&hit, &mut one);
+            // A ray missing the root cell: no leaf, no triangle; the kd-tree
+            // does not start, the hierarchy tests the root's children once.
+            let mut missed = TraversalCounters::default();
+            tree.closest_hit_counted(&away, &mut missed);
+            assert_eq!((missed.leaves, missed.triangles), (0, 0));
+            assert!(missed.inner <= 1);
+            assert_eq!(t.work.triangles, one.triangles);
+            assert_eq!(t.work.leaves, one.leaves);
+            assert_eq!(t.work.inner, one.inner + missed.inner);
+            assert!(one.triangles >= 1 && one.leaves >= 1);
+            let any = count_set(&tree, &[hit], Query::AnyHit);
+            assert!(any.work.triangles <= one.triangles);
+        }
     }
 }

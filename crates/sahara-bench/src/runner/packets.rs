@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use sahara_kd::{Hit, KdTree, Ray};
+use sahara_kd::{Hit, Ray, TriangleAccel};
 use sahara_kd::{PACKET, PACKET16};
 
 use super::throughput::{mrays_per_sec, thread_cpu_seconds};
@@ -80,7 +80,7 @@ pub fn tile_order(image: ImageSize, size: PacketSize) -> Vec<u32> {
 /// One pass: gather each tile's rays, trace the packet, scatter the hits
 /// (gathering and scattering are timed, as in `embree_bench.c`).
 fn trace_tiles(
-    tree: &KdTree,
+    tree: &TriangleAccel,
     rays: &[Ray],
     order: &[u32],
     size: PacketSize,
@@ -107,7 +107,7 @@ fn trace_tiles(
 /// calling thread: one warm-up, then the best of `runs`; the records are
 /// compared with `reference` (the single-ray path's).
 pub fn measure_packets(
-    tree: &KdTree,
+    tree: &TriangleAccel,
     rays: &[Ray],
     image: ImageSize,
     runs: usize,

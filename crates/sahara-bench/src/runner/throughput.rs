@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use sahara_kd::{KdTree, Ray};
+use sahara_kd::{Ray, TriangleAccel};
 
 use super::pools::Pools;
 use super::trace::{trace_into, BatchAnswers, Query};
@@ -87,7 +87,7 @@ fn best_of(
 /// Trace `rays` once on one thread as a warm-up, then `runs` times on one
 /// thread and `runs` times on all threads, timing each run.
 pub fn measure(
-    tree: &KdTree,
+    tree: &TriangleAccel,
     rays: &[Ray],
     query: Query,
     pools: &Pools,
@@ -144,17 +144,17 @@ pub fn measure(
 mod tests {
     use super::*;
     use glam::Vec3;
-    use sahara_kd::{BuildParams, Triangle};
+    use sahara_kd::{AccelParams, Triangle};
 
     #[test]
     fn measure_counts_hits_and_sums_t() {
-        let tree = KdTree::build(
+        let tree = TriangleAccel::build(
             vec![Triangle::new(
                 Vec3::new(-1.0, -1.0, 3.0),
                 Vec3::new(1.0, -1.0, 3.0),
                 Vec3::new(0.0, 1.0, 3.0),
             )],
-            &BuildParams::default(),
+            &AccelParams::default(),
         );
         let rays: Vec<Ray> = (0..10_000)
             .map(|i| {

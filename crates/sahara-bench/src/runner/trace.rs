@@ -2,7 +2,7 @@
 //! threads of the current rayon pool.
 
 use rayon::prelude::*;
-use sahara_kd::{KdTree, Ray};
+use sahara_kd::{Ray, TriangleAccel};
 
 use crate::record::HitRecord;
 
@@ -20,7 +20,7 @@ pub enum Query {
 
 /// The record of one ray.
 #[inline]
-pub fn trace_one(tree: &KdTree, ray: &Ray, query: Query) -> HitRecord {
+pub fn trace_one(tree: &TriangleAccel, ray: &Ray, query: Query) -> HitRecord {
     match query {
         Query::ClosestHit => HitRecord::from_closest(tree.closest_hit(ray)),
         Query::AnyHit => HitRecord::from_occluded(tree.any_hit(ray)),
@@ -32,7 +32,7 @@ pub fn trace_one(tree: &KdTree, ray: &Ray, query: Query) -> HitRecord {
 ///
 /// # Panics
 /// If `out` and `rays` differ in length.
-pub fn trace_into(tree: &KdTree, rays: &[Ray], query: Query, out: &mut [HitRecord]) {
+pub fn trace_into(tree: &TriangleAccel, rays: &[Ray], query: Query, out: &mut [HitRecord]) {
     assert_eq!(rays.len(), out.len(), "one record per ray");
     // Every chunk its own job (`with_max_len(1)`): rayon otherwise splits
     // the range only a few times unless a thief steals, and a costly
@@ -67,7 +67,7 @@ impl BatchAnswers {
     /// Answers `rays` with one call of the tree's batch query
     /// (`KdTree::closest_hits` or `KdTree::any_hits`), which splits the
     /// rays over the current rayon pool itself.
-    pub fn trace(&mut self, tree: &KdTree, rays: &[Ray], query: Query) {
+    pub fn trace(&mut self, tree: &TriangleAccel, rays: &[Ray], query: Query) {
         match query {
             Query::ClosestHit => {
                 self.hits.resize(rays.len(), None);
@@ -106,7 +106,7 @@ impl BatchAnswers {
 mod tests {
     use super::*;
     use glam::Vec3;
-    use sahara_kd::{BuildParams, Triangle};
+    use sahara_kd::{AccelParams, Triangle};
 
     #[test]
     fn records_match_single_ray_queries() {
@@ -122,7 +122,7 @@ mod tests {
                 Vec3::new(0.0, 1.0, 4.0),
             ),
         ];
-        let tree = KdTree::build(tris, &BuildParams::default());
+        let tree = TriangleAccel::build(tris, &AccelParams::default());
         // More than one chunk, alternating hits and misses.
         let rays: Vec<Ray> = (0..CHUNK + 100)
             .map(|i| {

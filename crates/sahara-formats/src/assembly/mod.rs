@@ -36,7 +36,7 @@ use sahara_readers::gltf::GltfCamera;
 use sahara_render::{Camera, Instance, MediumInterface, Placement, Scene, SceneMesh, Shape, Srt};
 
 use crate::description::{
-    CameraRequest, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
+    CameraRequest, Geometry, Object, ObjectPlacement, SceneDescription, SettingsLayer,
 };
 use crate::gltf::{gltf_camera, gltf_light};
 use crate::mesh::library::{file_key, MeshLibrary};
@@ -54,7 +54,7 @@ pub struct AssembledScene {
     /// size).
     pub scene: Scene,
     /// How the file asks to be rendered, if it says.
-    pub settings: Option<FileSettings>,
+    pub settings: Option<SettingsLayer>,
     /// Where the camera came from: the description's source for a given
     /// camera, a glTF camera (`file: camera 'name'`), or `auto`.
     pub camera_source: String,

@@ -3,17 +3,17 @@
 //! own format (the same media and interfaces, the same image).
 
 use glam::Vec3;
-use sahara_render::{render, Medium, RenderSettings, Scene};
+use sahara_render::{render, FrameSettings, Medium, RenderSettings, Scene};
 
 /// A 24 x 24 render of `scene` at `spp` samples, in one pass.
 pub(crate) fn image(scene: &Scene, spp: u32) -> Vec<Vec3> {
-    let settings = RenderSettings {
+    let settings = RenderSettings::from(FrameSettings {
         width: 24,
         height: 24,
         spp,
         pass_spp: spp,
-        ..RenderSettings::default()
-    };
+        ..Default::default()
+    });
     let mut scene = scene.clone();
     scene.camera.aspect = 1.0;
     render(&scene, &settings, &|_| {}).unwrap().film.pixels

@@ -21,7 +21,7 @@
 //! emissive material; point and spot as [`SceneDescription::lights`];
 //! `envmap` and `constant` as [`SceneDescription::environment`]), its
 //! sensor as [`CameraRequest::Given`] and its integrator and sampler as
-//! [`FileSettings`].
+//! [`SettingsLayer`].
 
 mod settings;
 
@@ -33,7 +33,7 @@ use sahara_render::{
     Camera, Environment, Light, Material, Medium, MediumInterface, SceneMesh, Shape, Srt,
 };
 
-pub use settings::{FileCrop, FileSettings};
+pub use settings::{FileCrop, PieceLayer, SettingsLayer, Split};
 
 /// A scene as a file describes it, before assembly.
 #[derive(Clone, Debug)]
@@ -66,7 +66,7 @@ pub struct SceneDescription {
     pub sky: Sky,
     /// How the file asks to be rendered (`None`: a file that does not
     /// say, as a bare mesh).
-    pub settings: Option<FileSettings>,
+    pub settings: Option<SettingsLayer>,
     /// Participating media, referred to by index by `camera_medium` and
     /// `medium_interfaces`.
     pub media: Vec<Medium>,

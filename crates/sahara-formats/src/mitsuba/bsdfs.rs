@@ -27,7 +27,8 @@ use std::sync::Arc;
 
 use sahara_readers::FormatError;
 use sahara_render::{
-    AlphaMode, Bsdf, Clearcoat, Distribution, Material, NormalMap, Texture, TextureMap,
+    isotropic_mean, roughness_from_alpha, AlphaMode, Bsdf, Clearcoat, Distribution, Material,
+    NormalMap, Texture, TextureMap,
 };
 
 use super::builder::{key, Builder};
@@ -76,11 +77,6 @@ const UNSUPPORTED: &[&str] = &[
     "retarder",
     "circular",
 ];
-
-/// A Sahara roughness of Mitsuba's GGX `alpha`.
-fn roughness(alpha: f64) -> f32 {
-    alpha.clamp(0.0, 1.0).sqrt() as f32
-}
 
 /// A diffuse material of reflectance `tint`.
 fn diffuse(tint: &Tint) -> Material {
@@ -215,7 +211,8 @@ impl<'a> Builder<'a> {
         let a = self.number(o, "alpha", default)?;
         let u = self.number(o, "alpha_u", a)?;
         let v = self.number(o, "alpha_v", a)?;
-        if (u - v).abs() > 1e-6 {
+        let (mean, anisotropic) = isotropic_mean(u, v);
+        if anisotropic {
             self.w.add(
                 format!(
                     "{}: anisotropic roughness is replaced by the mean of alpha_u and alpha_v",
@@ -224,7 +221,7 @@ impl<'a> Builder<'a> {
                 &o.node.loc,
             );
         }
-        Ok((distribution, roughness(0.5 * (u + v))))
+        Ok((distribution, roughness_from_alpha(mean)))
     }
 
     /// The single bsdf nested in `o` (a wrapper's).

@@ -22,12 +22,12 @@
 
 use glam::{DMat4, DVec3};
 use sahara_readers::FormatError;
-use sahara_render::{Camera, Filter, Integrator, SamplerKind, ToneMap};
+use sahara_render::{Camera, Filter, FrameLayer, Integrator, Pick, SamplerKind};
 
 use super::builder::Builder;
 use super::properties::Object;
 use super::xml::Node;
-use crate::description::{FileCrop, FileSettings};
+use crate::description::{FileCrop, SettingsLayer};
 
 /// A 35 mm film's diagonal, in mm (what `focal_length` refers to).
 const FILM_DIAGONAL_MM: f64 = 43.266_615_300_557;
@@ -307,21 +307,20 @@ pub(crate) fn sensor<'a>(
     b: &mut Builder<'a>,
     node: Option<&'a Node>,
     integrator: Integrator,
-) -> Result<(Option<Camera>, FileSettings), FormatError> {
-    let settings = |film: &Film, (sampler, spp, seed): (SamplerKind, u32, u64)| FileSettings {
-        integrator,
-        sampler,
-        spp,
-        adaptive: None,
-        seed,
-        filter: film.filter,
-        width: film.width,
-        height: film.height,
-        exposure: 0.0,
-        tonemap: ToneMap::Clamp,
-        output: None,
-        crop: film.crop,
-        denoise: false,
+) -> Result<(Option<Camera>, SettingsLayer), FormatError> {
+    let settings = |film: &Film, (sampler, spp, seed): (SamplerKind, u32, u64)| SettingsLayer {
+        frame: FrameLayer {
+            width: Some(film.width),
+            height: Some(film.height),
+            spp: Some(spp),
+            seed: Some(seed),
+            sampler: Some(sampler),
+            filter: Some(Pick::Value(film.filter)),
+            integrator: Some(Pick::Value(integrator)),
+            ..Default::default()
+        },
+        crop_window: film.crop,
+        ..Default::default()
     };
     let Some(node) = node else {
         let f = film(b, None)?;

@@ -161,7 +161,7 @@ fn a_path_element_adds_a_folder_to_look_in_and_sensors_refer_to_their_parts() {
     )
     .unwrap();
     assert!(matches!(d.objects[0].geometry, Geometry::Mesh(_)));
-    let s = d.settings.as_ref().unwrap();
+    let s = d.settings.as_ref().unwrap().frame_settings();
     assert_eq!(
         (s.sampler, s.spp, s.width),
         (SamplerKind::Stratified, 9, 32)
@@ -287,7 +287,7 @@ fn mitsuba_0_6_names_are_read_as_mitsuba_3_names() {
     let mut w = Warnings::default();
     let root = xml::parse_text(text.as_bytes(), "t.xml", Path::new("/x"), &mut w).unwrap();
     let d = described(root, "t.xml", Path::new("/x"), &[], w).unwrap();
-    let s = d.settings.as_ref().unwrap();
+    let s = d.settings.as_ref().unwrap().frame_settings();
     assert_eq!(
         s.integrator,
         Integrator::Path {
@@ -781,7 +781,8 @@ fn the_sensor_sees_as_mitsubas_and_sets_film_sampler_filter_and_depth() {
     let want = 2.0 * ((30f32.to_radians()).tan() / 2.0).atan().to_degrees();
     assert!((c.vfov_deg - want).abs() < 1e-4, "{}", c.vfov_deg);
     assert_eq!((c.lens_radius, c.focus_distance), (0.1, 4.0));
-    let s = d.settings.unwrap();
+    let layer = d.settings.unwrap();
+    let s = layer.frame_settings();
     assert_eq!(
         s.integrator,
         Integrator::Path {
@@ -791,7 +792,7 @@ fn the_sensor_sees_as_mitsubas_and_sets_film_sampler_filter_and_depth() {
     );
     assert_eq!((s.sampler, s.spp, s.seed), (SamplerKind::Stratified, 16, 7));
     assert_eq!((s.width, s.height), (200, 100));
-    assert_eq!(s.crop, Some(FileCrop::Pixels([10, 40, 20, 60])));
+    assert_eq!(layer.crop_window, Some(FileCrop::Pixels([10, 40, 20, 60])));
     assert_eq!(
         s.filter,
         Filter::Gaussian {
@@ -810,7 +811,7 @@ fn the_sensor_sees_as_mitsubas_and_sets_film_sampler_filter_and_depth() {
     assert!(close(c.right, -Vec3::X));
     // Mitsuba's defaults: 768 x 576, 4 independent samples, a Gaussian,
     // unlimited depth; a 50 mm lens on the diagonal.
-    let s = d.settings.unwrap();
+    let s = d.settings.unwrap().frame_settings();
     assert_eq!(
         (s.width, s.height, s.spp, s.sampler),
         (768, 576, 4, SamplerKind::Independent)
@@ -829,7 +830,7 @@ fn the_sensor_sees_as_mitsubas_and_sets_film_sampler_filter_and_depth() {
     // Direct light: one bounce.
     let d = describe("<integrator type=\"direct\"/>");
     assert!(matches!(
-        d.settings.unwrap().integrator,
+        d.settings.unwrap().frame_settings().integrator,
         Integrator::Path { max_depth: 1, .. }
     ));
 }
@@ -842,7 +843,7 @@ fn the_sensor_sees_as_mitsubas_and_sets_film_sampler_filter_and_depth() {
 fn light_tracing_bidirectional_and_photon_integrators_map_onto_saharas() {
     let integrator = |xml: &str| {
         let d = describe(xml);
-        (d.settings.unwrap().integrator, d.warnings)
+        (d.settings.unwrap().frame_settings().integrator, d.warnings)
     };
     let (i, w) = integrator(
         "<integrator type=\"ptracer\"><integer name=\"max_depth\" value=\"6\"/></integrator>",

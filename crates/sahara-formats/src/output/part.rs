@@ -12,7 +12,11 @@
 //! with adaptive sampling each pixel's sample count as `samples.n`, and the
 //! object and material ids as `object.id` and `material.id`.
 //! What the merge needs to know of it is in string attributes
-//! ([`PartInfo`]). It is written atomically.
+//! ([`PartInfo`]): the whole frame's settings ([`FrameSettings`], each
+//! filter and integrator parameter as `sahara:filter:<name>` and
+//! `sahara:integrator:<name>`) and how it is written ([`OutputSettings`]),
+//! so the merged frame is written as the frame rendered whole would be.
+//! It is written atomically.
 
 use std::io::{BufWriter, Read, Write};
 use std::ops::Range;
@@ -25,13 +29,15 @@ use exr::prelude::{
 };
 use sahara_readers::FormatError;
 use sahara_render::{
-    Aov, Aux, AuxSums, IntegratorKind, Named, PixelSum, PixelWindow, SumBuffer, ToneMap,
+    Adaptive, Aov, Aux, AuxSums, Filter, FilterKind, FrameSettings, Integrator, IntegratorKind,
+    Named, Parameter, PixelSum, PixelWindow, SumBuffer,
 };
 
 use crate::output::atomic::write_atomically;
+use crate::output::frame::OutputSettings;
 
 /// The value of `sahara:format` in a part file.
-const FORMAT: &str = "sahara render part 1";
+const FORMAT: &str = "sahara render part 2";
 
 /// Largest frame side a part may describe (as for `sahara render`).
 const MAX_SIDE: u32 = 65536;
@@ -42,12 +48,14 @@ pub struct PartInfo {
     /// Digest of the scene and of the settings that change pixels
     /// ([`sahara_render::frame_digest`]).
     pub digest: String,
-    /// Frame width in pixels.
-    pub width: u32,
-    /// Frame height in pixels.
-    pub height: u32,
-    /// Samples per pixel of the whole frame.
-    pub spp: u32,
+    /// The whole frame's settings: size, samples per pixel (of the whole
+    /// frame), seed, sampler, filter, integrator, adaptive sampling.
+    pub frame: FrameSettings,
+    /// How the merged frame is written: exposure and tone map for a PNG,
+    /// the render passes written as layers (sorted; the denoiser's albedo
+    /// and normal are held without being written), whether it is
+    /// denoised (parts never are).
+    pub output: OutputSettings,
     /// The pixels this part holds.
     pub window: PixelWindow,
     /// The sample indices this part was asked to render.
@@ -60,27 +68,11 @@ pub struct PartInfo {
     pub complete: bool,
     /// How the part was chosen, e.g. `3/8 tiles` (empty if by hand).
     pub part: String,
-    /// The integrator (for the merged image's metadata and its `cost` view).
-    pub integrator: IntegratorKind,
-    /// The seed (for the merged image's metadata).
-    pub seed: u64,
-    /// Exposure in stops for a PNG of the merged frame.
-    pub exposure: f32,
-    /// Tone map for a PNG of the merged frame.
-    pub tonemap: ToneMap,
     /// The render passes whose sums the part holds (sorted).
     pub passes: Vec<Aov>,
-    /// The render passes the merged frame writes as layers (sorted; the
-    /// denoiser's albedo and normal are held without being written).
-    pub aovs: Vec<Aov>,
-    /// True if the merged frame is denoised (parts never are).
-    pub denoise: bool,
     /// True if the denoiser is to clean the albedo and normal first
     /// (depth of field or motion blur make them noisy).
     pub noisy_guides: bool,
-    /// True if the part holds each pixel's sample count (adaptive
-    /// sampling).
-    pub sample_counts: bool,
     /// The list of names of the object and material passes (JSON, ASCII;
     /// empty without those passes).
     pub names: String,
@@ -170,37 +162,67 @@ fn pass_list(passes: &[Aov]) -> String {
 }
 
 impl PartInfo {
+    /// True if the part holds each pixel's sample count (adaptive
+    /// sampling).
+    pub fn sample_counts(&self) -> bool {
+        self.frame.adaptive.is_some()
+    }
+
     /// The attributes of the file.
     fn attributes(&self) -> Vec<(String, String)> {
-        let w = &self.window;
+        let (w, f, o) = (&self.window, &self.frame, &self.output);
         let mut a = vec![
-            ("sahara:format", FORMAT.to_string()),
-            ("sahara:digest", self.digest.clone()),
-            ("sahara:frame", format!("{}x{}", self.width, self.height)),
-            ("sahara:spp", self.spp.to_string()),
+            ("sahara:format".to_string(), FORMAT.to_string()),
+            ("sahara:digest".into(), self.digest.clone()),
+            ("sahara:frame".into(), format!("{}x{}", f.width, f.height)),
+            ("sahara:spp".into(), f.spp.to_string()),
+            ("sahara:pass_spp".into(), f.pass_spp.to_string()),
             (
-                "sahara:window",
+                "sahara:window".into(),
                 format!("{},{},{},{}", w.x0, w.x1, w.y0, w.y1),
             ),
-            ("sahara:samples", range(&self.samples)),
-            ("sahara:samples_done", range(&self.samples_done)),
-            ("sahara:complete", self.complete.to_string()),
-            ("sahara:partial", (!self.complete).to_string()),
-            ("sahara:part", self.part.clone()),
-            ("sahara:integrator", self.integrator.to_string()),
-            ("sahara:seed", self.seed.to_string()),
-            ("sahara:exposure", self.exposure.to_string()),
-            ("sahara:tonemap", self.tonemap.to_string()),
-            ("sahara:passes", pass_list(&self.passes)),
-            ("sahara:aovs", pass_list(&self.aovs)),
-            ("sahara:denoise", self.denoise.to_string()),
-            ("sahara:noisy_guides", self.noisy_guides.to_string()),
-            ("sahara:sample_counts", self.sample_counts.to_string()),
-            ("sahara:names", self.names.clone()),
-        ]
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v))
-        .collect::<Vec<_>>();
+            ("sahara:samples".into(), range(&self.samples)),
+            ("sahara:samples_done".into(), range(&self.samples_done)),
+            ("sahara:complete".into(), self.complete.to_string()),
+            ("sahara:partial".into(), (!self.complete).to_string()),
+            ("sahara:part".into(), self.part.clone()),
+            ("sahara:seed".into(), f.seed.to_string()),
+            ("sahara:sampler".into(), f.sampler.to_string()),
+            ("sahara:exposure".into(), o.exposure.to_string()),
+            ("sahara:tonemap".into(), o.tonemap.to_string()),
+            ("sahara:passes".into(), pass_list(&self.passes)),
+            ("sahara:aovs".into(), pass_list(&o.aovs)),
+            ("sahara:denoise".into(), o.denoise.to_string()),
+            ("sahara:noisy_guides".into(), self.noisy_guides.to_string()),
+            ("sahara:names".into(), self.names.clone()),
+        ];
+        let kinds = [
+            (
+                "filter",
+                f.filter.name(),
+                f.filter.kind().parameters(),
+                f.filter.parameters(),
+            ),
+            (
+                "integrator",
+                f.integrator.name(),
+                f.integrator.kind().parameters(),
+                f.integrator.parameters(),
+            ),
+        ];
+        for (what, name, keys, values) in kinds {
+            a.push((format!("sahara:{what}"), name.to_string()));
+            for (p, v) in keys.iter().zip(values) {
+                a.push((format!("sahara:{what}:{}", p.name), v.to_string()));
+            }
+        }
+        if let Some(adaptive) = f.adaptive {
+            a.push((
+                "sahara:noise_threshold".into(),
+                adaptive.threshold.to_string(),
+            ));
+            a.push(("sahara:min_spp".into(), adaptive.min_spp.to_string()));
+        }
         a.extend(
             self.stats
                 .iter()
@@ -246,30 +268,49 @@ impl PartInfo {
         if complete && samples_done != samples {
             return Err(h.bad("sahara:samples_done", &range(&samples_done)));
         }
-        let exposure = h.need("sahara:exposure")?;
-        Ok(PartInfo {
-            digest: h.need("sahara:digest")?,
+        let adaptive = match get("sahara:noise_threshold") {
+            None => None,
+            Some(_) => Some(Adaptive {
+                threshold: h.finite("sahara:noise_threshold")?,
+                min_spp: h.parsed("sahara:min_spp")?,
+            }),
+        };
+        let frame = FrameSettings {
             width,
             height,
             spp,
+            pass_spp: h.parsed("sahara:pass_spp")?,
+            seed: h.parsed("sahara:seed")?,
+            sampler: h.parsed("sahara:sampler")?,
+            filter: Filter::with_parameters(
+                h.parsed("sahara:filter")?,
+                &h.parameters("filter", FilterKind::parameters(h.parsed("sahara:filter")?))?,
+            ),
+            integrator: Integrator::with_parameters(
+                h.parsed("sahara:integrator")?,
+                &h.parameters(
+                    "integrator",
+                    IntegratorKind::parameters(h.parsed("sahara:integrator")?),
+                )?,
+            ),
+            adaptive,
+        };
+        Ok(PartInfo {
+            digest: h.need("sahara:digest")?,
+            frame,
+            output: OutputSettings {
+                exposure: h.finite("sahara:exposure")?,
+                tonemap: h.parsed("sahara:tonemap")?,
+                aovs,
+                denoise,
+            },
             window,
             samples,
             samples_done,
             complete,
             part: get("sahara:part").unwrap_or_default(),
-            integrator: h.parsed("sahara:integrator")?,
-            seed: h.parsed("sahara:seed")?,
-            exposure: exposure
-                .parse()
-                .ok()
-                .filter(|e: &f32| e.is_finite())
-                .ok_or_else(|| h.bad("sahara:exposure", &exposure))?,
-            tonemap: h.parsed("sahara:tonemap")?,
             passes: held,
-            aovs,
-            denoise,
             noisy_guides: h.flag("sahara:noisy_guides")?,
-            sample_counts: h.flag("sahara:sample_counts")?,
             names: get("sahara:names").unwrap_or_default(),
             stats: Vec::new(),
         })
@@ -305,6 +346,27 @@ impl Header<'_> {
     fn parsed<T: std::str::FromStr>(&self, key: &str) -> Result<T, FormatError> {
         let v = self.need(key)?;
         v.parse().map_err(|_| self.bad(key, &v))
+    }
+
+    /// Attribute `key`, a finite number.
+    fn finite(&self, key: &str) -> Result<f32, FormatError> {
+        let v = self.need(key)?;
+        v.parse()
+            .ok()
+            .filter(|x: &f32| x.is_finite())
+            .ok_or_else(|| self.bad(key, &v))
+    }
+
+    /// The values of a `what`'s parameters `keys` (`sahara:<what>:<name>`),
+    /// each accepted by its parameter.
+    fn parameters(&self, what: &str, keys: &[Parameter]) -> Result<Vec<f32>, FormatError> {
+        keys.iter()
+            .map(|p| {
+                let key = format!("sahara:{what}:{}", p.name);
+                let v = self.finite(&key)?;
+                p.check(v).map_err(|_| self.bad(&key, &v.to_string()))
+            })
+            .collect()
     }
 
     /// The frame's size, `WxH`, each side in `1..=MAX_SIDE`.
@@ -399,7 +461,7 @@ fn channel_names(info: &PartInfo) -> Vec<String> {
         names.extend(sum_channels(&format!("{name}.")));
     }
     for (held, channel) in [
-        (info.sample_counts, SAMPLES_CHANNEL),
+        (info.sample_counts(), SAMPLES_CHANNEL),
         (info.passes.contains(&Aov::Object), OBJECT_CHANNEL),
         (info.passes.contains(&Aov::Material), MATERIAL_CHANNEL),
     ] {
@@ -428,7 +490,7 @@ pub fn write_part(path: &Path, info: &PartInfo, sums: &PartSums) -> Result<(), F
         ));
     }
     if sums.passes() != info.passes
-        || sums.samples.is_some() != info.sample_counts
+        || sums.samples.is_some() != info.sample_counts()
         || sums
             .counts()
             .iter()
@@ -575,7 +637,7 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, PartSums), FormatError> {
     let mut sums = PartSums {
         beauty: SumBuffer::new(w.x0, w.y0, w.width(), w.height()),
         passes: empty_passes(&info.passes, &w),
-        samples: info.sample_counts.then(|| vec![0; w.pixels() as usize]),
+        samples: info.sample_counts().then(|| vec![0; w.pixels() as usize]),
         object: info
             .passes
             .contains(&Aov::Object)
@@ -640,28 +702,42 @@ pub fn read_part(path: &Path) -> Result<(PartInfo, PartSums), FormatError> {
 mod tests {
     use super::*;
     use glam::{Vec2, Vec3};
-    use sahara_render::Filter;
 
     fn info(window: PixelWindow) -> PartInfo {
         PartInfo {
             digest: "ab".repeat(32),
-            width: 9,
-            height: 7,
-            spp: 16,
+            frame: FrameSettings {
+                width: 9,
+                height: 7,
+                spp: 16,
+                pass_spp: 4,
+                seed: 3,
+                sampler: sahara_render::SamplerKind::Independent,
+                filter: Filter::Mitchell {
+                    radius: 1.75,
+                    b: 0.3,
+                    c: 0.35,
+                },
+                integrator: Integrator::Sppm {
+                    max_depth: 6,
+                    radius: 0.125,
+                    photons: 250_000,
+                },
+                adaptive: None,
+            },
+            output: OutputSettings {
+                exposure: -0.5,
+                tonemap: sahara_render::ToneMap::Filmic,
+                aovs: Vec::new(),
+                denoise: false,
+            },
             window,
             samples: 4..12,
             samples_done: 4..12,
             complete: true,
             part: "1/2 tiles".into(),
-            integrator: IntegratorKind::Path,
-            seed: 3,
-            exposure: -0.5,
-            tonemap: ToneMap::Filmic,
             passes: Vec::new(),
-            aovs: Vec::new(),
-            denoise: false,
             noisy_guides: false,
-            sample_counts: false,
             names: String::new(),
             stats: vec![("rays".into(), "123".into())],
         }
@@ -698,10 +774,19 @@ mod tests {
                 Aov::Variance,
                 Aov::Object,
             ],
-            aovs: vec![Aov::Uv, Aov::Variance],
-            denoise: true,
+            output: OutputSettings {
+                aovs: vec![Aov::Uv, Aov::Variance],
+                denoise: true,
+                ..info(window).output
+            },
+            frame: FrameSettings {
+                adaptive: Some(Adaptive {
+                    threshold: 0.03,
+                    min_spp: 8,
+                }),
+                ..info(window).frame
+            },
             noisy_guides: true,
-            sample_counts: true,
             names: "{\"object\": {\"1\": \"t\\u00eate\"}}".into(),
             ..info(window)
         };

@@ -24,8 +24,8 @@ use glam::{Affine3A, DMat3, DMat4, DVec3, Mat4, Vec3};
 use sahara_readers::FormatError;
 use sahara_render::SceneMesh;
 use sahara_render::{
-    AlphaMode, Camera, Filter, Integrator, Material, MediumInterface, SamplerKind, Shape, Srt,
-    TextureMap, ToneMap,
+    AlphaMode, Camera, Filter, FrameLayer, Integrator, Material, MediumInterface, Pick,
+    SamplerKind, Shape, Srt, TextureMap,
 };
 
 use super::declarations::{unknown_params, Declarations, Entity, MaterialRef, ShapeDecl, Xform};
@@ -38,8 +38,9 @@ use crate::common::mesh::smooth_normals;
 use crate::common::tint::with_opacity;
 use crate::common::warnings::Warnings;
 use crate::description::{
-    CameraRequest, FileCrop, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
+    CameraRequest, FileCrop, Geometry, Object, ObjectPlacement, SceneDescription, SettingsLayer,
 };
+use crate::output::frame::OutputLayer;
 
 /// Deepest chain of `mix` materials followed.
 const MAX_MIX_DEPTH: usize = 16;
@@ -479,25 +480,31 @@ fn settings(
     desc: &Declarations,
     folder: &Path,
     w: &mut Warnings,
-) -> Result<FileSettings, FormatError> {
+) -> Result<SettingsLayer, FormatError> {
     let film = film(desc, folder, w)?;
     let (mut spp, sampler, seed) = sampler(desc, w)?;
     let filter = pixel_filter(desc, w)?;
     let integrator = integrator(desc, &mut spp, w)?;
-    Ok(FileSettings {
-        integrator,
-        sampler,
-        spp: spp as u32,
-        adaptive: None,
-        seed,
-        filter,
-        width: film.width as u32,
-        height: film.height as u32,
-        exposure: film.exposure,
-        tonemap: ToneMap::Clamp,
-        output: film.output,
-        crop: film.crop,
-        denoise: false,
+    // pbrt's defaults are what a file without a directive says: every
+    // frame setting is given.
+    Ok(SettingsLayer {
+        frame: FrameLayer {
+            width: Some(film.width as u32),
+            height: Some(film.height as u32),
+            spp: Some(spp as u32),
+            seed: Some(seed),
+            sampler: Some(sampler),
+            filter: Some(Pick::Value(filter)),
+            integrator: Some(Pick::Value(integrator)),
+            ..Default::default()
+        },
+        output: OutputLayer {
+            exposure: Some(film.exposure),
+            ..Default::default()
+        },
+        path: film.output,
+        crop_window: film.crop,
+        ..Default::default()
     })
 }
 
@@ -849,7 +856,8 @@ pub(crate) fn build(
     w: &mut Warnings,
 ) -> Result<SceneDescription, FormatError> {
     let settings = settings(desc, folder, w)?;
-    let aspect = f64::from(settings.width) / f64::from(settings.height);
+    let size = |side: Option<u32>| f64::from(side.unwrap_or(1));
+    let aspect = size(settings.frame.width) / size(settings.frame.height);
     let (camera, shutter) = camera(desc, aspect, w)?;
     let mut scene = SceneDescription::new(name);
     scene.camera = CameraRequest::Given {

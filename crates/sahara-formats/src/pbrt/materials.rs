@@ -26,7 +26,9 @@
 
 use glam::Vec3;
 use sahara_readers::FormatError;
-use sahara_render::{AlphaMode, Bsdf, Distribution, Material};
+use sahara_render::{
+    isotropic_mean, roughness_from_alpha, AlphaMode, Bsdf, Distribution, Material,
+};
 
 use super::declarations::Entity;
 use super::params::SpectrumParam;
@@ -62,7 +64,7 @@ fn sahara_roughness(r: f64, remap: bool, v3: bool) -> f32 {
         (true, false) => r.max(0.0).sqrt(),
         (true, true) => v3_alpha(r),
     };
-    alpha.clamp(0.0, 1.0).sqrt() as f32
+    roughness_from_alpha(alpha)
 }
 
 /// The roughness of `e` (`roughness`, or the mean of `uroughness` and
@@ -79,7 +81,8 @@ fn roughness(
     let r = tex.float(e, &format!("{prefix}roughness"), default, w)?;
     let u = tex.float(e, &format!("{prefix}uroughness"), r, w)?;
     let v = tex.float(e, &format!("{prefix}vroughness"), r, w)?;
-    if (u - v).abs() > 1e-6 {
+    let (mean, anisotropic) = isotropic_mean(u, v);
+    if anisotropic {
         w.add(
             format!(
                 "material '{}': anisotropic roughness replaced by the mean of u and v",
@@ -89,7 +92,7 @@ fn roughness(
         );
     }
     let remap = e.params.bool("remaproughness", true)?;
-    Ok(sahara_roughness(0.5 * (u + v), remap, v3))
+    Ok(sahara_roughness(mean, remap, v3))
 }
 
 /// The material of shapes declared before any `Material` directive:

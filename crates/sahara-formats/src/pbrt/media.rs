@@ -13,6 +13,7 @@ use std::collections::HashMap;
 use glam::{Affine3A, DMat4, DVec3, Vec3};
 use sahara_readers::vdb::VdbGrid;
 use sahara_readers::FormatError;
+use sahara_render::{isotropic_mean, roughness_from_alpha};
 use sahara_render::{
     CloudMedium, ColourGrid, ColourVolume, DensityGrid, GridCoefficients, GridMedium,
     HenyeyGreenstein, Material, Medium,
@@ -569,18 +570,19 @@ pub(crate) fn subsurface(e: &Entity, w: &mut Warnings) -> Result<(Material, Medi
         None => {
             let u = e.params.float("uroughness", 0.0)?;
             let v = e.params.float("vroughness", u)?;
-            if u != v {
+            let (mean, anisotropic) = isotropic_mean(u, v);
+            if anisotropic {
                 w.add(
                     format!("{what}: anisotropic roughness is rendered isotropic (the mean)"),
                     &e.loc,
                 );
             }
-            0.5 * (u + v)
+            mean
         }
     };
-    // pbrt-v4 remaps roughness to alpha = sqrt(r); Sahara's roughness is sqrt(alpha).
+    // pbrt-v4 remaps roughness to alpha = sqrt(r).
     let alpha = if remap { r.max(0.0).sqrt() } else { r };
-    let roughness = alpha.clamp(0.0, 1.0).sqrt() as f32;
+    let roughness = roughness_from_alpha(alpha);
     let boundary = super::materials::glass(eta, roughness);
     for k in ["mfp", "displacement", "normalmap"] {
         if e.params.get(k).is_some() {

@@ -274,7 +274,7 @@ fn film_crop_windows_and_pixel_bounds_follow_pbrt_v4() {
     };
     let window = |extra: &str| {
         let s = film(extra).unwrap();
-        let c = s.settings.as_ref().unwrap().crop.expect("a crop");
+        let c = s.settings.as_ref().unwrap().crop_window.expect("a crop");
         (c, c.window(100, 50), s.warnings)
     };
     // Pairs in either order; pixels from ceil(f * size).
@@ -325,7 +325,8 @@ fn camera_fov_is_the_shorter_axis_and_settings_map() {
                 Sampler \"halton\" \"integer pixelsamples\" 8\nIntegrator \"volpath\" \"integer maxdepth\" 7\n\
                 PixelFilter \"box\"\nLookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 60 \"float lensradius\" 0.1 \"float focaldistance\" 5\nWorldBegin";
     let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/scenes")).unwrap();
-    let st = &s.settings.as_ref().unwrap();
+    let layer = s.settings.as_ref().unwrap();
+    let st = layer.frame_settings();
     assert_eq!((st.width, st.height, st.spp), (100, 200, 8));
     assert_eq!(
         st.integrator,
@@ -335,7 +336,7 @@ fn camera_fov_is_the_shorter_axis_and_settings_map() {
         }
     );
     assert_eq!(st.filter, sahara_render::Filter::Box { radius: 0.5 });
-    assert_eq!(st.output.as_deref(), Some(Path::new("/scenes/out.exr")));
+    assert_eq!(layer.path.as_deref(), Some(Path::new("/scenes/out.exr")));
     let c = &s.scene.camera;
     // Portrait: the 60 degrees span the width; tan(v/2) = tan(30) * 2.
     let expect = (2.0 * (30f64.to_radians().tan() * 2.0).atan()).to_degrees() as f32;
@@ -446,7 +447,7 @@ fn the_fuzz_seed_with_every_directive_loads() {
         .iter()
         .any(|m| m.is_emissive() && m.two_sided_emission));
     assert_eq!(
-        s.settings.as_ref().unwrap().crop,
+        s.settings.as_ref().unwrap().crop_window,
         Some(crate::description::FileCrop::Fractions([
             0.0, 1.0, 0.0, 1.0
         ]))
@@ -705,7 +706,10 @@ fn bidirectional_integrators_map_onto_bdpt_and_light_tracing() {
         let text =
             format!("{line}\nLookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin");
         let s = parse_pbrt(text.as_bytes(), "t.pbrt", Path::new("/scenes")).unwrap();
-        (s.settings.as_ref().unwrap().integrator, s.warnings.clone())
+        (
+            s.settings.as_ref().unwrap().frame_settings().integrator,
+            s.warnings.clone(),
+        )
     };
     let (i, w) = integrator("Integrator \"bdpt\" \"integer maxdepth\" 7");
     assert_eq!(i, Integrator::Bdpt { max_depth: 7 });

@@ -22,36 +22,17 @@ use sahara_render::{Camera, Environment, Material, Shape, Texture, TextureMap};
 use super::file::{CameraSpec, EnvironmentSpec, LightSpec, MaterialSpec, SceneFile, ShapeSpec};
 use crate::common::image::load_rgb_f32;
 use crate::common::materials::TextureCache;
-use crate::description::{
-    CameraRequest, FileSettings, Geometry, Object, ObjectPlacement, SceneDescription,
-};
+use crate::description::{CameraRequest, Geometry, Object, ObjectPlacement, SceneDescription};
 
 use super::placement::placement;
-
-/// The render settings of a parsed scene file.
-pub fn settings_of(file: &SceneFile) -> FileSettings {
-    FileSettings {
-        integrator: file.integrator,
-        sampler: file.sampler.kind,
-        spp: file.sampler.spp,
-        adaptive: file.sampler.adaptive,
-        seed: file.sampler.seed,
-        filter: file.filter,
-        width: file.film.width,
-        height: file.film.height,
-        exposure: file.film.exposure,
-        tonemap: file.film.tonemap,
-        output: file.film.output.clone(),
-        crop: None,
-        denoise: file.film.denoise,
-    }
-}
 
 /// The description of a parsed scene file; `name` (the scene file) is
 /// used in messages.
 pub fn describe(file: &SceneFile, name: &str) -> Result<SceneDescription, FormatError> {
-    let settings = settings_of(file);
-    let aspect = settings.width as f32 / settings.height as f32;
+    let settings = file.settings.clone();
+    // `[film]` gives both sides.
+    let frame = &settings.frame;
+    let aspect = frame.width.unwrap_or(1) as f32 / frame.height.unwrap_or(1) as f32;
     let mut desc = SceneDescription::new(name);
     desc.camera = CameraRequest::Given {
         camera: camera_of(&file.camera, aspect),

@@ -60,9 +60,9 @@
 use std::path::PathBuf;
 
 use glam::{Mat4, Quat, Vec3};
-use sahara_render::{
-    Filter, Integrator, Light, Material, Medium, MediumInterface, SamplerKind, Shape, ToneMap,
-};
+use sahara_render::{Light, Material, Medium, MediumInterface, Shape};
+
+use crate::description::SettingsLayer;
 
 /// A parsed and checked scene file.
 #[derive(Clone, Debug, PartialEq)]
@@ -83,16 +83,11 @@ pub struct SceneFile {
     pub objects: Vec<ObjectSpec>,
     /// Lights, in file order (at most one environment).
     pub lights: Vec<LightSpec>,
-    /// How radiance is estimated (`[integrator]`; parameters not given
-    /// take the renderer's defaults).
-    pub integrator: Integrator,
-    /// How pixel samples are placed.
-    pub sampler: SamplerSpec,
-    /// The pixel reconstruction filter (`[filter]`; parameters not given
-    /// take the renderer's defaults for the kind).
-    pub filter: Filter,
-    /// Image size, exposure, tone mapping and output file.
-    pub film: FilmSpec,
+    /// The render settings the file gives (`[integrator]`, `[sampler]`,
+    /// `[filter]`, `[film]`): the keys given, the rest left to the
+    /// defaults; an `[integrator]` or `[filter]` table's parameters not
+    /// given take the renderer's defaults for the kind.
+    pub settings: SettingsLayer,
 }
 
 /// `[camera]`: a thin-lens camera with a shutter interval.
@@ -246,35 +241,4 @@ pub enum EnvironmentSpec {
         /// Radiance multiplier (> 0, default 1).
         scale: f32,
     },
-}
-
-/// `[sampler]`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SamplerSpec {
-    /// Which sampler (default sobol).
-    pub kind: SamplerKind,
-    /// Samples per pixel (>= 1, default 64).
-    pub spp: u32,
-    /// Seed (>= 0, default 0).
-    pub seed: u64,
-    /// Adaptive sampling (`noise_threshold`, `min_spp`), if asked for.
-    pub adaptive: Option<sahara_render::Adaptive>,
-}
-
-/// `[film]`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FilmSpec {
-    /// Width in pixels (1..=65536).
-    pub width: u32,
-    /// Height in pixels (1..=65536).
-    pub height: u32,
-    /// Exposure in stops (pixels scaled by `2^exposure`; default 0).
-    pub exposure: f32,
-    /// Tone mapping for 8-bit output (default clamp).
-    pub tonemap: ToneMap,
-    /// Output image (`.png` or `.exr`) as given: relative to the working
-    /// folder unless absolute; `None` if not given.
-    pub output: Option<PathBuf>,
-    /// Denoise the image (default false).
-    pub denoise: bool,
 }

@@ -6,16 +6,16 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use sahara_readers::FormatError;
-use sahara_render::defaults;
 use sahara_render::{
-    Adaptive, Filter, FilterKind, Integrator, IntegratorKind, Named, Parameter, SamplerKind, Shape,
-    ShapeKind, ToneMap,
+    AdaptiveChoice, Filter, FilterKind, FrameLayer, Integrator, IntegratorKind, Named, Parameter,
+    Pick, Shape, ShapeKind,
 };
 use toml::Spanned;
 
 use super::file::*;
 use super::raw::*;
-use crate::description::Sky;
+use crate::description::{SettingsLayer, Sky};
+use crate::output::frame::OutputLayer;
 use crate::output::image::ImageFormat;
 
 mod kinds;
@@ -113,24 +113,7 @@ pub(super) fn resolve(text: &str, name: &str, folder: &Path) -> Result<SceneFile
         materials,
         objects,
         lights,
-        integrator: match &raw.integrator {
-            Some(i) => ctx.integrator(i)?,
-            None => Integrator::default(),
-        },
-        sampler: match &raw.sampler {
-            Some(s) => ctx.sampler(s.get_ref())?,
-            None => SamplerSpec {
-                kind: SamplerKind::default(),
-                spp: defaults::SPP,
-                seed: 0,
-                adaptive: None,
-            },
-        },
-        filter: match &raw.filter {
-            Some(f) => ctx.filter(f)?,
-            None => Filter::default(),
-        },
-        film: ctx.film(film.get_ref())?,
+        settings: ctx.settings(&raw, film.get_ref())?,
     })
 }
 
@@ -599,11 +582,38 @@ impl Ctx<'_> {
         Ok(Integrator::with_parameters(kind, &values))
     }
 
-    /// `[sampler]`.
-    fn sampler(&self, s: &RawSampler) -> Result<SamplerSpec, FormatError> {
-        let seed = match &s.seed {
-            None => 0,
-            Some(v) if *v.get_ref() >= 0 => *v.get_ref() as u64,
+    /// The render settings of `[integrator]`, `[sampler]`, `[filter]` and
+    /// `[film]`: what the file gives, each key not given left to the
+    /// layers below (the defaults).
+    fn settings(&self, raw: &RawScene, film: &RawFilm) -> Result<SettingsLayer, FormatError> {
+        let mut layer = SettingsLayer {
+            frame: FrameLayer {
+                integrator: raw
+                    .integrator
+                    .as_ref()
+                    .map(|i| self.integrator(i).map(Pick::Value))
+                    .transpose()?,
+                filter: raw
+                    .filter
+                    .as_ref()
+                    .map(|f| self.filter(f).map(Pick::Value))
+                    .transpose()?,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        if let Some(s) = &raw.sampler {
+            self.sampler(s.get_ref(), &mut layer.frame)?;
+        }
+        self.film(film, &mut layer)?;
+        Ok(layer)
+    }
+
+    /// `[sampler]`, into `frame`.
+    fn sampler(&self, s: &RawSampler, frame: &mut FrameLayer) -> Result<(), FormatError> {
+        frame.seed = match &s.seed {
+            None => None,
+            Some(v) if *v.get_ref() >= 0 => Some(*v.get_ref() as u64),
             Some(v) => {
                 return Err(self.at(
                     v.span(),
@@ -611,7 +621,7 @@ impl Ctx<'_> {
                 ))
             }
         };
-        let adaptive = match (&s.noise_threshold, &s.min_spp) {
+        frame.adaptive = match (&s.noise_threshold, &s.min_spp) {
             (None, None) => None,
             (None, Some(m)) => {
                 return Err(self.at(
@@ -619,26 +629,27 @@ impl Ctx<'_> {
                     "`min_spp` needs `noise_threshold` (adaptive sampling)",
                 ))
             }
-            (Some(_), min) => Some(Adaptive {
-                threshold: self.number(
+            (Some(_), min) => Some(AdaptiveChoice {
+                threshold: Some(self.number(
                     &s.noise_threshold,
                     "noise_threshold",
                     0.0,
                     |t| t > 0.0,
                     "greater than 0",
-                )?,
-                min_spp: self.count(min, "min_spp", Adaptive::DEFAULT_MIN_SPP, 2)?,
+                )?),
+                min_spp: min
+                    .as_ref()
+                    .map(|_| self.count(min, "min_spp", 0, 2))
+                    .transpose()?,
             }),
         };
-        Ok(SamplerSpec {
-            kind: s
-                .name
-                .as_ref()
-                .map_or_else(SamplerKind::default, |n| n.get_ref().0),
-            spp: self.count(&s.spp, "spp", defaults::SPP, 1)?,
-            seed,
-            adaptive,
-        })
+        frame.sampler = s.name.as_ref().map(|n| n.get_ref().0);
+        frame.spp = s
+            .spp
+            .as_ref()
+            .map(|_| self.count(&s.spp, "spp", 0, 1))
+            .transpose()?;
+        Ok(())
     }
 
     /// `[filter]`: `name` and the parameters the renderer lists for that
@@ -713,8 +724,8 @@ impl Ctx<'_> {
         Ok((kind, values))
     }
 
-    /// `[film]`.
-    fn film(&self, f: &RawFilm) -> Result<FilmSpec, FormatError> {
+    /// `[film]`, into `layer`.
+    fn film(&self, f: &RawFilm, layer: &mut SettingsLayer) -> Result<(), FormatError> {
         let side = |v: &Spanned<i64>, key: &str| {
             let x = *v.get_ref();
             if (1..=MAX_FILM_SIDE).contains(&x) {
@@ -741,17 +752,20 @@ impl Ctx<'_> {
                 Some(path)
             }
         };
-        Ok(FilmSpec {
-            width: side(&f.width, "width")?,
-            height: side(&f.height, "height")?,
-            exposure: self.number(&f.exposure, "exposure", 0.0, |_| true, "finite")?,
-            tonemap: f
-                .tonemap
+        layer.frame.width = Some(side(&f.width, "width")?);
+        layer.frame.height = Some(side(&f.height, "height")?);
+        layer.output = OutputLayer {
+            exposure: f
+                .exposure
                 .as_ref()
-                .map_or_else(ToneMap::default, |t| t.get_ref().0),
-            output,
-            denoise: f.denoise.as_ref().is_some_and(|d| *d.get_ref()),
-        })
+                .map(|_| self.number(&f.exposure, "exposure", 0.0, |_| true, "finite"))
+                .transpose()?,
+            tonemap: f.tonemap.as_ref().map(|t| t.get_ref().0),
+            aovs: None,
+            denoise: f.denoise.as_ref().map(|d| *d.get_ref()),
+        };
+        layer.path = output;
+        Ok(())
     }
 }
 

@@ -6,8 +6,12 @@ use super::file::*;
 use super::{load_scene_file, parse_scene_file};
 use glam::{Mat4, Quat, Vec3};
 use sahara_render::{
-    Bsdf, Distribution, Filter, Integrator, Light, Material, SamplerKind, Shape, ToneMap,
+    Bsdf, Distribution, Filter, FrameLayer, Integrator, Light, Material, SamplerKind, Shape,
+    ToneMap,
 };
+
+use crate::description::SettingsLayer;
+use crate::output::frame::OutputLayer;
 
 use super::test_helpers::TempDir;
 
@@ -283,41 +287,37 @@ fn a_complete_scene_parses_into_the_expected_values() {
             scale: 0.5
         })
     );
+    let f = s.settings.frame_settings();
     assert_eq!(
-        s.integrator,
+        f.integrator,
         Integrator::Distribution {
             max_depth: 6,
             light_samples: 4
         }
     );
     assert_eq!(
-        s.sampler,
-        SamplerSpec {
-            kind: SamplerKind::Stratified,
-            spp: 64,
-            seed: 42,
-            adaptive: None,
-        }
+        (f.sampler, f.spp, f.seed, f.adaptive),
+        (SamplerKind::Stratified, 64, 42, None)
     );
     assert_eq!(
-        s.filter,
+        f.filter,
         Filter::Mitchell {
             radius: 2.,
             b: 0.5,
             c: 0.25
         }
     );
+    assert_eq!((f.width, f.height), (320, 240));
     assert_eq!(
-        s.film,
-        FilmSpec {
-            width: 320,
-            height: 240,
-            exposure: -1.,
-            tonemap: ToneMap::Filmic,
-            output: Some(PathBuf::from("renders/out.EXR")),
-            denoise: false,
+        s.settings.output,
+        OutputLayer {
+            exposure: Some(-1.),
+            tonemap: Some(ToneMap::Filmic),
+            aovs: None,
+            denoise: None,
         }
     );
+    assert_eq!(s.settings.path, Some(PathBuf::from("renders/out.EXR")));
 }
 
 #[test]
@@ -329,32 +329,35 @@ fn a_minimal_scene_gets_the_documented_defaults() {
     assert_eq!(s.camera.aperture_radius, 0.0);
     assert_eq!(s.camera.focus_distance, 3.0, "|target - eye|");
     assert_eq!((s.camera.shutter_open, s.camera.shutter_close), (0.0, 0.0));
+    // The file gives its size alone: the rest is the defaults'.
+    let given = SettingsLayer {
+        frame: FrameLayer {
+            width: Some(8),
+            height: Some(4),
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    assert_eq!(s.settings, given);
+    let f = s.settings.frame_settings();
     assert_eq!(
-        s.integrator,
+        f.integrator,
         Integrator::Path {
             max_depth: 8,
             rr_depth: 3
         }
     );
     assert_eq!(
-        s.sampler,
-        SamplerSpec {
-            kind: SamplerKind::Sobol,
-            spp: 64,
-            seed: 0,
-            adaptive: None,
-        }
+        (f.sampler, f.spp, f.seed, f.adaptive),
+        (SamplerKind::Sobol, 64, 0, None)
     );
     assert_eq!(
-        s.filter,
+        f.filter,
         Filter::Gaussian {
             radius: 1.5,
             sigma: 0.5
         }
     );
-    assert_eq!(s.film.tonemap, ToneMap::Clamp);
-    assert_eq!(s.film.exposure, 0.0);
-    assert_eq!(s.film.output, None);
     assert!(s.objects.is_empty() && s.lights.is_empty() && s.materials.is_empty());
 }
 
@@ -622,7 +625,7 @@ fn every_example_scene_loads() {
         .iter()
         .any(|m| matches!(m.material.bsdf, Bsdf::Dielectric { .. })));
     assert!(matches!(
-        cornell.integrator,
+        cornell.settings.frame_settings().integrator,
         Integrator::Distribution { .. }
     ));
     let dof = load("bunny_dof.toml");

@@ -33,7 +33,7 @@ use sahara_formats::load_pbrt;
 use sahara_formats::load_rgb_f32;
 use sahara_formats::AssembledScene;
 use sahara_render::defaults::PASS_SPP;
-use sahara_render::{render, RenderSettings};
+use sahara_render::{render, FrameSettings, RenderSettings};
 
 use crate::blocks::block_errors;
 
@@ -267,10 +267,10 @@ fn scene_file(case: &Case) -> Option<PathBuf> {
 /// Sahara's image of `a` as `sahara render FILE --width W --height H --spp N
 /// --seed 0` makes it.
 fn render_image(a: &AssembledScene, case: &Case) -> Vec<Vec3> {
-    let s = a.settings.as_ref().unwrap();
+    let s = a.settings.as_ref().unwrap().frame_settings();
     let mut scene = a.scene.clone();
     scene.camera.aspect = case.width as f32 / case.height as f32;
-    let settings = RenderSettings {
+    let settings = RenderSettings::from(FrameSettings {
         width: case.width,
         height: case.height,
         spp: case.spp,
@@ -279,8 +279,8 @@ fn render_image(a: &AssembledScene, case: &Case) -> Vec<Vec3> {
         sampler: s.sampler,
         filter: s.filter,
         integrator: s.integrator,
-        ..RenderSettings::default()
-    };
+        ..Default::default()
+    });
     let result = render(&scene, &settings, &|_| {}).unwrap();
     assert_eq!(result.stats.nan_samples, 0, "{}", case.name);
     result.film.pixels

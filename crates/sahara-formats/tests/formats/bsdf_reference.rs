@@ -29,8 +29,8 @@ use glam::Vec3;
 use sahara_formats::load_pbrt;
 use sahara_formats::load_rgb_f32;
 use sahara_formats::load_scene;
-use sahara_formats::FileSettings;
-use sahara_render::{render, RenderSettings, Scene};
+
+use sahara_render::{render, FrameSettings, RenderSettings, Scene};
 
 use crate::blocks::block_errors;
 
@@ -69,8 +69,8 @@ fn tolerance(name: &str) -> Tolerance {
     }
 }
 
-fn render_image(scene: &Scene, s: &FileSettings) -> Vec<Vec3> {
-    let settings = RenderSettings {
+fn render_image(scene: &Scene, s: &FrameSettings) -> Vec<Vec3> {
+    let settings = RenderSettings::from(FrameSettings {
         width: s.width,
         height: s.height,
         spp: SPP,
@@ -79,8 +79,8 @@ fn render_image(scene: &Scene, s: &FileSettings) -> Vec<Vec3> {
         sampler: s.sampler,
         filter: s.filter,
         integrator: s.integrator,
-        ..RenderSettings::default()
-    };
+        ..Default::default()
+    });
     let result = render(scene, &settings, &|_| {}).unwrap();
     assert_eq!(result.stats.nan_samples, 0);
     result.film.pixels
@@ -140,12 +140,15 @@ fn every_bsdf_agrees_with_mitsuba() {
         assert!(loaded.warnings.is_empty(), "{name}: {:?}", loaded.warnings);
         assert_eq!(
             (
-                loaded.settings.as_ref().unwrap().width as usize,
-                loaded.settings.as_ref().unwrap().height as usize
+                loaded.settings.as_ref().unwrap().frame_settings().width as usize,
+                loaded.settings.as_ref().unwrap().frame_settings().height as usize
             ),
             (size, size)
         );
-        let image = render_image(&loaded.scene, loaded.settings.as_ref().unwrap());
+        let image = render_image(
+            &loaded.scene,
+            &loaded.settings.as_ref().unwrap().frame_settings(),
+        );
         match check(name, &image, &reference, size) {
             Ok(line) => println!("{line}"),
             Err(line) => failures.push(line),
@@ -153,7 +156,7 @@ fn every_bsdf_agrees_with_mitsuba() {
         let pbrt = dir.join(format!("{name}.pbrt"));
         if pbrt.exists() {
             let p = load_pbrt(&pbrt).unwrap();
-            let image = render_image(&p.scene, p.settings.as_ref().unwrap());
+            let image = render_image(&p.scene, &p.settings.as_ref().unwrap().frame_settings());
             match check(&format!("{name}.pbrt"), &image, &reference, size) {
                 Ok(line) => println!("{line}"),
                 Err(line) => failures.push(line),
@@ -178,7 +181,10 @@ fn a_conductor_with_energy_the_reference_lacks_is_caught() {
     let loaded = load_scene(&path).unwrap();
     let _ = std::fs::remove_dir_all(&tmp);
     let (size, reference) = reference_of(&dir.join("gold_0p3.exr"));
-    let image = render_image(&loaded.scene, loaded.settings.as_ref().unwrap());
+    let image = render_image(
+        &loaded.scene,
+        &loaded.settings.as_ref().unwrap().frame_settings(),
+    );
     let verdict = check("gold_0p3", &image, &reference, size);
     assert!(verdict.is_err(), "not caught: {verdict:?}");
 }

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use sahara_formats::{load_rgb_f32, parse_mitsuba, parse_scene};
-use sahara_render::{render, RenderSettings};
+use sahara_render::{render, FrameSettings, RenderSettings};
 
 use crate::blocks::block_errors;
 
@@ -49,9 +49,9 @@ fn errors(name: &str, text: &str, seed: u64) -> (Vec3, f32, f32) {
     };
     assert!(loaded.warnings.is_empty(), "{name}: {:?}", loaded.warnings);
     assert!(loaded.scene.has_media(), "{name}");
-    let s = loaded.settings.as_ref().unwrap();
+    let s = loaded.settings.as_ref().unwrap().frame_settings();
     assert_eq!((s.width, s.height), (w, h));
-    let settings = RenderSettings {
+    let settings = RenderSettings::from(FrameSettings {
         width: s.width,
         height: s.height,
         spp: SPP,
@@ -60,8 +60,8 @@ fn errors(name: &str, text: &str, seed: u64) -> (Vec3, f32, f32) {
         sampler: s.sampler,
         filter: s.filter,
         integrator: s.integrator,
-        ..RenderSettings::default()
-    };
+        ..Default::default()
+    });
     let result = render(&loaded.scene, &settings, &|_| {}).unwrap();
     assert_eq!(result.stats.nan_samples, 0);
     let image = result.film.pixels;

@@ -26,7 +26,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use sahara_formats::load_rgb_f32;
 use sahara_formats::{LoadOptions, Loaded};
-use sahara_render::{render, RenderSettings};
+use sahara_render::{render, FrameSettings, RenderSettings};
 
 use crate::blocks::block_errors;
 use crate::common::{scenes_dir, skip_note, TempDir};
@@ -81,10 +81,10 @@ fn load(path: &Path, scenes: &Path) -> Loaded {
 /// Sahara's image of `a` at `spp` (the file's size, filter, sampler and
 /// integrator).
 fn render_image(a: &Loaded, spp: u32) -> Vec<Vec3> {
-    let s = a.settings.as_ref().unwrap();
+    let s = a.settings.as_ref().unwrap().frame_settings();
     let mut scene = a.scene.clone();
     scene.camera.aspect = s.width as f32 / s.height as f32;
-    let settings = RenderSettings {
+    let settings = RenderSettings::from(FrameSettings {
         width: s.width,
         height: s.height,
         spp,
@@ -93,8 +93,8 @@ fn render_image(a: &Loaded, spp: u32) -> Vec<Vec3> {
         sampler: s.sampler,
         filter: s.filter,
         integrator: s.integrator,
-        ..RenderSettings::default()
-    };
+        ..Default::default()
+    });
     let result = render(&scene, &settings, &|_| {}).unwrap();
     assert_eq!(result.stats.nan_samples, 0);
     result.film.pixels

@@ -371,7 +371,7 @@ fn shapes_lights_motion_and_settings_are_converted() {
     assert!(matches!(scene.lights[0], Light::Spot { .. }));
     assert!(scene.environment.is_some());
     assert_eq!(
-        l.settings.as_ref().unwrap().integrator,
+        l.settings.as_ref().unwrap().frame_settings().integrator,
         Integrator::Distribution {
             max_depth: 8,
             light_samples: 3
@@ -379,15 +379,15 @@ fn shapes_lights_motion_and_settings_are_converted() {
     );
     assert_eq!(
         (
-            l.settings.as_ref().unwrap().spp,
-            l.settings.as_ref().unwrap().seed
+            l.settings.as_ref().unwrap().frame_settings().spp,
+            l.settings.as_ref().unwrap().frame_settings().seed
         ),
         (7, 9)
     );
     assert_eq!(
         (
-            l.settings.as_ref().unwrap().width,
-            l.settings.as_ref().unwrap().height
+            l.settings.as_ref().unwrap().frame_settings().width,
+            l.settings.as_ref().unwrap().frame_settings().height
         ),
         (8, 4)
     );
@@ -430,12 +430,12 @@ fn a_scene_file_integrator_without_parameters_gets_the_command_line_defaults() {
         );
         let l = load_scene(&path).unwrap();
         assert_eq!(
-            Ok(l.settings.as_ref().unwrap().integrator),
+            Ok(l.settings.as_ref().unwrap().frame_settings().integrator),
             Integrator::named(name),
             "{name}"
         );
         assert_eq!(
-            l.settings.as_ref().unwrap().spp,
+            l.settings.as_ref().unwrap().frame_settings().spp,
             sahara_render::defaults::SPP,
             "{name}"
         );

@@ -167,12 +167,14 @@ impl RayShear {
         if (u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0) {
             return None;
         }
-        let rcp = 1.0 / det;
         let t = plane().distance(self.origin, self.dir);
         // As in `intersect`.
         if !(t > tmin && t <= tmax) {
             return None;
         }
+        // Only now: most candidates lie outside the interval (the
+        // triangle a ray leaves, those beyond the closest hit so far).
+        let rcp = 1.0 / det;
         Some(TriangleHit {
             t: t + 0.0,
             u: v * rcp,

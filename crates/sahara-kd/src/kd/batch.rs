@@ -2,13 +2,12 @@
 
 use rayon::prelude::*;
 
-use super::query::{AnyLeaf, ClosestLeaf};
+use super::query::{AnyLeaf, ClosestLeaf, LayoutQuery, OverLeaves};
 use super::KdTree;
 use crate::isect::Hit;
-use crate::leaf::layout::{Indexed, Layout, Whole};
-use crate::leaf::TriangleLeaves;
+use crate::leaf::layout::Layout;
 use crate::math::{Aabb, Ray, Triangle};
-use crate::simd::{dispatch, level, Kernel};
+use crate::simd::{dispatch, level};
 
 /// Rays per work item of [`KdTree::closest_hits`] and [`KdTree::any_hits`].
 pub(crate) const BATCH: usize = 256;
@@ -41,11 +40,7 @@ impl KdTree<Triangle> {
             rays,
             out,
             walk,
-            |out| ClosestBatch {
-                tree: self,
-                rays,
-                out,
-            },
+            |out| ClosestBatch { rays, out },
             |r| self.closest_hit(r),
         );
     }
@@ -64,11 +59,7 @@ impl KdTree<Triangle> {
             rays,
             out,
             walk,
-            |out| AnyBatch {
-                tree: self,
-                rays,
-                out,
-            },
+            |out| AnyBatch { rays, out },
             |r| self.any_hit(r),
         );
     }
@@ -76,17 +67,18 @@ impl KdTree<Triangle> {
     /// Answers `rays` into `out`: by the interleaved wide walk of
     /// `kernel` if the batch takes it (see [`KdTree::interleaves`]), else
     /// ray by ray with `one`.
-    fn batch<'a, T, K: Kernel<Output = ()>>(
+    fn batch<'a, T, Q: LayoutQuery<Output = ()>>(
         &self,
         rays: &[Ray],
         out: &'a mut [T],
         walk: BatchWalk,
-        kernel: impl FnOnce(&'a mut [T]) -> K,
+        kernel: impl FnOnce(&'a mut [T]) -> Q,
         one: impl Fn(&Ray) -> T,
     ) {
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
         if self.interleaves(rays, walk) {
-            dispatch(level::AVX512, kernel(out));
+            let query = kernel(out);
+            dispatch(level::AVX512, OverLeaves { tree: self, query });
         } else {
             for (r, o) in rays.iter().zip(out) {
                 *o = one(r);
@@ -160,17 +152,17 @@ fn coherent(rays: &[Ray], bounds: Aabb) -> bool {
     4 * close >= 3 * pairs
 }
 
-/// [`KdTree::closest_hits_serial`] as a kernel for [`dispatch`].
+/// [`KdTree::closest_hits_serial`] as a [`LayoutQuery`].
 struct ClosestBatch<'a> {
-    tree: &'a KdTree<Triangle>,
     rays: &'a [Ray],
     out: &'a mut [Option<Hit>],
 }
 
-impl ClosestBatch<'_> {
+impl LayoutQuery for ClosestBatch<'_> {
+    type Output = ();
     #[inline(always)]
-    fn over<L: Layout, const SIMD: u8>(self, layout: L) {
-        let Self { tree, rays, out } = self;
+    fn over<L: Layout, const SIMD: u8>(self, tree: &KdTree<Triangle>, layout: L) {
+        let Self { rays, out } = self;
         tree.walk_interleaved::<_, SIMD>(
             rays,
             |i| ClosestLeaf::<L, SIMD>::new(tree, layout, &rays[i]),
@@ -179,28 +171,17 @@ impl ClosestBatch<'_> {
     }
 }
 
-impl Kernel for ClosestBatch<'_> {
-    type Output = ();
-    #[inline(always)]
-    unsafe fn run<const LEVEL: u8>(self) {
-        match &self.tree.leaf_data {
-            TriangleLeaves::Whole(v) => self.over::<_, LEVEL>(Whole(v)),
-            TriangleLeaves::Indexed(p) => self.over::<_, LEVEL>(Indexed(p)),
-        }
-    }
-}
-
-/// [`KdTree::any_hits_serial`] as a kernel for [`dispatch`].
+/// [`KdTree::any_hits_serial`] as a [`LayoutQuery`].
 struct AnyBatch<'a> {
-    tree: &'a KdTree<Triangle>,
     rays: &'a [Ray],
     out: &'a mut [bool],
 }
 
-impl AnyBatch<'_> {
+impl LayoutQuery for AnyBatch<'_> {
+    type Output = ();
     #[inline(always)]
-    fn over<L: Layout, const SIMD: u8>(self, layout: L) {
-        let Self { tree, rays, out } = self;
+    fn over<L: Layout, const SIMD: u8>(self, tree: &KdTree<Triangle>, layout: L) {
+        let Self { rays, out } = self;
         tree.walk_interleaved::<_, SIMD>(
             rays,
             |i| AnyLeaf::<L, SIMD>::new(layout, &rays[i]),
@@ -209,23 +190,16 @@ impl AnyBatch<'_> {
     }
 }
 
-impl Kernel for AnyBatch<'_> {
-    type Output = ();
-    #[inline(always)]
-    unsafe fn run<const LEVEL: u8>(self) {
-        match &self.tree.leaf_data {
-            TriangleLeaves::Whole(v) => self.over::<_, LEVEL>(Whole(v)),
-            TriangleLeaves::Indexed(p) => self.over::<_, LEVEL>(Indexed(p)),
-        }
-    }
-}
-
 /// `out[i] = query(&rays[i])` for every ray, in work items of [`BATCH`]
 /// rays, every one its own job (`with_max_len(1)`): rayon otherwise splits
 /// a range only a few times unless a thief steals, so a costly quarter of
 /// an image could hold one thread while the other idles (see
 /// `docs/performance.md`).
-fn in_parallel<T: Send>(rays: &[Ray], out: &mut [T], query: impl Fn(&[Ray], &mut [T]) + Sync) {
+pub(crate) fn in_parallel<T: Send>(
+    rays: &[Ray],
+    out: &mut [T],
+    query: impl Fn(&[Ray], &mut [T]) + Sync,
+) {
     assert_eq!(rays.len(), out.len(), "one output slot per ray");
     rays.par_chunks(BATCH)
         .zip(out.par_chunks_mut(BATCH))
@@ -265,26 +239,18 @@ mod tests {
             assert!(!tree.wide.is_empty());
             for top in [level::PORTABLE, level::AVX2, level::AVX512] {
                 let mut out = vec![None; rays.len()];
-                let out_ref = &mut out;
-                dispatch(
-                    top,
-                    ClosestBatch {
-                        tree: &tree,
-                        rays: &rays,
-                        out: out_ref,
-                    },
-                );
+                let query = ClosestBatch {
+                    rays: &rays,
+                    out: &mut out,
+                };
+                dispatch(top, OverLeaves { tree: &tree, query });
                 assert_eq!(out, want, "level {top}, compact {compact_leaves}");
                 let mut occluded = vec![false; rays.len()];
-                let o = &mut occluded;
-                dispatch(
-                    top,
-                    AnyBatch {
-                        tree: &tree,
-                        rays: &rays,
-                        out: o,
-                    },
-                );
+                let query = AnyBatch {
+                    rays: &rays,
+                    out: &mut occluded,
+                };
+                dispatch(top, OverLeaves { tree: &tree, query });
                 let any: Vec<bool> = want.iter().map(|h| h.is_some()).collect();
                 assert_eq!(occluded, any, "level {top}, compact {compact_leaves}");
             }

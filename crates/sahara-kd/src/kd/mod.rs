@@ -1,7 +1,7 @@
 //! The kd-tree: its 8-byte nodes, the flattening of a build into them, the
 //! single-ray walk and its queries, batches and packets.
 
-mod batch;
+pub(crate) mod batch;
 mod box_query;
 mod counters;
 mod flatten;

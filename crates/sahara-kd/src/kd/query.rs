@@ -216,12 +216,8 @@ impl KdTree<Triangle> {
 
     /// [`KdTree::closest_hit`], counting the work done.
     pub fn closest_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
-        let q = ClosestQuery {
-            tree: self,
-            ray,
-            counters,
-        };
-        dispatch(self.single_ray_level(), q)
+        let query = ClosestQuery { ray, counters };
+        dispatch(self.single_ray_level(), OverLeaves { tree: self, query })
     }
 
     /// True if any triangle is hit with `t` in `(ray.tmin, ray.tmax]`
@@ -232,12 +228,8 @@ impl KdTree<Triangle> {
 
     /// [`KdTree::any_hit`], counting the work done.
     pub fn any_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
-        let q = AnyQuery {
-            tree: self,
-            ray,
-            counters,
-        };
-        dispatch(self.single_ray_level(), q)
+        let query = AnyQuery { ray, counters };
+        dispatch(self.single_ray_level(), OverLeaves { tree: self, query })
     }
 
     /// Every hit with `t` in `(ray.tmin, ray.tmax]`, into `hits` (cleared
@@ -248,12 +240,8 @@ impl KdTree<Triangle> {
     /// for every hit along a ray.
     pub fn all_hits(&self, ray: &Ray, hits: &mut Vec<Hit>) {
         hits.clear();
-        let q = AllQuery {
-            tree: self,
-            ray,
-            hits,
-        };
-        dispatch(self.single_ray_level(), q);
+        let query = AllQuery { ray, hits };
+        dispatch(self.single_ray_level(), OverLeaves { tree: self, query });
         // A triangle referenced by several leaves is found in each.
         hits.sort_unstable_by_key(|h| h.tri);
         hits.dedup_by_key(|h| h.tri);
@@ -325,57 +313,77 @@ impl KdTree<Triangle> {
     }
 }
 
-/// [`KdTree::closest_hit_counted`] as a kernel for [`dispatch`].
+/// A query written once for both leaf layouts and every instruction-set
+/// level; [`OverLeaves`] runs it over a tree's own layout.
+pub(crate) trait LayoutQuery {
+    /// What the query returns.
+    type Output;
+
+    /// The query on `tree`, whose leaf blocks are `layout`, with level
+    /// `SIMD`'s instructions. Implementations are `#[inline(always)]`, as
+    /// [`Kernel::run`] is.
+    fn over<L: Layout, const SIMD: u8>(self, tree: &KdTree<Triangle>, layout: L) -> Self::Output;
+}
+
+/// `query` on `tree` as a kernel for [`dispatch`]. The layout is matched
+/// here, once per query, so that the walk's loop holds one leaf test (see
+/// `Layout`).
+pub(crate) struct OverLeaves<'t, Q> {
+    pub(crate) tree: &'t KdTree<Triangle>,
+    pub(crate) query: Q,
+}
+
+impl<Q: LayoutQuery> Kernel for OverLeaves<'_, Q> {
+    type Output = Q::Output;
+    #[inline(always)]
+    unsafe fn run<const LEVEL: u8>(self) -> Q::Output {
+        let Self { tree, query } = self;
+        match &tree.leaf_data {
+            TriangleLeaves::Whole(v) => query.over::<_, LEVEL>(tree, Whole(v)),
+            TriangleLeaves::Indexed(p) => query.over::<_, LEVEL>(tree, Indexed(p)),
+        }
+    }
+}
+
+/// [`KdTree::closest_hit_counted`] as a [`LayoutQuery`].
 pub(crate) struct ClosestQuery<'a, C> {
-    pub(crate) tree: &'a KdTree<Triangle>,
     pub(crate) ray: &'a Ray,
     pub(crate) counters: &'a mut C,
 }
 
-impl<C: Counters> Kernel for ClosestQuery<'_, C> {
+impl<C: Counters> LayoutQuery for ClosestQuery<'_, C> {
     type Output = Option<Hit>;
     #[inline(always)]
-    unsafe fn run<const LEVEL: u8>(self) -> Option<Hit> {
-        let (t, r, c) = (self.tree, self.ray, self.counters);
-        // The layout is picked once per query, so that the walk's loop
-        // holds one leaf test (see `Layout`).
-        match &t.leaf_data {
-            TriangleLeaves::Whole(v) => t.closest_hit_over::<C, LEVEL, _>(Whole(v), r, c),
-            TriangleLeaves::Indexed(p) => t.closest_hit_over::<C, LEVEL, _>(Indexed(p), r, c),
-        }
+    fn over<L: Layout, const SIMD: u8>(self, tree: &KdTree<Triangle>, layout: L) -> Option<Hit> {
+        tree.closest_hit_over::<C, SIMD, _>(layout, self.ray, self.counters)
     }
 }
 
-/// [`KdTree::any_hit_counted`] as a kernel for [`dispatch`].
+/// [`KdTree::any_hit_counted`] as a [`LayoutQuery`].
 pub(crate) struct AnyQuery<'a, C> {
-    pub(crate) tree: &'a KdTree<Triangle>,
     pub(crate) ray: &'a Ray,
     pub(crate) counters: &'a mut C,
 }
 
-impl<C: Counters> Kernel for AnyQuery<'_, C> {
+impl<C: Counters> LayoutQuery for AnyQuery<'_, C> {
     type Output = bool;
     #[inline(always)]
-    unsafe fn run<const LEVEL: u8>(self) -> bool {
-        let (t, r, c) = (self.tree, self.ray, self.counters);
-        match &t.leaf_data {
-            TriangleLeaves::Whole(v) => t.any_hit_over::<C, LEVEL, _>(Whole(v), r, c),
-            TriangleLeaves::Indexed(p) => t.any_hit_over::<C, LEVEL, _>(Indexed(p), r, c),
-        }
+    fn over<L: Layout, const SIMD: u8>(self, tree: &KdTree<Triangle>, layout: L) -> bool {
+        tree.any_hit_over::<C, SIMD, _>(layout, self.ray, self.counters)
     }
 }
 
-/// [`KdTree::all_hits`] as a kernel for [`dispatch`].
+/// [`KdTree::all_hits`] as a [`LayoutQuery`].
 struct AllQuery<'a> {
-    tree: &'a KdTree<Triangle>,
     ray: &'a Ray,
     hits: &'a mut Vec<Hit>,
 }
 
-impl AllQuery<'_> {
+impl LayoutQuery for AllQuery<'_> {
+    type Output = ();
     #[inline(always)]
-    fn over<L: Layout, const SIMD: u8>(self, layout: L) {
-        let Self { tree, ray, hits } = self;
+    fn over<L: Layout, const SIMD: u8>(self, tree: &KdTree<Triangle>, layout: L) {
+        let Self { ray, hits } = self;
         let mut leaf = AllLeaf::<L, SIMD> {
             tree,
             layout,
@@ -385,17 +393,6 @@ impl AllQuery<'_> {
             hits,
         };
         tree.walk(ray, &mut NoCounters, &mut leaf);
-    }
-}
-
-impl Kernel for AllQuery<'_> {
-    type Output = ();
-    #[inline(always)]
-    unsafe fn run<const LEVEL: u8>(self) {
-        match &self.tree.leaf_data {
-            TriangleLeaves::Whole(v) => self.over::<_, LEVEL>(Whole(v)),
-            TriangleLeaves::Indexed(p) => self.over::<_, LEVEL>(Indexed(p)),
-        }
     }
 }
 
@@ -427,18 +424,18 @@ mod tests {
                 assert_eq!(tree.any_hit(&ray), want.is_some());
                 for top in [level::PORTABLE, level::AVX2, level::AVX512] {
                     let counters = &mut NoCounters;
-                    let q = ClosestQuery {
-                        tree: &tree,
+                    let query = ClosestQuery {
                         ray: &ray,
                         counters,
                     };
+                    let q = OverLeaves { tree: &tree, query };
                     assert_eq!(dispatch(top, q), want, "level {top}");
                     let counters = &mut NoCounters;
-                    let q = AnyQuery {
-                        tree: &tree,
+                    let query = AnyQuery {
                         ray: &ray,
                         counters,
                     };
+                    let q = OverLeaves { tree: &tree, query };
                     assert_eq!(dispatch(top, q), want.is_some(), "level {top}");
                 }
             }

@@ -22,12 +22,13 @@ pub(crate) mod level {
     pub const AVX512: u8 = 2;
 }
 
-/// True when the CPU has AVX2, and the bit instructions every AVX2 CPU
-/// has (POPCNT, BMI1, BMI2); std caches the CPUID query.
+/// True when the CPU has AVX2, and the instructions every AVX2 CPU has
+/// (FMA, POPCNT, BMI1, BMI2); std caches the CPUID query.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 pub(crate) fn has_avx2() -> bool {
     std::arch::is_x86_feature_detected!("avx2")
+        && std::arch::is_x86_feature_detected!("fma")
         && std::arch::is_x86_feature_detected!("popcnt")
         && std::arch::is_x86_feature_detected!("bmi1")
         && std::arch::is_x86_feature_detected!("bmi2")
@@ -87,12 +88,12 @@ pub(crate) fn dispatch<K: Kernel>(top: u8, kernel: K) -> K::Output {
     }
 }
 
-/// `kernel` compiled for AVX2 (with POPCNT, BMI1, BMI2).
+/// `kernel` compiled for AVX2 (with FMA, POPCNT, BMI1, BMI2).
 ///
 /// # Safety
 /// The CPU must have them (`has_avx2`).
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,popcnt,bmi1,bmi2")]
+#[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2")]
 unsafe fn run_avx2<K: Kernel>(kernel: K) -> K::Output {
     // SAFETY: AVX2 (the caller's contract), and this function is compiled
     // for it.
@@ -104,7 +105,7 @@ unsafe fn run_avx2<K: Kernel>(kernel: K) -> K::Output {
 /// # Safety
 /// The CPU must have AVX2 and AVX-512 F, VL.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,popcnt,bmi1,bmi2,avx512f,avx512vl")]
+#[target_feature(enable = "avx2,fma,popcnt,bmi1,bmi2,avx512f,avx512vl")]
 unsafe fn run_avx512<K: Kernel>(kernel: K) -> K::Output {
     // SAFETY: as `run_avx2`, for this level.
     unsafe { kernel.run::<{ level::AVX512 }>() }

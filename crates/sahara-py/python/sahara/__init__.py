@@ -17,7 +17,6 @@ See docs/python.md in the repository.
 from __future__ import annotations
 
 import errno
-import operator
 import os
 import sys
 import time
@@ -83,45 +82,6 @@ def _define(v: Any) -> str:
     if isinstance(v, (list, tuple)):
         return ", ".join(str(x) for x in v)
     return str(v)
-
-
-def _whole(name: str, value: Any, low: int, high: int) -> Optional[int]:
-    """``value`` as a whole number in ``low..=high`` (None stays None): a
-    ``TypeError`` for what is not a whole number, a ``ValueError`` naming
-    the argument for one out of range."""
-    if value is None:
-        return None
-    if isinstance(value, bool):
-        raise TypeError(f"{name} must be a whole number, not bool")
-    try:
-        v = operator.index(value)
-    except TypeError:
-        raise TypeError(f"{name} must be a whole number, not {type(value).__name__}") from None
-    if low <= v <= high:
-        return v
-    if high < 2**31:
-        raise ValueError(f"{name} must be {low}..={high}, not {v}")
-    if v < low:
-        raise ValueError(f"{name} must be at least {low}, not {v}")
-    raise ValueError(f"{name} must be at most {high}, not {v}")
-
-
-def _pass_names(aovs: Any) -> Optional[list]:
-    """The render passes asked for: one name, or a sequence of names."""
-    if aovs is None:
-        return None
-    if isinstance(aovs, str):
-        return [aovs]
-    try:
-        names_ = list(aovs)
-    except TypeError:
-        raise TypeError(
-            f"aovs must be a pass name or a sequence of names, not {type(aovs).__name__}"
-        ) from None
-    for n in names_:
-        if not isinstance(n, str):
-            raise TypeError(f"aovs: each pass is named by a str, not {type(n).__name__}")
-    return names_
 
 
 class _Bar:
@@ -192,46 +152,44 @@ class _Bar:
 def render(
     scene: Union[Scene, PathLike],
     *,
-    spp: Optional[int] = None,
-    width: Optional[int] = None,
-    height: Optional[int] = None,
-    integrator: Optional[str] = None,
-    seed: Optional[int] = None,
-    threads: Optional[int] = None,
-    aovs: Optional[Union[str, Sequence[str]]] = None,
-    denoise: bool = False,
     progress: Union[bool, Callable[[int, int], Any]] = True,
-    sampler: Optional[str] = None,
-    filter: Optional[str] = None,
-    pass_spp: Optional[int] = None,
-    builder: Optional[str] = None,
+    threads: Optional[int] = None,
+    **settings: Any,
 ) -> Union[np.ndarray, Tuple[np.ndarray, Dict[str, np.ndarray]]]:
-    """Renders a scene (a ``Scene`` or a file's path) as ``sahara render``
-    does: the arguments given override the file's settings, which override
-    the defaults (512 x 512, 64 spp, the path tracer, seed 0); the same
-    arguments give the same image, bit for bit, as the command line.
+    """Renders a scene (a ``Scene`` or a file's path) through the request
+    ``sahara render`` makes: the settings given override the file's
+    settings, which override the defaults (512 x 512, 64 spp, the path
+    tracer, seed 0); the same settings give the same image, bit for bit,
+    as the command line, and with ``output`` the same file.
 
-    Returns the linear RGB image, a float32 array (height, width, 3); with
-    ``aovs`` (any of ``albedo``, ``normal``, ``depth``, ``position``,
-    ``uv``, ``variance``, ``object``, ``material``; one name or a
-    sequence of names) a pair ``(image, passes)`` whose dict holds one
-    array per pass. Settings out of range are a ``ValueError`` naming the
-    argument (``spp`` at least 1, ``width`` and ``height`` 1 to 65536,
-    ``seed`` at least 0, ``threads`` 0 (all) to 1024), what is not a
-    whole number a ``TypeError``. ``denoise`` runs Intel
-    Open Image Denoise (``pip install pyoidn``). ``progress``: a bar on
-    stderr (True), none (False), or a function called with (tiles done,
-    tiles in all). The GIL is released while rendering on ``threads``
-    threads (None: all); Ctrl-C stops the render after the tiles under way
-    and raises ``KeyboardInterrupt``.
+    The settings are the command line's render options as keywords
+    (``sahara.names()["setting"]`` lists them): ``spp``, ``width``,
+    ``height``, ``integrator``, ``sampler``, ``filter``, ``seed``,
+    ``pass_spp``, ``accel``, ``builder``; ``path_loop`` (``"auto"``,
+    ``"lanes"``, ``"lanes-no-refill"``, ``"scalar"``: how the path tracer
+    traces its samples); ``noise_threshold`` and ``min_spp``
+    (adaptive sampling); ``time_limit`` (seconds: without ``spp`` the
+    passes go on until it is up); ``aovs`` (any of ``albedo``, ``normal``,
+    ``depth``, ``position``, ``uv``, ``variance``, ``object``,
+    ``material``; one name or a sequence of names); ``denoise`` (Intel Open Image Denoise, ``pip install
+    pyoidn``); ``output`` (a ``.png`` or ``.exr`` file written as the
+    command line writes it, with ``exposure`` and ``tonemap``); ``part``
+    (``(i, n)``), ``split`` (``"tiles"`` or ``"samples"``), ``crop``
+    (``(x0, x1, y0, y1)``) and ``samples`` (``(start, end)``): a piece of
+    the frame, its ``output`` a part file for ``sahara merge``.
+
+    Returns the linear RGB image, a float32 array (height, width, 3), of
+    the crop window or piece if one is asked for; with ``aovs`` a pair
+    ``(image, passes)`` whose dict holds one array per pass.
+    ``progress``: a bar on stderr (True), none (False), or a function
+    called with (tiles done, tiles in all). The GIL is released while
+    rendering on ``threads`` threads (None or 0: all, at most 1024);
+    Ctrl-C stops the render after the tiles under way and raises
+    ``KeyboardInterrupt``. A setting out of range raises ``ValueError``, of
+    the wrong type (``spp=2.5``, ``spp="16"``) ``TypeError``, a render
+    larger than the memory available ``MemoryError``, each naming the
+    argument at fault.
     """
-    spp = _whole("spp", spp, 1, 2**32 - 1)
-    width = _whole("width", width, 1, 65536)
-    height = _whole("height", height, 1, 65536)
-    pass_spp = _whole("pass_spp", pass_spp, 1, 2**32 - 1)
-    seed = _whole("seed", seed, 0, 2**64 - 1)
-    threads = _whole("threads", threads, 0, 1024)
-    aovs = _pass_names(aovs)
     if not isinstance(scene, Scene):
         scene = load(scene)
     bar = None
@@ -244,27 +202,12 @@ def render(
         callback = None
     finished = False
     try:
-        image, passes = _sahara.render(
-            scene,
-            spp=spp,
-            width=width,
-            height=height,
-            integrator=integrator,
-            seed=seed,
-            threads=threads,
-            aovs=aovs or None,
-            denoise=denoise,
-            sampler=sampler,
-            filter=filter,
-            pass_spp=pass_spp,
-            builder=builder,
-            progress=callback,
-        )
+        image, passes = _sahara.render(scene, threads=threads, progress=callback, **settings)
         finished = True
     finally:
         if bar is not None:
             bar.close(finished)
-    return (image, passes) if aovs else image
+    return (image, passes) if settings.get("aovs") else image
 
 
 def write(

@@ -1,6 +1,7 @@
 """Type stubs of the native module `sahara._sahara` (see `sahara`)."""
 
-from typing import Any, Callable, Dict, List, Optional, Tuple, Union
+import os
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -22,7 +23,8 @@ class RayScene:
         vertices: Optional[npt.ArrayLike] = None,
         faces: Optional[npt.ArrayLike] = None,
         *,
-        builder: str = "sah",
+        accel: str = "bvh",
+        builder: Optional[str] = None,
         threads: Optional[int] = None,
     ) -> None: ...
     def add_mesh(self, vertices: npt.ArrayLike, faces: npt.ArrayLike) -> int:
@@ -111,19 +113,31 @@ def cornell_box(*, camera: Optional[str] = None, sky: Optional[str] = None) -> S
 def render(
     scene: Scene,
     *,
+    threads: Optional[int] = None,
+    progress: Optional[Callable[[int, int], Any]] = None,
+    output: Optional[Union[str, "os.PathLike[str]"]] = None,
     spp: Optional[int] = None,
+    noise_threshold: Optional[float] = None,
+    min_spp: Optional[int] = None,
+    pass_spp: Optional[int] = None,
     width: Optional[int] = None,
     height: Optional[int] = None,
     integrator: Optional[str] = None,
-    seed: Optional[int] = None,
-    threads: Optional[int] = None,
-    aovs: Optional[List[str]] = None,
-    denoise: bool = False,
     sampler: Optional[str] = None,
+    path_loop: Optional[str] = None,
     filter: Optional[str] = None,
-    pass_spp: Optional[int] = None,
+    seed: Optional[int] = None,
+    time_limit: Optional[float] = None,
+    accel: Optional[str] = None,
     builder: Optional[str] = None,
-    progress: Optional[Callable[[int, int], Any]] = None,
+    exposure: Optional[float] = None,
+    tonemap: Optional[str] = None,
+    part: Optional[Union[str, Tuple[int, int]]] = None,
+    split: Optional[str] = None,
+    crop: Optional[Union[str, Sequence[float]]] = None,
+    samples: Optional[Union[str, Tuple[int, int]]] = None,
+    aovs: Optional[Union[str, Sequence[str]]] = None,
+    denoise: Optional[bool] = None,
 ) -> Tuple[npt.NDArray[np.float32], Dict[str, np.ndarray]]: ...
 def write(
     path: str,

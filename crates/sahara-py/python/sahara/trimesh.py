@@ -34,15 +34,23 @@ __all__ = ["RayMeshIntersector"]
 
 
 class RayMeshIntersector:
-    """Ray queries on a trimesh mesh with Sahara's kd-tree.
+    """Ray queries on a trimesh mesh with Sahara's accelerator (the
+    eight-wide BVH by default).
 
-    The tree is built at the first query and rebuilt when the mesh changes
-    (its hash, as trimesh's intersectors check). ``builder`` and
-    ``threads`` are those of ``sahara.RayScene``.
+    The structure is built at the first query and rebuilt when the mesh
+    changes (its hash, as trimesh's intersectors check). ``accel``,
+    ``builder`` and ``threads`` are those of ``sahara.RayScene``.
     """
 
-    def __init__(self, geometry: Any, builder: str = "sah", threads: Optional[int] = None):
+    def __init__(
+        self,
+        geometry: Any,
+        accel: str = "bvh",
+        builder: Optional[str] = None,
+        threads: Optional[int] = None,
+    ):
         self.mesh = geometry
+        self._accel = accel
         self._builder = builder
         self._threads = threads
         self._scene: Optional[RayScene] = None
@@ -56,6 +64,7 @@ class RayMeshIntersector:
             self._scene = RayScene(
                 np.asarray(self.mesh.vertices, dtype=np.float64),
                 np.asarray(self.mesh.faces, dtype=np.int64),
+                accel=self._accel,
                 builder=self._builder,
                 threads=self._threads,
             )

@@ -16,8 +16,8 @@ use std::collections::{HashMap, HashSet};
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use crate::Mesh;
 use glam::{Vec2, Vec3};
+use sahara_kd::Mesh;
 
 use super::{locate, obj_load_options, tobj_source};
 use crate::error::FormatError;

@@ -1,6 +1,7 @@
 //! The scene's acceleration structure, organised as Mitsuba and Embree
 //! organise theirs: the static geometry that is not instanced sits in one
-//! world-space kd-tree, and real instances keep two levels.
+//! world-space tree (an eight-wide bounding volume hierarchy by default, or
+//! a kd-tree: `RenderSettings::build`), and real instances keep two levels.
 //!
 //! - Every instance that is static, whose mesh no other instance uses, and
 //!   that no occlusion query may ignore (see [`Accel::build`]) is *merged*:
@@ -8,7 +9,7 @@
 //!   world tree with the others, traced without any transform.
 //! - The others (meshes shared by several instances, moving instances,
 //!   analytic emitters, and a ground plane that dwarfs the rest, see
-//!   [`grounds`]) keep one kd-tree per mesh in object space and a top
+//!   [`grounds`]) keep one tree per mesh in object space and a top
 //!   level over their world (swept) bounds. Rays are moved into an
 //!   instance's object space at their time; ray parameters are preserved by
 //!   the affine map, so hits of different instances, and of the world tree,
@@ -23,7 +24,9 @@
 pub mod top_level;
 
 use glam::Affine3A;
-use sahara_kd::{Aabb, BuildParams, Counters, Hit, KdTree, NoCounters, Ray, Triangle, PACKET16};
+use sahara_kd::{
+    Aabb, AccelParams, Counters, Hit, NoCounters, Ray, Triangle, TriangleAccel, PACKET16,
+};
 
 use crate::scene::instance::{Instance, Placement};
 use crate::scene::mesh::SceneMesh;
@@ -73,11 +76,11 @@ impl RawHit {
     }
 }
 
-/// How a scene's geometry was organised: how many kd-trees were built for
+/// How a scene's geometry was organised: how many trees were built for
 /// how many instances, and how many of those went into the world tree.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct AccelLayout {
-    /// Kd-trees built: the world tree (if any instance was merged) and one
+    /// Trees built: the world tree (if any instance was merged) and one
     /// per mesh of the two-level instances.
     pub trees: usize,
     /// Instances in all.
@@ -134,7 +137,7 @@ fn reach(t: f32) -> f32 {
 pub struct Accel {
     /// The merged instances' triangles in world space (None when there
     /// are none).
-    world: Option<KdTree>,
+    world: Option<TriangleAccel>,
     /// The merged instances, in increasing index order.
     merged: Vec<u32>,
     /// The world tree's index of each merged instance's first triangle.
@@ -145,7 +148,7 @@ pub struct Accel {
     merged_first: Vec<u32>,
     /// One object-space tree per mesh of the instances that are not
     /// merged.
-    trees: Vec<KdTree>,
+    trees: Vec<TriangleAccel>,
     /// Every instance.
     placed: Vec<Placed>,
     /// The instances that are not merged, in increasing index order; the
@@ -235,7 +238,7 @@ impl Accel {
     pub fn build(
         meshes: &[SceneMesh],
         instances: &[Instance],
-        params: &BuildParams,
+        params: &AccelParams,
         ignorable: &[u32],
     ) -> Self {
         let mut uses = vec![0u32; meshes.len()];
@@ -290,7 +293,7 @@ impl Accel {
                 )
             }));
         }
-        let world = (!world_tris.is_empty()).then(|| KdTree::build(world_tris, params));
+        let world = (!world_tris.is_empty()).then(|| TriangleAccel::build(world_tris, params));
 
         // The two-level rest: one tree per mesh used, in mesh order.
         let mut tree_of = vec![MERGED; meshes.len()];
@@ -304,7 +307,7 @@ impl Accel {
             let m = inst.mesh as usize;
             if tree_of[m] == MERGED {
                 tree_of[m] = trees.len() as u32;
-                trees.push(KdTree::build(meshes[m].mesh.triangles(), params));
+                trees.push(TriangleAccel::build(meshes[m].mesh.triangles(), params));
             }
         }
         let placed: Vec<Placed> = instances
@@ -347,7 +350,7 @@ impl Accel {
         }
     }
 
-    /// Number of kd-trees: the world tree (if any instance was merged)
+    /// Number of trees: the world tree (if any instance was merged)
     /// and one per mesh of the other instances, however many instances
     /// share it.
     pub fn tree_count(&self) -> usize {
@@ -389,13 +392,13 @@ impl Accel {
         self.placed[i as usize].tree == MERGED
     }
 
-    /// Bytes held by the kd-trees (nodes, leaf indices, triangles, leaf
+    /// Bytes held by the trees (nodes, leaf indices, triangles, leaf
     /// blocks).
     pub fn tree_bytes(&self) -> usize {
         self.world
             .iter()
             .chain(&self.trees)
-            .map(|t| t.stats().memory_bytes)
+            .map(|t| t.memory_bytes())
             .sum()
     }
 
@@ -489,7 +492,7 @@ impl Accel {
     /// Closest hits of up to [`PACKET16`] rays, `rays[i]` at shutter
     /// fraction `s[i]`, exactly as [`Accel::closest`] finds them: the
     /// world tree traces the rays as one packet (see
-    /// [`KdTree::closest_hit_packet16`]); then a scene of a few two-level
+    /// [`TriangleAccel::closest_hit_packet16`]); then a scene of a few two-level
     /// instances traces the packet through each instance's tree in turn,
     /// each ray's interval cut at its closest hit so far, and a scene of
     /// more, ray by ray through the top level.
@@ -533,7 +536,7 @@ impl Accel {
 
     /// Closest hits of many rays, `rays[i]` at shutter fraction `s[i]`,
     /// exactly as [`Accel::closest`] finds them: the world tree traces all
-    /// the rays as one batch ([`KdTree::closest_hits_serial`], which walks
+    /// the rays as one batch ([`TriangleAccel::closest_hits_serial`], which walks
     /// incoherent rays interleaved over the wide nodes); then a scene of a
     /// few two-level instances traces them through each instance's tree
     /// in turn as one batch, each ray's interval cut at its closest hit so

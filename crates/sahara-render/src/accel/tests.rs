@@ -4,7 +4,15 @@
 //! single-ray form.
 
 use glam::{Affine3A, Quat, Vec3};
-use sahara_kd::{brute, BuildParams, NoCounters, Ray, Triangle, PACKET16};
+use sahara_kd::{brute, AccelParams, BuildParams, NoCounters, Ray, Triangle, PACKET16};
+
+/// Both structures, the hierarchy (the default) and the kd-tree.
+fn structures() -> [AccelParams; 2] {
+    [
+        AccelParams::default(),
+        AccelParams::kd(BuildParams::default()),
+    ]
+}
 
 use super::{Accel, BatchBuffers, RawHit};
 use crate::scene::instance::{Instance, Placement, Srt};
@@ -236,7 +244,7 @@ fn rays(meshes: &[SceneMesh], instances: &[Instance], n: usize) -> (Vec<Ray>, Ve
 #[test]
 fn the_layout_merges_what_is_static_unshared_and_not_ignorable() {
     let (meshes, instances, ignorable) = scene(3);
-    let accel = Accel::build(&meshes, &instances, &BuildParams::default(), &ignorable);
+    let accel = Accel::build(&meshes, &instances, &AccelParams::default(), &ignorable);
     let merged: Vec<u32> = (0..instances.len() as u32)
         .filter(|&i| accel.is_merged(i))
         .collect();
@@ -284,7 +292,7 @@ fn a_ground_that_dwarfs_the_rest_keeps_its_own_tree() {
     let instances: Vec<Instance> = (0..3)
         .map(|m| Instance::new(m, Affine3A::IDENTITY, None))
         .collect();
-    let accel = Accel::build(&meshes, &instances, &BuildParams::default(), &[]);
+    let accel = Accel::build(&meshes, &instances, &AccelParams::default(), &[]);
     let merged: Vec<bool> = (0..3).map(|i| accel.is_merged(i)).collect();
     assert_eq!(merged, [false, true, true]);
     let (rays, s) = rays(&meshes, &instances, 2000);
@@ -308,9 +316,12 @@ fn a_ground_that_dwarfs_the_rest_keeps_its_own_tree() {
 
 #[test]
 fn hits_equal_the_brute_force_oracle() {
-    for shared in [0, 3, 12] {
+    for (shared, params) in [0, 3, 12]
+        .into_iter()
+        .flat_map(|s| structures().map(|p| (s, p)))
+    {
         let (meshes, instances, ignorable) = scene(shared);
-        let accel = Accel::build(&meshes, &instances, &BuildParams::default(), &ignorable);
+        let accel = Accel::build(&meshes, &instances, &params, &ignorable);
         let (rays, s) = rays(&meshes, &instances, 1200);
         let mut hits = 0;
         let mut ties = 0;
@@ -338,9 +349,12 @@ fn hits_equal_the_brute_force_oracle() {
 
 #[test]
 fn batches_and_packets_equal_single_rays() {
-    for shared in [0, 12] {
+    for (shared, params) in [0, 12]
+        .into_iter()
+        .flat_map(|s| structures().map(|p| (s, p)))
+    {
         let (meshes, instances, ignorable) = scene(shared);
-        let accel = Accel::build(&meshes, &instances, &BuildParams::default(), &ignorable);
+        let accel = Accel::build(&meshes, &instances, &params, &ignorable);
         assert_eq!(
             accel.two_level_count() > super::PACKET_INSTANCES,
             shared > 0

@@ -135,6 +135,15 @@ impl Filter {
         }
     }
 
+    /// The values of its kind's [`FilterKind::parameters`], in order.
+    pub fn parameters(&self) -> Vec<f32> {
+        match *self {
+            Filter::Box { radius } | Filter::Tent { radius } => vec![radius],
+            Filter::Gaussian { radius, sigma } => vec![radius, sigma],
+            Filter::Mitchell { radius, b, c } => vec![radius, b, c],
+        }
+    }
+
     /// The filter called `name`, with its default parameters.
     pub fn named(name: &str) -> Result<Self, crate::names::UnknownName> {
         FilterKind::from_name(name).map(Self::from)
@@ -367,6 +376,7 @@ mod tests {
             let filter = Filter::with_parameters(kind, &defaults);
             assert_eq!((filter.kind(), filter.radius()), (kind, defaults[0]));
             assert_eq!(filter, Filter::from(kind));
+            assert_eq!(filter.parameters(), defaults, "{kind}");
             for (i, p) in parameters.iter().enumerate() {
                 assert!(p.check(p.default).is_ok(), "{kind} {}", p.name);
                 assert!(!parameters[..i].iter().any(|q| q.name == p.name));

@@ -760,7 +760,7 @@ mod tests {
     use crate::integrator::wavefront::tests::scene;
     use crate::sampler::SampleId;
     use glam::Vec2;
-    use sahara_kd::BuildParams;
+    use sahara_kd::AccelParams;
 
     /// The samples of a `w x h` image at `spp`, pixel by pixel.
     fn samples(scene: &crate::scene::Scene, kind: SamplerKind, spp: u32) -> Vec<LaneSample> {
@@ -802,7 +802,7 @@ mod tests {
     fn lanes_follow_the_scalar_paths() {
         for extra in [0, 12] {
             let scene = scene(extra);
-            let world = World::new(&scene, &BuildParams::default());
+            let world = World::new(&scene, &AccelParams::default());
             let integrator = Integrator::named("path").unwrap();
             for kind in [SamplerKind::Sobol, SamplerKind::Independent] {
                 let samples = samples(&scene, kind, 5);

@@ -356,30 +356,6 @@ impl Integrator {
         }
         self
     }
-
-    /// The integrator of a render that names `asked` (or nothing) over a
-    /// scene file's integrator `file` (or none): a kind asked for takes its
-    /// default parameters, unless the file names the same kind (then the
-    /// file's parameters hold); between `path`, `bdpt`, `lightpath` and
-    /// `sppm`, which count a path's length alike, the file's length holds
-    /// too, so that switching the estimator renders the same image. Nothing
-    /// asked: the file's, else the default. The command line's
-    /// `--integrator` and the Python package's `integrator=` both use it.
-    pub fn chosen(asked: Option<IntegratorKind>, file: Option<Integrator>) -> Integrator {
-        match (asked, file) {
-            (Some(kind), Some(f)) if f.kind() == kind => f,
-            (Some(kind), Some(f)) => {
-                let new = Integrator::from(kind);
-                match (f.path_length(), new.path_length()) {
-                    (Some(n), Some(_)) => new.with_path_length(n),
-                    _ => new,
-                }
-            }
-            (Some(kind), None) => Integrator::from(kind),
-            (None, Some(f)) => f,
-            (None, None) => Integrator::default(),
-        }
-    }
 }
 
 /// Work counted while tracing.
@@ -781,7 +757,7 @@ mod tests {
     use crate::scene::camera::Camera;
     use crate::scene::shape::Shape;
     use crate::scene::Scene;
-    use sahara_kd::BuildParams;
+    use sahara_kd::AccelParams;
 
     /// Radiance seen at the centre of a quad whose back faces the camera
     /// and a point light beside the camera.
@@ -798,7 +774,7 @@ mod tests {
             m,
         );
         scene.add_light(Light::point(Vec3::new(0.3, 0.0, -2.0), Vec3::splat(4.0)));
-        let world = World::new(&scene, &BuildParams::default());
+        let world = World::new(&scene, &AccelParams::default());
         let mut stats = TraceStats::default();
         let mut sum = Vec3::ZERO;
         for index in 0..16 {
@@ -894,13 +870,13 @@ mod tests {
         let up = Vec3::Y;
         let on_floor = |x: f32| Vec3::new(x, 1e-3, 0.0);
         let opaque = cut_out_scene(AlphaMode::Opaque);
-        let world = World::new(&opaque, &BuildParams::default());
+        let world = World::new(&opaque, &AccelParams::default());
         assert!(!world.unoccluded(on_floor(-0.5), up, f32::INFINITY, 0.0, None));
         assert!(!world.unoccluded(on_floor(0.5), up, f32::INFINITY, 0.0, None));
         assert_eq!(radiance_down(&world, 0.5), Vec3::ZERO);
 
         let mask = cut_out_scene(AlphaMode::Mask { cutoff: 0.5 });
-        let world = World::new(&mask, &BuildParams::default());
+        let world = World::new(&mask, &AccelParams::default());
         // The opaque half shadows the floor, the hole lets the light by.
         assert!(!world.unoccluded(on_floor(-0.5), up, f32::INFINITY, 0.0, None));
         assert!(world.unoccluded(on_floor(0.5), up, f32::INFINITY, 0.0, None));
@@ -920,7 +896,7 @@ mod tests {
 
         // Blend at opacity 1 on the left, 0 on the right: the same answers.
         let blend = cut_out_scene(AlphaMode::Blend);
-        let world = World::new(&blend, &BuildParams::default());
+        let world = World::new(&blend, &AccelParams::default());
         assert!(!world.unoccluded(on_floor(-0.5), up, f32::INFINITY, 0.0, None));
         assert!(world.unoccluded(on_floor(0.5), up, f32::INFINITY, 0.0, None));
 
@@ -929,7 +905,7 @@ mod tests {
         let mut half = cut_out_scene(AlphaMode::Blend);
         half.materials[1].textures.base_color = None;
         half.materials[1].alpha = 0.3;
-        let world = World::new(&half, &BuildParams::default());
+        let world = World::new(&half, &AccelParams::default());
         let n = 4000;
         let open = (0..n)
             .filter(|&i| {

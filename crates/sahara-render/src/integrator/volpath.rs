@@ -360,6 +360,7 @@ mod tests {
     use crate::scene::camera::Camera;
     use crate::scene::shape::Shape;
     use crate::scene::Scene;
+    use crate::settings::FrameSettings;
 
     /// Fills the inside of `instance`'s closed surface with `medium`, the
     /// surface only bounding it.
@@ -383,7 +384,7 @@ mod tests {
 
     /// [`mean`] with the sampler's `seed`.
     fn mean_seeded(scene: &Scene, size: u32, spp: u32, max_depth: u32, seed: u64) -> Vec3 {
-        let settings = RenderSettings {
+        let settings = RenderSettings::from(FrameSettings {
             width: size,
             height: size,
             spp,
@@ -393,8 +394,8 @@ mod tests {
                 max_depth,
                 rr_depth: max_depth,
             },
-            ..RenderSettings::default()
-        };
+            ..Default::default()
+        });
         let r = render(scene, &settings, &|_| {}).unwrap();
         assert_eq!(r.stats.nan_samples, 0);
         r.film.pixels.iter().copied().sum::<Vec3>() / r.film.pixels.len() as f32
@@ -438,9 +439,12 @@ mod tests {
                 fill(&mut scene, b, medium);
             }
             let settings = RenderSettings {
-                width: 8,
-                height: 8,
-                spp: 4,
+                frame: FrameSettings {
+                    width: 8,
+                    height: 8,
+                    spp: 4,
+                    ..Default::default()
+                },
                 aovs: vec![Aov::Albedo, Aov::Normal, Aov::Depth],
                 ..RenderSettings::default()
             };

@@ -141,7 +141,7 @@ pub(crate) mod tests {
     use crate::scene::shape::Shape;
     use crate::scene::Scene;
     use glam::{Quat, Vec2, Vec3};
-    use sahara_kd::BuildParams;
+    use sahara_kd::AccelParams;
 
     /// A scene with every kind of light and lobe, a moving instance, a
     /// thin lens and a shutter, and `extra` more small spheres (past the
@@ -232,7 +232,7 @@ pub(crate) mod tests {
     fn batches_give_the_radiance_of_single_paths() {
         for extra in [0, 12] {
             let scene = scene(extra);
-            let world = World::new(&scene, &BuildParams::default());
+            let world = World::new(&scene, &AccelParams::default());
             assert_eq!(world.accel.two_level_count() > 8, extra > 0);
             assert!(world.accel.merged_count() > 0);
             for integrator in ["path", "distribution"] {

@@ -6,7 +6,9 @@ use std::f32::consts::PI;
 
 use super::LightSample;
 use crate::math::piecewise::Distribution1D;
-use crate::math::warp::{concentric_disc, luminance, uniform_cone, uniform_triangle, Frame};
+use crate::math::warp::{
+    concentric_disc, luminance, uniform_cone, uniform_sphere, uniform_triangle, Frame,
+};
 use crate::texture::TextureMap;
 
 /// The emitting surface.
@@ -84,25 +86,10 @@ impl EmissionTextures {
     }
 }
 
-/// The emission texture's factor at barycentric `(b1, b2)` of a mesh
-/// light's triangle with texture `t` (1 without one).
-pub(crate) fn texture_factor(
-    maps: &[TextureMap],
-    t: &Option<(u32, [[Vec2; 3]; 2])>,
-    b1: f32,
-    b2: f32,
-) -> Vec3 {
-    EmissionTextures::at(maps, t, b1, b2)
-}
-
 /// A point of a mesh light's triangles, uniform by area (`u`): the
 /// triangle, the point's barycentrics `(b1, b2)`, the point and the
 /// triangle's front normal.
-pub(crate) fn mesh_point(
-    tris: &[[Vec3; 3]],
-    dist: &Distribution1D,
-    u: Vec2,
-) -> (usize, f32, f32, Vec3, Vec3) {
+fn mesh_point(tris: &[[Vec3; 3]], dist: &Distribution1D, u: Vec2) -> (usize, f32, f32, Vec3, Vec3) {
     let (x, _, i) = dist.sample_continuous(u.x);
     // Reuse the position within the chosen cell as a fresh uniform
     // number: it is uniform and independent of i.
@@ -112,6 +99,20 @@ pub(crate) fn mesh_point(
     let q = t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2;
     let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
     (i, b1, b2, q, n)
+}
+
+/// A point of an emitting surface ([`AreaLight::surface_point`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SurfacePoint {
+    /// The point.
+    pub p: Vec3,
+    /// The surface's unit front normal there.
+    pub n: Vec3,
+    /// Whether the surface emits from its back face too.
+    pub two_sided: bool,
+    /// A mesh light's triangle and the point's barycentrics on it (its
+    /// radiance and texture are the triangle's).
+    tri: Option<(usize, f32, f32)>,
 }
 
 /// An emitting surface with its radiance.
@@ -236,57 +237,99 @@ impl AreaLight {
         }
     }
 
-    /// A point on the light as seen from `p`: direction, distance, incident
-    /// radiance and solid-angle density.
-    pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
-        let (q, n, pdf_area, le, two) = match &self.emitter {
+    /// A point of the light, uniform by area (`u`): on a quad or a disc,
+    /// anywhere on a sphere, on a mesh's triangles chosen by their area.
+    /// Next-event estimation ([`AreaLight::sample`]) and the light leaving
+    /// a light (`LightSource::sample_emission`) both draw their points here.
+    pub(crate) fn surface_point(&self, u: Vec2) -> SurfacePoint {
+        let (p, n, tri) = match &self.emitter {
             Emitter::Quad {
                 corner,
                 u: eu,
                 v: ev,
                 n,
-            } => (
-                *corner + *eu * u.x + *ev * u.y,
-                *n,
-                1.0 / self.area,
-                None,
-                self.two_sided,
-            ),
+            } => (*corner + *eu * u.x + *ev * u.y, *n, None),
             Emitter::Disc {
                 center,
                 frame,
                 radius,
             } => {
                 let d = concentric_disc(u) * *radius;
-                (
-                    *center + frame.s * d.x + frame.t * d.y,
-                    frame.n,
-                    1.0 / self.area,
-                    None,
-                    self.two_sided,
-                )
+                (*center + frame.s * d.x + frame.t * d.y, frame.n, None)
             }
             Emitter::Sphere { center, radius } => {
-                return self.sample_sphere(*center, *radius, p, u)
+                let n = uniform_sphere(u);
+                (*center + *radius * n, n, None)
             }
             Emitter::Mesh {
                 tris,
-                radiance,
                 two_sided,
-                textures,
-                maps,
                 dist,
                 ..
             } => {
                 let (i, b1, b2, q, n) = mesh_point(tris, dist, u);
-                let le = emitted(radiance[i], two_sided[i], n, p - q);
-                let le = if le == Vec3::ZERO {
+                return SurfacePoint {
+                    p: q,
+                    n,
+                    two_sided: two_sided[i],
+                    tri: Some((i, b1, b2)),
+                };
+            }
+        };
+        SurfacePoint {
+            p,
+            n,
+            two_sided: self.two_sided,
+            tri,
+        }
+    }
+
+    /// The radiance leaving the front of the light at `s` (and its back,
+    /// when two-sided): a mesh triangle's own, times its emission texture
+    /// there.
+    pub(crate) fn radiance_at(&self, s: &SurfacePoint) -> Vec3 {
+        match (&self.emitter, s.tri) {
+            (
+                Emitter::Mesh {
+                    radiance,
+                    textures,
+                    maps,
+                    ..
+                },
+                Some((i, b1, b2)),
+            ) => radiance[i] * EmissionTextures::at(maps, &textures[i], b1, b2),
+            _ => self.radiance,
+        }
+    }
+
+    /// A point on the light as seen from `p`: direction, distance, incident
+    /// radiance and solid-angle density.
+    pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        if let Emitter::Sphere { center, radius } = self.emitter {
+            return self.sample_sphere(center, radius, p, u);
+        }
+        let s = self.surface_point(u);
+        let (q, n, pdf_area, two) = (s.p, s.n, 1.0 / self.area, s.two_sided);
+        // A mesh's triangles face their own ways; its texture is looked up
+        // only where the face seen emits.
+        let le = match (&self.emitter, s.tri) {
+            (
+                Emitter::Mesh {
+                    radiance,
+                    textures,
+                    maps,
+                    ..
+                },
+                Some((i, b1, b2)),
+            ) => {
+                let le = emitted(radiance[i], two, n, p - q);
+                Some(if le == Vec3::ZERO {
                     le
                 } else {
                     le * EmissionTextures::at(maps, &textures[i], b1, b2)
-                };
-                (q, n, 1.0 / self.area, Some(le), two_sided[i])
+                })
             }
+            _ => None,
         };
         let d = q - p;
         let dist2 = d.length_squared();
@@ -322,7 +365,7 @@ impl AreaLight {
         let d2 = to_c.length_squared();
         if d2 <= r * r {
             // Inside: uniform on the surface.
-            let n = crate::math::warp::uniform_sphere(u);
+            let n = uniform_sphere(u);
             let q = c + r * n;
             let d = q - p;
             let dist2 = d.length_squared();

@@ -10,16 +10,16 @@
 //! the direction, as pbrt does: the position density is then per unit area
 //! of that disc.
 //!
-//! Here are the surfaces and the environment; a point, spot or
-//! directional light's own emission is in its module, through
+//! Here are the surfaces (their points drawn by `AreaLight::surface_point`,
+//! as next-event estimation draws them) and the environment; a point, spot
+//! or directional light's own emission is in its module, through
 //! `Light::emission`.
 
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
-use super::area::{AreaLight, Emitter};
 use super::LightSource;
-use crate::math::warp::{concentric_disc, cosine_hemisphere, uniform_sphere, Frame};
+use crate::math::warp::{concentric_disc, cosine_hemisphere, Frame};
 
 /// Light leaving a light: where, where to, how much, and how likely.
 #[derive(Clone, Copy, Debug)]
@@ -68,57 +68,6 @@ fn face(u: f32, two_sided: bool) -> (bool, f32) {
     }
 }
 
-impl AreaLight {
-    /// A point of the light, uniform by area (`u`): the point, its front
-    /// normal, the radiance leaving the front (and the back when
-    /// two-sided), and whether it is two-sided.
-    fn surface_point(&self, u: Vec2) -> (Vec3, Vec3, Vec3, bool) {
-        match &self.emitter {
-            Emitter::Quad {
-                corner,
-                u: eu,
-                v: ev,
-                n,
-            } => (
-                *corner + *eu * u.x + *ev * u.y,
-                *n,
-                self.radiance,
-                self.two_sided,
-            ),
-            Emitter::Disc {
-                center,
-                frame,
-                radius,
-            } => {
-                let d = concentric_disc(u) * *radius;
-                (
-                    *center + frame.s * d.x + frame.t * d.y,
-                    frame.n,
-                    self.radiance,
-                    self.two_sided,
-                )
-            }
-            Emitter::Sphere { center, radius } => {
-                let n = uniform_sphere(u);
-                (*center + *radius * n, n, self.radiance, self.two_sided)
-            }
-            Emitter::Mesh {
-                tris,
-                radiance,
-                two_sided,
-                textures,
-                maps,
-                dist,
-                ..
-            } => {
-                let (i, b1, b2, q, n) = super::area::mesh_point(tris, dist, u);
-                let le = radiance[i] * super::area::texture_factor(maps, &textures[i], b1, b2);
-                (q, n, le, two_sided[i])
-            }
-        }
-    }
-}
-
 impl LightSource {
     /// True for the lights at infinity (environment, directional).
     pub(crate) fn is_infinite(&self) -> bool {
@@ -162,7 +111,8 @@ impl LightSource {
                 }
             }
             LightSource::Area(a) => {
-                let (p, n, le, two_sided) = a.surface_point(u_pos);
+                let s = a.surface_point(u_pos);
+                let (p, n, le, two_sided) = (s.p, s.n, a.radiance_at(&s), s.two_sided);
                 let (back, ux) = face(u_dir.x, two_sided);
                 let local = cosine_hemisphere(Vec2::new(ux, u_dir.y));
                 let front = if back { -n } else { n };
@@ -218,7 +168,8 @@ pub(crate) fn pdf_disc(radius: f32) -> f32 {
 mod tests {
     use super::*;
     use crate::light::area::Emitter;
-    use crate::light::Light;
+    use crate::light::{AreaLight, Light};
+    use crate::math::warp::uniform_sphere;
 
     /// Every light's sampled directions have the density `pdf_dir` gives,
     /// and integrate to one over the sphere (estimated by the sample mean

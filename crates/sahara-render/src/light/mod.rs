@@ -1,10 +1,12 @@
 //! Lights: point, spot and directional lights given explicitly; area
-//! lights made from emissive geometry; the environment.
+//! lights made from emissive geometry; the environment; and the lights of
+//! a scene gathered once for its world ([`gather`]).
 
 pub mod area;
 pub mod directional;
 pub(crate) mod emission;
 pub mod environment;
+pub(crate) mod gather;
 mod kinds;
 pub mod point;
 pub mod spot;
@@ -80,6 +82,28 @@ impl Light {
         Light::Directional {
             direction: direction.normalize(),
             irradiance,
+        }
+    }
+
+    /// Light arriving at `p` from this light.
+    #[inline]
+    pub fn sample(&self, p: Vec3) -> Option<LightSample> {
+        match *self {
+            Light::Point {
+                position,
+                intensity,
+            } => point::sample(position, intensity, p),
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                cos_inner,
+                cos_outer,
+            } => spot::sample(position, direction, intensity, cos_inner, cos_outer, p),
+            Light::Directional {
+                direction,
+                irradiance,
+            } => directional::sample(direction, irradiance),
         }
     }
 
@@ -188,21 +212,7 @@ impl LightSource {
     /// Light arriving at `p` (sample `u` places it on area lights).
     pub fn sample(&self, p: Vec3, u: glam::Vec2) -> Option<LightSample> {
         match self {
-            LightSource::Explicit(Light::Point {
-                position,
-                intensity,
-            }) => point::sample(*position, *intensity, p),
-            LightSource::Explicit(Light::Spot {
-                position,
-                direction,
-                intensity,
-                cos_inner,
-                cos_outer,
-            }) => spot::sample(*position, *direction, *intensity, *cos_inner, *cos_outer, p),
-            LightSource::Explicit(Light::Directional {
-                direction,
-                irradiance,
-            }) => directional::sample(*direction, *irradiance),
+            LightSource::Explicit(l) => l.sample(p),
             LightSource::Area(a) => a.sample(p, u),
             LightSource::Environment(e) => e.sample(u),
         }

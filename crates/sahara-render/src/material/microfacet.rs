@@ -49,6 +49,21 @@ impl Distribution {
     }
 }
 
+/// Sahara's perceptual roughness (`alpha = roughness^2`, see
+/// [`Microfacet::new`]) of a distribution's width `alpha` as pbrt and
+/// Mitsuba give it, `alpha` clamped to `[0, 1]`.
+pub fn roughness_from_alpha(alpha: f64) -> f32 {
+    alpha.clamp(0.0, 1.0).sqrt() as f32
+}
+
+/// The one width Sahara's isotropic distributions render for an
+/// anisotropic pair `(u, v)` of widths (or of roughnesses that map to
+/// them): their mean, and whether the two differ (which a reader warns
+/// about, naming its file).
+pub fn isotropic_mean(u: f64, v: f64) -> (f64, bool) {
+    (0.5 * (u + v), (u - v).abs() > 1e-6)
+}
+
 /// An isotropic microfacet distribution of width `alpha`.
 #[derive(Clone, Copy, Debug)]
 pub struct Microfacet {
@@ -292,6 +307,18 @@ mod tests {
 
     fn u2(a: u64, i: u64) -> Vec2 {
         Vec2::new(unit_f32(hash2(a, i)), unit_f32(hash2(a + 1, i)))
+    }
+
+    #[test]
+    fn a_files_alpha_is_the_square_of_saharas_roughness() {
+        assert_eq!(roughness_from_alpha(0.25), 0.5);
+        assert_eq!(roughness_from_alpha(-1.0), 0.0);
+        assert_eq!(roughness_from_alpha(4.0), 1.0);
+        // The roughness gives back the alpha it came from.
+        let r = roughness_from_alpha(0.09);
+        assert!((Microfacet::ggx(r).alpha - 0.09).abs() < 1e-7);
+        assert_eq!(isotropic_mean(0.1, 0.3), (0.2, true));
+        assert_eq!(isotropic_mean(0.2, 0.2), (0.2, false));
     }
 
     #[test]

@@ -29,8 +29,8 @@ use fresnel::schlick;
 pub use kinds::MaterialKind;
 use layered::Layered;
 pub use maps::{Clearcoat, MaterialTextures, NormalMap, OcclusionMap};
-pub use microfacet::Distribution;
 use microfacet::Microfacet;
+pub use microfacet::{isotropic_mean, roughness_from_alpha, Distribution};
 
 /// The scattering model of a material.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -39,6 +39,7 @@
 use glam::Vec3;
 
 use crate::film::window::PixelWindow;
+pub use crate::settings::Adaptive;
 
 /// The expected difference of two half-buffers' means, in standard errors
 /// of the whole mean: `sqrt(2/π)`, which keeps Cycles' threshold scale.
@@ -47,22 +48,6 @@ const HALVES: f64 = 0.797_884_560_802_865_4;
 /// The side of the pixel blocks that stop together, on a grid aligned with
 /// the image's corner.
 pub(crate) const BLOCK: u32 = 2;
-
-/// Adaptive sampling: stop a pixel once its estimated noise is below
-/// `threshold` (the render's `spp` is then a cap).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Adaptive {
-    /// The noise at which a pixel stops (see the module's formula; Cycles'
-    /// default is 0.01, lower is cleaner and slower).
-    pub threshold: f32,
-    /// Samples every pixel takes before it is first tested.
-    pub min_spp: u32,
-}
-
-impl Adaptive {
-    /// The minimum samples of [`Adaptive::min_spp`] when none is given.
-    pub const DEFAULT_MIN_SPP: u32 = 16;
-}
 
 /// What adaptive sampling did, over the window's pixels.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -136,7 +136,7 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
 mod tests {
     use super::*;
     use crate::scene::builtin;
-    use sahara_kd::{BuildParams, Builder};
+    use sahara_kd::{AccelParams, BuildParams, Builder};
 
     #[test]
     fn pixel_settings_change_it_and_speed_settings_do_not() {
@@ -145,34 +145,24 @@ mod tests {
         let d = frame_digest(&scene, &base);
         assert_eq!(d.len(), 64);
         let same = RenderSettings {
-            build: BuildParams::new(Builder::Binned { bins: 16 }),
+            build: AccelParams::kd(BuildParams::new(Builder::Binned { bins: 16 })),
             tile_size: 7,
             window: Some(crate::film::window::PixelWindow::full(3, 3)),
             samples: Some(1..2),
             ..base.clone()
         };
         assert_eq!(frame_digest(&scene, &same), d);
+        let with = |change: fn(&mut RenderSettings)| {
+            let mut s = base.clone();
+            change(&mut s);
+            s
+        };
         for other in [
-            RenderSettings {
-                seed: 1,
-                ..base.clone()
-            },
-            RenderSettings {
-                width: 511,
-                ..base.clone()
-            },
-            RenderSettings {
-                spp: 16,
-                ..base.clone()
-            },
-            RenderSettings {
-                pass_spp: 4,
-                ..base.clone()
-            },
-            RenderSettings {
-                filter: crate::Filter::from(crate::FilterKind::Tent),
-                ..base.clone()
-            },
+            with(|s| s.seed = 1),
+            with(|s| s.width = 511),
+            with(|s| s.spp = 16),
+            with(|s| s.pass_spp = 4),
+            with(|s| s.filter = crate::Filter::from(crate::FilterKind::Tent)),
         ] {
             assert_ne!(frame_digest(&scene, &other), d);
         }

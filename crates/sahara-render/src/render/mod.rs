@@ -52,7 +52,7 @@ use crate::integrator::{Integrator, SettingsError};
 use crate::scene::Scene;
 use crate::world::World;
 use accumulate::Accumulated;
-pub use adaptive::{Adaptive, AdaptiveStats};
+pub use adaptive::AdaptiveStats;
 pub use aux::{Aov, Aux, AuxImages, AuxSums};
 use pass::Run;
 use plan::{Frame, PassPlan};

@@ -5,30 +5,24 @@ use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Duration;
 
-use sahara_kd::BuildParams;
+use sahara_kd::AccelParams;
 
-use super::adaptive::Adaptive;
 use super::aux::Aov;
-use crate::film::filter::Filter;
 use crate::film::window::PixelWindow;
 #[cfg(doc)]
 use crate::integrator::Supports;
-use crate::integrator::{defaults, Feature, Integrator, SettingsError};
-use crate::sampler::SamplerKind;
+use crate::integrator::{Feature, Integrator, SettingsError};
 use crate::scene::Scene;
+use crate::settings::FrameSettings;
 
-/// How to render.
+/// How to render: what the frame is ([`FrameSettings`], read as these
+/// settings' own fields) and how this render goes about it.
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
-    /// Image width in pixels.
-    pub width: u32,
-    /// Image height in pixels (the camera's aspect should be width/height).
-    pub height: u32,
-    /// Samples per pixel of the image.
-    pub spp: u32,
-    /// Samples per pixel of each progressive pass (at most `spp`); the last
-    /// pass takes what is left of `spp`.
-    pub pass_spp: u32,
+    /// What the frame is: size, samples per pixel and per pass, seed,
+    /// sampler, filter, integrator, adaptive sampling. With a time limit,
+    /// `spp` can be [`UNLIMITED_SPP`].
+    pub frame: FrameSettings,
     /// Stop starting passes after this long, even before `spp` samples; a
     /// pass under way when it runs out is abandoned (the first pass always
     /// completes). With a time limit, `spp` can be [`UNLIMITED_SPP`].
@@ -36,18 +30,12 @@ pub struct RenderSettings {
     /// Set to true (e.g. on Ctrl-C) to stop; the passes completed are kept,
     /// and if the first pass is under way, the pixels it has finished.
     pub cancel: Option<Arc<AtomicBool>>,
-    /// Seed of every random decision.
-    pub seed: u64,
-    /// Sample generator.
-    pub sampler: SamplerKind,
-    /// Reconstruction filter.
-    pub filter: Filter,
-    /// Light transport.
-    pub integrator: Integrator,
     /// Tile edge in pixels.
     pub tile_size: u32,
-    /// Kd-tree build parameters for the meshes.
-    pub build: BuildParams,
+    /// The meshes' acceleration structure: which (the eight-wide
+    /// hierarchy by default, or the kd-tree) and its build parameters. A
+    /// speed setting only: every structure finds the same hits.
+    pub build: AccelParams,
     /// Full scale of the `cost` heat map in work units per camera ray
     /// (None: the image's maximum).
     pub cost_scale: Option<f32>,
@@ -70,14 +58,12 @@ pub struct RenderSettings {
     /// False: the window is a crop, an image of those pixels.
     pub part: bool,
     /// The render passes to make beside the beauty, the images a denoiser
-    /// and compositing use ([`AuxImages`](super::AuxImages); the
-    /// integrators whose [`Supports::aovs`] says so); empty: none.
+    /// and compositing use ([`AuxImages`](super::AuxImages); the integrators whose
+    /// [`Supports::aovs`] says so); empty: none. Adaptive sampling
+    /// ([`FrameSettings::adaptive`]) needs an integrator that supports it
+    /// ([`Supports::adaptive`]), and not with `samples` other than
+    /// `0..spp` (a pixel's decisions need all its samples).
     pub aovs: Vec<Aov>,
-    /// Adaptive sampling: pixels stop once their noise is low enough, and
-    /// `spp` is a cap (None: every pixel takes `spp`). Needs an integrator
-    /// that supports it ([`Supports::adaptive`]), and not with `samples`
-    /// other than `0..spp` (a pixel's decisions need all its samples).
-    pub adaptive: Option<Adaptive>,
     /// How the path tracer's samples are traced: in SIMD lanes or one
     /// path step at a time (the other integrators ignore it).
     pub path_loop: PathLoop,
@@ -128,6 +114,51 @@ impl PathLoop {
             PathLoop::Lanes => Some(true),
             PathLoop::LanesNoRefill => Some(false),
             PathLoop::Scalar => None,
+        }
+    }
+}
+
+/// The renderer reads the frame's settings as its own (`settings.spp`):
+/// they are the settings of every render, kept in one struct so that a
+/// scene file, a part file and a caller describe them once.
+impl std::ops::Deref for RenderSettings {
+    type Target = FrameSettings;
+
+    fn deref(&self) -> &FrameSettings {
+        &self.frame
+    }
+}
+
+impl std::ops::DerefMut for RenderSettings {
+    fn deref_mut(&mut self) -> &mut FrameSettings {
+        &mut self.frame
+    }
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            frame: FrameSettings::default(),
+            time_limit: None,
+            cancel: None,
+            tile_size: 32,
+            build: AccelParams::default(),
+            cost_scale: None,
+            window: None,
+            samples: None,
+            part: false,
+            aovs: Vec::new(),
+            path_loop: PathLoop::default(),
+        }
+    }
+}
+
+impl From<FrameSettings> for RenderSettings {
+    /// A render of the whole frame `frame` with the defaults for the rest.
+    fn from(frame: FrameSettings) -> Self {
+        Self {
+            frame,
+            ..Default::default()
         }
     }
 }
@@ -186,32 +217,6 @@ impl RenderSettings {
             self.integrator.kind().require(Feature::Media)?;
         }
         Ok(())
-    }
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        Self {
-            width: 512,
-            height: 512,
-            spp: defaults::SPP,
-            pass_spp: defaults::PASS_SPP,
-            time_limit: None,
-            cancel: None,
-            seed: 0,
-            sampler: SamplerKind::Sobol,
-            filter: Filter::default(),
-            integrator: Integrator::default(),
-            tile_size: 32,
-            build: BuildParams::default(),
-            cost_scale: None,
-            window: None,
-            samples: None,
-            part: false,
-            aovs: Vec::new(),
-            adaptive: None,
-            path_loop: PathLoop::default(),
-        }
     }
 }
 

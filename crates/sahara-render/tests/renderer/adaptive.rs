@@ -5,8 +5,8 @@
 use crate::common::pixel_inside_sphere;
 use glam::Vec3;
 use sahara_render::{
-    builtin, render, tile, Adaptive, Filter, FilterKind, Material, PixelWindow, RenderResult,
-    RenderSettings, SamplerKind, Scene, Shape, SumBuffer,
+    builtin, render, tile, Adaptive, Filter, FilterKind, FrameSettings, Material, PixelWindow,
+    RenderResult, RenderSettings, SamplerKind, Scene, Shape, SumBuffer,
 };
 
 const SPHERE: (Vec3, f32) = (Vec3::new(278.0, 380.0, 150.0), 90.0);
@@ -28,18 +28,21 @@ fn scene() -> Scene {
 
 fn settings(threshold: f32) -> RenderSettings {
     RenderSettings {
-        width: 32,
-        height: 32,
-        spp: 64,
-        pass_spp: 8,
-        seed: 3,
-        sampler: SamplerKind::Independent,
-        filter: Filter::from(FilterKind::Box),
+        frame: FrameSettings {
+            width: 32,
+            height: 32,
+            spp: 64,
+            pass_spp: 8,
+            seed: 3,
+            sampler: SamplerKind::Independent,
+            filter: Filter::from(FilterKind::Box),
+            adaptive: Some(Adaptive {
+                threshold,
+                min_spp: 16,
+            }),
+            ..Default::default()
+        },
         tile_size: 8,
-        adaptive: Some(Adaptive {
-            threshold,
-            min_spp: 16,
-        }),
         ..Default::default()
     }
 }
@@ -101,11 +104,9 @@ fn flat_pixels_stop_at_the_minimum_and_noisy_ones_reach_the_cap() {
 #[test]
 fn the_decisions_do_not_depend_on_the_thread_count() {
     let scene = scene();
-    let s = RenderSettings {
-        filter: Filter::from(FilterKind::Mitchell),
-        tile_size: 5,
-        ..settings(0.02)
-    };
+    let mut s = settings(0.02);
+    s.filter = Filter::from(FilterKind::Mitchell);
+    s.tile_size = 5;
     let one = in_pool(1, &scene, &s);
     let two = in_pool(2, &scene, &s);
     assert_eq!(one.samples, two.samples);
@@ -119,10 +120,8 @@ fn windows_rendered_apart_add_up_to_the_whole_frame() {
     let scene = scene();
     // A filter wider than a pixel: samples of pixels outside a window
     // reach into it, and their decisions must be the whole frame's.
-    let s = RenderSettings {
-        filter: Filter::from(FilterKind::Gaussian),
-        ..settings(0.02)
-    };
+    let mut s = settings(0.02);
+    s.filter = Filter::from(FilterKind::Gaussian);
     let whole = render(&scene, &s, &|_| {}).unwrap();
     let full = PixelWindow::full(32, 32);
     let mut merged = SumBuffer::new(0, 0, 32, 32);
@@ -157,10 +156,8 @@ fn windows_rendered_apart_add_up_to_the_whole_frame() {
 fn a_threshold_no_pixel_reaches_renders_the_plain_image() {
     let scene = scene();
     let adaptive = settings(0.0);
-    let plain = RenderSettings {
-        adaptive: None,
-        ..adaptive.clone()
-    };
+    let mut plain = adaptive.clone();
+    plain.adaptive = None;
     let a = render(&scene, &adaptive, &|_| {}).unwrap();
     let p = render(&scene, &plain, &|_| {}).unwrap();
     assert!(a.sums == p.sums, "the images differ");
@@ -176,18 +173,9 @@ fn pixels_that_stopped_are_as_clean_as_the_threshold_asks() {
     let threshold = 0.05;
     let s = settings(threshold);
     let r = render(&scene, &s, &|_| {}).unwrap();
-    let reference = render(
-        &scene,
-        &RenderSettings {
-            spp: 1024,
-            pass_spp: 64,
-            adaptive: None,
-            seed: 99,
-            ..s.clone()
-        },
-        &|_| {},
-    )
-    .unwrap();
+    let mut long = s.clone();
+    (long.spp, long.pass_spp, long.adaptive, long.seed) = (1024, 64, None, 99);
+    let reference = render(&scene, &long, &|_| {}).unwrap();
     let samples = r.samples.unwrap();
     // The module's error measure, against the reference instead of the
     // other half: for a stopped pixel it should be about the threshold.

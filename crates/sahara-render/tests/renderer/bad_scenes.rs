@@ -1,7 +1,9 @@
 //! Defined outcomes for bad geometry and unlit scenes.
 
 use glam::{Affine3A, Vec3};
-use sahara_render::{render, Camera, Environment, Material, Mesh, RenderSettings, Scene};
+use sahara_render::{
+    render, Camera, Environment, FrameSettings, Material, Mesh, RenderSettings, Scene,
+};
 
 fn quad_with_junk() -> Mesh {
     Mesh {
@@ -47,12 +49,12 @@ fn unhittable_triangles_are_skipped_and_counted() {
     // centre and, lit by a white sky, reflects albedo 0.5 there.
     let r = render(
         &scene,
-        &RenderSettings {
+        &RenderSettings::from(FrameSettings {
             width: 16,
             height: 16,
             spp: 64,
             ..Default::default()
-        },
+        }),
         &|_| {},
     )
     .unwrap();
@@ -77,12 +79,12 @@ fn an_unlit_scene_is_reported_and_renders_black() {
     assert!(scene.diagnostics().iter().any(|w| w.contains("no light")));
     let r = render(
         &scene,
-        &RenderSettings {
+        &RenderSettings::from(FrameSettings {
             width: 8,
             height: 8,
             spp: 4,
             ..Default::default()
-        },
+        }),
         &|_| {},
     )
     .unwrap();
@@ -107,12 +109,12 @@ fn a_camera_inside_a_closed_box_sees_its_walls() {
     );
     let r = render(
         &scene,
-        &RenderSettings {
+        &RenderSettings::from(FrameSettings {
             width: 8,
             height: 8,
             spp: 4,
             ..Default::default()
-        },
+        }),
         &|_| {},
     )
     .unwrap();

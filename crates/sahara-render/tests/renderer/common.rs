@@ -3,23 +3,26 @@
 
 use glam::Vec3;
 use sahara_render::{
-    render, Camera, Filter, FilterKind, Integrator, Light, Material, RenderResult, RenderSettings,
-    SamplerKind, Scene, Shape,
+    render, Camera, Filter, FilterKind, FrameSettings, Integrator, Light, Material, RenderResult,
+    RenderSettings, SamplerKind, Scene, Shape,
 };
 
 /// Settings for a small test render with a one-pixel box filter, its
 /// samples in one pass.
 pub fn settings(width: u32, height: u32, spp: u32, integrator: Integrator) -> RenderSettings {
     RenderSettings {
-        width,
-        height,
-        spp,
-        pass_spp: spp,
-        integrator,
-        filter: Filter::from(FilterKind::Box),
-        sampler: SamplerKind::Sobol,
+        frame: FrameSettings {
+            width,
+            height,
+            spp,
+            pass_spp: spp,
+            integrator,
+            filter: Filter::from(FilterKind::Box),
+            sampler: SamplerKind::Sobol,
+            seed: 1,
+            ..Default::default()
+        },
         tile_size: 16,
-        seed: 1,
         ..Default::default()
     }
 }

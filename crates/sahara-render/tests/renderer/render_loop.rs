@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use crate::common::{run, settings};
 use glam::{Affine3A, Quat, Vec3};
-use sahara_kd::KdTree;
+use sahara_kd::TriangleAccel;
 use sahara_render::internals::World;
 use sahara_render::{
     builtin, render, Camera, Environment, Filter, FilterKind, Instance, Integrator, Light,
@@ -285,12 +285,11 @@ fn instances_share_one_tree() {
     assert_eq!(world.accel.tree_count(), 1);
     assert_eq!(world.accel.merged_count(), 0);
     assert_eq!(world.accel.two_level_count(), 100);
-    let one = KdTree::build(
+    let one = TriangleAccel::build(
         scene.meshes[mesh as usize].mesh.triangles(),
         &Default::default(),
     )
-    .stats()
-    .memory_bytes;
+    .memory_bytes();
     assert_eq!(world.accel.tree_bytes(), one);
     // And all hundred are there: a lit render sees spheres everywhere.
     scene.environment = Some(Environment::Constant(Vec3::ONE));

@@ -4,8 +4,8 @@
 use glam::Vec3;
 use proptest::prelude::*;
 use sahara_render::{
-    builtin, render, Filter, FilterKind, Integrator, Material, PathLoop, RenderSettings,
-    SamplerKind, Scene, Shape, SumBuffer,
+    builtin, render, Filter, FilterKind, FrameSettings, Integrator, Material, PathLoop,
+    RenderSettings, SamplerKind, Scene, Shape, SumBuffer,
 };
 use sahara_render::{tile, PixelWindow};
 
@@ -84,14 +84,17 @@ proptest! {
         let scene = scene(material, (cx, cz), radius);
         let pass_spp = 1 + ((spp_total - 1) as f64 * pass_frac) as u32;
         let settings = RenderSettings {
-            width: w,
-            height: h,
-            spp: spp_total,
-            pass_spp,
-            seed,
-            sampler: sampler(samp),
-            filter: filter(filt),
-            integrator: integrator(integ),
+            frame: FrameSettings {
+                width: w,
+                height: h,
+                spp: spp_total,
+                pass_spp,
+                seed,
+                sampler: sampler(samp),
+                filter: filter(filt),
+                integrator: integrator(integ),
+                ..Default::default()
+            },
             tile_size: 8,
             path_loop: path_loops(lanes).0,
             ..Default::default()

@@ -53,10 +53,8 @@ fn assert_unsupported(e: SettingsError, integrator: IntegratorKind, feature: Fea
 
 #[test]
 fn adaptive_sppm_is_refused_not_dropped() {
-    let s = RenderSettings {
-        adaptive: adaptive(),
-        ..settings(8, 8, 4, sppm())
-    };
+    let mut s = settings(8, 8, 4, sppm());
+    s.adaptive = adaptive();
     assert_unsupported(refused(&s), IntegratorKind::Sppm, Feature::Adaptive);
 }
 
@@ -105,11 +103,9 @@ fn light_tracing_refuses_parts_by_pixels_and_adaptive_sampling_but_renders_crops
             ..part.clone()
         };
         assert!(render(&scene, &by_samples, &|_| {}).is_ok(), "{kind}");
-        let adaptive = RenderSettings {
-            adaptive: adaptive(),
-            ..settings(8, 8, 2, integrator)
-        };
-        assert_unsupported(refused(&adaptive), kind, Feature::Adaptive);
+        let mut adaptive_settings = settings(8, 8, 2, integrator);
+        adaptive_settings.adaptive = adaptive();
+        assert_unsupported(refused(&adaptive_settings), kind, Feature::Adaptive);
     }
 }
 
@@ -134,11 +130,11 @@ fn render_passes_are_refused_by_the_integrators_that_cannot_make_them() {
 
 #[test]
 fn adaptive_sampling_with_a_sample_range_is_refused_for_every_integrator() {
-    let s = RenderSettings {
-        adaptive: adaptive(),
+    let mut s = RenderSettings {
         samples: Some(0..2),
         ..settings(8, 8, 4, Integrator::default())
     };
+    s.adaptive = adaptive();
     assert_eq!(
         refused(&s),
         SettingsError::AdaptiveSampleRange {
@@ -188,17 +184,13 @@ fn media_are_refused_by_the_integrators_that_cannot_trace_them() {
         Integrator::Bdpt { max_depth: 4 },
         Integrator::from(IntegratorKind::Distribution),
     ] {
-        let s = RenderSettings {
-            integrator,
-            ..base.clone()
-        };
+        let mut s = base.clone();
+        s.integrator = integrator;
         let e = render(&scene, &s, &|_| {}).expect_err("rendered a scene with media");
         assert_unsupported(e, integrator.kind(), Feature::Media);
     }
-    let path = RenderSettings {
-        integrator: Integrator::from(IntegratorKind::Path),
-        ..base.clone()
-    };
+    let mut path = base.clone();
+    path.integrator = Integrator::from(IntegratorKind::Path);
     assert!(render(&scene, &path, &|_| {}).is_ok());
     let passes = RenderSettings {
         aovs: vec![Aov::Albedo],

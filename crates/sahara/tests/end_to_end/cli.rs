@@ -80,6 +80,8 @@ fn bench_json_matches_a_brute_force_count() {
         "--threads",
         "2",
         "--counters",
+        "--accel",
+        "kd",
     ]);
     let j = stdout_json(&out);
     for key in [
@@ -95,7 +97,7 @@ fn bench_json_matches_a_brute_force_count() {
         assert!(j.get(key).is_some(), "missing {key} in {j}");
     }
     assert_eq!(j["triangles"], 2);
-    assert_eq!(j["builder"], "sah");
+    assert_eq!(j["builder"], "kd-tree (sah)");
     assert_eq!(j["threads"], 2);
     assert_eq!(j["camera"]["vfov_deg"], 90.0);
     let sets = &j["sets"];
@@ -198,6 +200,8 @@ fn stats_json_has_the_tree_statistics() {
         "stats",
         obj.to_str().unwrap(),
         "--json",
+        "--accel",
+        "kd",
         "--builder",
         "binned",
     ]);
@@ -232,6 +236,8 @@ fn human_output_has_a_header_and_a_table() {
             "1",
             "--sets",
             "primary",
+            "--accel",
+            "kd",
         ];
         let out = sahara(&[&base[..], extra].concat());
         assert!(out.status.success());
@@ -240,7 +246,7 @@ fn human_output_has_a_header_and_a_table() {
     let text = bench(&[]);
     for needle in [
         "triangles  2",
-        "builder    sah",
+        "builder    kd-tree (sah)",
         "SAH cost",
         "primary    1,048,576",
         "  batch    (one call of the set)",

@@ -326,7 +326,7 @@ fn part_options_are_checked() {
                 "-o",
                 "x.exr",
             ],
-            "--time-limit cannot make a part",
+            "--time-limit: cannot make a part",
         ),
         (
             &["render", "--skip-existing", "-o", "x.exr"],
@@ -591,7 +591,10 @@ fn a_denoised_frame_is_denoised_once_merged() {
     let files = parts(&dir, "tile", &with(split(2, "tiles"), &["--denoise"]));
     for f in &files {
         let (info, sums) = read_part(f).unwrap();
-        assert!(info.denoise && info.aovs.is_empty(), "{info:?}");
+        assert!(
+            info.output.denoise && info.output.aovs.is_empty(),
+            "{info:?}"
+        );
         assert!(sums.passes.albedo.is_some() && sums.passes.normal.is_some());
     }
     let out = dir.join("merged.exr");

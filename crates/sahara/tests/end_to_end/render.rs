@@ -1402,7 +1402,7 @@ fn render_passes_need_an_exr_and_a_path_tracer() {
     let out = sahara(&["render", "--aov", "albedo", "-o", png.to_str().unwrap()]);
     assert!(!out.status.success());
     assert!(
-        stderr(&out).contains("is not one (use -o NAME.exr)"),
+        stderr(&out).contains("is not one (name a .exr file)"),
         "{}",
         stderr(&out)
     );

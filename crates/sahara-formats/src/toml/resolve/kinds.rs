@@ -17,7 +17,7 @@ use toml::Spanned;
 use super::{Ctx, ShapeKeys};
 use crate::toml::file::{EnvironmentSpec, LightSpec, MaterialSpec};
 use crate::toml::raw::{Opt, RawDescribed, ShapeType, V3};
-use crate::FormatError;
+use sahara_readers::FormatError;
 
 /// The file's name for the file of a kind's textured key: a material's
 /// `texture`, an environment's `map`.

@@ -13,7 +13,7 @@ use toml::Spanned;
 use super::{span, Ctx};
 use crate::toml::file::MediumSpec;
 use crate::toml::raw::{MediumType, Opt, RawMedium, RawObject};
-use crate::FormatError;
+use sahara_readers::FormatError;
 
 /// The keys every kind of medium takes.
 const EVERY_MEDIUM: [&str; 6] = [

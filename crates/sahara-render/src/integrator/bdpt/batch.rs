@@ -232,7 +232,7 @@ mod tests {
     use super::*;
     use crate::integrator::wavefront::tests::scene;
     use crate::sampler::{dims, SampleId, SamplerKind};
-    use sahara_kd::BuildParams;
+    use sahara_kd::AccelParams;
 
     /// Samples traced in batches give each sample the radiance and the
     /// splats [`super::super::sample`] gives it alone, bit for bit and in
@@ -243,7 +243,7 @@ mod tests {
     fn batches_give_the_radiance_and_splats_of_single_samples() {
         for extra in [0, 12] {
             let scene = scene(extra);
-            let world = World::new(&scene, &BuildParams::default());
+            let world = World::new(&scene, &AccelParams::default());
             let (w, h, spp) = (12u32, 10u32, 3u32);
             let film = Vec2::new(w as f32, h as f32);
             let mut cameras = Vec::new();

@@ -1,15 +1,17 @@
-//! `sahara render --part / --crop / --samples`: which piece of the frame a
-//! render is, and the part file it writes.
+//! A piece of a frame rendered on its own (a render farm's part: a pixel
+//! window and a range of every pixel's samples) and the part file it
+//! writes for `sahara merge`.
 
 use std::ops::Range;
 use std::path::Path;
 
-use anyhow::{anyhow, bail, Result};
-use sahara_formats::{read_part_info, write_part, PartInfo, PartSums};
 use sahara_render::{crop, sample_range, tile, PixelWindow};
-use sahara_render::{Aov, Aux, AuxImages, RenderResult, RenderSettings, SumBuffer, ToneMap};
+use sahara_render::{Aov, Aux, AuxImages, RenderResult, RenderSettings, SumBuffer};
 
-use crate::cli::{RenderArgs, Split};
+use super::error::{Asked, RequestError};
+use crate::description::{PieceLayer, Split};
+use crate::output::frame::OutputSettings;
+use crate::output::part::{read_part_info, write_part, PartInfo, PartSums};
 
 /// A piece of a frame: its pixels and its samples.
 #[derive(Clone, Debug, PartialEq)]
@@ -22,58 +24,38 @@ pub struct Piece {
     pub label: String,
 }
 
-/// True if the options ask for a part of the frame (`--part`, `--crop` or
-/// `--samples`).
-pub fn is_part(args: &RenderArgs) -> bool {
-    args.part.is_some() || args.crop.is_some() || args.samples.is_some()
-}
-
-/// Refuses options that do not go with the part asked for (or with no part).
-pub fn check_args(args: &RenderArgs) -> Result<()> {
-    if !is_part(args) {
-        if args.skip_existing {
-            bail!("--skip-existing applies to parts (--part, --crop or --samples)");
-        }
-        return Ok(());
-    }
-    if args.time_limit.is_some() {
-        bail!("--time-limit cannot make a part: a part's samples must be fixed in advance");
-    }
-    if args.preview_every.is_some() {
-        bail!("--preview-every does not apply to a part");
-    }
-    Ok(())
-}
-
-/// The piece the options ask for (None: a plain image). `file_window` is
-/// the crop the scene file asks for: the pixels `--part` divides unless
-/// `--crop` names others. The options were checked by [`check_args`].
-pub fn plan(
-    args: &RenderArgs,
-    settings: &RenderSettings,
+/// The piece `asked` for (None: the whole frame) of a `width x height`
+/// frame of `spp` samples per pixel. `file_window`: the crop the scene
+/// file asks for, the pixels a part divides unless a crop window names
+/// others.
+pub(crate) fn plan(
+    asked: &PieceLayer,
+    (width, height, spp): (u32, u32, u32),
     file_window: Option<PixelWindow>,
-) -> Result<Option<Piece>> {
-    if !is_part(args) {
+) -> Result<Option<Piece>, RequestError> {
+    if !asked.is_piece() {
         return Ok(None);
     }
-    let (w, h) = (settings.width, settings.height);
-    let total = settings.spp;
-    let mut window = match args.crop {
-        Some(f) => crop(w, h, f),
-        None => file_window.unwrap_or_else(|| PixelWindow::full(w, h)),
+    let mut window = match asked.crop {
+        Some(f) => crop(width, height, f),
+        None => file_window.unwrap_or_else(|| PixelWindow::full(width, height)),
     };
-    let mut samples = match &args.samples {
-        Some(r) if r.end > total => bail!(
-            "--samples {}..{} reaches past the frame's {total} samples per pixel",
-            r.start,
-            r.end
-        ),
+    let mut samples = match &asked.samples {
+        Some(r) if r.end > spp => {
+            return Err(RequestError::refused(
+                Asked::Caller("samples", None),
+                format!(
+                    "{}..{} reaches past the frame's {spp} samples per pixel",
+                    r.start, r.end
+                ),
+            ))
+        }
         Some(r) => r.clone(),
-        None => 0..total,
+        None => 0..spp,
     };
     let mut label = String::new();
-    if let Some((i, n)) = args.part {
-        match args.split.unwrap_or_default() {
+    if let Some((i, n)) = asked.part {
+        match asked.split.unwrap_or_default() {
             Split::Tiles => {
                 window = tile(&window, i, n);
                 label = format!("{i}/{n} tiles");
@@ -91,9 +73,9 @@ pub fn plan(
     }))
 }
 
-/// Why an existing part file at `path` is not this piece, complete (None:
-/// it is, and need not be rendered again).
-pub fn existing_differs(path: &Path, digest: &str, piece: &Piece) -> Option<String> {
+/// Why an existing part file at `path` is not `piece` of the frame of
+/// `digest`, complete (None: it is, and need not be rendered again).
+pub fn existing_part_differs(path: &Path, digest: &str, piece: &Piece) -> Option<String> {
     if !path.exists() {
         return Some("it does not exist".into());
     }
@@ -108,20 +90,14 @@ pub fn existing_differs(path: &Path, digest: &str, piece: &Piece) -> Option<Stri
     }
 }
 
-/// What the part file of a render records.
-pub struct PartRecord<'a> {
+/// What the part file of a render records besides its sums.
+pub(crate) struct PartRecord<'a> {
     /// The piece.
     pub piece: &'a Piece,
     /// The frame's digest.
     pub digest: &'a str,
-    /// Exposure for a PNG of the merged frame.
-    pub exposure: f32,
-    /// Tone map for a PNG of the merged frame.
-    pub tonemap: ToneMap,
-    /// The render passes the merged frame writes as layers.
-    pub aovs: &'a [Aov],
-    /// True if the merged frame is to be denoised.
-    pub denoise: bool,
+    /// How the merged frame is written.
+    pub output: &'a OutputSettings,
     /// True if the denoiser is to clean the albedo and normal first.
     pub noisy_guides: bool,
     /// The list of names of the object and material passes (JSON).
@@ -130,13 +106,14 @@ pub struct PartRecord<'a> {
     pub interrupted: bool,
 }
 
-/// Writes the part file of `result`; returns the samples its sums hold.
-pub fn write(
+/// Writes the part file of `result`, rendered with `settings`; returns
+/// the samples its sums hold.
+pub(crate) fn write(
     path: &Path,
     record: &PartRecord<'_>,
     settings: &RenderSettings,
     result: &RenderResult,
-) -> Result<Range<u32>> {
+) -> Result<Range<u32>, RequestError> {
     let piece = record.piece;
     let s = &result.stats;
     // An interrupted first pass leaves some pixels with fewer samples than
@@ -186,28 +163,17 @@ pub fn write(
             },
         )
     };
-    let mut aovs = record.aovs.to_vec();
-    aovs.sort();
-    aovs.dedup();
     let info = PartInfo {
         digest: record.digest.to_string(),
-        width: settings.width,
-        height: settings.height,
-        spp: settings.spp,
+        frame: settings.frame.clone(),
+        output: record.output.clone(),
         window: piece.window,
         samples: piece.samples.clone(),
         samples_done: done.clone(),
         complete: !record.interrupted && done == piece.samples,
         part: piece.label.clone(),
-        integrator: settings.integrator.kind(),
-        seed: settings.seed,
-        exposure: record.exposure,
-        tonemap: record.tonemap,
         passes: settings.aovs.clone(),
-        aovs,
-        denoise: record.denoise,
         noisy_guides: record.noisy_guides,
-        sample_counts: sums.samples.is_some(),
         names: record.names.unwrap_or_default().to_string(),
         stats: vec![
             ("passes".into(), s.passes.to_string()),
@@ -228,7 +194,6 @@ pub fn write(
         ],
     };
     write_part(path, &info, &sums)
-        .map_err(|e| anyhow!("{e}"))
-        .map_err(|e| e.context("cannot write the part file"))?;
+        .map_err(|e| RequestError::File(format!("cannot write the part file: {e}")))?;
     Ok(done)
 }

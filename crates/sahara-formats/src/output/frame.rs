@@ -1,50 +1,81 @@
-//! Writing a rendered frame: the image (PNG or EXR, atomically, with its
-//! metadata) of `sahara render` and `sahara merge`, and the rules that keep
-//! a complete image from being replaced by a partial one.
+//! A rendered frame written out: how ([`OutputSettings`]), the image (PNG
+//! or EXR, atomically, with its metadata and render passes as layers),
+//! the checks on its path made before anything is loaded or rendered, the
+//! rule that keeps a complete image from being replaced by a partial one,
+//! and the list of names beside the `object` and `material` passes. `sahara render`,
+//! `sahara merge` and the Python package's `render` write through here.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, bail, Context, Result};
-use sahara_formats::check_writable;
-use sahara_formats::{write_exr_layers, write_image, ExrLayer, ImageFormat, Pixels};
-use sahara_render::{Aov, AuxImages, Integrator, Named, RenderResult, RenderSettings, ToneMap};
+use sahara_readers::FormatError;
+use sahara_render::{Aov, AuxImages, FrameSettings, Integrator, Named, RenderResult};
+
+use sahara_render::{layered, ToneMap};
+
+use super::atomic::{check_writable, write_atomically};
+use super::image::{write_exr_layers, write_image, ExrLayer, ImageFormat, Pixels};
+
+layered! {
+    /// How a frame is written out: the look of an 8-bit image, the render
+    /// passes beside it, and whether it is denoised. A render's output
+    /// and a farm's part files both carry it.
+    pub struct OutputSettings;
+    /// Some of how a frame is written, as a scene file or a caller gives
+    /// it (`None`: not given).
+    pub struct OutputLayer;
+    {
+        /// Exposure in stops for 8-bit output (pixels scaled by
+        /// `2^exposure`).
+        exposure: f32 = 0.0;
+        /// Tone map for 8-bit output.
+        tonemap: ToneMap = ToneMap::Clamp;
+        /// Render passes written beside the beauty, as layers of an EXR
+        /// (sorted, each once, once decided by the request).
+        aovs: Vec<Aov> = Vec::new();
+        /// Denoise the image with Intel Open Image Denoise, guided by the
+        /// albedo and normal of what each pixel sees.
+        denoise: bool = false;
+    }
+}
 
 /// Checks, before anything is loaded or rendered, that `path` names an
 /// image Sahara writes (`.png` or `.exr`, or `.exr` only for a part) in a
 /// folder where it can be written, and that an existing file there may be
 /// replaced (not read-only).
-pub(crate) fn check_output(path: &Path, part: bool) -> Result<()> {
+pub fn check_output(path: &Path, part: bool) -> Result<(), FormatError> {
+    let name = path.display().to_string();
     if path.is_dir() {
-        bail!(
-            "{}: is a folder; name an image file in it, e.g. {}",
-            path.display(),
-            path.join(if part { "part.exr" } else { "image.png" })
-                .display()
-        );
+        return Err(FormatError::in_file(
+            &name,
+            format!(
+                "is a folder; name an image file in it, e.g. {}",
+                path.join(if part { "part.exr" } else { "image.png" })
+                    .display()
+            ),
+        ));
     }
-    let format = ImageFormat::from_path(path).map_err(|e| anyhow!("{e}"))?;
+    let format = ImageFormat::from_path(path)?;
     if part && format != ImageFormat::Exr {
-        bail!(
-            "{}: a part (--part, --crop, --samples) is written as OpenEXR: name a .exr file",
-            path.display()
-        );
+        return Err(FormatError::in_file(
+            &name,
+            "a part of a frame is written as OpenEXR: name a .exr file",
+        ));
     }
     if path.metadata().is_ok_and(|m| m.permissions().readonly()) {
-        bail!(
-            "{}: the file is read-only: not replaced (make it writable, or write elsewhere)",
-            path.display()
-        );
+        return Err(FormatError::in_file(
+            &name,
+            "the file is read-only: not replaced (make it writable, or write elsewhere)",
+        ));
     }
     check_writable(path)
-        .map_err(|e| anyhow!("{e}"))
-        .context("cannot write the output image")
 }
 
 /// Where a partial image (a preview, an interrupted render) of `path`
 /// goes: `path` itself if nothing is there yet, else beside it as
 /// `<stem>.partial.<ext>`, so that a complete image from an earlier run is
 /// never replaced by an incomplete one.
-pub(crate) fn partial_path(path: &Path, existed: bool) -> PathBuf {
+pub fn partial_path(path: &Path, existed: bool) -> PathBuf {
     if !existed {
         return path.to_path_buf();
     }
@@ -58,50 +89,55 @@ pub(crate) fn partial_path(path: &Path, existed: bool) -> PathBuf {
 }
 
 /// True if `path` ends in `.exr` (any case).
-pub(crate) fn is_exr(path: &Path) -> bool {
+pub fn is_exr(path: &Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
 }
 
-/// Where and how the image is written.
-pub(crate) struct Output<'a> {
-    pub(crate) path: PathBuf,
-    pub(crate) settings: &'a RenderSettings,
-    pub(crate) exposure: f32,
-    pub(crate) tonemap: ToneMap,
-    /// Render passes written as layers beside the beauty (EXR only).
-    pub(crate) aovs: &'a [Aov],
+/// Where and how a rendered frame's image is written.
+pub struct FrameImage<'a> {
+    /// The image file.
+    pub path: PathBuf,
+    /// The frame (its integrator and seed go into the metadata; the depth
+    /// view is mapped to grey in a PNG).
+    pub frame: &'a FrameSettings,
+    /// Exposure, tone map (for a PNG), and the render passes written as
+    /// layers beside the beauty (EXR only).
+    pub look: &'a OutputSettings,
     /// The image before denoising (linear RGB), written as the layer
     /// `noisy` of an EXR.
-    pub(crate) noisy: Option<&'a [f32]>,
+    pub noisy: Option<&'a [f32]>,
 }
 
-impl Output<'_> {
-    /// Writes `result` (atomically), marked `partial` or not; `log` prints
-    /// what a debug view's colours mean.
-    pub(crate) fn write(&self, result: &RenderResult, partial: bool, log: bool) -> Result<()> {
-        let settings = self.settings;
+impl FrameImage<'_> {
+    /// Writes `result` (atomically), marked `partial` or not. Returns what
+    /// a debug view's colours mean, for the log (the depth view's range).
+    pub fn write(
+        &self,
+        result: &RenderResult,
+        partial: bool,
+    ) -> Result<Option<String>, FormatError> {
+        let frame = self.frame;
         let s = &result.stats;
         let exr = is_exr(&self.path);
         let rgb = result.film.to_rgb_f32();
+        let mut said = None;
         let rgb8 = if exr {
             Vec::new()
-        } else if matches!(settings.integrator, Integrator::Depth) {
+        } else if matches!(frame.integrator, Integrator::Depth) {
             // Raw distances would be a flat white or grey: map the nearest
             // to the farthest hit onto white to dark grey (EXR keeps them raw).
             let range = depth_range(&rgb, result.film.width, result.film.height);
-            if log {
-                match range {
-                    Some((near, far)) => eprintln!(
-                        "depth: nearest hit {near:.4} (white) to farthest {far:.4} (dark grey), \
-                         no hit black; EXR output keeps the raw distances"
-                    ),
-                    None => eprintln!("depth: no ray hit anything"),
-                }
-            }
+            said = Some(match range {
+                Some((near, far)) => format!(
+                    "depth: nearest hit {near:.4} (white) to farthest {far:.4} (dark grey), \
+                     no hit black; EXR output keeps the raw distances"
+                ),
+                None => "depth: no ray hit anything".to_string(),
+            });
             depth_to_gray8(&rgb, range)
         } else {
-            result.film.to_srgb8(self.exposure, self.tonemap)
+            result.film.to_srgb8(self.look.exposure, self.look.tonemap)
         };
         let pixels = if exr {
             Pixels::LinearRgbF32(&rgb)
@@ -118,15 +154,15 @@ impl Output<'_> {
         let metadata = vec![
             (
                 "sahara:integrator".to_string(),
-                settings.integrator.name().to_string(),
+                frame.integrator.name().to_string(),
             ),
             ("sahara:spp".to_string(), s.spp.to_string()),
-            ("sahara:seed".to_string(), settings.seed.to_string()),
+            ("sahara:seed".to_string(), frame.seed.to_string()),
             ("sahara:partial".to_string(), partial.to_string()),
             ("sahara:finished_pixels".to_string(), finished.to_string()),
         ];
         let passes = match &result.aux {
-            Some(aux) => aov_layers(self.aovs, &aux.images),
+            Some(aux) => aov_layers(&self.look.aovs, &aux.images),
             None => Vec::new(),
         };
         let mut layers: Vec<ExrLayer> = passes
@@ -155,19 +191,17 @@ impl Output<'_> {
                 values: noisy,
             });
         }
-        let written = if exr && !layers.is_empty() {
-            write_exr_layers(&self.path, width, height, &rgb, &layers, &metadata)
+        if exr && !layers.is_empty() {
+            write_exr_layers(&self.path, width, height, &rgb, &layers, &metadata)?;
         } else {
-            write_image(&self.path, width, height, pixels, &metadata)
-        };
-        written
-            .map_err(|e| anyhow!("{e}"))
-            .context("cannot write the output image")
+            write_image(&self.path, width, height, pixels, &metadata)?;
+        }
+        Ok(said)
     }
 }
 
 /// Vectors as interleaved floats.
-pub(crate) fn flat(v: &[glam::Vec3]) -> Vec<f32> {
+pub fn flat(v: &[glam::Vec3]) -> Vec<f32> {
     v.iter().flat_map(|p| p.to_array()).collect()
 }
 
@@ -257,6 +291,23 @@ fn depth_to_gray8(rgb: &[f32], range: Option<(f32, f32)>) -> Vec<u8> {
             [v; 3]
         })
         .collect()
+}
+
+/// Where the list of names of the image `image` goes.
+pub fn names_path(image: &Path) -> PathBuf {
+    let stem = image
+        .file_stem()
+        .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+    image.with_file_name(format!("{stem}.names.json"))
+}
+
+/// Writes the list of names `text` beside `image`, atomically.
+pub fn write_names_beside(image: &Path, text: &str) -> Result<(), FormatError> {
+    let path = names_path(image);
+    write_atomically(&path, |out| {
+        out.write_all(text.as_bytes())
+            .map_err(|e| FormatError::write(&path, e))
+    })
 }
 
 #[cfg(test)]
