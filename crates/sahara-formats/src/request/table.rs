@@ -10,7 +10,8 @@ use std::time::Duration;
 
 use sahara_kd::{AccelKind, Builder};
 use sahara_render::{
-    AdaptiveChoice, Aov, FilterKind, IntegratorKind, Named, Pick, SamplerKind, ToneMap,
+    AdaptiveChoice, Aov, FilterKind, IntegratorKind, LightSampler, Named, Pick, SamplerKind,
+    ToneMap,
 };
 
 use crate::description::{SettingsLayer, Split};
@@ -256,6 +257,20 @@ pub static SETTINGS: &[Setting] = &[
         requires: None,
         set: |l, g| {
             l.frame.sampler = Some(named(g)?);
+            Ok(())
+        },
+    },
+    Setting {
+        name: "light_sampler",
+        keyword: "light_sampler",
+        short: None,
+        value_name: "NAME",
+        takes: Takes::Name(LightSampler::names),
+        help: "How next-event estimation chooses a light: tree (by power, distance and \
+               orientation from the shading point), power, or uniform [default: tree]",
+        requires: None,
+        set: |l, g| {
+            l.frame.light_sampler = Some(named(g)?);
             Ok(())
         },
     },

@@ -3,6 +3,7 @@
 //! a scene gathered once for its world ([`gather`]).
 
 pub mod area;
+pub(crate) mod choice;
 pub mod directional;
 pub(crate) mod emission;
 pub mod environment;
@@ -10,10 +11,12 @@ pub(crate) mod gather;
 mod kinds;
 pub mod point;
 pub mod spot;
+pub(crate) mod tree;
 
 use glam::Vec3;
 
 pub use area::AreaLight;
+pub use choice::LightSampler;
 pub use environment::{EnvLight, Environment};
 pub use kinds::{LightKind, LightOf, AREA_SHAPES};
 

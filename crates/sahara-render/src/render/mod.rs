@@ -89,7 +89,7 @@ pub fn render_watched(
 ) -> Result<RenderResult, SettingsError> {
     settings.check_for(scene)?;
     let start = Instant::now();
-    let mut world = World::new(scene, &settings.build);
+    let mut world = World::with_light_sampler(scene, &settings.build, settings.light_sampler);
     let build_time = start.elapsed();
     render_world(&mut world, settings, progress, preview, start, build_time)
 }
@@ -127,6 +127,7 @@ pub fn render_world(
     settings.check_for(world.scene)?;
     world.set_film(settings.height.max(1), u64::from(settings.spp.max(1)));
     world.accel.set_isa(SAMPLE_LOOP_ISA);
+    world.set_light_sampler(settings.light_sampler);
     let world = &*world;
     let stats = RenderStats {
         build_time,
