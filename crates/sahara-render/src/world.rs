@@ -598,6 +598,22 @@ impl<'a> World<'a> {
         Some((s, pmf))
     }
 
+    /// [`World::sample_light`] for estimators that weigh the light's
+    /// sample against BSDF sampling by MIS (with [`World::env_pdf_mis`]):
+    /// the environment's sample is MIS-compensated
+    /// ([`EnvLight::sample_mis`](crate::light::environment::EnvLight::sample_mis)).
+    pub fn sample_light_mis(&self, p: Vec3, u_pick: f32, u: Vec2) -> Option<(LightSample, f32)> {
+        if self.lights.is_empty() {
+            return None;
+        }
+        let (i, pmf) = self.nee.sample_discrete(u_pick);
+        if pmf <= 0.0 {
+            return None;
+        }
+        let s = self.lights[i].sample_mis(p, u)?;
+        Some((s, pmf))
+    }
+
     /// One light chosen by power (`u_pick`), as its index and the
     /// probability of the choice.
     pub(crate) fn pick_light(&self, u_pick: f32) -> Option<(usize, f32)> {
@@ -653,6 +669,17 @@ impl<'a> World<'a> {
         match self.env {
             Some(i) => match &self.lights[i as usize] {
                 LightSource::Environment(e) => self.nee.pmf(i as usize) * e.pdf(w),
+                LightSource::Explicit(_) | LightSource::Area(_) => 0.0,
+            },
+            None => 0.0,
+        }
+    }
+
+    /// [`World::env_pdf`] of [`World::sample_light_mis`].
+    pub fn env_pdf_mis(&self, w: Vec3) -> f32 {
+        match self.env {
+            Some(i) => match &self.lights[i as usize] {
+                LightSource::Environment(e) => self.nee.pmf(i as usize) * e.pdf_mis(w),
                 LightSource::Explicit(_) | LightSource::Area(_) => 0.0,
             },
             None => 0.0,
