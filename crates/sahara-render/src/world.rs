@@ -620,12 +620,40 @@ impl<'a> World<'a> {
         u_pick: f32,
         u: Vec2,
     ) -> Option<(LightSample, f32)> {
+        self.sample_light_as(p, n, u_pick, u, false)
+    }
+
+    /// [`World::sample_light`] for estimators that weigh the light's
+    /// sample against BSDF sampling by MIS (with [`World::env_pdf_mis`]):
+    /// the environment's sample is MIS-compensated
+    /// ([`EnvLight::sample_mis`](crate::light::environment::EnvLight::sample_mis)).
+    pub fn sample_light_mis(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        u_pick: f32,
+        u: Vec2,
+    ) -> Option<(LightSample, f32)> {
+        self.sample_light_as(p, n, u_pick, u, true)
+    }
+
+    /// [`World::sample_light`], or with `mis` its MIS-compensated form.
+    #[inline]
+    fn sample_light_as(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        u_pick: f32,
+        u: Vec2,
+        mis: bool,
+    ) -> Option<(LightSample, f32)> {
         if self.lights.is_empty() {
             return None;
         }
         let c = self.nee.sample(p, n, u_pick)?;
         let s = match (&self.lights[c.light], c.tri) {
             (LightSource::Area(a), Some(tri)) => a.sample_triangle(p, tri, u)?,
+            (l, _) if mis => l.sample_mis(p, u)?,
             (l, _) => l.sample(p, u)?,
         };
         Some((s, c.pmf))
@@ -699,6 +727,19 @@ impl<'a> World<'a> {
             Some(i) => match &self.lights[i as usize] {
                 LightSource::Environment(e) => {
                     self.nee.pmf(Vec3::ZERO, Vec3::ZERO, i as usize, None) * e.pdf(w)
+                }
+                LightSource::Explicit(_) | LightSource::Area(_) => 0.0,
+            },
+            None => 0.0,
+        }
+    }
+
+    /// [`World::env_pdf`] of [`World::sample_light_mis`].
+    pub fn env_pdf_mis(&self, w: Vec3) -> f32 {
+        match self.env {
+            Some(i) => match &self.lights[i as usize] {
+                LightSource::Environment(e) => {
+                    self.nee.pmf(Vec3::ZERO, Vec3::ZERO, i as usize, None) * e.pdf_mis(w)
                 }
                 LightSource::Explicit(_) | LightSource::Area(_) => 0.0,
             },

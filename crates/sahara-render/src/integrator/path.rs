@@ -33,7 +33,7 @@ pub(crate) fn step(
             let w = if st.prev_delta {
                 1.0
             } else {
-                power_heuristic(st.prev_pdf, world.env_pdf(ray.dir))
+                power_heuristic(st.prev_pdf, world.env_pdf_mis(ray.dir))
             };
             st.l += st.beta * le * w;
         }
@@ -73,7 +73,7 @@ pub(crate) fn step(
     if !sh.bsdf.is_delta() {
         let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
         let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
-        if let Some((ls, pmf)) = world.sample_light(hit.p, hit.ns, u_pick, u) {
+        if let Some((ls, pmf)) = world.sample_light_mis(hit.p, hit.ns, u_pick, u) {
             if let Some((c, bsdf_pdf, shadow)) = light_contribution(ctx, &hit, &sh, &ls, st.time) {
                 let light_pdf = pmf * ls.pdf;
                 let w = if ls.delta {

@@ -136,7 +136,7 @@ pub(crate) fn li(
                 let w = if prev_delta {
                     1.0
                 } else {
-                    power_heuristic(prev_pdf, world.env_pdf(ray.dir))
+                    power_heuristic(prev_pdf, world.env_pdf_mis(ray.dir))
                 };
                 l += beta * le * w;
             }
@@ -238,7 +238,7 @@ fn surface_light(
     let world = ctx.world;
     let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
     let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
-    let Some((ls, pmf)) = world.sample_light(hit.p, hit.ns, u_pick, u) else {
+    let Some((ls, pmf)) = world.sample_light_mis(hit.p, hit.ns, u_pick, u) else {
         return Vec3::ZERO;
     };
     let Some((c, bsdf_pdf, shadow)) = light_contribution(ctx, hit, sh, &ls, time) else {
@@ -283,7 +283,7 @@ fn medium_light(
     let world = ctx.world;
     let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
     let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
-    let Some((ls, pmf)) = world.sample_light(p, Vec3::ZERO, u_pick, u) else {
+    let Some((ls, pmf)) = world.sample_light_mis(p, Vec3::ZERO, u_pick, u) else {
         return Vec3::ZERO;
     };
     let f = m.phase().eval(w_in, ls.wi);

@@ -221,6 +221,16 @@ impl LightSource {
         }
     }
 
+    /// [`LightSource::sample`] for estimators that pair light sampling
+    /// with BSDF sampling by MIS: the environment samples its compensated
+    /// distribution ([`EnvLight::sample_mis`]).
+    pub fn sample_mis(&self, p: Vec3, u: glam::Vec2) -> Option<LightSample> {
+        match self {
+            LightSource::Environment(e) => e.sample_mis(u),
+            _ => self.sample(p, u),
+        }
+    }
+
     /// True for lights a ray can never hit.
     pub fn is_delta(&self) -> bool {
         match self {
