@@ -246,6 +246,21 @@ mod tests {
         assert!(direction(Vec2::new(0.3, 0.0)).0.y > 0.999);
     }
 
+    /// The integral over the sphere of a piecewise-constant map's red
+    /// channel (`w` by `h` texels), by quadrature: each texel's value times
+    /// its patch's solid angle, the integral of sin(theta) over its row.
+    fn integral(texels: &[Vec3], w: u32, h: u32) -> f64 {
+        let mut sum = 0.0f64;
+        for y in 0..h {
+            let (t0, t1) = (PI * y as f32 / h as f32, PI * (y + 1) as f32 / h as f32);
+            let band = (t0.cos() - t1.cos()) as f64;
+            for x in 0..w {
+                sum += texels[(y * w + x) as usize].x as f64 * band * (2.0 * PI / w as f32) as f64;
+            }
+        }
+        sum
+    }
+
     #[test]
     fn map_sampling_is_unbiased() {
         // A map with a bright patch: the mean of L / pdf over samples must
@@ -267,16 +282,7 @@ mod tests {
             scale: 1.0,
         };
         let light = EnvLight::new(&env);
-        let mut exact = 0.0f64;
-        for y in 0..h {
-            // Integral of sin(theta) over the row's theta range.
-            let (t0, t1) = (PI * y as f32 / h as f32, PI * (y + 1) as f32 / h as f32);
-            let band = (t0.cos() - t1.cos()) as f64;
-            for x in 0..w {
-                exact +=
-                    texels[(y * w + x) as usize].x as f64 * band * (2.0 * PI / w as f32) as f64;
-            }
-        }
+        let exact = integral(&texels, w, h);
         let n = 200_000u64;
         let mut est = 0.0f64;
         let mut mismatches = 0;
@@ -320,15 +326,7 @@ mod tests {
         };
         let light = EnvLight::new(&env);
         assert!(light.compensated.is_some());
-        let mut exact = 0.0f64;
-        for y in 0..h {
-            let (t0, t1) = (PI * y as f32 / h as f32, PI * (y + 1) as f32 / h as f32);
-            let band = (t0.cos() - t1.cos()) as f64;
-            for x in 0..w {
-                exact +=
-                    texels[(y * w + x) as usize].x as f64 * band * (2.0 * PI / w as f32) as f64;
-            }
-        }
+        let exact = integral(&texels, w, h);
         let power = |a: f32, b: f32| a * a / (a * a + b * b);
         let n = 400_000u64;
         let (mut est, mut mismatches, mut dim) = (0.0f64, 0, 0);

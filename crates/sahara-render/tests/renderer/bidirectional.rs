@@ -107,11 +107,9 @@ fn bdpt_agrees_with_the_path_tracer_on_a_glossy_box_with_glass_and_delta_lights(
     assert_agree("bdpt", &reference, &b, 0.015, 0.1);
 }
 
-/// Lights at infinity: a constant sky and a sun over a diffuse sphere on
-/// a ground plane, seen by bidirectional path tracing and by the path
-/// tracer.
-#[test]
-fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
+/// A red diffuse sphere on a ground plane of `ground`, seen from above
+/// and in front, with no light yet.
+fn red_sphere_on(ground: Material) -> Scene {
     let camera = Camera::look_at(
         Vec3::new(0.0, 1.5, -4.0),
         Vec3::new(0.0, 0.5, 0.0),
@@ -120,7 +118,7 @@ fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
         1.0,
     );
     let mut scene = Scene::new(camera);
-    let white = scene.add_material(Material::diffuse(Vec3::splat(0.7)));
+    let ground = scene.add_material(ground);
     let red = scene.add_material(Material::diffuse(Vec3::new(0.7, 0.2, 0.1)));
     scene.add_shape(
         Shape::Quad {
@@ -128,7 +126,7 @@ fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
             edge_u: Vec3::new(0.0, 0.0, 6.0),
             edge_v: Vec3::new(6.0, 0.0, 0.0),
         },
-        white,
+        ground,
     );
     scene.add_shape(
         Shape::Sphere {
@@ -137,6 +135,15 @@ fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
         },
         red,
     );
+    scene
+}
+
+/// Lights at infinity: a constant sky and a sun over a diffuse sphere on
+/// a ground plane, seen by bidirectional path tracing and by the path
+/// tracer.
+#[test]
+fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
+    let mut scene = red_sphere_on(Material::diffuse(Vec3::splat(0.7)));
     scene.environment = Some(Environment::Constant(Vec3::new(0.3, 0.4, 0.6)));
     scene.add_light(Light::directional(
         Vec3::new(0.4, -1.0, 0.3),
@@ -203,31 +210,7 @@ fn bdpt_is_deterministic_across_thread_counts() {
 fn bdpt_agrees_with_the_compensated_path_tracer_under_a_sky_map_with_a_sun() {
     use sahara_render::Texture;
     use std::sync::Arc;
-    let camera = Camera::look_at(
-        Vec3::new(0.0, 1.5, -4.0),
-        Vec3::new(0.0, 0.5, 0.0),
-        Vec3::Y,
-        45.0,
-        1.0,
-    );
-    let mut scene = Scene::new(camera);
-    let metal = scene.add_material(Material::conductor(Vec3::new(0.9, 0.7, 0.4), 0.4));
-    let red = scene.add_material(Material::diffuse(Vec3::new(0.7, 0.2, 0.1)));
-    scene.add_shape(
-        Shape::Quad {
-            corner: Vec3::new(-3.0, 0.0, -3.0),
-            edge_u: Vec3::new(0.0, 0.0, 6.0),
-            edge_v: Vec3::new(6.0, 0.0, 0.0),
-        },
-        metal,
-    );
-    scene.add_shape(
-        Shape::Sphere {
-            center: Vec3::new(0.0, 0.7, 0.0),
-            radius: 0.7,
-        },
-        red,
-    );
+    let mut scene = red_sphere_on(Material::conductor(Vec3::new(0.9, 0.7, 0.4), 0.4));
     // A sky brighter towards the zenith, and a sun of 2x2 texels.
     let (w, h) = (64u32, 32u32);
     let texels: Vec<Vec3> = (0..w * h)
