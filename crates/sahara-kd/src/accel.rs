@@ -8,6 +8,7 @@ use crate::bvh::{Bvh, BvhBuilder, BvhParams};
 use crate::isect::Hit;
 use crate::kd::{Counters, KdTree};
 use crate::math::{Aabb, Ray, Triangle};
+use crate::simd::Isa;
 
 /// Which structure an accelerator is.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -48,6 +49,9 @@ pub struct AccelParams {
     pub kd: BuildParams,
     /// The hierarchy's parameters (for [`AccelKind::Bvh`]).
     pub bvh: BvhParams,
+    /// The widest instructions its queries may use (the default: the
+    /// best the CPU has; see [`Isa`]).
+    pub isa: Isa,
 }
 
 impl AccelParams {
@@ -158,10 +162,23 @@ impl TriangleAccel {
     /// Build the structure `params.kind` over `triangles` (those no ray
     /// can hit are left out; hit indices are positions in `triangles`).
     pub fn build(triangles: Vec<Triangle>, params: &AccelParams) -> Self {
-        match params.kind {
+        let mut a = match params.kind {
             AccelKind::Kd => TriangleAccel::Kd(KdTree::build(triangles, &params.kd)),
             AccelKind::Bvh => TriangleAccel::Bvh(Bvh::build(triangles, &params.bvh)),
-        }
+        };
+        a.set_isa(params.isa);
+        a
+    }
+
+    /// Hold its queries to the instructions of `isa` at most (see
+    /// [`Isa`]); answers do not change.
+    pub fn set_isa(&mut self, isa: Isa) {
+        each!(self, t => t.set_isa(isa))
+    }
+
+    /// The widest instructions its queries may use.
+    pub fn isa(&self) -> Isa {
+        each!(self, t => t.isa())
     }
 
     /// Which structure this is.

@@ -59,6 +59,7 @@ pub use kd::{
 pub use leaf::{TriangleBlock, TriangleLeaves};
 pub use math::slack::gamma;
 pub use math::{Aabb, Mesh, Ray, Triangle};
+pub use simd::Isa;
 pub use stats::TreeStats;
 pub use validate::validate;
 

@@ -21,8 +21,8 @@ use sahara_formats::{write_image, Pixels};
 use sahara_formats::{Given, Plan, Refused, Request, RequestError, Setting, SettingsLayer};
 use sahara_formats::{LoadOptions, Loaded, Note, SceneNames, Spelling, SETTINGS};
 use sahara_render::{
-    render_watched, Aov, AuxImages, Film, FilterKind, IntegratorKind, Named, Progress,
-    RenderResult, SamplerKind, Scene as RenderScene, ToneMap,
+    render_watched, Aov, AuxImages, Film, FilterKind, IntegratorKind, LightSampler, Named,
+    Progress, RenderResult, SamplerKind, Scene as RenderScene, ToneMap,
 };
 
 use crate::pool::pool;
@@ -120,6 +120,7 @@ impl Scene {
         let d = PyDict::new(py);
         d.set_item("integrator", f.integrator.name())?;
         d.set_item("sampler", f.sampler.name())?;
+        d.set_item("light_sampler", f.light_sampler.name())?;
         d.set_item("spp", f.spp)?;
         d.set_item("seed", f.seed)?;
         d.set_item("filter", f.filter.kind().name())?;
@@ -556,6 +557,7 @@ pub fn names(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("setting", PyList::new(py, keywords)?)?;
     d.set_item("integrator", PyList::new(py, IntegratorKind::names())?)?;
     d.set_item("sampler", PyList::new(py, SamplerKind::names())?)?;
+    d.set_item("light_sampler", PyList::new(py, LightSampler::names())?)?;
     d.set_item("filter", PyList::new(py, FilterKind::names())?)?;
     d.set_item("aov", PyList::new(py, Aov::names())?)?;
     d.set_item("tonemap", PyList::new(py, ToneMap::names())?)?;

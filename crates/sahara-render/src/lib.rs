@@ -63,7 +63,7 @@ pub use scene::{Scene, ShapeInstance};
 
 // Materials, textures and lights.
 pub use light::environment::{coordinates as environment_uv, direction as environment_direction};
-pub use light::{Environment, Light, LightKind, LightOf, AREA_SHAPES};
+pub use light::{Environment, Light, LightKind, LightOf, LightSampler, AREA_SHAPES};
 pub use material::{
     fresnel, isotropic_mean, metals, roughness_from_alpha, AlphaMode, Bsdf, Clearcoat,
     Distribution, Material, MaterialKind, MaterialTextures, NormalMap, OcclusionMap,

@@ -19,6 +19,7 @@ use std::fmt::Debug;
 
 use crate::film::filter::{Filter, FilterKind};
 use crate::integrator::{defaults, Integrator, IntegratorKind};
+use crate::light::LightSampler;
 use crate::sampler::SamplerKind;
 
 /// Declares a struct of settings with its defaults, and its layer: the
@@ -294,6 +295,8 @@ layered! {
         /// Adaptive sampling: pixels stop once their noise is low enough,
         /// and `spp` is a cap (None: every pixel takes `spp`).
         adaptive: Option<Adaptive> = None, by AdaptiveChoice;
+        /// How next-event estimation chooses the light it samples.
+        light_sampler: LightSampler = LightSampler::Tree;
     }
 }
 
@@ -310,6 +313,7 @@ impl From<FrameSettings> for FrameLayer {
             filter: Some(Pick::Value(s.filter)),
             integrator: Some(Pick::Value(s.integrator)),
             adaptive: s.adaptive.map(AdaptiveChoice::from),
+            light_sampler: Some(s.light_sampler),
         }
     }
 }

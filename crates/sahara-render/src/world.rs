@@ -6,8 +6,9 @@ use sahara_kd::gamma;
 use sahara_kd::{AccelParams, Counters, NoCounters, Ray};
 
 use crate::accel::{Accel, BatchBuffers, RawHit};
+use crate::light::choice::LightChoice;
 use crate::light::gather::SceneLights;
-use crate::light::{LightSample, LightSource};
+use crate::light::{AreaLight, LightSample, LightSampler, LightSource};
 use crate::material::Material;
 use crate::math::piecewise::Distribution1D;
 use crate::math::warp::Frame;
@@ -115,10 +116,15 @@ pub struct World<'a> {
     pub lights: Vec<LightSource>,
     /// How light tracing picks the light a path starts from: by power.
     select: Distribution1D,
-    /// How next-event estimation picks the light it samples
-    /// ([`next_event_choice`]).
-    nee: Distribution1D,
+    /// How next-event estimation picks the light it samples from a
+    /// shading point.
+    nee: LightChoice,
+    /// Each light's powers, by which the choice is made.
+    powers: Vec<f32>,
     instance_light: Vec<Option<u32>>,
+    /// Per light, the triangles of its instance's mesh a mesh light is
+    /// made of (empty for other lights).
+    mesh_triangles: Vec<Vec<u32>>,
     env: Option<u32>,
     default_material: Material,
     /// Whether any material has holes (alpha): shadow rays then look at
@@ -139,12 +145,23 @@ pub struct World<'a> {
 }
 
 impl<'a> World<'a> {
-    /// Builds trees and lights.
+    /// Builds trees and lights, the lights chosen by the default light
+    /// sampler.
     pub fn new(scene: &'a Scene, params: &AccelParams) -> Self {
+        Self::with_light_sampler(scene, params, LightSampler::default())
+    }
+
+    /// Builds trees and lights, the lights chosen by `light_sampler`.
+    pub fn with_light_sampler(
+        scene: &'a Scene,
+        params: &AccelParams,
+        light_sampler: LightSampler,
+    ) -> Self {
         let SceneLights {
             lights,
             instance_light,
             env,
+            mesh_triangles,
         } = SceneLights::gather(scene);
         // The analytic emitters' shadow rays ignore the emitter's own
         // instance, which therefore keeps a tree of its own.
@@ -158,15 +175,17 @@ impl<'a> World<'a> {
         let accel = Accel::build(&scene.meshes, &scene.instances, params, &ignorable);
         let (center, radius) = bounding_sphere(&accel);
         let powers: Vec<f32> = lights.iter().map(|l| l.power(radius)).collect();
-        let nee = Distribution1D::new(next_event_choice(&lights, &powers));
-        let select = Distribution1D::new(powers);
+        let nee = LightChoice::new(light_sampler, &lights, &powers);
+        let select = Distribution1D::new(powers.clone());
         Self {
             scene,
             accel,
             lights,
             select,
             nee,
+            powers,
             instance_light,
+            mesh_triangles,
             env,
             default_material: Material::default(),
             has_holes: scene.materials.iter().any(Material::has_holes),
@@ -206,6 +225,14 @@ impl<'a> World<'a> {
     #[inline]
     pub fn medium(&self, i: u32) -> &Medium {
         &self.scene.media[i as usize]
+    }
+
+    /// Chooses the lights next-event estimation samples by `kind` (a
+    /// world is made with the default, [`LightSampler::Tree`]).
+    pub fn set_light_sampler(&mut self, kind: LightSampler) {
+        if self.nee.kind() != kind {
+            self.nee = LightChoice::new(kind, &self.lights, &self.powers);
+        }
     }
 
     /// Sets the footprint of texture lookups from the film: `height`
@@ -583,19 +610,53 @@ impl<'a> World<'a> {
         !self.lights.is_empty()
     }
 
-    /// One light chosen for next-event estimation (`u_pick`,
-    /// [`next_event_choice`]), sampled from `p` (`u`), with the
-    /// probability of the choice.
-    pub fn sample_light(&self, p: Vec3, u_pick: f32, u: Vec2) -> Option<(LightSample, f32)> {
+    /// One light chosen for next-event estimation (`u_pick`) from the
+    /// point `p` with shading normal `n` (zero for a point in a medium),
+    /// sampled from `p` (`u`), with the probability of the choice.
+    pub fn sample_light(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        u_pick: f32,
+        u: Vec2,
+    ) -> Option<(LightSample, f32)> {
+        self.sample_light_as(p, n, u_pick, u, false)
+    }
+
+    /// [`World::sample_light`] for estimators that weigh the light's
+    /// sample against BSDF sampling by MIS (with [`World::env_pdf_mis`]):
+    /// the environment's sample is MIS-compensated
+    /// ([`EnvLight::sample_mis`](crate::light::environment::EnvLight::sample_mis)).
+    pub fn sample_light_mis(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        u_pick: f32,
+        u: Vec2,
+    ) -> Option<(LightSample, f32)> {
+        self.sample_light_as(p, n, u_pick, u, true)
+    }
+
+    /// [`World::sample_light`], or with `mis` its MIS-compensated form.
+    #[inline]
+    fn sample_light_as(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        u_pick: f32,
+        u: Vec2,
+        mis: bool,
+    ) -> Option<(LightSample, f32)> {
         if self.lights.is_empty() {
             return None;
         }
-        let (i, pmf) = self.nee.sample_discrete(u_pick);
-        if pmf <= 0.0 {
-            return None;
-        }
-        let s = self.lights[i].sample(p, u)?;
-        Some((s, pmf))
+        let c = self.nee.sample(p, n, u_pick)?;
+        let s = match (&self.lights[c.light], c.tri) {
+            (LightSource::Area(a), Some(tri)) => a.sample_triangle(p, tri, u)?,
+            (l, _) if mis => l.sample_mis(p, u)?,
+            (l, _) => l.sample(p, u)?,
+        };
+        Some((s, c.pmf))
     }
 
     /// One light chosen by power (`u_pick`), as its index and the
@@ -624,16 +685,28 @@ impl<'a> World<'a> {
     }
 
     /// Density (selection times solid angle) with which light sampling from
-    /// `p_ref` produces direction `wi` towards the emissive `hit`; 0 when the
-    /// hit surface is not a sampled light.
-    pub fn light_pdf(&self, p_ref: Vec3, hit: &SurfaceHit, wi: Vec3) -> f32 {
+    /// `p_ref` (shading normal `n_ref`, zero in a medium) produces
+    /// direction `wi` towards the emissive `hit`; 0 when the hit surface is
+    /// not a sampled light.
+    pub fn light_pdf(&self, p_ref: Vec3, n_ref: Vec3, hit: &SurfaceHit, wi: Vec3) -> f32 {
         let Some(l) = self.instance_light[hit.instance as usize] else {
             return 0.0;
         };
-        match &self.lights[l as usize] {
-            LightSource::Area(a) => self.nee.pmf(l as usize) * a.pdf(p_ref, hit.p, hit.ng, wi),
-            LightSource::Explicit(_) | LightSource::Environment(_) => 0.0,
+        let l = l as usize;
+        let LightSource::Area(a) = &self.lights[l] else {
+            return 0.0;
+        };
+        if self.nee.by_triangle() && a.is_mesh() {
+            let Some(k) = AreaLight::triangle_of(&self.mesh_triangles[l], hit.tri) else {
+                return 0.0;
+            };
+            let pmf = self.nee.pmf(p_ref, n_ref, l, Some(k));
+            if pmf == 0.0 {
+                return 0.0;
+            }
+            return pmf * a.pdf_triangle(k, p_ref, hit.p, hit.ng, wi);
         }
+        self.nee.pmf(p_ref, n_ref, l, None) * a.pdf(p_ref, hit.p, hit.ng, wi)
     }
 
     /// Radiance of the environment along `w` (black without one).
@@ -652,7 +725,22 @@ impl<'a> World<'a> {
     pub fn env_pdf(&self, w: Vec3) -> f32 {
         match self.env {
             Some(i) => match &self.lights[i as usize] {
-                LightSource::Environment(e) => self.nee.pmf(i as usize) * e.pdf(w),
+                LightSource::Environment(e) => {
+                    self.nee.pmf(Vec3::ZERO, Vec3::ZERO, i as usize, None) * e.pdf(w)
+                }
+                LightSource::Explicit(_) | LightSource::Area(_) => 0.0,
+            },
+            None => 0.0,
+        }
+    }
+
+    /// [`World::env_pdf`] of [`World::sample_light_mis`].
+    pub fn env_pdf_mis(&self, w: Vec3) -> f32 {
+        match self.env {
+            Some(i) => match &self.lights[i as usize] {
+                LightSource::Environment(e) => {
+                    self.nee.pmf(Vec3::ZERO, Vec3::ZERO, i as usize, None) * e.pdf_mis(w)
+                }
                 LightSource::Explicit(_) | LightSource::Area(_) => 0.0,
             },
             None => 0.0,
@@ -667,33 +755,6 @@ impl<'a> World<'a> {
 
 /// Relative shortening of shadow rays towards points on lights.
 pub const SHADOW_EPS: f32 = 1.0 / 4096.0;
-
-/// The weights by which next-event estimation picks a light: by power
-/// within each of two families, the lights infinitely far away (the
-/// environment, directional lights) and the lights in the scene, with
-/// half the choices to each family when the scene has both. Power alone
-/// would rate an environment by the disc of the whole scene it lights, and
-/// a dim sky around a room would take nearly every choice from the lamp
-/// that lights the room (pbrt-v4's light samplers split the same way).
-fn next_event_choice(lights: &[LightSource], powers: &[f32]) -> Vec<f32> {
-    let infinite = LightSource::is_infinite;
-    let (mut far, mut near) = (0.0f64, 0.0f64);
-    for (l, &p) in lights.iter().zip(powers) {
-        if infinite(l) {
-            far += p as f64;
-        } else {
-            near += p as f64;
-        }
-    }
-    if far <= 0.0 || near <= 0.0 {
-        return powers.to_vec();
-    }
-    lights
-        .iter()
-        .zip(powers)
-        .map(|(l, &p)| (p as f64 / if infinite(l) { far } else { near }) as f32)
-        .collect()
-}
 
 /// The centre and radius of a sphere around the scene's geometry (the unit
 /// sphere when there is none).

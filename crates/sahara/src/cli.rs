@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::{ArgAction, Args, Parser, Subcommand};
 use sahara_bench::SetKind;
-use sahara_kd::{AccelKind, AccelParams, BuildParams, Builder, BvhBuilder, BvhParams};
+use sahara_kd::{AccelKind, AccelParams, BuildParams, Builder, BvhBuilder, BvhParams, Isa};
 use sahara_render::Mesh;
 
 pub use crate::setting_args::SettingArgs;
@@ -274,6 +274,11 @@ pub struct TreeOptions {
     /// kd-tree).
     #[arg(long, default_value = "spatial", value_name = "NAME", value_parser = parse_bvh_builder)]
     pub bvh_builder: BvhBuilder,
+    /// The widest instructions the queries may use, of those the CPU has:
+    /// avx512 (the default), avx2 or portable. Renders hold their queries
+    /// to avx2 (docs/performance.md says why); answers are the same.
+    #[arg(long, default_value = "avx512", value_parser = parse_isa)]
+    pub isa: Isa,
     /// Tree builder: sah, binned, binnedN (N bins, 2..=1024), rr-middle,
     /// rr-median, largest-middle, largest-median, middle, median.
     #[arg(long, default_value = "sah", value_parser = parse_builder)]
@@ -326,6 +331,7 @@ impl Default for TreeOptions {
         Self {
             accel: AccelKind::Bvh,
             bvh_builder: BvhBuilder::Spatial,
+            isa: Isa::Avx512,
             builder: Builder::Sah,
             traversal_cost: None,
             intersection_cost: None,
@@ -353,6 +359,7 @@ impl TreeOptions {
                 kd,
                 ..BvhParams::new(self.bvh_builder)
             },
+            isa: self.isa,
         }
     }
 
@@ -421,6 +428,12 @@ fn parse_subset(s: &str) -> Result<f64, String> {
 /// A structure by name.
 fn parse_accel(s: &str) -> Result<AccelKind, String> {
     AccelKind::parse(s).ok_or_else(|| format!("unknown structure '{s}'; expected bvh or kd"))
+}
+
+/// An instruction limit by name.
+fn parse_isa(s: &str) -> Result<Isa, String> {
+    Isa::parse(s)
+        .ok_or_else(|| format!("unknown instructions '{s}'; expected avx512, avx2 or portable"))
 }
 
 /// A hierarchy builder by name.

@@ -181,7 +181,7 @@ fn render_frame(args: &RenderArgs, plan: &Plan) -> Result<RenderResult> {
     let start = Instant::now();
     let mut world = pool.install(|| {
         let _building = crate::status::Step::start("building the trees and light tables");
-        World::new(&plan.scene, &settings.build)
+        World::with_light_sampler(&plan.scene, &settings.build, settings.light_sampler)
     });
     let build_time = start.elapsed();
     // Started after the lines above, so that it does not draw over them.

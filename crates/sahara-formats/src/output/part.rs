@@ -30,7 +30,7 @@ use exr::prelude::{
 use sahara_readers::FormatError;
 use sahara_render::{
     Adaptive, Aov, Aux, AuxSums, Filter, FilterKind, FrameSettings, Integrator, IntegratorKind,
-    Named, Parameter, PixelSum, PixelWindow, SumBuffer,
+    LightSampler, Named, Parameter, PixelSum, PixelWindow, SumBuffer,
 };
 
 use crate::output::atomic::write_atomically;
@@ -188,6 +188,7 @@ impl PartInfo {
             ("sahara:part".into(), self.part.clone()),
             ("sahara:seed".into(), f.seed.to_string()),
             ("sahara:sampler".into(), f.sampler.to_string()),
+            ("sahara:light_sampler".into(), f.light_sampler.to_string()),
             ("sahara:exposure".into(), o.exposure.to_string()),
             ("sahara:tonemap".into(), o.tonemap.to_string()),
             ("sahara:passes".into(), pass_list(&self.passes)),
@@ -294,6 +295,11 @@ impl PartInfo {
                 )?,
             ),
             adaptive,
+            // Parts written before the setting existed chose by power.
+            light_sampler: match get("sahara:light_sampler") {
+                None => LightSampler::Power,
+                Some(_) => h.parsed("sahara:light_sampler")?,
+            },
         };
         Ok(PartInfo {
             digest: h.need("sahara:digest")?,
@@ -713,6 +719,7 @@ mod tests {
                 pass_spp: 4,
                 seed: 3,
                 sampler: sahara_render::SamplerKind::Independent,
+                light_sampler: LightSampler::Uniform,
                 filter: Filter::Mitchell {
                     radius: 1.75,
                     b: 0.3,

@@ -10,7 +10,8 @@ use std::time::Duration;
 
 use sahara_kd::{AccelKind, Builder};
 use sahara_render::{
-    AdaptiveChoice, Aov, FilterKind, IntegratorKind, Named, PathLoop, Pick, SamplerKind, ToneMap,
+    AdaptiveChoice, Aov, FilterKind, IntegratorKind, LightSampler, Named, PathLoop, Pick,
+    SamplerKind, ToneMap,
 };
 
 use crate::description::{SettingsLayer, Split};
@@ -269,10 +270,24 @@ pub static SETTINGS: &[Setting] = &[
                AVX-512, 8 under AVX2, refilled as paths end), lanes-no-refill, or scalar (the \
                reference the lanes are held to); auto takes the lanes where every material of \
                the scene is shaded in the lanes. The lanes' image equals the scalar one to \
-               noise, not bit for bit [default: auto]",
+               noise, not bit for bit [default: scalar]",
         requires: None,
         set: |l, g| {
             l.path_loop = Some(named(g)?);
+            Ok(())
+        },
+    },
+    Setting {
+        name: "light_sampler",
+        keyword: "light_sampler",
+        short: None,
+        value_name: "NAME",
+        takes: Takes::Name(LightSampler::names),
+        help: "How next-event estimation chooses a light: tree (by power, distance and \
+               orientation from the shading point), power, or uniform [default: tree]",
+        requires: None,
+        set: |l, g| {
+            l.frame.light_sampler = Some(named(g)?);
             Ok(())
         },
     },

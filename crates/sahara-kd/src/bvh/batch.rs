@@ -7,7 +7,7 @@ use crate::isect::Hit;
 use crate::kd::batch::in_parallel;
 use crate::kd::NoCounters;
 use crate::math::Ray;
-use crate::simd::{dispatch, level, Kernel};
+use crate::simd::{dispatch, Kernel};
 
 impl Bvh {
     /// Closest hits of many rays, in parallel; `out[i]` answers `rays[i]`.
@@ -25,7 +25,7 @@ impl Bvh {
     pub fn closest_hits_serial(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
         dispatch(
-            level::AVX512,
+            self.max_level,
             ClosestBatch {
                 bvh: self,
                 rays,
@@ -39,7 +39,7 @@ impl Bvh {
     pub fn any_hits_serial(&self, rays: &[Ray], out: &mut [bool]) {
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
         dispatch(
-            level::AVX512,
+            self.max_level,
             AnyBatch {
                 bvh: self,
                 rays,
@@ -95,7 +95,7 @@ impl Bvh {
         assert!(rays.len() <= PACKET8, "{} rays in a packet", rays.len());
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
         dispatch(
-            level::AVX512,
+            self.max_level,
             PacketQuery {
                 bvh: self,
                 wide16: false,
@@ -118,7 +118,7 @@ impl Bvh {
         assert!(rays.len() <= PACKET16, "{} rays in a packet", rays.len());
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
         dispatch(
-            level::AVX512,
+            self.max_level,
             PacketQuery {
                 bvh: self,
                 wide16: true,

@@ -44,6 +44,8 @@ pub struct Bvh {
     pub(crate) params: BvhParams,
     /// Triangle references in leaves.
     pub(crate) references: usize,
+    /// The highest dispatch level of its queries ([`crate::Isa`]).
+    pub(crate) max_level: u8,
 }
 
 impl Bvh {
@@ -52,6 +54,18 @@ impl Bvh {
     /// indices are positions in `triangles`).
     pub fn build(triangles: Vec<Triangle>, params: &BvhParams) -> Bvh {
         build::build(triangles, params)
+    }
+
+    /// Hold its queries to the instructions of `isa` at most (the default
+    /// is the best the CPU has; see [`crate::Isa`] for why a caller would
+    /// lower it). Answers do not change.
+    pub fn set_isa(&mut self, isa: crate::Isa) {
+        self.max_level = isa.level();
+    }
+
+    /// The widest instructions its queries may use.
+    pub fn isa(&self) -> crate::Isa {
+        crate::Isa::of_level(self.max_level)
     }
 
     /// Number of wide nodes.

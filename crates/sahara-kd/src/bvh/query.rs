@@ -7,7 +7,7 @@ use super::Bvh;
 use crate::isect::{Hit, RayShear};
 use crate::kd::{Counters, NoCounters};
 use crate::math::Ray;
-use crate::simd::{dispatch, level, Kernel};
+use crate::simd::{dispatch, Kernel};
 
 impl Bvh {
     /// The closest hit with `t` in `(ray.tmin, ray.tmax]`; among hits at the
@@ -20,7 +20,7 @@ impl Bvh {
     /// nodes).
     pub fn closest_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> Option<Hit> {
         dispatch(
-            level::AVX512,
+            self.max_level,
             Closest {
                 bvh: self,
                 ray,
@@ -38,7 +38,7 @@ impl Bvh {
     /// [`Bvh::any_hit`], counting the work done.
     pub fn any_hit_counted<C: Counters>(&self, ray: &Ray, counters: &mut C) -> bool {
         dispatch(
-            level::AVX512,
+            self.max_level,
             Any {
                 bvh: self,
                 ray,
@@ -121,6 +121,7 @@ mod tests {
     use super::*;
     use crate::brute;
     use crate::bvh::{BvhBuilder, BvhParams};
+    use crate::simd::level;
     use crate::test_support::{floats, soup};
     use glam::Vec3;
 

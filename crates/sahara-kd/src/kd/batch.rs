@@ -7,7 +7,7 @@ use super::KdTree;
 use crate::isect::Hit;
 use crate::leaf::layout::Layout;
 use crate::math::{Aabb, Ray, Triangle};
-use crate::simd::{dispatch, level};
+use crate::simd::dispatch;
 
 /// Rays per work item of [`KdTree::closest_hits`] and [`KdTree::any_hits`].
 pub(crate) const BATCH: usize = 256;
@@ -78,7 +78,7 @@ impl KdTree<Triangle> {
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
         if self.interleaves(rays, walk) {
             let query = kernel(out);
-            dispatch(level::AVX512, OverLeaves { tree: self, query });
+            dispatch(self.max_level, OverLeaves { tree: self, query });
         } else {
             for (r, o) in rays.iter().zip(out) {
                 *o = one(r);
@@ -212,6 +212,7 @@ mod tests {
     use super::*;
     use crate::brute;
     use crate::build::BuildParams;
+    use crate::simd::level;
     use crate::test_support::{floats, soup};
     use glam::Vec3;
 

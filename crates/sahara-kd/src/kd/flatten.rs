@@ -28,6 +28,7 @@ impl<P: LeafStorage> KdTree<P> {
             wide,
             wide_shift,
             expected_inner: 0.0,
+            max_level: crate::simd::level::AVX512,
         };
         tree.expected_inner = tree.sah_expected_inner();
         tree

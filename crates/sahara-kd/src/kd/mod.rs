@@ -48,9 +48,23 @@ pub struct KdTree<P: LeafStorage = Triangle> {
     pub(crate) expected_inner: f64,
     /// Leaf offsets in `wide`'s leaf words are shifted down by this.
     pub(crate) wide_shift: u32,
+    /// The highest dispatch level of its queries ([`crate::Isa`]).
+    pub(crate) max_level: u8,
 }
 
 impl<P: LeafStorage> KdTree<P> {
+    /// Hold its queries to the instructions of `isa` at most (the default
+    /// is the best the CPU has; see [`crate::Isa`] for why a caller would
+    /// lower it). Answers do not change.
+    pub fn set_isa(&mut self, isa: crate::Isa) {
+        self.max_level = isa.level();
+    }
+
+    /// The widest instructions its queries may use.
+    pub fn isa(&self) -> crate::Isa {
+        crate::Isa::of_level(self.max_level)
+    }
+
     /// The nodes, root first, in depth-first order.
     pub fn nodes(&self) -> &[Node] {
         &self.nodes

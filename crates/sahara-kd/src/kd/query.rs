@@ -7,7 +7,7 @@ use crate::isect::{keep_closer, Hit, RayShear};
 use crate::leaf::layout::{Indexed, Layout, LeafBlock, Whole};
 use crate::leaf::{TriangleLeaves, BLOCK_WIDTH};
 use crate::math::{Ray, Triangle};
-use crate::simd::{dispatch, level, Kernel};
+use crate::simd::{dispatch, Kernel};
 
 /// The closest-hit leaf visit of one ray, a named type rather than a
 /// closure so that `#[inline(always)]` can put it into the walk's loop
@@ -197,15 +197,10 @@ impl<C: Counters, L: Layout, const SIMD: u8> LeafVisit<C> for AllLeaf<'_, L, SIM
 }
 
 impl KdTree<Triangle> {
-    /// The highest level worth dispatching a single-ray query to: AVX-512
-    /// only speeds up the compact layout's gathers, so the whole layout
-    /// keeps the AVX2 build.
+    /// The level its single-ray queries are dispatched at.
     #[inline(always)]
     fn single_ray_level(&self) -> u8 {
-        match self.leaf_data {
-            TriangleLeaves::Whole(_) => level::AVX512,
-            TriangleLeaves::Indexed(_) => level::AVX512,
-        }
+        self.max_level
     }
 
     /// The closest hit with `t` in `(ray.tmin, ray.tmax]`; among hits at the
@@ -401,6 +396,7 @@ mod tests {
     use super::*;
     use crate::brute;
     use crate::build::BuildParams;
+    use crate::simd::level;
     use crate::test_support::{floats, soup};
     use glam::Vec3;
 

@@ -22,6 +22,65 @@ pub(crate) mod level {
     pub const AVX512: u8 = 2;
 }
 
+/// The widest instructions a structure's queries may use: each query runs
+/// at the best level the CPU has, up to this one. Answers are the same bit
+/// for bit at every level; only speed differs.
+///
+/// Why a caller would lower it: on Intel's server cores (measured on an
+/// Ice Lake Xeon) 512-bit instructions lower the core's clock for about a
+/// millisecond after the last one. A loop that runs mostly scalar code
+/// (shading, sampling) with a walk now and then pays that lower clock on
+/// all of its code; whole renders there measured 1.07-1.22x faster with
+/// the queries held to AVX2. Queries in bulk (batches, sixteen-ray
+/// packets, the protocol benchmark) keep AVX-512, where it pays.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Isa {
+    /// The portable code (baseline x86-64, vectorised by the compiler).
+    Portable,
+    /// AVX2 with FMA: vectors of 256 bits at most.
+    Avx2,
+    /// AVX-512 F and VL where the CPU has them (the default).
+    #[default]
+    Avx512,
+}
+
+impl Isa {
+    /// The dispatch level this allows.
+    #[inline(always)]
+    pub(crate) const fn level(self) -> u8 {
+        match self {
+            Isa::Portable => level::PORTABLE,
+            Isa::Avx2 => level::AVX2,
+            Isa::Avx512 => level::AVX512,
+        }
+    }
+
+    /// The limit of dispatch level `l`.
+    pub(crate) const fn of_level(l: u8) -> Isa {
+        match l {
+            level::PORTABLE => Isa::Portable,
+            level::AVX2 => Isa::Avx2,
+            _ => Isa::Avx512,
+        }
+    }
+
+    /// Its name: `portable`, `avx2` or `avx512`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Isa::Portable => "portable",
+            Isa::Avx2 => "avx2",
+            Isa::Avx512 => "avx512",
+        }
+    }
+
+    /// The limit named `s` (as [`Isa::name`] gives it).
+    pub fn parse(s: &str) -> Option<Isa> {
+        [Isa::Portable, Isa::Avx2, Isa::Avx512]
+            .into_iter()
+            .find(|i| i.name() == s)
+    }
+}
+
 /// True when the CPU has AVX2, and the instructions every AVX2 CPU has
 /// (FMA, POPCNT, BMI1, BMI2); std caches the CPUID query.
 #[cfg(target_arch = "x86_64")]

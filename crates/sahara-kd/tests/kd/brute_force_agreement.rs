@@ -376,3 +376,48 @@ fn empty_and_non_finite_scenes() {
         assert_eq!((hit.t, hit.tri), (2.0, 1));
     }
 }
+
+/// Either structure held to each instruction limit answers as brute force
+/// does, single rays, batches and packets alike.
+#[test]
+fn every_instruction_limit_matches_brute_force() {
+    use sahara_kd::{AccelKind, AccelParams, Isa, TriangleAccel};
+    let mut rng = crate::common::Rng(0x5eed_0f15_0a11_u64);
+    let mut tris = crate::common::uv_sphere(Vec3::new(0.1, -0.2, 0.3), 1.5, 12, 16);
+    tris.extend(crate::common::subdivided_cube(1.0, 3.0, 3));
+    let rays: Vec<Ray> = (0..512)
+        .map(|_| {
+            let o = Vec3::new(rng.f32(), rng.f32(), rng.f32()) * 6.0 - Vec3::splat(2.0);
+            Ray::new(o, rng.dir())
+        })
+        .collect();
+    let want: Vec<_> = rays.iter().map(|r| brute::closest_hit(&tris, r)).collect();
+    for kind in [AccelKind::Kd, AccelKind::Bvh] {
+        for isa in [Isa::Portable, Isa::Avx2, Isa::Avx512] {
+            let params = AccelParams {
+                kind,
+                isa,
+                ..AccelParams::default()
+            };
+            let accel = TriangleAccel::build(tris.clone(), &params);
+            assert_eq!(accel.isa(), isa);
+            let what = format!("{} at {}", kind.name(), isa.name());
+            for (r, w) in rays.iter().zip(&want) {
+                assert!(same_hit(*w, accel.closest_hit(r)), "{what}: {r:?}");
+                assert_eq!(accel.any_hit(r), w.is_some(), "{what}: {r:?}");
+            }
+            let mut batch = vec![None; rays.len()];
+            accel.closest_hits_serial(&rays, &mut batch);
+            for (k, chunk) in rays.chunks(16).enumerate() {
+                let mut packet = vec![None; chunk.len()];
+                accel.closest_hit_packet16(chunk, &mut packet);
+                for (i, h) in packet.iter().enumerate() {
+                    assert!(same_hit(want[16 * k + i], *h), "{what}: packet");
+                }
+            }
+            for (w, h) in want.iter().zip(&batch) {
+                assert!(same_hit(*w, *h), "{what}: batch");
+            }
+        }
+    }
+}

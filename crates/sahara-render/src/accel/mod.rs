@@ -25,7 +25,7 @@ pub mod top_level;
 
 use glam::Affine3A;
 use sahara_kd::{
-    Aabb, AccelParams, Counters, Hit, NoCounters, Ray, Triangle, TriangleAccel, PACKET16,
+    Aabb, AccelParams, Counters, Hit, Isa, NoCounters, Ray, Triangle, TriangleAccel, PACKET16,
 };
 
 use crate::scene::instance::{Instance, Placement};
@@ -347,6 +347,14 @@ impl Accel {
             apart,
             top: InstanceList::build(&apart_boxes),
             bounds,
+        }
+    }
+
+    /// Hold every tree's queries to the instructions of `isa` at most
+    /// (answers do not change; see [`Isa`]).
+    pub fn set_isa(&mut self, isa: Isa) {
+        for t in self.world.iter_mut().chain(&mut self.trees) {
+            t.set_isa(isa);
         }
     }
 

@@ -28,6 +28,7 @@
 //! takes the general conversion straight into the `i128` sums.
 
 use glam::{Vec2, Vec3, Vec4};
+use sahara_kd::Isa;
 
 use crate::film::filter::{BoxKernel, Filter, GaussianKernel, Kernel, MitchellKernel, TentKernel};
 use crate::film::sums::{filter_margin, PixelSum, SumBuffer, FRACTION_BITS};
@@ -56,6 +57,8 @@ const FOLD_EVERY: u64 = 1 << 31;
 pub(crate) struct Splatter {
     kernel: Kernels,
     margin: u32,
+    /// Whether it may add taps with AVX-512 (where the CPU has it).
+    wide: bool,
 }
 
 /// The kernel of each filter kind.
@@ -81,6 +84,16 @@ impl Splatter {
         Self {
             kernel,
             margin: filter_margin(filter),
+            wide: true,
+        }
+    }
+
+    /// This splatter held to the instructions of `isa` at most (the sums
+    /// are the same bit for bit; see [`sahara_kd::Isa`] for why).
+    pub fn at_most(self, isa: Isa) -> Self {
+        Self {
+            wide: self.wide && isa == Isa::Avx512,
+            ..self
         }
     }
 
@@ -252,7 +265,7 @@ impl SplatSums {
         self.pending += n as u64;
         let (pos, radiance) = (&pos[..n], &radiance[..n]);
         #[cfg(target_arch = "x86_64")]
-        if avx512::available() {
+        if splatter.wide && avx512::available() {
             // SAFETY: the CPU has the instructions (detected).
             unsafe { self.splat_each_avx512(splatter, pixels, pos, radiance) };
             return;

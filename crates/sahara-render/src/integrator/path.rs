@@ -33,7 +33,7 @@ pub(crate) fn step(
             let w = if st.prev_delta {
                 1.0
             } else {
-                power_heuristic(st.prev_pdf, world.env_pdf(ray.dir))
+                power_heuristic(st.prev_pdf, world.env_pdf_mis(ray.dir))
             };
             st.l += st.beta * le * w;
         }
@@ -50,7 +50,7 @@ pub(crate) fn step(
             let w = if st.prev_delta {
                 1.0
             } else {
-                let lp = world.light_pdf(st.prev_p, &hit, ray.dir);
+                let lp = world.light_pdf(st.prev_p, st.prev_n, &hit, ray.dir);
                 // Emitters that light sampling never picks (moving ones)
                 // are found by BSDF sampling alone: weight 1.
                 if lp > 0.0 {
@@ -69,11 +69,11 @@ pub(crate) fn step(
     if depth >= max_depth {
         return false;
     }
-    // Next-event estimation: one light, chosen by power.
+    // Next-event estimation: one light, chosen as the world chooses.
     if !sh.bsdf.is_delta() {
         let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
         let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
-        if let Some((ls, pmf)) = world.sample_light(hit.p, u_pick, u) {
+        if let Some((ls, pmf)) = world.sample_light_mis(hit.p, hit.ns, u_pick, u) {
             if let Some((c, bsdf_pdf, shadow)) = light_contribution(ctx, &hit, &sh, &ls, st.time) {
                 let light_pdf = pmf * ls.pdf;
                 let w = if ls.delta {
@@ -97,6 +97,7 @@ pub(crate) fn step(
     st.prev_delta = s.delta;
     st.prev_pdf = s.pdf;
     st.prev_p = hit.p;
+    st.prev_n = hit.ns;
     st.ray = next;
     st.depth += 1;
     roulette(ctx, &mut st.beta, st.depth, rr_depth)

@@ -151,7 +151,7 @@ pub(crate) fn camera_path(
 fn direct_light(ctx: &mut Context, hit: &SurfaceHit, sh: &Shading, depth: u32, time: f32) -> Vec3 {
     let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
     let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
-    let Some((ls, pmf)) = ctx.world.sample_light(hit.p, u_pick, u) else {
+    let Some((ls, pmf)) = ctx.world.sample_light(hit.p, hit.ns, u_pick, u) else {
         return Vec3::ZERO;
     };
     match super::light_contribution(ctx, hit, sh, &ls, time) {

@@ -39,6 +39,8 @@ pub(crate) struct PathState {
     pub prev_pdf: f32,
     /// Point of the last scattering.
     pub prev_p: Vec3,
+    /// Shading normal there (light choice depends on it).
+    pub prev_n: Vec3,
     /// Running sum of one light's samples (the distribution tracer).
     pub light_sum: Vec3,
     /// Surfaces with holes the path has passed through.
@@ -143,6 +145,7 @@ impl PathState {
             prev_delta: true,
             prev_pdf: 0.0,
             prev_p: ray.origin,
+            prev_n: Vec3::ZERO,
             light_sum: Vec3::ZERO,
             pass_throughs: 0,
             occlusion: 1.0,

@@ -86,7 +86,10 @@ pub(crate) fn li(
     // The last scattering event: whether it was a delta lobe (the camera
     // counts as one: emitters it sees count fully), its density for the
     // direction taken, and where it was.
-    let (mut prev_delta, mut prev_pdf, mut prev_p) = (true, 0.0f32, ray.origin);
+    // The last scattering: whether by a delta lobe, its density, its point
+    // and the shading normal there (zero in a medium).
+    let (mut prev_delta, mut prev_pdf, mut prev_p, mut prev_n) =
+        (true, 0.0f32, ray.origin, Vec3::ZERO);
     let mut occlusion = 1.0f32;
     loop {
         let hit = world.intersect(&ray, time);
@@ -116,7 +119,7 @@ pub(crate) fn li(
                     ctx.sampler.get_2d(dims::bounce(depth, dims::BSDF_DIR)),
                 );
                 ctx.stats.bounce_rays += 1;
-                (prev_delta, prev_pdf, prev_p) = (false, pdf, p);
+                (prev_delta, prev_pdf, prev_p, prev_n) = (false, pdf, p, Vec3::ZERO);
                 ray = Ray::new(p, wi);
                 depth += 1;
                 flights = draws(ctx.sampler, depth, MEDIUM_DIMS);
@@ -133,7 +136,7 @@ pub(crate) fn li(
                 let w = if prev_delta {
                     1.0
                 } else {
-                    power_heuristic(prev_pdf, world.env_pdf(ray.dir))
+                    power_heuristic(prev_pdf, world.env_pdf_mis(ray.dir))
                 };
                 l += beta * le * w;
             }
@@ -167,7 +170,7 @@ pub(crate) fn li(
             let w = if prev_delta {
                 1.0
             } else {
-                emitter_weight(world, prev_pdf, prev_p, &hit, ray.dir)
+                emitter_weight(world, prev_pdf, (prev_p, prev_n), &hit, ray.dir)
             };
             l += beta * sh.emitted * w;
         }
@@ -187,7 +190,7 @@ pub(crate) fn li(
         beta *= s.weight;
         occlusion = sh.occlusion;
         medium = leaving(next.dir);
-        (prev_delta, prev_pdf, prev_p) = (s.delta, s.pdf, hit.p);
+        (prev_delta, prev_pdf, prev_p, prev_n) = (s.delta, s.pdf, hit.p, hit.ns);
         ray = next;
         depth += 1;
         flights = draws(ctx.sampler, depth, MEDIUM_DIMS);
@@ -199,10 +202,16 @@ pub(crate) fn li(
 }
 
 /// The power heuristic's weight of an emitter that a path found at `hit`
-/// along `dir` by scattering at `prev_p` with density `prev_pdf`, against
-/// light sampling from there.
-fn emitter_weight(world: &World, prev_pdf: f32, prev_p: Vec3, hit: &SurfaceHit, dir: Vec3) -> f32 {
-    let lp = world.light_pdf(prev_p, hit, dir);
+/// along `dir` by scattering at `prev` (point and shading normal, zero in
+/// a medium) with density `prev_pdf`, against light sampling from there.
+fn emitter_weight(
+    world: &World,
+    prev_pdf: f32,
+    prev: (Vec3, Vec3),
+    hit: &SurfaceHit,
+    dir: Vec3,
+) -> f32 {
+    let lp = world.light_pdf(prev.0, prev.1, hit, dir);
     // Emitters that light sampling never picks are found by scattering
     // alone: weight 1.
     if lp > 0.0 {
@@ -229,7 +238,7 @@ fn surface_light(
     let world = ctx.world;
     let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
     let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
-    let Some((ls, pmf)) = world.sample_light(hit.p, u_pick, u) else {
+    let Some((ls, pmf)) = world.sample_light_mis(hit.p, hit.ns, u_pick, u) else {
         return Vec3::ZERO;
     };
     let Some((c, bsdf_pdf, shadow)) = light_contribution(ctx, hit, sh, &ls, time) else {
@@ -258,7 +267,7 @@ fn light_weight(ls: &LightSample, pmf: f32, other_pdf: f32) -> (f32, f32) {
 }
 
 /// Light arriving at `p` in medium `m` (index `medium`) from one light
-/// chosen by power, scattered by the phase function towards `-w_in`
+/// chosen as the world chooses, scattered by the phase function towards `-w_in`
 /// (light travelling along `w_in` scatters at `p`), weighted against
 /// phase sampling by the power heuristic; not yet times the path's
 /// throughput.
@@ -274,7 +283,7 @@ fn medium_light(
     let world = ctx.world;
     let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
     let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
-    let Some((ls, pmf)) = world.sample_light(p, u_pick, u) else {
+    let Some((ls, pmf)) = world.sample_light_mis(p, Vec3::ZERO, u_pick, u) else {
         return Vec3::ZERO;
     };
     let f = m.phase().eval(w_in, ls.wi);

@@ -4,6 +4,7 @@
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
+use super::tree::LightBounds;
 use super::LightSample;
 use crate::math::piecewise::Distribution1D;
 use crate::math::warp::{
@@ -214,27 +215,93 @@ impl AreaLight {
         }
     }
 
+    /// True for a light over a mesh's triangles.
+    pub(crate) fn is_mesh(&self) -> bool {
+        matches!(self.emitter, Emitter::Mesh { .. })
+    }
+
     /// Emitted power (luminance) for light selection.
     pub fn power(&self) -> f32 {
         match &self.emitter {
-            Emitter::Mesh {
-                tris,
-                radiance,
-                two_sided,
-                texture_power,
-                ..
-            } => tris
-                .iter()
-                .zip(radiance)
-                .zip(two_sided)
-                .zip(texture_power)
-                .map(|(((t, l), &two), &k)| {
-                    let a = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
-                    PI * a * luminance(*l) * k * if two { 2.0 } else { 1.0 }
-                })
-                .sum(),
+            Emitter::Mesh { tris, .. } => (0..tris.len()).map(|i| self.triangle_power(i)).sum(),
             _ => PI * self.area * luminance(self.radiance) * if self.two_sided { 2.0 } else { 1.0 },
         }
+    }
+
+    /// Emitted power (luminance) of a mesh light's triangle `i` (zero for
+    /// other lights).
+    fn triangle_power(&self, i: usize) -> f32 {
+        let Emitter::Mesh {
+            tris,
+            radiance,
+            two_sided,
+            texture_power,
+            ..
+        } = &self.emitter
+        else {
+            return 0.0;
+        };
+        let t = &tris[i];
+        let a = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+        PI * a * luminance(radiance[i]) * texture_power[i] * if two_sided[i] { 2.0 } else { 1.0 }
+    }
+
+    /// The emitting pieces the light tree holds of this light: a mesh
+    /// light's triangles one by one, another light whole. Each bound's
+    /// power is the piece's peak radiant intensity (radiance times the
+    /// area seen face on), which a point light's intensity compares with.
+    pub(crate) fn tree_bounds(&self) -> Vec<LightBounds> {
+        let face = |power: f32, two: bool| power / PI / if two { 2.0 } else { 1.0 };
+        match &self.emitter {
+            Emitter::Mesh {
+                tris, two_sided, ..
+            } => tris
+                .iter()
+                .enumerate()
+                .map(|(i, t)| {
+                    let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+                    let phi = face(self.triangle_power(i), two_sided[i]);
+                    LightBounds::surface(t, n, phi, two_sided[i])
+                })
+                .collect(),
+            Emitter::Quad { corner, u, v, n } => vec![LightBounds::surface(
+                &[*corner, *corner + *u, *corner + *v, *corner + *u + *v],
+                *n,
+                face(self.power(), self.two_sided),
+                self.two_sided,
+            )],
+            Emitter::Disc {
+                center,
+                frame,
+                radius,
+            } => {
+                let (s, t) = (frame.s * *radius, frame.t * *radius);
+                vec![LightBounds::surface(
+                    &[
+                        *center - s - t,
+                        *center + s - t,
+                        *center - s + t,
+                        *center + s + t,
+                    ],
+                    frame.n,
+                    face(self.power(), self.two_sided),
+                    self.two_sided,
+                )]
+            }
+            // A sphere shows a disc of its radius from every side.
+            Emitter::Sphere { center, radius } => vec![LightBounds::sphere(
+                *center,
+                *radius,
+                face(self.power(), self.two_sided) / 4.0,
+                self.two_sided,
+            )],
+        }
+    }
+
+    /// The index among a mesh light's triangles of triangle `tri` of its
+    /// mesh, given the mesh triangles `source` it was made of (in order).
+    pub(crate) fn triangle_of(source: &[u32], tri: u32) -> Option<usize> {
+        source.binary_search(&tri).ok()
     }
 
     /// A point of the light, uniform by area (`u`): on a quad or a disc,
@@ -308,8 +375,34 @@ impl AreaLight {
         if let Emitter::Sphere { center, radius } = self.emitter {
             return self.sample_sphere(center, radius, p, u);
         }
-        let s = self.surface_point(u);
-        let (q, n, pdf_area, two) = (s.p, s.n, 1.0 / self.area, s.two_sided);
+        self.sample_at(p, self.surface_point(u), 1.0 / self.area)
+    }
+
+    /// [`AreaLight::sample`] of a mesh light's triangle `i` alone, its
+    /// point uniform over the triangle (other lights: the whole light).
+    pub(crate) fn sample_triangle(&self, p: Vec3, i: usize, u: Vec2) -> Option<LightSample> {
+        let Emitter::Mesh {
+            tris, two_sided, ..
+        } = &self.emitter
+        else {
+            return self.sample(p, u);
+        };
+        let t = &tris[i];
+        let (b1, b2) = uniform_triangle(u);
+        let e = (t[1] - t[0]).cross(t[2] - t[0]);
+        let s = SurfacePoint {
+            p: t[0] * (1.0 - b1 - b2) + t[1] * b1 + t[2] * b2,
+            n: e.normalize_or_zero(),
+            two_sided: two_sided[i],
+            tri: Some((i, b1, b2)),
+        };
+        self.sample_at(p, s, 2.0 / e.length())
+    }
+
+    /// The light of the point `s` of the surface (drawn with density
+    /// `pdf_area` by area) seen from `p`.
+    fn sample_at(&self, p: Vec3, s: SurfacePoint, pdf_area: f32) -> Option<LightSample> {
+        let (q, n, two) = (s.p, s.n, s.two_sided);
         // A mesh's triangles face their own ways; its texture is looked up
         // only where the face seen emits.
         let le = match (&self.emitter, s.tri) {
@@ -434,5 +527,21 @@ impl AreaLight {
             return 0.0;
         }
         (q - p).length_squared() / (cos * self.area)
+    }
+
+    /// Solid-angle density with which [`AreaLight::sample_triangle`] of
+    /// triangle `i` picks the point `q` (front normal `n`) seen from `p`
+    /// along unit `wi`.
+    pub(crate) fn pdf_triangle(&self, i: usize, p: Vec3, q: Vec3, n: Vec3, wi: Vec3) -> f32 {
+        let Emitter::Mesh { tris, .. } = &self.emitter else {
+            return self.pdf(p, q, n, wi);
+        };
+        let t = &tris[i];
+        let area = 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+        let cos = n.dot(wi).abs();
+        if cos == 0.0 || area == 0.0 {
+            return 0.0;
+        }
+        (q - p).length_squared() / (cos * area)
     }
 }

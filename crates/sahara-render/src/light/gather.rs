@@ -21,6 +21,9 @@ pub(crate) struct SceneLights {
     pub(crate) instance_light: Vec<Option<u32>>,
     /// The environment's light.
     pub(crate) env: Option<u32>,
+    /// Per light, the triangles of its instance's mesh a mesh light was
+    /// made of, in order (empty for other lights).
+    pub(crate) mesh_triangles: Vec<Vec<u32>>,
 }
 
 impl SceneLights {
@@ -32,6 +35,7 @@ impl SceneLights {
             .map(|l| LightSource::Explicit(*l))
             .collect();
         let mut instance_light = vec![None; scene.instances.len()];
+        let mut mesh_triangles = vec![Vec::new(); lights.len()];
         let material = |id: u32| scene.materials.get(id as usize);
         // Analytic shapes first.
         for s in &scene.shapes {
@@ -47,6 +51,7 @@ impl SceneLights {
                 continue;
             }
             instance_light[s.instance as usize] = Some(lights.len() as u32);
+            mesh_triangles.push(Vec::new());
             lights.push(LightSource::Area(AreaLight::analytic(
                 emitter_of(&s.shape),
                 m.emission,
@@ -75,12 +80,15 @@ impl SceneLights {
                 Some(id) => emissive(id),
                 None => mesh_emits[inst.mesh as usize],
             };
-            if let Some(light) = emits.then(|| triangle_light(scene, i as u32)).flatten() {
+            if let Some((light, source)) = emits.then(|| triangle_light(scene, i as u32)).flatten()
+            {
                 instance_light[i] = Some(lights.len() as u32);
+                mesh_triangles.push(source);
                 lights.push(LightSource::Area(light));
             }
         }
         let env = scene.environment.as_ref().map(|e| {
+            mesh_triangles.push(Vec::new());
             lights.push(LightSource::Environment(EnvLight::new(e)));
             lights.len() as u32 - 1
         });
@@ -88,6 +96,7 @@ impl SceneLights {
             lights,
             instance_light,
             env,
+            mesh_triangles,
         }
     }
 }
@@ -121,15 +130,17 @@ fn emitter_of(shape: &Shape) -> Emitter {
 }
 
 /// The emissive triangles of static instance `i` in world space as one
-/// area light, with their radiance and emission textures (None: none of
-/// its triangles emits, or none is finite).
-fn triangle_light(scene: &Scene, i: u32) -> Option<AreaLight> {
+/// area light, with their radiance and emission textures, and the mesh's
+/// triangles they are (None: none of its triangles emits, or none is
+/// finite).
+fn triangle_light(scene: &Scene, i: u32) -> Option<(AreaLight, Vec<u32>)> {
     let inst = &scene.instances[i as usize];
     let mesh = &scene.meshes[inst.mesh as usize];
     let xf = inst.placement.at(0.0);
     let (mut tris, mut radiance, mut two) = (Vec::new(), Vec::new(), Vec::new());
     let mut textures = EmissionTextures::default();
     let mut map_of: Vec<(u32, u32)> = Vec::new();
+    let mut source = Vec::new();
     for (t, idx) in mesh.mesh.indices.iter().enumerate() {
         let id = scene.material_of(i, t as u32);
         let Some(m) = scene.materials.get(id as usize) else {
@@ -143,6 +154,7 @@ fn triangle_light(scene: &Scene, i: u32) -> Option<AreaLight> {
             continue;
         }
         tris.push(corners);
+        source.push(t as u32);
         radiance.push(m.emission);
         two.push(m.two_sided_emission);
         textures
@@ -167,5 +179,5 @@ fn triangle_light(scene: &Scene, i: u32) -> Option<AreaLight> {
                 (slot, [uv0, uv1])
             }));
     }
-    (!tris.is_empty()).then(|| AreaLight::mesh(tris, radiance, two, textures))
+    (!tris.is_empty()).then(|| (AreaLight::mesh(tris, radiance, two, textures), source))
 }

@@ -3,6 +3,7 @@
 //! a scene gathered once for its world ([`gather`]).
 
 pub mod area;
+pub(crate) mod choice;
 pub mod directional;
 pub(crate) mod emission;
 pub mod environment;
@@ -10,10 +11,12 @@ pub(crate) mod gather;
 mod kinds;
 pub mod point;
 pub mod spot;
+pub(crate) mod tree;
 
 use glam::Vec3;
 
 pub use area::AreaLight;
+pub use choice::LightSampler;
 pub use environment::{EnvLight, Environment};
 pub use kinds::{LightKind, LightOf, AREA_SHAPES};
 
@@ -215,6 +218,16 @@ impl LightSource {
             LightSource::Explicit(l) => l.sample(p),
             LightSource::Area(a) => a.sample(p, u),
             LightSource::Environment(e) => e.sample(u),
+        }
+    }
+
+    /// [`LightSource::sample`] for estimators that pair light sampling
+    /// with BSDF sampling by MIS: the environment samples its compensated
+    /// distribution ([`EnvLight::sample_mis`]).
+    pub fn sample_mis(&self, p: Vec3, u: glam::Vec2) -> Option<LightSample> {
+        match self {
+            LightSource::Environment(e) => e.sample_mis(u),
+            _ => self.sample(p, u),
         }
     }
 

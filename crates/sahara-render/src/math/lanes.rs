@@ -22,6 +22,7 @@
 use std::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub};
 
 use glam::Vec3;
+use sahara_kd::Isa;
 
 /// `N` floats.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -602,10 +603,11 @@ pub trait Kernel {
 }
 
 /// Runs `k` with 16 lanes under AVX-512 or 8 under AVX2 (and FMA), as the
-/// machine has them (`pulp` checks once and enables the instruction set
-/// for the code inlined into it); 8 lanes of plain code otherwise.
+/// machine has them and `limit` allows (`pulp` checks once and enables the
+/// instruction set for the code inlined into it); 8 lanes of plain code
+/// otherwise.
 #[inline(always)]
-pub fn dispatch<K: Kernel>(k: K) -> K::Output {
+pub fn dispatch<K: Kernel>(limit: Isa, k: K) -> K::Output {
     struct Wide<K>(K);
     impl<K: Kernel> pulp::WithSimd for Wide<K> {
         type Output = K::Output;
@@ -618,7 +620,26 @@ pub fn dispatch<K: Kernel>(k: K) -> K::Output {
             }
         }
     }
-    pulp::Arch::new().dispatch(Wide(k))
+    #[cfg(target_arch = "x86_64")]
+    {
+        use pulp::Simd;
+        if limit == Isa::Avx512 {
+            if let Some(v4) = pulp::x86::V4::try_new() {
+                return Simd::vectorize(v4, Wide(k));
+            }
+        }
+        if limit != Isa::Portable {
+            if let Some(v3) = pulp::x86::V3::try_new() {
+                return Simd::vectorize(v3, Wide(k));
+            }
+        }
+        Simd::vectorize(pulp::Scalar::new(), Wide(k))
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = limit;
+        pulp::Arch::new().dispatch(Wide(k))
+    }
 }
 
 /// The number of lanes [`dispatch`] runs kernels with on this machine.
@@ -631,7 +652,7 @@ pub fn width() -> usize {
             N
         }
     }
-    dispatch(Width)
+    dispatch(Isa::Avx512, Width)
 }
 
 #[cfg(test)]

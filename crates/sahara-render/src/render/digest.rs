@@ -45,7 +45,7 @@ fn vec3s(v: &[Vec3]) -> impl Iterator<Item = [u8; 4]> + '_ {
 
 /// SHA-256, in hex, of the scene and of the settings that change pixels:
 /// size, samples per pixel and per pass, seed, sampler, filter, integrator
-/// with its parameters, and the cost view's scale. The tree builder, tile
+/// with its parameters, light sampler, and the cost view's scale. The tree builder, tile
 /// size, threads, time limit, window and sample range are left out: they
 /// do not change a pixel of the frame.
 ///
@@ -107,7 +107,7 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
     let _ = write!(
         h,
         "sahara frame 1\nsize {}x{}\nspp {} in passes of {}\nseed {}\nsampler {:?}\nfilter {:?}\n\
-         integrator {:?}\ncost scale {:?}\nscene {:?}",
+         integrator {:?}\nlight sampler {}\ncost scale {:?}\nscene {:?}",
         s.width,
         s.height,
         s.spp,
@@ -116,6 +116,7 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
         s.sampler,
         s.filter,
         s.integrator,
+        s.light_sampler,
         s.cost_scale,
         scene
     );

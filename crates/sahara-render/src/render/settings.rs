@@ -77,10 +77,7 @@ pub struct RenderSettings {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum PathLoop {
     /// The lanes, refilled, where every material of the scene has a lane
-    /// BSDF, else the scalar loop: measured, the lanes are as fast or
-    /// faster on such scenes (up to 1.3x on a diffuse interior), and gain
-    /// nothing where part of the shading falls back to the scalar code.
-    #[default]
+    /// BSDF, else the scalar loop.
     Auto,
     /// Paths in SIMD lanes (packets of 16 under AVX-512, 8 under AVX2),
     /// lanes refilled from the next samples as their paths end.
@@ -89,7 +86,11 @@ pub enum PathLoop {
     /// have ended.
     LanesNoRefill,
     /// The scalar path tracer, a step of every path of a strip at a time
-    /// (the wavefront): the reference the lanes are held to.
+    /// (the wavefront): the reference the lanes are held to, and the
+    /// default, because the lanes are not yet faster on every scene
+    /// (measured faster on a box of quads, slower on a large mesh whose
+    /// paths escape often; docs/performance.md, "Paths in SIMD lanes").
+    #[default]
     Scalar,
 }
 

@@ -85,7 +85,7 @@ pub(super) fn render_tile(
 ) -> TileOut {
     let convergence = samples.convergence();
     let (w, h) = (s.width.max(1), s.height.max(1));
-    let splatter = Splatter::new(&s.filter);
+    let splatter = Splatter::new(&s.filter).at_most(super::SAMPLE_LOOP_ISA);
     let reach = PixelWindow {
         x0: t.x0,
         x1: t.x1,

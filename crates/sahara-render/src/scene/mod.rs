@@ -60,6 +60,9 @@ pub struct Scene {
     /// The media on the two sides of instances' surfaces, by instance
     /// (an instance named twice takes the last).
     pub medium_interfaces: Vec<(u32, MediumInterface)>,
+    /// The mesh of a unit sphere that every emitting sphere added with
+    /// [`Scene::add_shape`] places by its own transform (none yet).
+    pub unit_sphere: Option<u32>,
 }
 
 impl Scene {
@@ -76,6 +79,7 @@ impl Scene {
             media: Vec::new(),
             camera_medium: None,
             medium_interfaces: Vec::new(),
+            unit_sphere: None,
         }
     }
 
@@ -133,8 +137,40 @@ impl Scene {
 
     /// Adds a built-in shape with a material; returns its instance. An
     /// emissive quad, disc or sphere becomes an analytically sampled light.
+    ///
+    /// Emitting spheres share one tessellation, a unit sphere placed by
+    /// each one's transform: a hall of a hundred small lamps then builds
+    /// one small tree for all of them, not a hundred (shadow rays towards
+    /// a lamp ignore its own instance, so a lamp is never merged into the
+    /// world tree).
     pub fn add_shape(&mut self, shape: Shape, material: u32) -> u32 {
-        let instance = self.add_object(shape.to_mesh(), Affine3A::IDENTITY, material);
+        let emits = self
+            .materials
+            .get(material as usize)
+            .is_some_and(|m| m.is_emissive() && m.textures.emission.is_none());
+        let instance = match shape {
+            Shape::Sphere { center, radius } if emits => {
+                let mesh = match self.unit_sphere {
+                    Some(m) => m,
+                    None => {
+                        let unit = Shape::Sphere {
+                            center: Vec3::ZERO,
+                            radius: 1.0,
+                        };
+                        let m = self.add_mesh(unit.to_mesh());
+                        self.unit_sphere = Some(m);
+                        m
+                    }
+                };
+                let xf = Affine3A::from_scale_rotation_translation(
+                    Vec3::splat(radius),
+                    glam::Quat::IDENTITY,
+                    center,
+                );
+                self.add_instance(Instance::new(mesh, xf, Some(material)))
+            }
+            _ => self.add_object(shape.to_mesh(), Affine3A::IDENTITY, material),
+        };
         self.shapes.push(ShapeInstance { instance, shape });
         instance
     }

@@ -107,11 +107,9 @@ fn bdpt_agrees_with_the_path_tracer_on_a_glossy_box_with_glass_and_delta_lights(
     assert_agree("bdpt", &reference, &b, 0.015, 0.1);
 }
 
-/// Lights at infinity: a constant sky and a sun over a diffuse sphere on
-/// a ground plane, seen by bidirectional path tracing and by the path
-/// tracer.
-#[test]
-fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
+/// A red diffuse sphere on a ground plane of `ground`, seen from above
+/// and in front, with no light yet.
+fn red_sphere_on(ground: Material) -> Scene {
     let camera = Camera::look_at(
         Vec3::new(0.0, 1.5, -4.0),
         Vec3::new(0.0, 0.5, 0.0),
@@ -120,7 +118,7 @@ fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
         1.0,
     );
     let mut scene = Scene::new(camera);
-    let white = scene.add_material(Material::diffuse(Vec3::splat(0.7)));
+    let ground = scene.add_material(ground);
     let red = scene.add_material(Material::diffuse(Vec3::new(0.7, 0.2, 0.1)));
     scene.add_shape(
         Shape::Quad {
@@ -128,7 +126,7 @@ fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
             edge_u: Vec3::new(0.0, 0.0, 6.0),
             edge_v: Vec3::new(6.0, 0.0, 0.0),
         },
-        white,
+        ground,
     );
     scene.add_shape(
         Shape::Sphere {
@@ -137,6 +135,15 @@ fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
         },
         red,
     );
+    scene
+}
+
+/// Lights at infinity: a constant sky and a sun over a diffuse sphere on
+/// a ground plane, seen by bidirectional path tracing and by the path
+/// tracer.
+#[test]
+fn bdpt_agrees_with_the_path_tracer_under_a_sky_and_a_sun() {
+    let mut scene = red_sphere_on(Material::diffuse(Vec3::splat(0.7)));
     scene.environment = Some(Environment::Constant(Vec3::new(0.3, 0.4, 0.6)));
     scene.add_light(Light::directional(
         Vec3::new(0.4, -1.0, 0.3),
@@ -193,4 +200,34 @@ fn bdpt_is_deterministic_across_thread_counts() {
     };
     let one = bits(1);
     assert!(one == bits(2), "images differ between 1 and 2 threads");
+}
+
+/// An environment map with a small bright sun over a dim sky, lighting a
+/// diffuse sphere and a rough metal ground: the path tracer samples the
+/// map with MIS compensation (the texels above the mean only), the
+/// bidirectional tracer with the whole map; both converge to one image.
+#[test]
+fn bdpt_agrees_with_the_compensated_path_tracer_under_a_sky_map_with_a_sun() {
+    use sahara_render::Texture;
+    use std::sync::Arc;
+    let mut scene = red_sphere_on(Material::conductor(Vec3::new(0.9, 0.7, 0.4), 0.4));
+    // A sky brighter towards the zenith, and a sun of 2x2 texels.
+    let (w, h) = (64u32, 32u32);
+    let texels: Vec<Vec3> = (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            if (20..22).contains(&x) && (9..11).contains(&y) {
+                Vec3::new(400.0, 380.0, 340.0)
+            } else {
+                Vec3::new(0.2, 0.3, 0.5) * (1.0 - y as f32 / h as f32)
+            }
+        })
+        .collect();
+    scene.environment = Some(Environment::Map {
+        texture: Arc::new(Texture::new(w, h, texels)),
+        scale: 1.0,
+    });
+    let reference = run(&scene, &settings(32, 32, 1024, path(5)));
+    let b = run(&scene, &settings(32, 32, 256, bdpt(5)));
+    assert_agree("bdpt", &reference, &b, 0.01, 0.06);
 }

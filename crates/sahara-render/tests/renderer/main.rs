@@ -11,6 +11,7 @@ mod camera;
 mod common;
 mod energy;
 mod lanes;
+mod light_choice;
 mod lighting;
 mod photons;
 mod render_loop;

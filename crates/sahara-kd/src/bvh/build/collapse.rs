@@ -34,6 +34,7 @@ pub(crate) fn collapse(root: Option<&BinaryNode>, tris: &[Triangle], params: &Bv
         scale: 0.0,
         params: *params,
         references: 0,
+        max_level: crate::simd::level::AVX512,
     };
     let Some(root) = root else {
         return out;

@@ -127,7 +127,7 @@ impl KdTree<Triangle> {
                 out,
                 p: &mut h[0],
             };
-            dispatch(level::AVX2, k)
+            dispatch(level::AVX2.min(self.max_level), k)
         });
     }
 
@@ -155,7 +155,7 @@ impl KdTree<Triangle> {
                     out,
                     h,
                 };
-                dispatch(level::AVX512, k)
+                dispatch(self.max_level, k)
             });
         if traced {
             return;
