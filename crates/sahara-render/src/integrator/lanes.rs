@@ -765,6 +765,13 @@ impl<'a, 'w> Kernel for Run<'a, 'w> {
     }
 }
 
+/// The widest vectors the lane loop may use: AVX-512's sixteen lanes
+/// where the CPU has them. Unlike the scalar loop (held to AVX2 because a
+/// few 512-bit instructions lower the clock of all its scalar code), the
+/// lane loop does its shading in 512-bit vectors; measured on a box of
+/// quads, 16 lanes were 1.20x the scalar loop's speed and 8 lanes 0.89x.
+const LANE_ISA: sahara_kd::Isa = sahara_kd::Isa::Avx512;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -874,10 +881,3 @@ mod tests {
         }
     }
 }
-
-/// The widest vectors the lane loop may use: AVX-512's sixteen lanes
-/// where the CPU has them. Unlike the scalar loop (held to AVX2 because a
-/// few 512-bit instructions lower the clock of all its scalar code), the
-/// lane loop does its shading in 512-bit vectors; measured on a box of
-/// quads, 16 lanes were 1.20x the scalar loop's speed and 8 lanes 0.89x.
-const LANE_ISA: sahara_kd::Isa = sahara_kd::Isa::Avx512;
