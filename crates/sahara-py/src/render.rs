@@ -22,7 +22,7 @@ use sahara_formats::{Given, Plan, Refused, Request, RequestError, Setting, Setti
 use sahara_formats::{LoadOptions, Loaded, Note, SceneNames, Spelling, SETTINGS};
 use sahara_render::{
     render_watched, Aov, AuxImages, Film, FilterKind, IntegratorKind, LightSampler, Named,
-    Progress, RenderResult, SamplerKind, Scene as RenderScene, ToneMap,
+    PathLoop, Progress, RenderResult, SamplerKind, Scene as RenderScene, ToneMap,
 };
 
 use crate::pool::pool;
@@ -547,9 +547,9 @@ fn write_rgb(
     written.map_err(format_error)
 }
 
-/// The names each setting takes: integrators, samplers, filters, render
-/// passes and tone maps; and `setting`, the keyword arguments of
-/// `render` that are render settings.
+/// The names each setting takes: integrators, samplers, light samplers,
+/// path loops, filters, render passes and tone maps; and `setting`, the
+/// keyword arguments of `render` that are render settings.
 #[pyfunction]
 pub fn names(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let d = PyDict::new(py);
@@ -558,6 +558,7 @@ pub fn names(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("integrator", PyList::new(py, IntegratorKind::names())?)?;
     d.set_item("sampler", PyList::new(py, SamplerKind::names())?)?;
     d.set_item("light_sampler", PyList::new(py, LightSampler::names())?)?;
+    d.set_item("path_loop", PyList::new(py, PathLoop::names())?)?;
     d.set_item("filter", PyList::new(py, FilterKind::names())?)?;
     d.set_item("aov", PyList::new(py, Aov::names())?)?;
     d.set_item("tonemap", PyList::new(py, ToneMap::names())?)?;

@@ -82,11 +82,12 @@ pub use texture::{
 pub use film::filter::{Filter, FilterKind};
 pub use film::ToneMap;
 pub use integrator::{
-    defaults, Feature, Integrator, IntegratorKind, SettingsError, Support, Supports, TraceStats,
+    defaults, Feature, Integrator, IntegratorKind, LaneCounts, SettingsError, Support, Supports,
+    TraceStats,
 };
 pub use keys::{Fallback, Key, KeyError, KeyType, Value, Values};
 pub use names::{one_of, Accepts, Named, Parameter, UnknownName};
-pub use render::{AdaptiveStats, RenderSettings, UNLIMITED_SPP};
+pub use render::{AdaptiveStats, PathLoop, RenderSettings, UNLIMITED_SPP};
 pub use sampler::SamplerKind;
 pub use settings::{Adaptive, AdaptiveChoice, Choice, FrameLayer, FrameSettings, Pick, Pickable};
 

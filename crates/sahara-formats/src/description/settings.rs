@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use sahara_kd::{AccelKind, Builder};
-use sahara_render::{FrameLayer, FrameSettings, PixelWindow};
+use sahara_render::{FrameLayer, FrameSettings, PathLoop, PixelWindow};
 
 use crate::output::frame::OutputLayer;
 
@@ -39,6 +39,9 @@ pub struct SettingsLayer {
     /// The kd-tree builder (for [`AccelKind::Kd`]): a speed setting only,
     /// the image is the same with any.
     pub builder: Option<Builder>,
+    /// How the path tracer traces its samples: in SIMD lanes or the
+    /// scalar loop (the images equal to noise, not bit for bit).
+    pub path_loop: Option<PathLoop>,
     /// The pixels a scene file keeps of its image (pbrt's `cropwindow`
     /// and `pixelbounds`, Mitsuba's crop): a render is an image of those
     /// pixels of the whole frame.
@@ -115,6 +118,7 @@ impl SettingsLayer {
             time_limit: above.time_limit.or(self.time_limit),
             accel: above.accel.or(self.accel),
             builder: above.builder.or(self.builder),
+            path_loop: above.path_loop.or(self.path_loop),
             crop_window: above.crop_window.or(self.crop_window),
             piece: PieceLayer {
                 part: piece.part.or(self.piece.part),

@@ -204,6 +204,7 @@ impl Request {
             samples: piece.as_ref().map(|p| p.samples.clone()),
             part: piece.is_some(),
             aovs,
+            path_loop: layer.path_loop.unwrap_or_default(),
             ..Default::default()
         };
         check_supported(caller, &scene, &settings, output.denoise)?;

@@ -10,8 +10,8 @@ use std::time::Duration;
 
 use sahara_kd::{AccelKind, Builder};
 use sahara_render::{
-    AdaptiveChoice, Aov, FilterKind, IntegratorKind, LightSampler, Named, Pick, SamplerKind,
-    ToneMap,
+    AdaptiveChoice, Aov, FilterKind, IntegratorKind, LightSampler, Named, PathLoop, Pick,
+    SamplerKind, ToneMap,
 };
 
 use crate::description::{SettingsLayer, Split};
@@ -257,6 +257,23 @@ pub static SETTINGS: &[Setting] = &[
         requires: None,
         set: |l, g| {
             l.frame.sampler = Some(named(g)?);
+            Ok(())
+        },
+    },
+    Setting {
+        name: "path_loop",
+        keyword: "path_loop",
+        short: None,
+        value_name: "NAME",
+        takes: Takes::Name(PathLoop::names),
+        help: "How the path tracer traces its samples: lanes (paths in SIMD lanes, 16 under \
+               AVX-512, 8 under AVX2, refilled as paths end), lanes-no-refill, or scalar (the \
+               reference the lanes are held to); auto takes the lanes where every material of \
+               the scene is shaded in the lanes. The lanes' image equals the scalar one to \
+               noise, not bit for bit [default: scalar]",
+        requires: None,
+        set: |l, g| {
+            l.path_loop = Some(named(g)?);
             Ok(())
         },
     },
@@ -705,6 +722,7 @@ mod tests {
                 text("2..6"),
                 Given::List(vec![Given::Whole(2), Given::Whole(6)]),
             ),
+            ("path_loop", text("scalar"), Given::Str("scalar".into())),
             (
                 "aov",
                 text("depth,albedo"),
@@ -776,6 +794,9 @@ mod tests {
         assert!(refused("accel", text("octree"))
             .to_string()
             .contains("unknown structure 'octree'"));
+        assert!(refused("path_loop", text("wide"))
+            .to_string()
+            .contains("unknown path loop 'wide'"));
         assert!(matches!(
             refused("denoise", Given::Whole(1)),
             Refused::Type(_)

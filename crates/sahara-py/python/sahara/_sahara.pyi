@@ -124,6 +124,7 @@ def render(
     height: Optional[int] = None,
     integrator: Optional[str] = None,
     sampler: Optional[str] = None,
+    path_loop: Optional[str] = None,
     light_sampler: Optional[str] = None,
     filter: Optional[str] = None,
     seed: Optional[int] = None,

@@ -4,6 +4,7 @@
 pub(crate) mod bdpt;
 pub mod debug;
 mod distribution;
+pub(crate) mod lanes;
 pub(crate) mod laps;
 mod path;
 mod queries;
@@ -26,6 +27,7 @@ use crate::sampler::dims;
 use crate::sampler::PixelSampler;
 use crate::texture::footprint::UvFootprint;
 use crate::world::{ShadowQuery, SurfaceHit, World};
+pub use lanes::LaneCounts;
 use state::Deferred;
 pub(crate) use state::{AuxSample, PathState};
 pub use supports::{Feature, SettingsError, Support, Supports};
@@ -367,6 +369,8 @@ pub struct TraceStats {
     pub shadow_rays: u64,
     /// Kd-tree work of camera rays in the `cost` view.
     pub traversal: TraversalCounters,
+    /// How the lane loop shaded its path vertices.
+    pub lanes: LaneCounts,
 }
 
 impl std::ops::AddAssign for TraceStats {
@@ -375,6 +379,7 @@ impl std::ops::AddAssign for TraceStats {
         self.bounce_rays += o.bounce_rays;
         self.shadow_rays += o.shadow_rays;
         self.traversal += o.traversal;
+        self.lanes += o.lanes;
     }
 }
 

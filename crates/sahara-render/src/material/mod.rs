@@ -12,6 +12,7 @@ pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
 mod kinds;
+pub(crate) mod lanes;
 mod layered;
 pub mod maps;
 pub mod metals;

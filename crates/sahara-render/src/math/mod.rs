@@ -3,5 +3,6 @@
 //! discs, hemispheres, spheres, cones and triangles.
 
 pub mod hash;
+pub(crate) mod lanes;
 pub mod piecewise;
 pub mod warp;

@@ -120,6 +120,11 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
         s.cost_scale,
         scene
     );
+    // The lane loop's images differ from the scalar loop's in rounding:
+    // parts of one frame must come from one loop.
+    if s.path_loop.lanes(&s.integrator, scene).is_some() {
+        let _ = write!(h, "\npath loop lanes");
+    }
     h.0.finalize()
         .iter()
         .fold(String::with_capacity(64), |mut out, b| {

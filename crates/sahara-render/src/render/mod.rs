@@ -60,7 +60,7 @@ use result::develop;
 pub use result::{cost_maps, CostMaps, RenderResult};
 use sahara_kd::Isa;
 use samples::RoundSamples;
-pub use settings::{RenderSettings, UNLIMITED_SPP};
+pub use settings::{PathLoop, RenderSettings, UNLIMITED_SPP};
 pub use stats::{RenderStats, TimeShares, TimeSplit};
 use stop::Stop;
 use watch::Previews;

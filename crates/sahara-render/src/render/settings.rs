@@ -11,7 +11,7 @@ use super::aux::Aov;
 use crate::film::window::PixelWindow;
 #[cfg(doc)]
 use crate::integrator::Supports;
-use crate::integrator::{Feature, SettingsError};
+use crate::integrator::{Feature, Integrator, SettingsError};
 use crate::scene::Scene;
 use crate::settings::FrameSettings;
 
@@ -64,6 +64,59 @@ pub struct RenderSettings {
     /// ([`Supports::adaptive`]), and not with `samples` other than
     /// `0..spp` (a pixel's decisions need all its samples).
     pub aovs: Vec<Aov>,
+    /// How the path tracer's samples are traced: in SIMD lanes or one
+    /// path step at a time (the other integrators ignore it).
+    pub path_loop: PathLoop,
+}
+
+/// The loop that traces the path tracer's samples (`path`, in a scene
+/// without media). Both run the same estimator; their images are equal
+/// to noise, not bit for bit (the lanes' arithmetic differs in rounding).
+/// Each gives the same bytes for a seed at any thread count, and under a
+/// render farm's split and merge (the frame digest tells the loops apart).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum PathLoop {
+    /// The lanes, refilled, where every material of the scene has a lane
+    /// BSDF, else the scalar loop.
+    Auto,
+    /// Paths in SIMD lanes (packets of 16 under AVX-512, 8 under AVX2),
+    /// lanes refilled from the next samples as their paths end.
+    Lanes,
+    /// Paths in SIMD lanes, a packet refilled only once all its paths
+    /// have ended.
+    LanesNoRefill,
+    /// The scalar path tracer, a step of every path of a strip at a time
+    /// (the wavefront): the reference the lanes are held to, and the
+    /// default, because the lanes are not yet faster on every scene
+    /// (measured faster on a box of quads, slower on a large mesh whose
+    /// paths escape often; docs/performance.md, "Paths in SIMD lanes").
+    #[default]
+    Scalar,
+}
+
+crate::names::name_table!(PathLoop, "path loop", {
+    PathLoop::Auto => "auto",
+    PathLoop::Lanes => "lanes",
+    PathLoop::LanesNoRefill => "lanes-no-refill",
+    PathLoop::Scalar => "scalar",
+});
+
+impl PathLoop {
+    /// Whether `integrator`'s samples in `scene` go to the lanes, and if
+    /// so whether lanes are refilled.
+    pub(crate) fn lanes(self, integrator: &Integrator, scene: &Scene) -> Option<bool> {
+        if !matches!(integrator, Integrator::Path { .. }) || scene.has_media() {
+            return None;
+        }
+        match self {
+            PathLoop::Auto => {
+                crate::material::lanes::all_in_lanes(&scene.materials).then_some(true)
+            }
+            PathLoop::Lanes => Some(true),
+            PathLoop::LanesNoRefill => Some(false),
+            PathLoop::Scalar => None,
+        }
+    }
 }
 
 /// The renderer reads the frame's settings as its own (`settings.spp`):
@@ -96,6 +149,7 @@ impl Default for RenderSettings {
             samples: None,
             part: false,
             aovs: Vec::new(),
+            path_loop: PathLoop::default(),
         }
     }
 }
@@ -164,5 +218,36 @@ impl RenderSettings {
             self.integrator.kind().require(Feature::Media)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod path_loop_tests {
+    use super::*;
+    use crate::material::{Bsdf, Material};
+    use glam::Vec3;
+
+    /// `auto` takes the lanes (refilled) where every material has a lane
+    /// BSDF, the scalar loop where one has not, and never for other
+    /// integrators.
+    #[test]
+    fn auto_takes_the_lanes_where_every_material_has_a_lane_bsdf() {
+        let path = Integrator::default();
+        let mut scene = crate::builtin::cornell_box();
+        assert!(matches!(path, Integrator::Path { .. }));
+        assert_eq!(PathLoop::Auto.lanes(&path, &scene), Some(true));
+        assert_eq!(PathLoop::Scalar.lanes(&path, &scene), None);
+        let distribution = Integrator::named("distribution").unwrap();
+        assert_eq!(PathLoop::Auto.lanes(&distribution, &scene), None);
+        scene.add_material(Material::new(Bsdf::MetallicRoughness {
+            base_color: Vec3::ONE,
+            metallic: 0.5,
+            roughness: 0.5,
+            ior: 1.5,
+            specular: 1.0,
+            specular_color: Vec3::ONE,
+        }));
+        assert_eq!(PathLoop::Auto.lanes(&path, &scene), None);
+        assert_eq!(PathLoop::Lanes.lanes(&path, &scene), Some(true));
     }
 }

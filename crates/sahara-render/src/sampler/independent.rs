@@ -7,11 +7,14 @@ use crate::math::hash::{hash3, mix64, unit_f32};
 
 #[inline]
 fn key(id: &SampleId, dim: u32) -> u64 {
-    hash3(
-        id.stream,
-        ((id.pass as u64) << 32) | id.index as u64,
-        dim as u64,
-    )
+    key_of(id.stream, ((id.pass as u64) << 32) | id.index as u64, dim)
+}
+
+/// The hash of a draw from its stream, `pass << 32 | index`, and
+/// dimension.
+#[inline(always)]
+pub(crate) fn key_of(stream: u64, pass_index: u64, dim: u32) -> u64 {
+    hash3(stream, pass_index, dim as u64)
 }
 
 /// One uniform number for dimension `dim`.

@@ -8,6 +8,7 @@
 //! receives a well-stratified set whatever the path length.
 
 pub mod independent;
+pub(crate) mod lanes;
 pub mod sobol;
 pub mod stratified;
 
@@ -79,6 +80,12 @@ impl PixelSampler {
     #[inline]
     pub fn id(&self) -> SampleId {
         self.id
+    }
+
+    /// The Sobol generator's per-sample state (default for the others).
+    #[inline]
+    pub(crate) fn sobol(&self) -> sobol::SobolSample {
+        self.sobol
     }
 
     /// One number in `[0, 1)` for dimension `dim`.

@@ -33,16 +33,16 @@ const HASH2_KEY: u64 = 0x9e37_79b9_7f4a_7c15;
 // dimensions 0 and 1. The tests compare against `sobol_burley::sample`.
 const SHUFFLE_KEY: u32 = 0x79c6_8e4a;
 const SEED_MUL: u32 = 0x9c8f_2d3b;
-const DIM0_KEY: u32 = 0x912f_69ba;
-const DIM1_KEY: u32 = 0x174f_18ab;
+pub(super) const DIM0_KEY: u32 = 0x912f_69ba;
+pub(super) const DIM1_KEY: u32 = 0x174f_18ab;
 
 /// The per-pixel-sample part of every draw of one pixel sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SobolSample {
     /// The sample index in its sequence, bit-reversed.
-    index_rev: u32,
+    pub(super) index_rev: u32,
     /// The inner half of `hash2(stream ^ (epoch << 40), dim)`.
-    stream_key: u64,
+    pub(super) stream_key: u64,
 }
 
 impl SobolSample {
@@ -61,14 +61,14 @@ impl SobolSample {
 
     /// The scramble seed of dimension `dim`.
     #[inline(always)]
-    fn seed(&self, dim: u32) -> u32 {
+    pub(super) fn seed(&self, dim: u32) -> u32 {
         let s = mix64(self.stream_key.wrapping_add(dim as u64));
         (s ^ (s >> 32)) as u32
     }
 
     /// The shuffled sample index under `seed` (16 bits, not reversed).
     #[inline(always)]
-    fn shuffled_index(&self, seed: u32) -> u32 {
+    pub(super) fn shuffled_index(&self, seed: u32) -> u32 {
         let rev = owen_scramble_rev(self.index_rev, hash(seed ^ SHUFFLE_KEY));
         // Only the top 16 bits of the reversed index enter the sequence.
         (rev & 0xffff_0000).reverse_bits()
@@ -97,7 +97,7 @@ impl SobolSample {
 /// Sobol dimension 0 (van der Corput) of the 16-bit index `n`, bit-reversed:
 /// output bit `31 - i` is index bit `i`, so reversed it is the index.
 #[inline(always)]
-fn sobol0_rev(n: u32) -> u32 {
+pub(super) fn sobol0_rev(n: u32) -> u32 {
     n
 }
 
@@ -107,7 +107,7 @@ fn sobol0_rev(n: u32) -> u32 {
 /// `j`. That superset sum over the four bits of a bit position takes four
 /// shift-and-xor steps.
 #[inline(always)]
-fn sobol1_rev(mut n: u32) -> u32 {
+pub(super) fn sobol1_rev(mut n: u32) -> u32 {
     n ^= (n >> 1) & 0x5555;
     n ^= (n >> 2) & 0x3333;
     n ^= (n >> 4) & 0x0f0f;
@@ -118,7 +118,7 @@ fn sobol1_rev(mut n: u32) -> u32 {
 /// Owen-scrambles the bit-reversed Sobol value `sobol_rev` of one dimension
 /// (`key` that dimension's constant) and maps it to `[0, 1)`.
 #[inline(always)]
-fn scramble(sobol_rev: u32, seed: u32, key: u32) -> f32 {
+pub(super) fn scramble(sobol_rev: u32, seed: u32, key: u32) -> f32 {
     let s = hash(seed.wrapping_mul(SEED_MUL) ^ key);
     u32_to_f32_norm(owen_scramble_rev(sobol_rev, s).reverse_bits())
 }

@@ -11,7 +11,7 @@ use sahara_kd::TriangleAccel;
 use sahara_render::internals::World;
 use sahara_render::{
     builtin, render, Camera, Environment, Filter, FilterKind, Instance, Integrator, Light,
-    Material, SamplerKind, Scene, Shape, Srt, Texture,
+    Material, PathLoop, SamplerKind, Scene, Shape, Srt, Texture,
 };
 
 fn render_in_pool(threads: usize, scene: &Scene, s: &sahara_render::RenderSettings) -> Vec<u32> {
@@ -30,13 +30,17 @@ fn render_in_pool(threads: usize, scene: &Scene, s: &sahara_render::RenderSettin
 #[test]
 fn same_seed_same_bits_whatever_the_thread_count() {
     let scene = builtin::cornell_box();
-    for sampler in [
-        SamplerKind::Sobol,
-        SamplerKind::Stratified,
-        SamplerKind::Independent,
+    for (sampler, path_loop) in [
+        (SamplerKind::Sobol, PathLoop::Scalar),
+        (SamplerKind::Stratified, PathLoop::Scalar),
+        (SamplerKind::Independent, PathLoop::Scalar),
+        (SamplerKind::Sobol, PathLoop::Lanes),
+        (SamplerKind::Stratified, PathLoop::Lanes),
+        (SamplerKind::Independent, PathLoop::LanesNoRefill),
     ] {
         let mut s = settings(24, 24, 4, Integrator::default());
         s.sampler = sampler;
+        s.path_loop = path_loop;
         // A filter wider than a pixel and small tiles: samples cross tiles.
         s.filter = Filter::from(FilterKind::Mitchell);
         s.tile_size = 5;

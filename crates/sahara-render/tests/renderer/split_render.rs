@@ -4,8 +4,8 @@
 use glam::Vec3;
 use proptest::prelude::*;
 use sahara_render::{
-    builtin, render, Filter, FilterKind, FrameSettings, Integrator, Material, RenderSettings,
-    SamplerKind, Scene, Shape, SumBuffer,
+    builtin, render, Filter, FilterKind, FrameSettings, Integrator, Material, PathLoop,
+    RenderSettings, SamplerKind, Scene, Shape, SumBuffer,
 };
 use sahara_render::{tile, PixelWindow};
 
@@ -48,6 +48,17 @@ fn filter(f: u8) -> Filter {
     }
 }
 
+/// The path loops of the whole render and of its parts: the scalar one
+/// for both, or the lanes, refilled in one and not in the other (a
+/// sample's result does not depend on its packet).
+fn path_loops(l: u8) -> (PathLoop, PathLoop) {
+    match l % 3 {
+        0 => (PathLoop::Scalar, PathLoop::Scalar),
+        1 => (PathLoop::Lanes, PathLoop::LanesNoRefill),
+        _ => (PathLoop::LanesNoRefill, PathLoop::Lanes),
+    }
+}
+
 fn sampler(s: u8) -> SamplerKind {
     match s % 3 {
         0 => SamplerKind::Independent,
@@ -68,6 +79,7 @@ proptest! {
         tiles in 1u32..=7,
         cuts in proptest::collection::vec(0.0f64..=1.0, 0..=4),
         threads in 1usize..=2,
+        lanes in 0u8..3,
     ) {
         let scene = scene(material, (cx, cz), radius);
         let pass_spp = 1 + ((spp_total - 1) as f64 * pass_frac) as u32;
@@ -84,6 +96,7 @@ proptest! {
                 ..Default::default()
             },
             tile_size: 8,
+            path_loop: path_loops(lanes).0,
             ..Default::default()
         };
         let total = settings.spp;
@@ -102,6 +115,7 @@ proptest! {
                     window: Some(window),
                     samples: Some(r[0]..r[1]),
                     tile_size: 4,
+                    path_loop: path_loops(lanes).1,
                     ..settings.clone()
                 };
                 let out = pool.install(|| render(&scene, &part, &|_| {}).unwrap());

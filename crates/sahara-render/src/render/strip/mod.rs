@@ -15,7 +15,9 @@
 //! - `stepped`: the wavefront, every path of the strip a step at a time,
 //!   in camera-packet order (`path` and `distribution`);
 //! - `bidirectional`: camera and light subpaths in batches (`bdpt`,
-//!   `lightpath`).
+//!   `lightpath`);
+//! - `lanes`: paths in SIMD lanes, every step of 8 or 16 paths at once
+//!   (`path`, as [`RenderSettings::path_loop`] asks).
 //!
 //! What every loop keeps, and with it the image's bits for a seed:
 //! - a sample's random numbers come from [`CameraSamples::at`] for its
@@ -26,10 +28,11 @@
 //! - the result goes to the sample's slot, and the light it adds to other
 //!   pixels to [`Slots::splats`] (added to exact sums, so in any order).
 //!
-//! A new way of tracing a strip (paths as SIMD lanes, say) is a module
-//! beside these and a variant of [`SampleLoop`], held to the same.
+//! A new way of tracing a strip is a module beside these and a variant of
+//! [`SampleLoop`], held to the same.
 
 mod bidirectional;
+mod lanes;
 mod single;
 mod stepped;
 
@@ -72,6 +75,7 @@ pub(super) struct Strip {
     pub(super) slots: Slots,
     stepped: stepped::Stepped,
     bidirectional: bidirectional::Bidirectional,
+    lanes: lanes::Lanes,
 }
 
 /// The pixels `[x0, x1) x [y0, y1)` of a strip.
@@ -170,14 +174,20 @@ enum SampleLoop {
     },
     /// The wavefront, a step of every path at a time ([`stepped`]).
     Stepped,
+    /// Paths in SIMD lanes ([`lanes`]), lanes refilled as paths end if
+    /// `refill`.
+    Lanes { refill: bool },
     /// One sample at a time ([`single`]).
     Single,
 }
 
 impl SampleLoop {
-    /// The loop of `integrator` in `world`.
-    fn of(integrator: &Integrator, world: &World) -> Self {
-        if let Some((max_depth, strategies)) = integrator.bidirectional() {
+    /// The loop of the settings' integrator in `world`.
+    fn of(s: &RenderSettings, world: &World) -> Self {
+        let integrator = &s.integrator;
+        if let Some(refill) = s.path_loop.lanes(integrator, world.scene) {
+            Self::Lanes { refill }
+        } else if let Some((max_depth, strategies)) = integrator.bidirectional() {
             Self::Bidirectional {
                 max_depth,
                 strategies,
@@ -218,7 +228,7 @@ impl Strip {
         };
         let slots = &mut self.slots;
         slots.lay_out(&round);
-        match SampleLoop::of(&s.integrator, world) {
+        match SampleLoop::of(s, world) {
             SampleLoop::Bidirectional {
                 max_depth,
                 strategies,
@@ -226,6 +236,7 @@ impl Strip {
                 .bidirectional
                 .trace(slots, world, &round, max_depth, strategies, stats),
             SampleLoop::Stepped => self.stepped.trace(slots, world, &round, stats),
+            SampleLoop::Lanes { refill } => self.lanes.trace(slots, world, &round, stats, refill),
             SampleLoop::Single => single::trace(slots, world, &round, stats),
         }
     }
@@ -235,6 +246,7 @@ impl Strip {
     pub(super) fn take_times(&mut self) -> Laps {
         let mut laps = self.stepped.take_times();
         laps += self.bidirectional.take_times();
+        laps += self.lanes.take_times();
         laps
     }
 }
