@@ -164,7 +164,7 @@ def render(
 
     The settings are the command line's render options as keywords
     (``sahara.names()["setting"]`` lists them): ``spp``, ``width``,
-    ``height``, ``integrator``, ``sampler``, ``light_sampler``, ``filter``, ``seed``,
+    ``height``, ``integrator``, ``sampler``, ``light_sampler``, ``guiding``, ``filter``, ``seed``,
     ``pass_spp``, ``accel``, ``builder``; ``noise_threshold`` and ``min_spp``
     (adaptive sampling); ``time_limit`` (seconds: without ``spp`` the
     passes go on until it is up); ``aovs`` (any of ``albedo``, ``normal``,

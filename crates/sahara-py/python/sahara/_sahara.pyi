@@ -125,6 +125,7 @@ def render(
     integrator: Optional[str] = None,
     sampler: Optional[str] = None,
     light_sampler: Optional[str] = None,
+    guiding: Optional[str] = None,
     filter: Optional[str] = None,
     seed: Optional[int] = None,
     time_limit: Optional[float] = None,
