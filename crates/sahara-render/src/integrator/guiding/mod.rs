@@ -203,7 +203,7 @@ pub(crate) fn close(st: &PathState) {
 /// density `pdf`, its throughput now `beta`.
 #[inline]
 fn record(st: &PathState, leaf: u32, dir: Vec3, beta: Vec3, pdf: f32) {
-    if st.guide == NO_RECORD || !(pdf > 0.0) {
+    if st.guide == NO_RECORD || pdf.is_nan() || pdf <= 0.0 {
         return;
     }
     RECORDS.with_borrow_mut(|r| {
@@ -294,7 +294,7 @@ impl<'g> AtVertex<'g> {
             let e = sh.bsdf.eval(sh.wo, local);
             let pdf = 0.5 * e.pdf + 0.5 * guide_pdf;
             let weight = e.f * local.z.abs() / pdf;
-            if !(pdf > 0.0) || weight.max_element() <= 0.0 {
+            if pdf.is_nan() || pdf <= 0.0 || weight.max_element() <= 0.0 {
                 return None;
             }
             (

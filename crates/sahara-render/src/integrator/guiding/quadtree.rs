@@ -254,7 +254,7 @@ impl Training {
     /// the fixed-point value stochastically.
     pub(crate) fn splat(&self, d: Vec3, value: f32, jitter: f32) {
         let v = (value as f64 * SCALE).min(MAX_ADD);
-        if !(v > 0.0) {
+        if v.is_nan() || v <= 0.0 {
             return;
         }
         let n = (v + jitter as f64) as u64;
