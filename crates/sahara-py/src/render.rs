@@ -21,7 +21,7 @@ use sahara_formats::{write_image, Pixels};
 use sahara_formats::{Given, Plan, Refused, Request, RequestError, Setting, SettingsLayer};
 use sahara_formats::{LoadOptions, Loaded, Note, SceneNames, Spelling, SETTINGS};
 use sahara_render::{
-    render_watched, Aov, AuxImages, Film, FilterKind, IntegratorKind, LightSampler, Named,
+    render_watched, Aov, AuxImages, Film, FilterKind, Guiding, IntegratorKind, LightSampler, Named,
     PathLoop, Progress, RenderResult, SamplerKind, Scene as RenderScene, ToneMap,
 };
 
@@ -121,6 +121,7 @@ impl Scene {
         d.set_item("integrator", f.integrator.name())?;
         d.set_item("sampler", f.sampler.name())?;
         d.set_item("light_sampler", f.light_sampler.name())?;
+        d.set_item("guiding", f.guiding.name())?;
         d.set_item("spp", f.spp)?;
         d.set_item("seed", f.seed)?;
         d.set_item("filter", f.filter.kind().name())?;
@@ -559,6 +560,7 @@ pub fn names(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("sampler", PyList::new(py, SamplerKind::names())?)?;
     d.set_item("light_sampler", PyList::new(py, LightSampler::names())?)?;
     d.set_item("path_loop", PyList::new(py, PathLoop::names())?)?;
+    d.set_item("guiding", PyList::new(py, Guiding::names())?)?;
     d.set_item("filter", PyList::new(py, FilterKind::names())?)?;
     d.set_item("aov", PyList::new(py, Aov::names())?)?;
     d.set_item("tonemap", PyList::new(py, ToneMap::names())?)?;

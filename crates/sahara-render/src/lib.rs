@@ -81,6 +81,7 @@ pub use texture::{
 // How to render: the settings and their names.
 pub use film::filter::{Filter, FilterKind};
 pub use film::ToneMap;
+pub use integrator::guiding::Guiding;
 pub use integrator::{
     defaults, Feature, Integrator, IntegratorKind, LaneCounts, SettingsError, Support, Supports,
     TraceStats,

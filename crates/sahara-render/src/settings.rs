@@ -18,6 +18,7 @@
 use std::fmt::Debug;
 
 use crate::film::filter::{Filter, FilterKind};
+use crate::integrator::guiding::Guiding;
 use crate::integrator::{defaults, Integrator, IntegratorKind};
 use crate::light::LightSampler;
 use crate::sampler::SamplerKind;
@@ -297,6 +298,9 @@ layered! {
         adaptive: Option<Adaptive> = None, by AdaptiveChoice;
         /// How next-event estimation chooses the light it samples.
         light_sampler: LightSampler = LightSampler::Tree;
+        /// Whether `path` guides its bounces by what the render learns of
+        /// where light comes from ([`Guiding`]).
+        guiding: Guiding = Guiding::Off;
     }
 }
 
@@ -314,6 +318,7 @@ impl From<FrameSettings> for FrameLayer {
             integrator: Some(Pick::Value(s.integrator)),
             adaptive: s.adaptive.map(AdaptiveChoice::from),
             light_sampler: Some(s.light_sampler),
+            guiding: Some(s.guiding),
         }
     }
 }

@@ -6,6 +6,7 @@ use sahara_kd::gamma;
 use sahara_kd::{AccelParams, Counters, NoCounters, Ray};
 
 use crate::accel::{Accel, BatchBuffers, RawHit};
+use crate::integrator::guiding::Guide;
 use crate::light::choice::LightChoice;
 use crate::light::gather::SceneLights;
 use crate::light::{AreaLight, LightSample, LightSampler, LightSource};
@@ -142,6 +143,9 @@ pub struct World<'a> {
     interfaces: Vec<Option<MediumInterface>>,
     /// Whether light travels through media ([`Scene::has_media`]).
     has_media: bool,
+    /// What a guided render has learned of where light comes from
+    /// (`integrator::guiding`); None when the render is not guided.
+    guide: Option<Guide>,
 }
 
 impl<'a> World<'a> {
@@ -204,7 +208,20 @@ impl<'a> World<'a> {
                 Vec::new()
             },
             has_media: scene.has_media(),
+            guide: None,
         }
+    }
+
+    /// The path guide of the iteration under way, if the render is guided.
+    #[inline]
+    pub(crate) fn guide(&self) -> Option<&Guide> {
+        self.guide.as_ref()
+    }
+
+    /// Sets the path guide the next passes sample and train (None: none),
+    /// returning the one before.
+    pub(crate) fn swap_guide(&mut self, guide: Option<Guide>) -> Option<Guide> {
+        std::mem::replace(&mut self.guide, guide)
     }
 
     /// True if light travels through media in this scene (see

@@ -29,8 +29,8 @@ use exr::prelude::{
 };
 use sahara_readers::FormatError;
 use sahara_render::{
-    Adaptive, Aov, Aux, AuxSums, Filter, FilterKind, FrameSettings, Integrator, IntegratorKind,
-    LightSampler, Named, Parameter, PixelSum, PixelWindow, SumBuffer,
+    Adaptive, Aov, Aux, AuxSums, Filter, FilterKind, FrameSettings, Guiding, Integrator,
+    IntegratorKind, LightSampler, Named, Parameter, PixelSum, PixelWindow, SumBuffer,
 };
 
 use crate::output::atomic::write_atomically;
@@ -189,6 +189,7 @@ impl PartInfo {
             ("sahara:seed".into(), f.seed.to_string()),
             ("sahara:sampler".into(), f.sampler.to_string()),
             ("sahara:light_sampler".into(), f.light_sampler.to_string()),
+            ("sahara:guiding".into(), f.guiding.to_string()),
             ("sahara:exposure".into(), o.exposure.to_string()),
             ("sahara:tonemap".into(), o.tonemap.to_string()),
             ("sahara:passes".into(), pass_list(&self.passes)),
@@ -299,6 +300,11 @@ impl PartInfo {
             light_sampler: match get("sahara:light_sampler") {
                 None => LightSampler::Power,
                 Some(_) => h.parsed("sahara:light_sampler")?,
+            },
+            // Parts written before the setting existed were not guided.
+            guiding: match get("sahara:guiding") {
+                None => Guiding::Off,
+                Some(_) => h.parsed("sahara:guiding")?,
             },
         };
         Ok(PartInfo {
@@ -720,6 +726,7 @@ mod tests {
                 seed: 3,
                 sampler: sahara_render::SamplerKind::Independent,
                 light_sampler: LightSampler::Uniform,
+                guiding: Guiding::Off,
                 filter: Filter::Mitchell {
                     radius: 1.75,
                     b: 0.3,

@@ -470,6 +470,10 @@ fn check_supported(
         let feature = match e {
             SettingsError::Unsupported { feature, .. } => *feature,
             SettingsError::AdaptiveSampleRange { .. } => Feature::Adaptive,
+            SettingsError::Guiding(_) if caller.frame.guiding.is_some() => {
+                return Asked::Caller("guiding", None)
+            }
+            SettingsError::Guiding(_) => return Asked::File("guiding"),
         };
         let p = &caller.piece;
         match feature {

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use sahara_kd::{AccelKind, Builder};
 use sahara_render::{
-    AdaptiveChoice, Aov, FilterKind, IntegratorKind, LightSampler, Named, PathLoop, Pick,
+    AdaptiveChoice, Aov, FilterKind, Guiding, IntegratorKind, LightSampler, Named, PathLoop, Pick,
     SamplerKind, ToneMap,
 };
 
@@ -288,6 +288,21 @@ pub static SETTINGS: &[Setting] = &[
         requires: None,
         set: |l, g| {
             l.frame.light_sampler = Some(named(g)?);
+            Ok(())
+        },
+    },
+    Setting {
+        name: "guiding",
+        keyword: "guiding",
+        short: None,
+        value_name: "WHEN",
+        takes: Takes::Name(Guiding::names),
+        help: "Path guiding (path integrator): learn where light comes from as the render goes \
+               and sample bounces by it; on, off, or auto (on where it applies: path without \
+               media, a whole frame, no adaptive sampling) [default: off]",
+        requires: None,
+        set: |l, g| {
+            l.frame.guiding = Some(named(g)?);
             Ok(())
         },
     },

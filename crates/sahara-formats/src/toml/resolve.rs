@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use sahara_readers::FormatError;
 use sahara_render::{
-    AdaptiveChoice, Filter, FilterKind, FrameLayer, Integrator, IntegratorKind, Named, Parameter,
-    Pick, Shape, ShapeKind,
+    AdaptiveChoice, Filter, FilterKind, FrameLayer, Guiding, Integrator, IntegratorKind, Named,
+    Parameter, Pick, Shape, ShapeKind,
 };
 use toml::Spanned;
 
@@ -577,22 +577,39 @@ impl Ctx<'_> {
     /// `[integrator]`: `name` and the parameters the renderer lists for
     /// that integrator ([`IntegratorKind::parameters`]), so a new
     /// integrator or parameter needs no change here.
-    fn integrator(&self, table: &Spanned<RawNamedTable>) -> Result<Integrator, FormatError> {
-        let (kind, values) = self.named_table("integrator", table, IntegratorKind::parameters)?;
-        Ok(Integrator::with_parameters(kind, &values))
+    /// The integrator of `[integrator]`, and its `guiding` key if given
+    /// (a frame setting beside the integrator's parameters).
+    fn integrator(
+        &self,
+        table: &Spanned<RawNamedTable>,
+    ) -> Result<(Integrator, Option<Guiding>), FormatError> {
+        let mut table = table.clone();
+        let guiding = match table.get_mut().remove("guiding") {
+            None => None,
+            Some(v) => match v.get_ref() {
+                toml::Value::String(s) => {
+                    Some(Guiding::from_name(s).map_err(|e| self.at(v.span(), e.to_string()))?)
+                }
+                _ => return Err(self.at(v.span(), "`guiding` must be a string")),
+            },
+        };
+        let (kind, values) = self.named_table("integrator", &table, IntegratorKind::parameters)?;
+        Ok((Integrator::with_parameters(kind, &values), guiding))
     }
 
     /// The render settings of `[integrator]`, `[sampler]`, `[filter]` and
     /// `[film]`: what the file gives, each key not given left to the
     /// layers below (the defaults).
     fn settings(&self, raw: &RawScene, film: &RawFilm) -> Result<SettingsLayer, FormatError> {
+        let integrator = raw
+            .integrator
+            .as_ref()
+            .map(|i| self.integrator(i))
+            .transpose()?;
         let mut layer = SettingsLayer {
             frame: FrameLayer {
-                integrator: raw
-                    .integrator
-                    .as_ref()
-                    .map(|i| self.integrator(i).map(Pick::Value))
-                    .transpose()?,
+                integrator: integrator.map(|(i, _)| Pick::Value(i)),
+                guiding: integrator.and_then(|(_, g)| g),
                 filter: raw
                     .filter
                     .as_ref()

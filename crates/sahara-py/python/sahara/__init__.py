@@ -165,10 +165,10 @@ def render(
     The settings are the command line's render options as keywords
     (``sahara.names()["setting"]`` lists them): ``spp``, ``width``,
     ``height``, ``integrator``, ``sampler``, ``light_sampler``,
-    ``filter``, ``seed``, ``pass_spp``, ``accel``, ``builder``;
-    ``path_loop`` (``"auto"``, ``"lanes"``, ``"lanes-no-refill"``,
-    ``"scalar"``: how the path tracer traces its samples);
-    ``noise_threshold`` and ``min_spp``
+    ``guiding``, ``filter``, ``seed``, ``pass_spp``, ``accel``,
+    ``builder``; ``path_loop`` (``"auto"``, ``"lanes"``,
+    ``"lanes-no-refill"``, ``"scalar"``: how the path tracer traces its
+    samples); ``noise_threshold`` and ``min_spp``
     (adaptive sampling); ``time_limit`` (seconds: without ``spp`` the
     passes go on until it is up); ``aovs`` (any of ``albedo``, ``normal``,
     ``depth``, ``position``, ``uv``, ``variance``, ``object``,

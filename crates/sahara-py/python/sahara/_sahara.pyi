@@ -126,6 +126,7 @@ def render(
     sampler: Optional[str] = None,
     path_loop: Optional[str] = None,
     light_sampler: Optional[str] = None,
+    guiding: Optional[str] = None,
     filter: Optional[str] = None,
     seed: Optional[int] = None,
     time_limit: Optional[float] = None,

@@ -4,6 +4,7 @@
 pub(crate) mod bdpt;
 pub mod debug;
 mod distribution;
+pub mod guiding;
 pub(crate) mod lanes;
 pub(crate) mod laps;
 mod path;

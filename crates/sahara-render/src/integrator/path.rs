@@ -2,6 +2,7 @@
 //! importance sampling (power heuristic) of light and BSDF sampling, and
 //! Russian roulette.
 
+use super::guiding::{self, AtVertex};
 use super::state::{Deferred, Op, PathState};
 use super::{light_contribution, Context, Shading};
 use crate::math::warp::power_heuristic;
@@ -26,6 +27,7 @@ pub(crate) fn step(
 ) -> bool {
     let world = ctx.world;
     let ray = st.ray;
+    guiding::close(st);
     let Some(hit) = hit else {
         if world.has_environment() {
             let le = world.env_radiance(ray.dir);
@@ -69,12 +71,17 @@ pub(crate) fn step(
     if depth >= max_depth {
         return false;
     }
+    // Where the render learns where light comes from, the bounce is
+    // guided by it (`guiding`); the scattering density is then the
+    // balance of the BSDF's and the guide's.
+    let guide = AtVertex::of(world.guide(), &sh, &hit);
     // Next-event estimation: one light, chosen as the world chooses.
     if !sh.bsdf.is_delta() {
         let u_pick = ctx.sampler.get_1d(dims::bounce(depth, dims::LIGHT_PICK));
         let u = ctx.sampler.get_2d(dims::bounce(depth, dims::LIGHT_POINT));
         if let Some((ls, pmf)) = world.sample_light_mis(hit.p, hit.ns, u_pick, u) {
             if let Some((c, bsdf_pdf, shadow)) = light_contribution(ctx, &hit, &sh, &ls, st.time) {
+                let bsdf_pdf = guide.map_or(bsdf_pdf, |g| g.pdf(ls.wi, bsdf_pdf));
                 let light_pdf = pmf * ls.pdf;
                 let w = if ls.delta {
                     1.0
@@ -89,7 +96,11 @@ pub(crate) fn step(
         }
     }
     // Continue the path by sampling the BSDF.
-    let Some((s, next)) = sh.sample_bounce(ctx, &hit, depth) else {
+    let bounce = match &guide {
+        Some(g) => g.sample_bounce(ctx, &sh, &hit, depth),
+        None => sh.sample_bounce(ctx, &hit, depth),
+    };
+    let Some((s, next)) = bounce else {
         return false;
     };
     st.beta *= s.weight;
@@ -100,7 +111,14 @@ pub(crate) fn step(
     st.prev_n = hit.ns;
     st.ray = next;
     st.depth += 1;
-    roulette(ctx, &mut st.beta, st.depth, rr_depth)
+    let beta = st.beta;
+    let more = roulette(ctx, &mut st.beta, st.depth, rr_depth);
+    if let Some(g) = guide.filter(|_| more && !s.delta) {
+        // Before roulette's division: what survives stands for what did
+        // not, which trains nothing.
+        g.record(st, next.dir, beta, s.pdf);
+    }
+    more
 }
 
 /// Russian roulette after `depth` bounces: the path goes on with

@@ -51,6 +51,9 @@ pub(crate) struct PathState {
     pub occlusion: f32,
     /// What a denoiser is told about this sample.
     pub aux: AuxSample,
+    /// The path's number among the batch whose vertices train the guide
+    /// ([`super::guiding::NO_RECORD`]: it records none).
+    pub guide: u32,
 }
 
 /// What a denoiser is told about one sample (Intel Open Image Denoise's
@@ -150,6 +153,7 @@ impl PathState {
             pass_throughs: 0,
             occlusion: 1.0,
             aux: AuxSample::default(),
+            guide: super::guiding::NO_RECORD,
         }
     }
 

@@ -209,6 +209,9 @@ pub enum SettingsError {
         /// The frame's samples per pixel.
         spp: u32,
     },
+    /// Path guiding asked for (`guiding = on`) where it cannot apply, for
+    /// the reason given.
+    Guiding(&'static str),
 }
 
 impl fmt::Display for SettingsError {
@@ -231,6 +234,7 @@ impl fmt::Display for SettingsError {
                  instead",
                 samples.start, samples.end
             ),
+            SettingsError::Guiding(why) => write!(f, "path guiding cannot be used here: {why}"),
         }
     }
 }

@@ -107,7 +107,7 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
     let _ = write!(
         h,
         "sahara frame 1\nsize {}x{}\nspp {} in passes of {}\nseed {}\nsampler {:?}\nfilter {:?}\n\
-         integrator {:?}\nlight sampler {}\ncost scale {:?}\nscene {:?}",
+         integrator {:?}\nlight sampler {}{}\ncost scale {:?}\nscene {:?}",
         s.width,
         s.height,
         s.spp,
@@ -117,6 +117,12 @@ pub fn frame_digest(scene: &Scene, s: &RenderSettings) -> String {
         s.filter,
         s.integrator,
         s.light_sampler,
+        // Named only when on, so that the digests of unguided frames
+        // stay what they were before the setting existed.
+        match s.guiding {
+            crate::Guiding::Off => String::new(),
+            g => format!("\nguiding {g}"),
+        },
         s.cost_scale,
         scene
     );

@@ -31,6 +31,7 @@ mod accumulate;
 pub mod adaptive;
 pub mod aux;
 pub mod digest;
+mod guided;
 mod ids;
 mod pass;
 mod plan;
@@ -128,12 +129,15 @@ pub fn render_world(
     world.set_film(settings.height.max(1), u64::from(settings.spp.max(1)));
     world.accel.set_isa(SAMPLE_LOOP_ISA);
     world.set_light_sampler(settings.light_sampler);
-    let world = &*world;
     let stats = RenderStats {
         build_time,
         layout: world.accel.layout(),
         ..Default::default()
     };
+    if settings.guided(world.has_media()) {
+        return Ok(guided::render(world, settings, progress, stats, start));
+    }
+    let world = &*world;
     let mut previews = Previews::new(preview);
     if let Integrator::Sppm {
         max_depth,

@@ -9,6 +9,7 @@ use sahara_kd::AccelParams;
 
 use super::aux::Aov;
 use crate::film::window::PixelWindow;
+use crate::integrator::guiding::Guiding;
 #[cfg(doc)]
 use crate::integrator::Supports;
 use crate::integrator::{Feature, Integrator, SettingsError};
@@ -207,7 +208,41 @@ impl RenderSettings {
         if !self.aovs.is_empty() {
             kind.require(Feature::Aovs)?;
         }
+        if self.guiding == Guiding::On {
+            if let Some(why) = self.unguided(false) {
+                return Err(SettingsError::Guiding(why));
+            }
+        }
         Ok(())
+    }
+
+    /// Why this render cannot be guided (None: it can), in a scene with
+    /// media if `media`.
+    fn unguided(&self, media: bool) -> Option<&'static str> {
+        let whole = self.samples.as_ref().is_none_or(|r| *r == (0..self.spp));
+        if !matches!(self.integrator, Integrator::Path { .. }) {
+            Some("it guides the path integrator only")
+        } else if self.part || !whole {
+            Some(
+                "a farm's part cannot learn from the other parts' paths (render parts with \
+                 guiding off)",
+            )
+        } else if self.adaptive.is_some() {
+            Some("it does not combine with adaptive sampling")
+        } else if media {
+            Some("it does not guide through participating media")
+        } else {
+            None
+        }
+    }
+
+    /// True if this render is guided ([`Guiding`]): asked for (`on`), or
+    /// `auto` where guiding applies, in a scene with media if `media`.
+    pub fn guided(&self, media: bool) -> bool {
+        match self.guiding {
+            Guiding::Off => false,
+            Guiding::On | Guiding::Auto => self.unguided(media).is_none(),
+        }
     }
 
     /// [`RenderSettings::check`], and refuses what the integrator cannot
@@ -216,6 +251,11 @@ impl RenderSettings {
         self.check()?;
         if scene.has_media() {
             self.integrator.kind().require(Feature::Media)?;
+            if self.guiding == Guiding::On {
+                if let Some(why) = self.unguided(true) {
+                    return Err(SettingsError::Guiding(why));
+                }
+            }
         }
         Ok(())
     }

@@ -10,6 +10,7 @@ mod bidirectional;
 mod camera;
 mod common;
 mod energy;
+mod guiding;
 mod lanes;
 mod light_choice;
 mod lighting;

@@ -185,7 +185,11 @@ impl SampleLoop {
     /// The loop of the settings' integrator in `world`.
     fn of(s: &RenderSettings, world: &World) -> Self {
         let integrator = &s.integrator;
-        if let Some(refill) = s.path_loop.lanes(integrator, world.scene) {
+        // A guided render takes the scalar loop: the guide is sampled and
+        // trained by the scalar path step, and the lanes have no guided
+        // sampling.
+        let lanes = s.path_loop.lanes(integrator, world.scene);
+        if let Some(refill) = lanes.filter(|_| world.guide().is_none()) {
             Self::Lanes { refill }
         } else if let Some((max_depth, strategies)) = integrator.bidirectional() {
             Self::Bidirectional {

@@ -3,6 +3,7 @@
 //! time, each step's rays as one batch.
 
 use super::{Slots, StripPixels, StripRound};
+use crate::integrator::guiding;
 use crate::integrator::laps::Laps;
 use crate::integrator::wavefront::Wavefront;
 use crate::integrator::{PathState, TraceStats};
@@ -61,8 +62,15 @@ impl Stepped {
                 }
             }
         }
+        let guide = world.guide();
+        if guide.is_some() {
+            guiding::begin(&mut self.paths);
+        }
         self.wavefront
             .trace(&round.settings.integrator, world, stats, &mut self.paths);
+        if let Some(g) = guide {
+            guiding::finish(g, &self.paths);
+        }
         for (p, &k) in self.paths.iter().zip(&self.slot) {
             slots.radiance[k as usize] = p.l;
         }
