@@ -12,8 +12,12 @@ the sun's texels are then some 10^4 times brighter than the zenith, so nearly al
 from about 0.02 % of the map, the case for sampling the map by its brightness and for MIS
 compensation.
 
-The objects: a diffuse sphere, a rough gold sphere, a rough plastic sphere and a diffuse box on a
-grey ground square reaching almost to the horizon; the sky is seen above the horizon behind them, the sun is not in view.
+The objects: two diffuse spheres, a rough gold sphere (eta and k given as RGB, so that both renderers
+read the same numbers) and a diffuse box on a grey ground square reaching almost to the horizon. The
+camera looks down on them and sees no sky: the map's light arrives only by reflection. (Sahara looks
+a map up by nearest texel and Mitsuba 3 bilinearly; where a pixel is much smaller than a texel, a sky
+seen directly would differ pixel by pixel though not on average, an error floor that has nothing to do
+with how fast either renderer converges.)
 
 usage: python3 scripts/kit_env_sun.py [OUT_DIR]   (default scenes/kit; needs numpy and OpenEXR)
 """
@@ -124,7 +128,7 @@ def scene_xml():
     add('        <float name="fov" value="45"/>')
     add('        <string name="fov_axis" value="x"/>')
     add('        <transform name="to_world">')
-    add('            <lookat origin="0, 1.6, 5.5" target="0, 0.45, 0" up="0, 1, 0"/>')
+    add('            <lookat origin="0, 2.8, 5.2" target="0, 0.3, 0" up="0, 1, 0"/>')
     add('        </transform>')
     add('        <sampler type="independent">')
     add('            <integer name="sample_count" value="$spp"/>')
@@ -151,17 +155,14 @@ def scene_xml():
     add('    </bsdf>')
     add('    <bsdf type="twosided" id="gold">')
     add('        <bsdf type="roughconductor">')
-    add('            <string name="material" value="Au"/>')
+    add('            <rgb name="eta" value="0.143, 0.374, 1.442"/>')
+    add('            <rgb name="k" value="3.983, 2.385, 1.603"/>')
     add('            <string name="distribution" value="ggx"/>')
     add('            <float name="alpha" value="0.15"/>')
     add('        </bsdf>')
     add('    </bsdf>')
-    add('    <bsdf type="twosided" id="plastic">')
-    add('        <bsdf type="roughplastic">')
-    add('            <string name="distribution" value="ggx"/>')
-    add('            <float name="alpha" value="0.1"/>')
-    add('            <rgb name="diffuse_reflectance" value="0.1, 0.2, 0.6"/>')
-    add('        </bsdf>')
+    add('    <bsdf type="twosided" id="blue">')
+    add('        <bsdf type="diffuse"><rgb name="reflectance" value="0.15, 0.25, 0.65"/></bsdf>')
     add('    </bsdf>')
     add('')
     add('    <!-- the ground: a 400 x 400 square at y = 0 -->')
@@ -169,7 +170,7 @@ def scene_xml():
     add('        <transform name="to_world"><matrix value="200 0 0 0  0 0 1 0  0 -200 0 0  0 0 0 1"/></transform>')
     add('        <ref id="ground"/>')
     add('    </shape>')
-    for (x, z, r, mat) in [(-1.3, 0.2, 0.5, "clay"), (0.0, -0.4, 0.6, "gold"), (1.3, 0.3, 0.45, "plastic")]:
+    for (x, z, r, mat) in [(-1.3, 0.2, 0.5, "clay"), (0.0, -0.4, 0.6, "gold"), (1.3, 0.3, 0.45, "blue")]:
         add('    <shape type="sphere">')
         add(f'        <point name="center" x="{x:g}" y="{r:g}" z="{z:g}"/>')
         add(f'        <float name="radius" value="{r:g}"/>')
