@@ -7,7 +7,7 @@
 //! | `spot` (`intensity`, `cutoff_angle`, `beam_width`, `to_world`: it shines along `+z`) | spot light, full inside `beam_width`, dark beyond `cutoff_angle` (Sahara's smoothstep in between, warned) |
 //! | `directional` (`irradiance`, `direction` or `to_world`'s `+z`) | directional light |
 //! | `constant` (`radiance`) | constant environment |
-//! | `envmap` (`filename`, `scale`, `to_world`) | the lat-long map moved onto Sahara's layout (nearest texel; a quarter turn about `+y` is exact) |
+//! | `envmap` (`filename`, `scale`, `to_world`) | the lat-long map moved onto Sahara's layout, each texel what Mitsuba's bilinear lookup gives in its direction |
 //! | `sunsky`, `sky`, `sun`, `projector` | skipped (warned) |
 //! | `sampling_weight` (any emitter) | checked, not used: Sahara picks lights by power |
 
@@ -34,22 +34,45 @@ fn mitsuba_uv(d: DVec3) -> (f64, f64) {
 
 /// Mitsuba's map `img` (row 0 up), whose frame's axes in world space are
 /// the columns of `to_world`, on Sahara's lat-long layout; true if every
-/// texel landed on a texel centre.
+/// texel landed on a column of the map (the transform turns the map by a
+/// whole number of columns about its axis).
+///
+/// Each texel of Sahara's layout takes the radiance Mitsuba looks up in
+/// the texel's centre direction: bilinear between the map's texels, whose
+/// columns are centred at u = (i + 1/2) / W (wrapping around) and whose
+/// rows lie at v = j / (H - 1), the first on the upward pole and the last
+/// on the downward one (Mitsuba's `envmap`, measured), where Sahara's rows
+/// are centred at (j + 1/2) / H.
 fn to_sahara(img: &Texture, to_world: DMat3) -> (Texture, bool) {
     let inv = to_world.inverse();
     let (w, h) = (img.width, img.height);
     let mut exact = true;
     let mut texels = Vec::with_capacity(w as usize * h as usize);
+    let texel =
+        |x: i64, y: i64| img.texel(x.rem_euclid(i64::from(w)), y.clamp(0, i64::from(h) - 1));
     for y in 0..h {
         for x in 0..w {
             let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
             let (d, _) = environment_direction(uv);
             let (u, v) = mitsuba_uv((inv * d.as_dvec3()).normalize_or_zero());
-            let (sx, sy) = (u * f64::from(w) - 0.5, v * f64::from(h) - 0.5);
-            exact &= (sx - sx.round()).abs() < 1e-3 && (sy - sy.round()).abs() < 1e-3;
-            let tx = (sx.round() as i64).rem_euclid(i64::from(w));
-            let ty = (sy.round() as i64).clamp(0, i64::from(h) - 1);
-            texels.push(img.texel(tx, ty));
+            let sx = u * f64::from(w) - 0.5;
+            let sy = v * f64::from(h.max(2) - 1);
+            exact &= (sx - sx.round()).abs() < 1e-3;
+            // On a texel (to rounding), that texel alone.
+            let snap = |s: f64| {
+                if (s - s.round()).abs() < 1e-4 {
+                    s.round()
+                } else {
+                    s
+                }
+            };
+            let (sx, sy) = (snap(sx), snap(sy));
+            let (x0, y0) = (sx.floor(), sy.floor());
+            let (fx, fy) = ((sx - x0) as f32, (sy - y0) as f32);
+            let (x0, y0) = (x0 as i64, y0 as i64);
+            let top = texel(x0, y0) * (1.0 - fx) + texel(x0 + 1, y0) * fx;
+            let bottom = texel(x0, y0 + 1) * (1.0 - fx) + texel(x0 + 1, y0 + 1) * fx;
+            texels.push(top * (1.0 - fy) + bottom * fy);
         }
     }
     (Texture::new(w, h, texels), exact)
@@ -182,7 +205,7 @@ impl<'a> Builder<'a> {
                 let (map, exact) = to_sahara(&img, rot);
                 if !exact {
                     self.w.add(
-                        "envmap: resampled (nearest texel) onto Sahara's lat-long layout",
+                        "envmap: the transform turns the map by part of a texel; resampled (bilinear)",
                         &node.loc,
                     );
                 }
@@ -246,5 +269,35 @@ mod tests {
                 assert_eq!(out.texel(x, y), want, "({x}, {y})");
             }
         }
+    }
+
+    #[test]
+    fn mitsubas_rows_lie_from_pole_to_pole() {
+        // Mitsuba 3.9.1's envmap, a map whose row j has value j, looked
+        // up at v = 1/16 (8 rows): 0.4375 = v (H - 1). Sahara's row y is
+        // centred at v = (y + 1/2) / H.
+        let (w, h) = (16u32, 8u32);
+        let t = (0..w * h).map(|k| Vec3::splat((k / w) as f32)).collect();
+        let (out, exact) = to_sahara(&Texture::new(w, h, t), DMat3::IDENTITY);
+        assert!(exact);
+        for y in 0..h {
+            let want = (y as f32 + 0.5) / h as f32 * (h - 1) as f32;
+            for x in 0..w {
+                assert!(
+                    (out.texel(i64::from(x), i64::from(y)).x - want).abs() < 1e-4,
+                    "({x}, {y})"
+                );
+            }
+        }
+        // A column's value between two columns is their mean.
+        let t = (0..w * h).map(|k| Vec3::splat((k % w) as f32)).collect();
+        let turn = DMat3::from_rotation_y(std::f64::consts::TAU / 32.0);
+        let (out, exact) = to_sahara(&Texture::new(w, h, t), turn);
+        assert!(!exact);
+        let row: Vec<f32> = (0..w).map(|x| out.texel(i64::from(x), 3).x).collect();
+        assert!(
+            row.iter().all(|v| (v.fract() - 0.5).abs() < 1e-3),
+            "{row:?}"
+        );
     }
 }
