@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::{Slots, StripPixels, StripRound};
+use super::{Slots, StripRound};
 use crate::integrator::lanes::{LaneSample, PathLanes};
 use crate::integrator::laps::Laps;
 use crate::integrator::{AuxSample, TraceStats};
@@ -38,30 +38,11 @@ impl Lanes {
         refill: bool,
     ) {
         let aux = round.aux();
-        let StripPixels { x0, x1, y0, y1 } = round.pixels;
         self.samples.clear();
-        self.slot.clear();
-        for (bx, by) in (y0..y1)
-            .step_by(4)
-            .flat_map(|by| (x0..x1).step_by(4).map(move |bx| (bx, by)))
-        {
-            for m in 0..16u32 {
-                // De-interleave the Morton index's bits.
-                let dx = (m & 1) | (m >> 1 & 2);
-                let dy = (m >> 1 & 1) | (m >> 2 & 2);
-                let (x, y) = (bx + dx, by + dy);
-                if x >= x1 || y >= y1 {
-                    continue;
-                }
-                for g in round.samples.of(x, y) {
-                    let (sampler, pos, ray, time) = round.cameras.at(x, y, g);
-                    let k = slots.slot(round, x, y, g);
-                    slots.pos[k] = pos;
-                    self.slot.push(k as u32);
-                    self.samples.push(LaneSample { ray, time, sampler });
-                }
-            }
-        }
+        let samples = &mut self.samples;
+        slots.in_camera_packet_order(round, &mut self.slot, |sampler, ray, time| {
+            samples.push(LaneSample { ray, time, sampler })
+        });
         self.radiance.clear();
         self.radiance.resize(self.samples.len(), Vec3::ZERO);
         self.aux.clear();

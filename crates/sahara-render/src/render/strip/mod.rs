@@ -43,6 +43,7 @@ use super::settings::RenderSettings;
 use crate::integrator::bdpt::{Splat, Strategies};
 use crate::integrator::laps::Laps;
 use crate::integrator::{AuxSample, Integrator, TraceStats};
+use crate::sampler::PixelSampler;
 use crate::world::World;
 
 /// Rows of a tile whose samples are traced as one batch by the stepped
@@ -161,6 +162,43 @@ impl Slots {
         let p = round.pixels;
         let start = round.samples.of(x, y).start;
         (self.first[((y - p.y0) * (p.x1 - p.x0) + (x - p.x0)) as usize] + g - start) as usize
+    }
+
+    /// Calls `each` with every sample of the round's pixels in
+    /// camera-packet order, noting each sample's film position in its slot
+    /// and its slot in `slot` (cleared first): 4x4 pixel blocks, the pixels
+    /// of a block in Morton order (2x2 blocks of 2x2), each pixel's samples
+    /// together. A run of 16 samples is then one pixel's, or a 2x2 block's
+    /// when a pixel takes 4, whose rays leave close together.
+    fn in_camera_packet_order(
+        &mut self,
+        round: &StripRound,
+        slot: &mut Vec<u32>,
+        mut each: impl FnMut(PixelSampler, sahara_kd::Ray, f32),
+    ) {
+        let StripPixels { x0, x1, y0, y1 } = round.pixels;
+        slot.clear();
+        for (bx, by) in (y0..y1)
+            .step_by(4)
+            .flat_map(|by| (x0..x1).step_by(4).map(move |bx| (bx, by)))
+        {
+            for m in 0..16u32 {
+                // De-interleave the Morton index's bits.
+                let dx = (m & 1) | (m >> 1 & 2);
+                let dy = (m >> 1 & 1) | (m >> 2 & 2);
+                let (x, y) = (bx + dx, by + dy);
+                if x >= x1 || y >= y1 {
+                    continue;
+                }
+                for g in round.samples.of(x, y) {
+                    let (sampler, pos, ray, time) = round.cameras.at(x, y, g);
+                    let k = self.slot(round, x, y, g);
+                    self.pos[k] = pos;
+                    slot.push(k as u32);
+                    each(sampler, ray, time);
+                }
+            }
+        }
     }
 }
 

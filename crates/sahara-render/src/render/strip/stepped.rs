@@ -2,7 +2,7 @@
 //! wavefront ([`Wavefront`]) traces every path of the strip a step at a
 //! time, each step's rays as one batch.
 
-use super::{Slots, StripPixels, StripRound};
+use super::{Slots, StripRound};
 use crate::integrator::guiding;
 use crate::integrator::laps::Laps;
 use crate::integrator::wavefront::Wavefront;
@@ -37,31 +37,11 @@ impl Stepped {
         stats: &mut TraceStats,
     ) {
         let aux = round.aux();
-        let StripPixels { x0, x1, y0, y1 } = round.pixels;
         self.paths.clear();
-        self.slot.clear();
-        for (bx, by) in (y0..y1)
-            .step_by(4)
-            .flat_map(|by| (x0..x1).step_by(4).map(move |bx| (bx, by)))
-        {
-            for m in 0..16u32 {
-                // De-interleave the Morton index's bits.
-                let dx = (m & 1) | (m >> 1 & 2);
-                let dy = (m >> 1 & 1) | (m >> 2 & 2);
-                let (x, y) = (bx + dx, by + dy);
-                if x >= x1 || y >= y1 {
-                    continue;
-                }
-                for g in round.samples.of(x, y) {
-                    let (sampler, pos, ray, time) = round.cameras.at(x, y, g);
-                    let k = slots.slot(round, x, y, g);
-                    slots.pos[k] = pos;
-                    self.slot.push(k as u32);
-                    self.paths
-                        .push(PathState::new(ray, time, sampler).with_aux(aux));
-                }
-            }
-        }
+        let paths = &mut self.paths;
+        slots.in_camera_packet_order(round, &mut self.slot, |sampler, ray, time| {
+            paths.push(PathState::new(ray, time, sampler).with_aux(aux))
+        });
         let guide = world.guide();
         if guide.is_some() {
             guiding::begin(&mut self.paths);
