@@ -8,12 +8,12 @@
 //!   its triangles are moved to world space at build time and go into one
 //!   world tree with the others, traced without any transform.
 //! - The others (meshes shared by several instances, moving instances,
-//!   analytic emitters, and a ground plane that dwarfs the rest, see
-//!   [`grounds`]) keep one tree per mesh in object space and a top
-//!   level over their world (swept) bounds. Rays are moved into an
-//!   instance's object space at their time; ray parameters are preserved by
-//!   the affine map, so hits of different instances, and of the world tree,
-//!   compare directly.
+//!   emitting spheres, whose shadow rays ignore them, and a ground plane
+//!   that dwarfs the rest, see [`grounds`]) keep one tree per mesh in
+//!   object space and a top level over their world (swept) bounds. Rays
+//!   are moved into an instance's object space at their time; ray
+//!   parameters are preserved by the affine map, so hits of different
+//!   instances, and of the world tree, compare directly.
 //!
 //! Among equally distant hits the smallest instance index wins, then the
 //! smallest triangle index: the world tree holds the merged instances'
@@ -23,7 +23,7 @@
 
 pub mod top_level;
 
-use glam::Affine3A;
+use glam::{Affine3A, Mat3};
 use sahara_kd::{
     Aabb, AccelParams, Counters, Hit, Isa, NoCounters, Ray, Triangle, TriangleAccel, PACKET16,
 };
@@ -113,6 +113,10 @@ struct Placed {
     placement: Placement,
     /// World-to-object map of a static instance (None when moving).
     to_object: Option<Affine3A>,
+    /// The normals' object-to-world map of a static instance (the
+    /// inverse transpose of its linear part), kept because every hit's
+    /// shading needs it (None when moving).
+    normals: Option<Mat3>,
 }
 
 /// [`Placed::tree`] of an instance merged into the world tree.
@@ -322,6 +326,10 @@ impl Accel {
                 placement: inst.placement,
                 to_object: match inst.placement {
                     Placement::Static(a) => Some(a.inverse()),
+                    Placement::Moving { .. } => None,
+                },
+                normals: match inst.placement {
+                    Placement::Static(a) => Some(normal_map(&a)),
                     Placement::Moving { .. } => None,
                 },
             })
@@ -676,6 +684,22 @@ impl Accel {
     pub fn transform(&self, i: u32, s: f32) -> Affine3A {
         self.placed[i as usize].placement.at(s)
     }
+
+    /// The map of instance `i`'s normals to world space when its
+    /// transform is `xf` ([`Accel::transform`] at the same time): the
+    /// inverse transpose of `xf`'s linear part.
+    #[inline]
+    pub fn normal_transform(&self, i: u32, xf: &Affine3A) -> Mat3 {
+        self.placed[i as usize]
+            .normals
+            .unwrap_or_else(|| normal_map(xf))
+    }
+}
+
+/// The inverse transpose of `xf`'s linear part, which maps normals.
+#[inline]
+fn normal_map(xf: &Affine3A) -> Mat3 {
+    Mat3::from(xf.matrix3).inverse().transpose()
 }
 
 #[cfg(test)]

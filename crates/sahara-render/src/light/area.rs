@@ -127,8 +127,7 @@ pub struct AreaLight {
     pub two_sided: bool,
     /// Total area.
     pub area: f32,
-    /// The instance of an analytic (convex) emitter, which never shadows
-    /// its own samples.
+    /// The instance of an analytic emitter (none for mesh lights).
     pub instance: Option<u32>,
 }
 
@@ -144,6 +143,17 @@ fn emitted(radiance: Vec3, two_sided: bool, n: Vec3, w: Vec3) -> Vec3 {
 }
 
 impl AreaLight {
+    /// The instance a shadow ray towards this light must ignore: a
+    /// sphere's, whose tessellation lies inside the sphere sampled, so
+    /// that a segment from inside it to a sampled point would cross it.
+    /// Flat emitters need none (see [`AreaLight::sample`]).
+    pub fn shadow_ignore(&self) -> Option<u32> {
+        match self.emitter {
+            Emitter::Sphere { .. } => self.instance,
+            _ => None,
+        }
+    }
+
     /// A light over an analytic emitter.
     pub fn analytic(emitter: Emitter, radiance: Vec3, two_sided: bool, instance: u32) -> Self {
         let area = match &emitter {
@@ -445,7 +455,10 @@ impl AreaLight {
             li,
             pdf: pdf_area * dist2 / cos,
             delta: false,
-            ignore: self.instance,
+            // A flat emitter cannot block the segment to its own point,
+            // which stops short of it (`World::shadow_query`), so its
+            // instance need not be ignored and joins the world tree.
+            ignore: None,
             n,
             two_sided: two,
         })
