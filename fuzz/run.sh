@@ -8,6 +8,14 @@
 # input is left in fuzz/artifacts/<target>/ and libFuzzer prints how to
 # reproduce it (`cargo fuzz run TARGET fuzz/artifacts/TARGET/crash-...`).
 # Extra libFuzzer flags can be given in $FUZZ_FLAGS.
+#
+# The kd-tree's target (unsafe SIMD walks) is built with the address
+# sanitizer, alone (`--no-default-features`: the kd-tree and nothing else)
+# in a target folder of its own. The readers' targets (safe Rust) are built
+# without a sanitizer unless $FUZZ_SANITIZER names one: libFuzzer still
+# catches their panics, timeouts and excess allocations, and their build
+# (the readers, the scene formats and the renderer under them) takes
+# 5 min 24 s on 2 cores instead of 8 min 07 s with the address sanitizer.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -23,9 +31,14 @@ for target in "$@"; do
     if [ -f "fuzz/dicts/$target.dict" ]; then
         dict=("-dict=fuzz/dicts/$target.dict")
     fi
+    if [ "$target" = kdtree ]; then
+        build=(--no-default-features --target-dir fuzz/target/kdtree)
+    else
+        build=(--sanitizer "${FUZZ_SANITIZER:-none}")
+    fi
     echo "== fuzz $target for ${seconds}s"
     # shellcheck disable=SC2086
-    cargo fuzz run --fuzz-dir fuzz "$target" -- \
+    cargo fuzz run --fuzz-dir fuzz "${build[@]}" "$target" -- \
         -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
         -print_final_stats=1 "${dict[@]}" ${FUZZ_FLAGS:-}
 done

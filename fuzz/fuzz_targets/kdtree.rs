@@ -18,8 +18,8 @@ use arbitrary::Arbitrary;
 use glam::Vec3;
 use libfuzzer_sys::fuzz_target;
 use sahara_kd::internals::BatchWalk;
-use sahara_kd::PACKET;
 use sahara_kd::validate;
+use sahara_kd::PACKET;
 use sahara_kd::{brute, BuildParams, Builder, Bvh, BvhBuilder, BvhParams, KdTree, Ray, Triangle};
 
 #[derive(Arbitrary, Debug, Clone, Copy)]
@@ -258,13 +258,20 @@ fuzz_target!(|input: Input| {
                 same(got, closest),
                 "bvh {name}: closest hit {got:?} but brute force gives {closest:?} for {ray:?}"
             );
-            assert_eq!(bvh.any_hit(ray), any, "bvh {name}: any hit disagrees for {ray:?}");
+            assert_eq!(
+                bvh.any_hit(ray),
+                any,
+                "bvh {name}: any hit disagrees for {ray:?}"
+            );
             assert!(
                 same(hits[k], closest),
                 "bvh {name} batch: closest hit {:?} but brute force gives {closest:?} for {ray:?}",
                 hits[k]
             );
-            assert_eq!(occluded[k], any, "bvh {name} batch: any hit disagrees for {ray:?}");
+            assert_eq!(
+                occluded[k], any,
+                "bvh {name} batch: any hit disagrees for {ray:?}"
+            );
         }
         for size in [8, 16] {
             for idx in order.chunks(size) {
