@@ -835,22 +835,15 @@ mod tests {
         let mut scene = Scene::new(cam);
         let floor = scene.add_material(Material::diffuse(Vec3::splat(0.5)));
         let lamp = scene.add_material(Material::emitter(Vec3::splat(4.0)).with_two_sided(false));
-        let f = scene.add_shape(
-            Shape::Quad {
-                corner: Vec3::new(-50.0, 0.0, -50.0),
-                edge_u: Vec3::new(0.0, 0.0, 100.0),
-                edge_v: Vec3::new(100.0, 0.0, 0.0),
-            },
-            floor,
-        );
-        let q = scene.add_shape(
-            Shape::Quad {
-                corner: Vec3::new(-0.5, 1.0, -0.5),
-                edge_u: Vec3::new(1.0, 0.0, 0.0),
-                edge_v: Vec3::new(0.0, 0.0, 1.0),
-            },
-            lamp,
-        );
+        // A square of side `a` at height `y`, facing down (the floor's
+        // side does not matter to its shadows).
+        let square = |y: f32, a: f32| Shape::Quad {
+            corner: Vec3::new(-a / 2.0, y, -a / 2.0),
+            edge_u: Vec3::new(a, 0.0, 0.0),
+            edge_v: Vec3::new(0.0, 0.0, a),
+        };
+        let f = scene.add_shape(square(0.0, 100.0), floor);
+        let q = scene.add_shape(square(1.0, 1.0), lamp);
         let s = scene.add_shape(
             Shape::Sphere {
                 center: Vec3::new(30.0, 2.0, 0.0),
