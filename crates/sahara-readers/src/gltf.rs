@@ -399,6 +399,7 @@ fn parse(bytes: &[u8], name: &str) -> Result<::gltf::Gltf, FormatError> {
     // fuzzing). Read without validation first and check those indices here.
     if let Ok(unchecked) = ::gltf::Gltf::from_slice_without_validation(bytes) {
         check_position_accessors(unchecked.document.as_json(), name)?;
+        check_image_sources(unchecked.document.as_json(), name)?;
     }
     match ::gltf::Gltf::from_slice(bytes) {
         Err(::gltf::Error::Validation(problems))
@@ -441,6 +442,29 @@ fn check_position_accessors(root: &::gltf::json::Root, name: &str) -> Result<(),
                 }
             }
         }
+    }
+    Ok(())
+}
+
+/// `gltf::Image::source` unwraps what the specification requires of an
+/// image: a `uri`, or a `bufferView` (that exists) with a `mimeType`. An
+/// image without them panicked (found by fuzzing); it is an error here.
+fn check_image_sources(root: &::gltf::json::Root, name: &str) -> Result<(), FormatError> {
+    for (i, image) in root.images.iter().enumerate() {
+        let problem = match (&image.buffer_view, &image.mime_type, &image.uri) {
+            (Some(view), _, _) if view.value() >= root.buffer_views.len() => format!(
+                "buffer view {} does not exist ({} buffer views)",
+                view.value(),
+                root.buffer_views.len()
+            ),
+            (Some(_), None, _) => "a bufferView without a mimeType".to_owned(),
+            (None, _, None) => "neither a uri nor a bufferView".to_owned(),
+            _ => continue,
+        };
+        return Err(FormatError::in_file(
+            name,
+            format!("invalid glTF: images[{i}]: {problem}"),
+        ));
     }
     Ok(())
 }

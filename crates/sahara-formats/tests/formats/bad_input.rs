@@ -704,6 +704,37 @@ fn truncated_image_errors_are_one_line() {
     }
 }
 
+/// Fuzzing found (gltf, crash-f5cecd87...): the gltf crate unwraps an
+/// image's `mimeType` when it has a `bufferView`, and its `uri` when it
+/// has none; an image lacking them is an error naming the image.
+#[test]
+fn a_gltf_image_without_its_source_is_an_error() {
+    let dir = Folder::new("gltf-image-source");
+    for (image, says) in [
+        (
+            r#"{"bufferView": 0}"#,
+            "images[0]: a bufferView without a mimeType",
+        ),
+        (
+            r#"{"name": "x"}"#,
+            "images[0]: neither a uri nor a bufferView",
+        ),
+        (
+            r#"{"bufferView": 7, "mimeType": "image/png"}"#,
+            "images[0]: buffer view 7 does not exist (1 buffer views)",
+        ),
+    ] {
+        let text = format!(
+            r#"{{"asset": {{"version": "2.0"}}, "buffers": [{{"byteLength": 4, "uri": "data:application/octet-stream;base64,AAAAAA=="}}],
+               "bufferViews": [{{"buffer": 0, "byteLength": 4}}], "images": [{image}]}}"#
+        );
+        let path = dir.0.join("image.gltf");
+        std::fs::write(&path, text).unwrap();
+        let name = path.display().to_string();
+        assert_error(load_gltf(&path), &format!("{name}: "), &[says]);
+    }
+}
+
 /// Fuzzing found (gltf, crash-6349e2a3...): the gltf crate computes a GLB's
 /// `length - 12` unchecked, so a header claiming fewer than 12 bytes
 /// overflowed (a panic in debug builds).
