@@ -9,6 +9,13 @@
 # reproduce it (`cargo fuzz run TARGET fuzz/artifacts/TARGET/crash-...`).
 # Extra libFuzzer flags can be given in $FUZZ_FLAGS.
 #
+# $FUZZ_SEED and $FUZZ_RUNS make a run repeatable: libFuzzer's -seed and
+# -runs (inputs tried per target), with SECONDS still the cap. .ci/run sets
+# both, so that CI mutates the same corpus the same way on every clone of a
+# commit (nearly: coverage through the readers' per-process hash seeds
+# varies a little); by hand, leave them unset to explore from a fresh
+# random seed until the time is up.
+#
 # The kd-tree's target (unsafe SIMD walks) is built with the address
 # sanitizer, alone (`--no-default-features`: the kd-tree and nothing else)
 # in a target folder of its own. The readers' targets (safe Rust) are built
@@ -37,8 +44,15 @@ for target in "$@"; do
         build=(--sanitizer "${FUZZ_SANITIZER:-none}")
     fi
     echo "== fuzz $target for ${seconds}s"
+    repeat=()
+    if [ -n "${FUZZ_SEED:-}" ]; then
+        repeat+=("-seed=$FUZZ_SEED")
+    fi
+    if [ -n "${FUZZ_RUNS:-}" ]; then
+        repeat+=("-runs=$FUZZ_RUNS")
+    fi
     # shellcheck disable=SC2086
     cargo fuzz run --fuzz-dir fuzz "${build[@]}" "$target" -- \
         -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2048 \
-        -print_final_stats=1 "${dict[@]}" ${FUZZ_FLAGS:-}
+        -print_final_stats=1 "${dict[@]}" "${repeat[@]}" ${FUZZ_FLAGS:-}
 done

@@ -44,34 +44,31 @@ const ALLOCATION_LIMIT: usize = 2048 << 20;
 /// is never touched would not show in the resident size either.
 struct Limited;
 
-/// Writes `message` to the standard error and aborts, allocating nothing.
-fn refuse(message: &[u8]) -> ! {
+/// Aborts, allocating nothing, if `size` is over [`ALLOCATION_LIMIT`],
+/// after saying so on the standard error.
+fn check_size(size: usize) {
     use std::io::Write;
-    let _ = std::io::stderr().write_all(message);
-    std::process::abort()
+    if size > ALLOCATION_LIMIT {
+        let _ = std::io::stderr().write_all(b"allocation over the fuzz targets' 2 GiB limit\n");
+        std::process::abort()
+    }
 }
 
 // SAFETY: every call is passed on to the system allocator unchanged; the
 // limit only refuses, before any memory is handed out.
 unsafe impl std::alloc::GlobalAlloc for Limited {
     unsafe fn alloc(&self, layout: std::alloc::Layout) -> *mut u8 {
-        if layout.size() > ALLOCATION_LIMIT {
-            refuse(b"allocation over the fuzz targets' 2 GiB limit\n");
-        }
+        check_size(layout.size());
         std::alloc::System.alloc(layout)
     }
 
     unsafe fn alloc_zeroed(&self, layout: std::alloc::Layout) -> *mut u8 {
-        if layout.size() > ALLOCATION_LIMIT {
-            refuse(b"allocation over the fuzz targets' 2 GiB limit\n");
-        }
+        check_size(layout.size());
         std::alloc::System.alloc_zeroed(layout)
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: std::alloc::Layout, new_size: usize) -> *mut u8 {
-        if new_size > ALLOCATION_LIMIT {
-            refuse(b"allocation over the fuzz targets' 2 GiB limit\n");
-        }
+        check_size(new_size);
         std::alloc::System.realloc(ptr, layout, new_size)
     }
 

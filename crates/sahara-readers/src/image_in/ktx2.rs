@@ -588,9 +588,11 @@ mod basis {
         if scheme == ZSTANDARD {
             // 16 bytes per 4 x 4 block (UASTC and ASTC blocks), for each layer
             // and face of the level; the whole stack within Sahara's pixel
-            // limit.
+            // limit. A side of 0 (a 1D texture's height) counts as 1, as the
+            // blocks below do, so a 0 cannot hide a huge other factor.
             let stack = layers.max(1).saturating_mul(faces.max(1));
-            if width.saturating_mul(height).saturating_mul(stack) > MAX_IMAGE_PIXELS {
+            let texels = width.max(1).saturating_mul(height.max(1));
+            if texels.saturating_mul(stack) > MAX_IMAGE_PIXELS {
                 return Err("size");
             }
             for level in 0..levels.clamp(1, 32) {

@@ -358,6 +358,17 @@ fn bad_ktx2_data_is_a_one_line_error_naming_the_file() {
         e,
         "wraps.ktx2: cannot read the KTX2 texture: its level index is corrupt"
     );
+    // A height of 0 (as a 1D texture has) beside 2^32 - 1 layers and
+    // faces: the stack is still counted against the pixel limit (a 0 once
+    // hid it, and the level check's product overflowed).
+    let mut flat = ktx2("quad_uastc.ktx2");
+    flat[24..28].copy_from_slice(&0u32.to_le_bytes());
+    flat[32..40].copy_from_slice(&[0xFF; 8]);
+    let e = decode_raw(&flat, "flat.ktx2").unwrap_err().to_string();
+    assert_eq!(
+        e,
+        "flat.ktx2: cannot read the KTX2 texture: its size is corrupt"
+    );
     let mut kvd = ktx2("quad_uastc.ktx2");
     kvd[60..64].copy_from_slice(&35u32.to_le_bytes());
     let e = decode_raw(&kvd, "kvd.ktx2").unwrap_err().to_string();

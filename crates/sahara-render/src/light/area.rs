@@ -488,7 +488,7 @@ impl AreaLight {
                 li,
                 pdf: dist2 / (cos * self.area),
                 delta: false,
-                ignore: self.instance,
+                ignore: self.shadow_ignore(),
                 n,
                 two_sided: self.two_sided,
             });
@@ -518,7 +518,7 @@ impl AreaLight {
             li,
             pdf: 1.0 / (2.0 * PI * one_minus),
             delta: false,
-            ignore: self.instance,
+            ignore: self.shadow_ignore(),
             n,
             two_sided: self.two_sided,
         })
