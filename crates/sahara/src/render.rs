@@ -426,14 +426,15 @@ fn say_what_was_written(path: &std::path::Path, result: &RenderResult, partial: 
         }
     );
     let lanes = s.trace.lanes;
-    let vertices = lanes.lane_bounces + lanes.scalar_material + lanes.scalar_other;
+    let vertices = lanes.lane_bounces + lanes.misses + lanes.scalar_material + lanes.scalar_other;
     if vertices > 0 {
         let share = |n: u64| 100.0 * n as f64 / vertices as f64;
         eprintln!(
-            "path loop lanes: {:.1}% of path vertices shaded in the lanes, {:.1}% by the scalar \
-             code for want of a lane BSDF, {:.1}% for other reasons (misses, holes, normal \
-             maps); lanes busy {:.1}% of the rounds",
+            "path loop lanes: {:.1}% of path vertices shaded in the lanes, {:.1}% misses, {:.1}% \
+             by the scalar code under a clear coat, {:.1}% with holes or normal maps; lanes busy \
+             {:.1}% of the rounds",
             share(lanes.lane_bounces),
+            share(lanes.misses),
             share(lanes.scalar_material),
             share(lanes.scalar_other),
             100.0 * lanes.busy_lanes as f64 / lanes.lane_slots.max(1) as f64

@@ -12,10 +12,12 @@
 //! 2. each lane's hit, looked up lane by lane: its material and textures
 //!    ([`Material::at`]), emission and its MIS weight; a lane the lanes
 //!    cannot shade takes its whole step in the scalar code instead
-//!    ([`Integrator::step`], counted in [`LaneCounts`]): a miss, a surface
-//!    with holes or a normal map, a BSDF with no lane version;
+//!    ([`Integrator::step`], counted in [`LaneCounts`]): a surface with
+//!    holes or a normal map, a clear coat; a miss ends its path with the
+//!    environment's light, added lane by lane;
 //! 3. in the lanes: the shading frame, the light sample's draws, the
-//!    BSDF's value for the light's direction, the MIS weights, the shadow
+//!    BSDF's value for the light's direction (lane by lane for BSDFs
+//!    without lane formulas, [`BsdfLanes`]), the MIS weights, the shadow
 //!    rays' origins; the light's sample itself lane by lane
 //!    ([`World::sample_light_mis`]);
 //! 4. the shadow rays as one batch ([`World::visible_batch`]);
@@ -63,11 +65,13 @@ pub(crate) struct LaneSample {
 pub struct LaneCounts {
     /// Path vertices shaded in the lanes.
     pub lane_bounces: u64,
-    /// Path vertices shaded by the scalar code because their BSDF has no
-    /// lane version.
+    /// Paths ended by a miss, the environment's light added lane by lane.
+    pub misses: u64,
+    /// Path vertices shaded by the scalar code because their BSDF is
+    /// under a clear coat.
     pub scalar_material: u64,
-    /// Path vertices shaded by the scalar code for another reason: a miss
-    /// (the environment), a surface with holes or a normal map.
+    /// Path vertices shaded by the scalar code for another reason: a
+    /// surface with holes or a normal map.
     pub scalar_other: u64,
     /// Rounds of a packet (one closest-hit query each).
     pub rounds: u64,
@@ -80,6 +84,7 @@ pub struct LaneCounts {
 impl std::ops::AddAssign for LaneCounts {
     fn add_assign(&mut self, o: Self) {
         self.lane_bounces += o.lane_bounces;
+        self.misses += o.misses;
         self.scalar_material += o.scalar_material;
         self.scalar_other += o.scalar_other;
         self.rounds += o.rounds;
@@ -400,8 +405,31 @@ impl<'a, 'w> Shared<'a, 'w> {
             if !paths.alive.0[i] {
                 continue;
             }
+            if hit.is_none() {
+                // The environment's light, weighted against light
+                // sampling, as `path::step` adds it at a miss (the same
+                // operations), without the scalar step's round trip
+                // through a whole path state.
+                if world.has_environment() {
+                    let dir = paths.ray[i].dir;
+                    let le = world.env_radiance(dir);
+                    paths.aux[i].escape(le);
+                    let w = if paths.prev_delta.0[i] {
+                        1.0
+                    } else {
+                        crate::math::warp::power_heuristic(
+                            paths.prev_pdf.0[i],
+                            world.env_pdf_mis(dir),
+                        )
+                    };
+                    paths.l.set(i, paths.l.get(i) + paths.beta.get(i) * le * w);
+                }
+                stats.lanes.misses += 1;
+                round.ended.0[i] = true;
+                continue;
+            }
             // The surface, if the lanes can shade it; else why not
-            // (true: its BSDF has no lane version).
+            // (true: its BSDF is under a clear coat).
             let mut scalar_material = false;
             let lane = hit.as_ref().and_then(|hit| {
                 let m = world.material(hit.material);

@@ -15,9 +15,14 @@
 //! search in double precision) are computed lane by lane by the scalar
 //! code, the rest of the Beckmann lobe in the lanes.
 //!
-//! A point whose BSDF has no lane version here ([`BsdfLanes::set`] says
-//! so: the layered BSDFs, thin glass, a clear coat) is shaded by the
-//! scalar code.
+//! The other BSDFs (the layered ones of [`super::layered`]: glTF's
+//! metallic-roughness, coated diffuse, measured conductors; thin glass)
+//! have no formulas here: their lanes are evaluated and sampled lane by
+//! lane by the scalar BSDF itself, so the path stays in the lanes (its
+//! light sample, shadow ray in the round's batch, MIS and roulette) and
+//! those lanes' values are the scalar ones bit for bit. A point under a
+//! clear coat is shaded by the scalar code ([`BsdfLanes::set`] says so):
+//! the coat's normal is set in the scalar shading frame.
 
 use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, PI};
 
@@ -42,6 +47,14 @@ pub(crate) struct BsdfLanes<const N: usize> {
     pub rough_glass: M<N>,
     /// Lanes whose microfacets are Beckmann's (else GGX).
     pub beckmann: M<N>,
+    /// Lanes evaluated and sampled by their scalar BSDF (`scalar`).
+    pub by_lane: M<N>,
+    /// Of those, lanes whose every lobe is a delta, and lanes that may
+    /// transmit.
+    pub by_lane_delta: M<N>,
+    pub by_lane_transmits: M<N>,
+    /// The scalar BSDF of each `by_lane` lane.
+    pub scalar: [Option<PointBsdf>; N],
     /// Albedo, or reflectance at normal incidence, tint applied.
     pub color: V<N>,
     /// Microfacet width.
@@ -75,6 +88,10 @@ impl<const N: usize> Default for BsdfLanes<N> {
             glass: no,
             rough_glass: no,
             beckmann: no,
+            by_lane: no,
+            by_lane_delta: no,
+            by_lane_transmits: no,
+            scalar: [None; N],
             color: V::default(),
             alpha: F::splat(0.0),
             ior: F::splat(1.5),
@@ -83,26 +100,17 @@ impl<const N: usize> Default for BsdfLanes<N> {
 }
 
 /// True if every material of `materials` is shaded in the lanes wherever
-/// it is hit: a BSDF with a lane version, no clear coat, no normal map,
-/// no holes (each of those sends a lane to the scalar code).
+/// it is hit: no clear coat, no normal map, no holes (each of those sends
+/// a lane to the scalar code).
 pub(crate) fn all_in_lanes(materials: &[Material]) -> bool {
-    materials.iter().all(|m| {
-        m.clearcoat.is_none()
-            && m.textures.normal.is_none()
-            && !m.has_holes()
-            && !matches!(
-                m.bsdf,
-                Bsdf::ComplexConductor { .. }
-                    | Bsdf::MetallicRoughness { .. }
-                    | Bsdf::CoatedDiffuse { .. }
-                    | Bsdf::ThinDielectric { .. }
-            )
-    })
+    materials
+        .iter()
+        .all(|m| m.clearcoat.is_none() && m.textures.normal.is_none() && !m.has_holes())
 }
 
 impl<const N: usize> BsdfLanes<N> {
-    /// Makes lane `i` the BSDF `p`; false (the lane untouched) if that
-    /// BSDF has no lane version.
+    /// Makes lane `i` the BSDF `p`; false (the lane untouched) if it is
+    /// under a clear coat, which the lanes leave to the scalar code.
     #[inline]
     pub fn set(&mut self, i: usize, p: &PointBsdf) -> bool {
         if p.coat.is_some() {
@@ -160,8 +168,12 @@ impl<const N: usize> BsdfLanes<N> {
             Bsdf::ComplexConductor { .. }
             | Bsdf::MetallicRoughness { .. }
             | Bsdf::CoatedDiffuse { .. }
-            | Bsdf::ThinDielectric { .. } => return false,
+            | Bsdf::ThinDielectric { .. } => 5,
         };
+        self.by_lane.0[i] = kind == 5;
+        self.by_lane_delta.0[i] = kind == 5 && p.is_delta();
+        self.by_lane_transmits.0[i] = kind == 5 && !p.is_reflective_only();
+        self.scalar[i] = (kind == 5).then_some(*p);
         self.diffuse.0[i] = kind == 0;
         self.conductor.0[i] = kind == 1;
         self.mirror.0[i] = kind == 2;
@@ -177,13 +189,22 @@ impl<const N: usize> BsdfLanes<N> {
     /// Lanes whose every lobe is a delta (light sampling cannot help).
     #[inline(always)]
     pub fn is_delta(&self) -> M<N> {
-        self.mirror | self.glass
+        self.mirror | self.glass | self.by_lane_delta
     }
 
     /// Lanes that only reflect.
     #[inline(always)]
     pub fn is_reflective_only(&self) -> M<N> {
-        !(self.glass | self.rough_glass)
+        !(self.glass | self.rough_glass | self.by_lane_transmits)
+    }
+
+    /// The `by_lane` lanes' scalar BSDFs, with their lane numbers.
+    #[inline(always)]
+    fn scalar_lanes(&self) -> impl Iterator<Item = (usize, &PointBsdf)> {
+        self.scalar
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| Some((i, p.as_ref()?)))
     }
 
     /// The microfacets of the lanes.
@@ -224,6 +245,13 @@ impl<const N: usize> BsdfLanes<N> {
             let (rf, rpdf) = self.eval_rough_glass(wo, wi);
             f = self.rough_glass.select_v(V::new(rf, rf, rf), f);
             pdf = self.rough_glass.select(rpdf, pdf);
+        }
+        if self.by_lane.any() {
+            for (i, p) in self.scalar_lanes() {
+                let e = p.eval(wo.get(i), wi.get(i));
+                f.set(i, e.f);
+                pdf.0[i] = e.pdf;
+            }
         }
         (f, pdf)
     }
@@ -354,6 +382,21 @@ impl<const N: usize> BsdfLanes<N> {
             s.wi = ok.select_v(wi_w, s.wi);
             s.weight = ok.select_v(V::new(w, w, w), s.weight);
             s.pdf = ok.select(pdf, s.pdf);
+        }
+        if self.by_lane.any() {
+            for (i, p) in self.scalar_lanes() {
+                let u = glam::Vec2::new(u.0 .0[i], u.1 .0[i]);
+                let Some(r) = p.sample(wo.get(i), u_lobe.0[i], u) else {
+                    continue;
+                };
+                s.ok.0[i] = true;
+                s.wi.set(i, r.wi);
+                s.weight.set(i, r.weight);
+                s.pdf.0[i] = r.pdf;
+                // A layered BSDF's smooth specular lobe is a delta, its
+                // other lobes are not: the lobe sampled says.
+                s.delta.0[i] = r.delta;
+            }
         }
         // As the scalar BSDFs: a sample that would poison the image is
         // dropped.
@@ -559,7 +602,8 @@ mod tests {
     use crate::math::hash::{hash2, unit_f32};
     use glam::Vec2;
 
-    /// The BSDFs with a lane version, textured (tint) and not.
+    /// Every kind of BSDF, textured (tint) and not: those with lane
+    /// formulas, and those evaluated lane by lane by their scalar code.
     fn bsdfs() -> Vec<PointBsdf> {
         let mut v = Vec::new();
         for (i, m) in [
@@ -578,6 +622,37 @@ mod tests {
                 ior: 1.33,
                 roughness: 0.6,
                 distribution: Distribution::Beckmann,
+            }),
+            Material::new(Bsdf::MetallicRoughness {
+                base_color: Vec3::new(0.8, 0.3, 0.2),
+                metallic: 0.4,
+                roughness: 0.35,
+                ior: 1.5,
+                specular: 1.0,
+                specular_color: Vec3::ONE,
+            }),
+            // Smooth: a delta specular lobe over a diffuse one.
+            Material::new(Bsdf::MetallicRoughness {
+                base_color: Vec3::new(0.2, 0.4, 0.8),
+                metallic: 0.0,
+                roughness: 0.0,
+                ior: 1.5,
+                specular: 1.0,
+                specular_color: Vec3::ONE,
+            }),
+            Material::new(Bsdf::CoatedDiffuse {
+                albedo: Vec3::new(0.7, 0.1, 0.1),
+                ior: 1.5,
+                roughness: 0.2,
+                distribution: Distribution::Ggx,
+            }),
+            Material::new(Bsdf::ThinDielectric { ior: 1.5 }),
+            Material::new(Bsdf::ComplexConductor {
+                eta: Vec3::new(0.143, 0.374, 1.442),
+                k: Vec3::new(3.983, 2.385, 1.603),
+                roughness: 0.3,
+                distribution: Distribution::Ggx,
+                multiple_scattering: true,
             }),
         ]
         .into_iter()
@@ -674,17 +749,8 @@ mod tests {
     }
 
     #[test]
-    fn layered_and_coated_bsdfs_have_no_lane_version() {
+    fn a_clear_coat_has_no_lane_version() {
         let mut lanes = BsdfLanes::<8>::default();
-        let mr = PointBsdf::new(Bsdf::MetallicRoughness {
-            base_color: Vec3::ONE,
-            metallic: 0.5,
-            roughness: 0.5,
-            ior: 1.5,
-            specular: 1.0,
-            specular_color: Vec3::ONE,
-        });
-        assert!(!lanes.set(0, &mr));
         let mut coated = PointBsdf::new(Bsdf::Diffuse { albedo: Vec3::ONE });
         coated.coat = Some(super::super::Coat::new(1.0, 0.1, 1.5));
         assert!(!lanes.set(0, &coated));

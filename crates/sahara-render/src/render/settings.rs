@@ -267,11 +267,11 @@ mod path_loop_tests {
     use crate::material::{Bsdf, Material};
     use glam::Vec3;
 
-    /// `auto` takes the lanes (refilled) where every material has a lane
-    /// BSDF, the scalar loop where one has not, and never for other
-    /// integrators.
+    /// `auto` takes the lanes (refilled) where every material is shaded
+    /// in the lanes (a layered BSDF is, lane by lane), the scalar loop
+    /// where one is under a clear coat, and never for other integrators.
     #[test]
-    fn auto_takes_the_lanes_where_every_material_has_a_lane_bsdf() {
+    fn auto_takes_the_lanes_where_every_material_is_shaded_in_lanes() {
         let path = Integrator::default();
         let mut scene = crate::builtin::cornell_box();
         assert!(matches!(path, Integrator::Path { .. }));
@@ -279,14 +279,25 @@ mod path_loop_tests {
         assert_eq!(PathLoop::Scalar.lanes(&path, &scene), None);
         let distribution = Integrator::named("distribution").unwrap();
         assert_eq!(PathLoop::Auto.lanes(&distribution, &scene), None);
-        scene.add_material(Material::new(Bsdf::MetallicRoughness {
+        let mut metal = Material::new(Bsdf::MetallicRoughness {
             base_color: Vec3::ONE,
             metallic: 0.5,
             roughness: 0.5,
             ior: 1.5,
             specular: 1.0,
             specular_color: Vec3::ONE,
+        });
+        scene.add_material(metal.clone());
+        assert_eq!(PathLoop::Auto.lanes(&path, &scene), Some(true));
+        metal.clearcoat = Some(Box::new(crate::material::maps::Clearcoat {
+            factor: 1.0,
+            roughness: 0.1,
+            ior: 1.5,
+            factor_map: None,
+            roughness_map: None,
+            normal_map: None,
         }));
+        scene.add_material(metal);
         assert_eq!(PathLoop::Auto.lanes(&path, &scene), None);
         assert_eq!(PathLoop::Lanes.lanes(&path, &scene), Some(true));
     }

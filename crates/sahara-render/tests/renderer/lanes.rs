@@ -1,6 +1,7 @@
 //! The path tracer's lane loop held to the scalar loop: images equal to
-//! noise, on scenes with every BSDF the lanes shade and with one they
-//! hand to the scalar code.
+//! noise, on scenes with every BSDF the lanes shade (with their own
+//! formulas, or lane by lane by the scalar BSDF) and with a clear coat,
+//! which they hand to the scalar code.
 
 use glam::Vec3;
 use sahara_render::{
@@ -10,9 +11,9 @@ use sahara_render::{
 
 use crate::common::{run, settings};
 
-/// The Cornell box with a glass, a rough metal, a mirror, a rough glass
-/// and a metallic-roughness sphere (no lane version: scalar shading), a
-/// point light and a dim sky.
+/// The Cornell box with a glass, a rough metal, a mirror, a rough glass,
+/// a metallic-roughness sphere (shaded lane by lane by its scalar BSDF)
+/// and a clear-coated one (scalar shading), a point light and a dim sky.
 fn scene() -> Scene {
     let mut s = builtin::cornell_box();
     let spheres = [
@@ -39,6 +40,22 @@ fn scene() -> Scene {
             }),
             (130.0, 40.0, 400.0),
             40.0,
+        ),
+        (
+            {
+                let mut m = Material::diffuse(Vec3::new(0.6, 0.2, 0.2));
+                m.clearcoat = Some(Box::new(sahara_render::Clearcoat {
+                    factor: 1.0,
+                    roughness: 0.1,
+                    ior: 1.5,
+                    factor_map: None,
+                    roughness_map: None,
+                    normal_map: None,
+                }));
+                m
+            },
+            (230.0, 35.0, 250.0),
+            35.0,
         ),
     ];
     for (m, c, r) in spheres {
@@ -109,8 +126,8 @@ fn lanes_render_the_scalar_image_to_noise() {
         let lanes = render(PathLoop::Lanes, 11);
         let same = render(PathLoop::Scalar, 11);
         let scalar = [12, 13].map(|seed| render(PathLoop::Scalar, seed));
-        // The metallic-roughness sphere was shaded by the scalar code,
-        // everything else in the lanes.
+        // The coated sphere was shaded by the scalar code, everything
+        // else in the lanes.
         let counts = lanes.stats.trace.lanes;
         assert!(counts.scalar_material > 0 && counts.lane_bounces > 20 * counts.scalar_material);
         let (l, s0, s1) = (values(&lanes), values(&scalar[0]), values(&scalar[1]));
