@@ -604,14 +604,11 @@ impl<'a> Builder<'a> {
         if coat > 0.0 {
             // Disney's coat: alpha from 0.1 (gloss 0) to 0.001 (gloss 1).
             let alpha = 0.1 + (0.001 - 0.1) * gloss.clamp(0.0, 1.0);
-            m.clearcoat = Some(Box::new(Clearcoat {
-                factor: coat.clamp(0.0, 1.0),
-                roughness: alpha.sqrt(),
-                ior: 1.5,
-                factor_map: None,
-                roughness_map: None,
-                normal_map: None,
-            }));
+            m.clearcoat = Some(Box::new(Clearcoat::uniform(
+                coat.clamp(0.0, 1.0),
+                alpha.sqrt(),
+                1.5,
+            )));
         }
         Ok(m.with_two_sided(false))
     }

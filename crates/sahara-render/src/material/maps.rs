@@ -102,6 +102,21 @@ pub struct Clearcoat {
     pub normal_map: Option<NormalMap>,
 }
 
+impl Clearcoat {
+    /// A coat of the same `factor`, `roughness` and index `ior`
+    /// everywhere: no maps.
+    pub fn uniform(factor: f32, roughness: f32, ior: f32) -> Self {
+        Self {
+            factor,
+            roughness,
+            ior,
+            factor_map: None,
+            roughness_map: None,
+            normal_map: None,
+        }
+    }
+}
+
 /// A tangent-space normal `t` (a normal map's texel, linear RGB) as a
 /// unit vector, X and Y scaled by `scale`; `None` for a texel that is no
 /// direction.

@@ -289,14 +289,7 @@ mod path_loop_tests {
         });
         scene.add_material(metal.clone());
         assert_eq!(PathLoop::Auto.lanes(&path, &scene), Some(true));
-        metal.clearcoat = Some(Box::new(crate::material::maps::Clearcoat {
-            factor: 1.0,
-            roughness: 0.1,
-            ior: 1.5,
-            factor_map: None,
-            roughness_map: None,
-            normal_map: None,
-        }));
+        metal.clearcoat = Some(Box::new(crate::material::Clearcoat::uniform(1.0, 0.1, 1.5)));
         scene.add_material(metal);
         assert_eq!(PathLoop::Auto.lanes(&path, &scene), None);
         assert_eq!(PathLoop::Lanes.lanes(&path, &scene), Some(true));

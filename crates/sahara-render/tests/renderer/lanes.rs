@@ -44,14 +44,7 @@ fn scene() -> Scene {
         (
             {
                 let mut m = Material::diffuse(Vec3::new(0.6, 0.2, 0.2));
-                m.clearcoat = Some(Box::new(sahara_render::Clearcoat {
-                    factor: 1.0,
-                    roughness: 0.1,
-                    ior: 1.5,
-                    factor_map: None,
-                    roughness_map: None,
-                    normal_map: None,
-                }));
+                m.clearcoat = Some(Box::new(sahara_render::Clearcoat::uniform(1.0, 0.1, 1.5)));
                 m
             },
             (230.0, 35.0, 250.0),
