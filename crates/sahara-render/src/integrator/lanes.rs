@@ -406,23 +406,18 @@ impl<'a, 'w> Shared<'a, 'w> {
                 continue;
             }
             if hit.is_none() {
-                // The environment's light, weighted against light
-                // sampling, as `path::step` adds it at a miss (the same
-                // operations), without the scalar step's round trip
-                // through a whole path state.
-                if world.has_environment() {
-                    let dir = paths.ray[i].dir;
-                    let le = world.env_radiance(dir);
-                    paths.aux[i].escape(le);
-                    let w = if paths.prev_delta.0[i] {
-                        1.0
-                    } else {
-                        crate::math::warp::power_heuristic(
-                            paths.prev_pdf.0[i],
-                            world.env_pdf_mis(dir),
-                        )
-                    };
-                    paths.l.set(i, paths.l.get(i) + paths.beta.get(i) * le * w);
+                // The environment's light, as `path::step` adds it at a
+                // miss, without the scalar step's round trip through a
+                // whole path state.
+                if let Some(le) = super::escaped(
+                    world,
+                    &mut paths.aux[i],
+                    paths.ray[i].dir,
+                    paths.beta.get(i),
+                    paths.prev_delta.0[i],
+                    paths.prev_pdf.0[i],
+                ) {
+                    paths.l.set(i, paths.l.get(i) + le);
                 }
                 stats.lanes.misses += 1;
                 round.ended.0[i] = true;

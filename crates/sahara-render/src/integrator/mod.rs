@@ -723,6 +723,31 @@ pub(crate) fn leave_light(
     Some((i, pmf, e, beta, Ray::new(origin, e.dir)))
 }
 
+/// The environment's light reaching a path that leaves the scene along
+/// `dir` with throughput `beta` (recorded in `aux` too), weighted against
+/// light sampling by the power heuristic unless the last bounce was a
+/// delta; `None` without an environment.
+pub(crate) fn escaped(
+    world: &World,
+    aux: &mut AuxSample,
+    dir: Vec3,
+    beta: Vec3,
+    prev_delta: bool,
+    prev_pdf: f32,
+) -> Option<Vec3> {
+    if !world.has_environment() {
+        return None;
+    }
+    let le = world.env_radiance(dir);
+    aux.escape(le);
+    let w = if prev_delta {
+        1.0
+    } else {
+        crate::math::warp::power_heuristic(prev_pdf, world.env_pdf_mis(dir))
+    };
+    Some(beta * le * w)
+}
+
 /// Light from a light sample if nothing blocks it: `f |cos| Li` (not
 /// divided by the pdf), the BSDF's density for the direction, and the
 /// shadow ray that decides whether it arrives (counted); `None` if zero.

@@ -4,7 +4,7 @@
 
 use super::guiding::{self, AtVertex};
 use super::state::{Deferred, Op, PathState};
-use super::{light_contribution, Context, Shading};
+use super::{escaped, light_contribution, Context, Shading};
 use crate::math::warp::power_heuristic;
 use crate::sampler::dims;
 use crate::world::SurfaceHit;
@@ -29,15 +29,15 @@ pub(crate) fn step(
     let ray = st.ray;
     guiding::close(st);
     let Some(hit) = hit else {
-        if world.has_environment() {
-            let le = world.env_radiance(ray.dir);
-            st.aux.escape(le);
-            let w = if st.prev_delta {
-                1.0
-            } else {
-                power_heuristic(st.prev_pdf, world.env_pdf_mis(ray.dir))
-            };
-            st.l += st.beta * le * w;
+        if let Some(l) = escaped(
+            world,
+            &mut st.aux,
+            ray.dir,
+            st.beta,
+            st.prev_delta,
+            st.prev_pdf,
+        ) {
+            st.l += l;
         }
         return false;
     };

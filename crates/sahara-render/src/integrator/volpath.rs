@@ -24,7 +24,7 @@ use glam::Vec3;
 use sahara_kd::Ray;
 
 use super::path::roulette;
-use super::{light_contribution, through_hole, AuxSample, Context, Shading};
+use super::{escaped, light_contribution, through_hole, AuxSample, Context, Shading};
 use crate::light::LightSample;
 use crate::math::warp::power_heuristic;
 use crate::medium::Medium;
@@ -130,15 +130,8 @@ pub(crate) fn li(
             }
         }
         let Some(hit) = hit else {
-            if world.has_environment() {
-                let le = world.env_radiance(ray.dir);
-                aux.escape(le);
-                let w = if prev_delta {
-                    1.0
-                } else {
-                    power_heuristic(prev_pdf, world.env_pdf_mis(ray.dir))
-                };
-                l += beta * le * w;
+            if let Some(le) = escaped(world, aux, ray.dir, beta, prev_delta, prev_pdf) {
+                l += le;
             }
             break;
         };

@@ -47,14 +47,13 @@ pub(crate) struct BsdfLanes<const N: usize> {
     pub rough_glass: M<N>,
     /// Lanes whose microfacets are Beckmann's (else GGX).
     pub beckmann: M<N>,
-    /// Lanes evaluated and sampled by their scalar BSDF (`scalar`).
-    pub by_lane: M<N>,
-    /// Of those, lanes whose every lobe is a delta, and lanes that may
-    /// transmit.
+    /// The scalar BSDF of each lane evaluated and sampled by its scalar
+    /// code (none for the lanes with lane formulas).
+    pub scalar: [Option<PointBsdf>; N],
+    /// Of the `scalar` lanes, those whose every lobe is a delta, and those
+    /// that may transmit.
     pub by_lane_delta: M<N>,
     pub by_lane_transmits: M<N>,
-    /// The scalar BSDF of each `by_lane` lane.
-    pub scalar: [Option<PointBsdf>; N],
     /// Albedo, or reflectance at normal incidence, tint applied.
     pub color: V<N>,
     /// Microfacet width.
@@ -88,7 +87,6 @@ impl<const N: usize> Default for BsdfLanes<N> {
             glass: no,
             rough_glass: no,
             beckmann: no,
-            by_lane: no,
             by_lane_delta: no,
             by_lane_transmits: no,
             scalar: [None; N],
@@ -170,7 +168,6 @@ impl<const N: usize> BsdfLanes<N> {
             | Bsdf::CoatedDiffuse { .. }
             | Bsdf::ThinDielectric { .. } => 5,
         };
-        self.by_lane.0[i] = kind == 5;
         self.by_lane_delta.0[i] = kind == 5 && p.is_delta();
         self.by_lane_transmits.0[i] = kind == 5 && !p.is_reflective_only();
         self.scalar[i] = (kind == 5).then_some(*p);
@@ -198,7 +195,8 @@ impl<const N: usize> BsdfLanes<N> {
         !(self.glass | self.rough_glass | self.by_lane_transmits)
     }
 
-    /// The `by_lane` lanes' scalar BSDFs, with their lane numbers.
+    /// The lanes' scalar BSDFs (of those that have one), with their lane
+    /// numbers.
     #[inline(always)]
     fn scalar_lanes(&self) -> impl Iterator<Item = (usize, &PointBsdf)> {
         self.scalar
@@ -246,12 +244,10 @@ impl<const N: usize> BsdfLanes<N> {
             f = self.rough_glass.select_v(V::new(rf, rf, rf), f);
             pdf = self.rough_glass.select(rpdf, pdf);
         }
-        if self.by_lane.any() {
-            for (i, p) in self.scalar_lanes() {
-                let e = p.eval(wo.get(i), wi.get(i));
-                f.set(i, e.f);
-                pdf.0[i] = e.pdf;
-            }
+        for (i, p) in self.scalar_lanes() {
+            let e = p.eval(wo.get(i), wi.get(i));
+            f.set(i, e.f);
+            pdf.0[i] = e.pdf;
         }
         (f, pdf)
     }
@@ -383,20 +379,18 @@ impl<const N: usize> BsdfLanes<N> {
             s.weight = ok.select_v(V::new(w, w, w), s.weight);
             s.pdf = ok.select(pdf, s.pdf);
         }
-        if self.by_lane.any() {
-            for (i, p) in self.scalar_lanes() {
-                let u = glam::Vec2::new(u.0 .0[i], u.1 .0[i]);
-                let Some(r) = p.sample(wo.get(i), u_lobe.0[i], u) else {
-                    continue;
-                };
-                s.ok.0[i] = true;
-                s.wi.set(i, r.wi);
-                s.weight.set(i, r.weight);
-                s.pdf.0[i] = r.pdf;
-                // A layered BSDF's smooth specular lobe is a delta, its
-                // other lobes are not: the lobe sampled says.
-                s.delta.0[i] = r.delta;
-            }
+        for (i, p) in self.scalar_lanes() {
+            let u = glam::Vec2::new(u.0 .0[i], u.1 .0[i]);
+            let Some(r) = p.sample(wo.get(i), u_lobe.0[i], u) else {
+                continue;
+            };
+            s.ok.0[i] = true;
+            s.wi.set(i, r.wi);
+            s.weight.set(i, r.weight);
+            s.pdf.0[i] = r.pdf;
+            // A layered BSDF's smooth specular lobe is a delta, its
+            // other lobes are not: the lobe sampled says.
+            s.delta.0[i] = r.delta;
         }
         // As the scalar BSDFs: a sample that would poison the image is
         // dropped.
