@@ -12,32 +12,15 @@ usage (a Python with numpy and Mitsuba 3, for reading EXR):
 """
 import argparse
 import os
-import resource
 import shlex
-import subprocess
-import sys
 import tempfile
 
 import numpy as np
 
+# The same EXR reading and CPU accounting as the time-to-clean-image script.
+from clean_time import cpu_run, read_exr
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-def read_exr(path):
-    import mitsuba as mi
-
-    if not mi.variant():
-        mi.set_variant("scalar_rgb")
-    return np.array(mi.Bitmap(path), dtype=np.float64)[..., :3]
-
-
-def cpu_run(cmd):
-    before = resource.getrusage(resource.RUSAGE_CHILDREN)
-    p = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if p.returncode != 0:
-        sys.exit(f"{shlex.join(cmd)} failed:\n{p.stderr}")
-    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
 
 
 def main():

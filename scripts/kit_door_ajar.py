@@ -14,6 +14,8 @@ usage: python3 scripts/kit_door_ajar.py [OUT]   (default scenes/kit/door_ajar.xm
 import os
 import sys
 
+import kit_xml
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
@@ -25,38 +27,11 @@ def main():
     add('     scripts/kit_door_ajar.py). Parameters: spp, width, height, max_depth.')
     add('     Render: sahara render scenes/kit/door_ajar.xml -D spp=64')
     add('     Mitsuba 3: mitsuba -D spp=64 scenes/kit/door_ajar.xml -->')
-    add('<scene version="3.0.0">')
-    add('    <default name="spp" value="64"/>')
-    add('    <default name="width" value="240"/>')
-    add('    <default name="height" value="135"/>')
-    add('    <default name="max_depth" value="10"/>')
-    add('')
-    add('    <integrator type="path">')
-    add('        <integer name="max_depth" value="$max_depth"/>')
-    add('    </integrator>')
-    add('')
-    add('    <sensor type="perspective">')
-    add('        <float name="fov" value="65"/>')
-    add('        <string name="fov_axis" value="x"/>')
-    add('        <transform name="to_world">')
-    add('            <lookat origin="0.6, 1.6, 4.5" target="6, 1.0, 2.0" up="0, 1, 0"/>')
-    add('        </transform>')
-    add('        <sampler type="independent">')
-    add('            <integer name="sample_count" value="$spp"/>')
-    add('        </sampler>')
-    add('        <film type="hdrfilm">')
-    add('            <integer name="width" value="$width"/>')
-    add('            <integer name="height" value="$height"/>')
-    add('            <rfilter type="box"/>')
-    add('        </film>')
-    add('    </sensor>')
-    add('')
-    for name, rgb in [("wall", "0.75, 0.73, 0.7"), ("floor", "0.5, 0.4, 0.3"),
-                      ("door", "0.55, 0.35, 0.2"), ("green", "0.2, 0.5, 0.25"),
-                      ("black", "0, 0, 0")]:
-        add(f'    <bsdf type="twosided" id="{name}">')
-        add(f'        <bsdf type="diffuse"><rgb name="reflectance" value="{rgb}"/></bsdf>')
-        add('    </bsdf>')
+    kit_xml.scene_start(add, width=240, height=135, max_depth=10, fov=65,
+                        origin="0.6, 1.6, 4.5", target="6, 1.0, 2.0")
+    kit_xml.diffuse(add, [("wall", "0.75, 0.73, 0.7"), ("floor", "0.5, 0.4, 0.3"),
+                          ("door", "0.55, 0.35, 0.2"), ("green", "0.2, 0.5, 0.25"),
+                          ("black", "0, 0, 0")])
     add('')
 
     def box(x0, x1, y0, y1, z0, z1, mat, rot_y=None):
@@ -76,14 +51,7 @@ def main():
         add('    </shape>')
 
     def rect(matrix, mat, radiance=None):
-        add('    <shape type="rectangle">')
-        add(f'        <transform name="to_world"><matrix value="{matrix}"/></transform>')
-        add(f'        <ref id="{mat}"/>')
-        if radiance:
-            add('        <emitter type="area">')
-            add(f'            <rgb name="radiance" value="{radiance}"/>')
-            add('        </emitter>')
-        add('    </shape>')
+        kit_xml.rect(add, matrix, mat, radiance)
 
     add('    <!-- floor and ceiling of both rooms: rectangles scaled from [-1, 1]^2 -->')
     rect("5 0 0 5  0 0 1 0  0 -2.5 0 2.5  0 0 0 1", "floor")
@@ -105,9 +73,7 @@ def main():
     add('    <!-- the light: a panel on room B\'s ceiling beside the shared wall -->')
     rect("0.5 0 0 6.8  0 0 -1 2.99  0 0.5 0 0.8  0 0 0 1", "black", "2000, 1800, 1500")
     add('</scene>')
-    os.makedirs(os.path.dirname(out), exist_ok=True)
-    with open(out, "w") as f:
-        f.write("\n".join(lines) + "\n")
+    kit_xml.write(out, lines)
 
 
 if __name__ == "__main__":

@@ -27,6 +27,8 @@ import sys
 
 import numpy as np
 
+import kit_xml
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 W, H = 512, 256
 SUN_ELEVATION = math.radians(35.0)
@@ -107,52 +109,21 @@ def write_exr(path, img):
     os.replace(tmp, path)
 
 
-def scene_xml():
+def scene_lines():
     lines = []
     add = lines.append
     add('<!-- Objects on a ground under a sky with a small bright sun (written by')
     add('     scripts/kit_env_sun.py, with env_sun_sky.exr). Parameters: spp, width, height, max_depth.')
     add('     Render: sahara render scenes/kit/env_sun.xml -D spp=64')
     add('     Mitsuba 3: mitsuba -D spp=64 scenes/kit/env_sun.xml -->')
-    add('<scene version="3.0.0">')
-    add('    <default name="spp" value="64"/>')
-    add('    <default name="width" value="320"/>')
-    add('    <default name="height" value="200"/>')
-    add('    <default name="max_depth" value="6"/>')
-    add('')
-    add('    <integrator type="path">')
-    add('        <integer name="max_depth" value="$max_depth"/>')
-    add('    </integrator>')
-    add('')
-    add('    <sensor type="perspective">')
-    add('        <float name="fov" value="45"/>')
-    add('        <string name="fov_axis" value="x"/>')
-    add('        <transform name="to_world">')
-    add('            <lookat origin="0, 2.8, 5.2" target="0, 0.3, 0" up="0, 1, 0"/>')
-    add('        </transform>')
-    add('        <sampler type="independent">')
-    add('            <integer name="sample_count" value="$spp"/>')
-    add('        </sampler>')
-    add('        <film type="hdrfilm">')
-    add('            <integer name="width" value="$width"/>')
-    add('            <integer name="height" value="$height"/>')
-    add('            <rfilter type="box"/>')
-    add('        </film>')
-    add('    </sensor>')
-    add('')
+    kit_xml.scene_start(add, width=320, height=200, max_depth=6, fov=45,
+                        origin="0, 2.8, 5.2", target="0, 0.3, 0")
     add('    <emitter type="envmap">')
     add('        <string name="filename" value="env_sun_sky.exr"/>')
     add('    </emitter>')
     add('')
-    add('    <bsdf type="twosided" id="ground">')
-    add('        <bsdf type="diffuse"><rgb name="reflectance" value="0.45, 0.43, 0.4"/></bsdf>')
-    add('    </bsdf>')
-    add('    <bsdf type="twosided" id="clay">')
-    add('        <bsdf type="diffuse"><rgb name="reflectance" value="0.75, 0.35, 0.2"/></bsdf>')
-    add('    </bsdf>')
-    add('    <bsdf type="twosided" id="box">')
-    add('        <bsdf type="diffuse"><rgb name="reflectance" value="0.3, 0.5, 0.35"/></bsdf>')
-    add('    </bsdf>')
+    kit_xml.diffuse(add, [("ground", "0.45, 0.43, 0.4"), ("clay", "0.75, 0.35, 0.2"),
+                          ("box", "0.3, 0.5, 0.35")])
     add('    <bsdf type="twosided" id="gold">')
     add('        <bsdf type="roughconductor">')
     add('            <rgb name="eta" value="0.143, 0.374, 1.442"/>')
@@ -161,15 +132,10 @@ def scene_xml():
     add('            <float name="alpha" value="0.15"/>')
     add('        </bsdf>')
     add('    </bsdf>')
-    add('    <bsdf type="twosided" id="blue">')
-    add('        <bsdf type="diffuse"><rgb name="reflectance" value="0.15, 0.25, 0.65"/></bsdf>')
-    add('    </bsdf>')
+    kit_xml.diffuse(add, [("blue", "0.15, 0.25, 0.65")])
     add('')
     add('    <!-- the ground: a 400 x 400 square at y = 0 -->')
-    add('    <shape type="rectangle">')
-    add('        <transform name="to_world"><matrix value="200 0 0 0  0 0 1 0  0 -200 0 0  0 0 0 1"/></transform>')
-    add('        <ref id="ground"/>')
-    add('    </shape>')
+    kit_xml.rect(add, "200 0 0 0  0 0 1 0  0 -200 0 0  0 0 0 1", "ground")
     for (x, z, r, mat) in [(-1.3, 0.2, 0.5, "clay"), (0.0, -0.4, 0.6, "gold"), (1.3, 0.3, 0.45, "blue")]:
         add('    <shape type="sphere">')
         add(f'        <point name="center" x="{x:g}" y="{r:g}" z="{z:g}"/>')
@@ -185,7 +151,7 @@ def scene_xml():
     add('        <ref id="box"/>')
     add('    </shape>')
     add('</scene>')
-    return "\n".join(lines) + "\n"
+    return lines
 
 
 def main():
@@ -193,8 +159,7 @@ def main():
     os.makedirs(out, exist_ok=True)
     img, info = make_map()
     write_exr(os.path.join(out, "env_sun_sky.exr"), img)
-    with open(os.path.join(out, "env_sun.xml"), "w") as f:
-        f.write(scene_xml())
+    kit_xml.write(os.path.join(out, "env_sun.xml"), scene_lines())
     print(info)
 
 

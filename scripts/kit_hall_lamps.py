@@ -13,6 +13,8 @@ usage: python3 scripts/kit_hall_lamps.py [OUT]   (default scenes/kit/hall_lamps.
 import os
 import sys
 
+import kit_xml
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
@@ -36,38 +38,11 @@ def main():
     add('     scripts/kit_hall_lamps.py). Parameters: spp, width, height, max_depth.')
     add('     Render: sahara render scenes/kit/hall_lamps.xml -D spp=64')
     add('     Mitsuba 3: mitsuba -D spp=64 scenes/kit/hall_lamps.xml -->')
-    add('<scene version="3.0.0">')
-    add('    <default name="spp" value="64"/>')
-    add('    <default name="width" value="320"/>')
-    add('    <default name="height" value="180"/>')
-    add('    <default name="max_depth" value="6"/>')
-    add('')
-    add('    <integrator type="path">')
-    add('        <integer name="max_depth" value="$max_depth"/>')
-    add('    </integrator>')
-    add('')
-    add('    <sensor type="perspective">')
-    add('        <float name="fov" value="60"/>')
-    add('        <string name="fov_axis" value="x"/>')
-    add('        <transform name="to_world">')
-    add('            <lookat origin="-11.5, 1.8, 1.2" target="6, 1.5, -0.6" up="0, 1, 0"/>')
-    add('        </transform>')
-    add('        <sampler type="independent">')
-    add('            <integer name="sample_count" value="$spp"/>')
-    add('        </sampler>')
-    add('        <film type="hdrfilm">')
-    add('            <integer name="width" value="$width"/>')
-    add('            <integer name="height" value="$height"/>')
-    add('            <rfilter type="box"/>')
-    add('        </film>')
-    add('    </sensor>')
-    add('')
-    for name, rgb in [("wall", "0.7, 0.68, 0.64"), ("floor", "0.45, 0.42, 0.4"),
-                      ("pillar", "0.6, 0.6, 0.62"), ("red", "0.6, 0.12, 0.1"),
-                      ("blue", "0.12, 0.2, 0.55"), ("black", "0, 0, 0")]:
-        add(f'    <bsdf type="twosided" id="{name}">')
-        add(f'        <bsdf type="diffuse"><rgb name="reflectance" value="{rgb}"/></bsdf>')
-        add('    </bsdf>')
+    kit_xml.scene_start(add, width=320, height=180, max_depth=6, fov=60,
+                        origin="-11.5, 1.8, 1.2", target="6, 1.5, -0.6")
+    kit_xml.diffuse(add, [("wall", "0.7, 0.68, 0.64"), ("floor", "0.45, 0.42, 0.4"),
+                          ("pillar", "0.6, 0.6, 0.62"), ("red", "0.6, 0.12, 0.1"),
+                          ("blue", "0.12, 0.2, 0.55"), ("black", "0, 0, 0")])
     add('')
 
     def box(cx, cy, cz, sx, sy, sz, mat):
@@ -80,10 +55,7 @@ def main():
         add('    </shape>')
 
     def rect(matrix, mat):
-        add('    <shape type="rectangle">')
-        add(f'        <transform name="to_world"><matrix value="{matrix}"/></transform>')
-        add(f'        <ref id="{mat}"/>')
-        add('    </shape>')
+        kit_xml.rect(add, matrix, mat)
 
     add('    <!-- floor, ceiling, walls: rectangles scaled from [-1, 1]^2 -->')
     rect("12 0 0 0  0 0 1 0  0 -6 0 0  0 0 0 1", "floor")
@@ -123,9 +95,7 @@ def main():
         add('        </emitter>')
         add('    </shape>')
     add('</scene>')
-    os.makedirs(os.path.dirname(out), exist_ok=True)
-    with open(out, "w") as f:
-        f.write("\n".join(lines) + "\n")
+    kit_xml.write(out, lines)
 
 
 if __name__ == "__main__":
