@@ -405,7 +405,7 @@ impl<'a, 'w> Shared<'a, 'w> {
             if !paths.alive.0[i] {
                 continue;
             }
-            if hit.is_none() {
+            let Some(hit) = hit else {
                 // The environment's light, as `path::step` adds it at a
                 // miss, without the scalar step's round trip through a
                 // whole path state.
@@ -422,14 +422,14 @@ impl<'a, 'w> Shared<'a, 'w> {
                 stats.lanes.misses += 1;
                 round.ended.0[i] = true;
                 continue;
-            }
-            // The surface, if the lanes can shade it; else why not
-            // (true: its BSDF is under a clear coat).
-            let mut scalar_material = false;
-            let lane = hit.as_ref().and_then(|hit| {
-                let m = world.material(hit.material);
+            };
+            // The surface, if the lanes can shade it; else the whole step
+            // in the scalar code, counted by why.
+            let m = world.material(hit.material);
+            let lane = 'shade: {
                 if m.has_holes() || m.textures.normal.is_some() {
-                    return None;
+                    stats.lanes.scalar_other += 1;
+                    break 'shade None;
                 }
                 let uvs = hit.uvs();
                 let fp = if m.has_textures() {
@@ -439,18 +439,14 @@ impl<'a, 'w> Shared<'a, 'w> {
                 };
                 let point = m.at(&uvs, &fp);
                 if !pt.bsdf.set(i, &point.bsdf) {
-                    scalar_material = true;
-                    return None;
-                }
-                Some((m, hit, point.occlusion, uvs, fp))
-            });
-            let Some((m, hit, occlusion, uvs, fp)) = lane else {
-                if scalar_material {
+                    // Under a clear coat.
                     stats.lanes.scalar_material += 1;
-                } else {
-                    stats.lanes.scalar_other += 1;
+                    break 'shade None;
                 }
-                if !self.scalar_step(paths, i, *hit, deferred, stats) {
+                Some((point.occlusion, uvs, fp))
+            };
+            let Some((occlusion, uvs, fp)) = lane else {
+                if !self.scalar_step(paths, i, Some(*hit), deferred, stats) {
                     round.ended.0[i] = true;
                 }
                 continue;
