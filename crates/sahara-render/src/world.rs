@@ -7,10 +7,12 @@ use sahara_kd::{AccelParams, Counters, NoCounters, Ray};
 
 use crate::accel::{Accel, BatchBuffers, RawHit};
 use crate::integrator::guiding::Guide;
+use crate::light::area::{sample_flat_lanes, FlatPiece};
 use crate::light::choice::LightChoice;
 use crate::light::gather::SceneLights;
 use crate::light::{AreaLight, LightSample, LightSampler, LightSource};
 use crate::material::Material;
+use crate::math::lanes::{F, M, V};
 use crate::math::piecewise::Distribution1D;
 use crate::math::warp::Frame;
 use crate::medium::{Medium, MediumInterface};
@@ -654,6 +656,76 @@ impl<'a> World<'a> {
         self.sample_light_as(p, n, u_pick, u, true)
     }
 
+    /// [`World::sample_light_mis`] for the lanes `on` of a packet of
+    /// paths (points `p`, shading normals `n`): the light chosen in the
+    /// lanes, and flat pieces (untextured triangles of mesh lights, quads)
+    /// sampled in the lanes; other lights lane by lane. Each lane's sample
+    /// is the scalar one, bit for bit.
+    #[inline(always)]
+    pub(crate) fn sample_light_mis_lanes<const N: usize>(
+        &self,
+        on: M<N>,
+        p: V<N>,
+        n: V<N>,
+        u_pick: F<N>,
+        u: (F<N>, F<N>),
+    ) -> LightLanes<N> {
+        let mut out = LightLanes {
+            has: M::splat(false),
+            wi: V::default(),
+            li: V::default(),
+            pdf: F::splat(1.0),
+            dist: F::splat(0.0),
+            delta: M::splat(false),
+            ignore: [None; N],
+        };
+        if self.lights.is_empty() || !on.any() {
+            return out;
+        }
+        let chosen = self.nee.sample_lanes(on, p, n, u_pick);
+        let mut pieces = [FlatPiece::default(); N];
+        let mut flat = M::<N>::splat(false);
+        let mut pmf = F::<N>::splat(1.0);
+        for (i, c) in chosen.iter().enumerate() {
+            let Some(c) = c else { continue };
+            let light = &self.lights[c.light];
+            let piece = match light {
+                LightSource::Area(a) => a.flat_piece(c.tri),
+                _ => None,
+            };
+            if let Some(f) = piece {
+                pieces[i] = f;
+                flat.0[i] = true;
+                pmf.0[i] = c.pmf;
+                continue;
+            }
+            let (pi, ui) = (p.get(i), Vec2::new(u.0 .0[i], u.1 .0[i]));
+            let s = match (light, c.tri) {
+                (LightSource::Area(a), Some(tri)) => a.sample_triangle(pi, tri, ui),
+                (l, _) => l.sample_mis(pi, ui),
+            };
+            if let Some(ls) = s {
+                out.has.0[i] = true;
+                out.wi.set(i, ls.wi);
+                out.li.set(i, ls.li);
+                out.pdf.0[i] = c.pmf * ls.pdf;
+                out.dist.0[i] = ls.dist;
+                out.delta.0[i] = ls.delta;
+                out.ignore[i] = ls.ignore;
+            }
+        }
+        if flat.any() {
+            let fs = sample_flat_lanes(&pieces, p, u);
+            let ok = flat & fs.ok;
+            out.has = out.has | ok;
+            out.wi = ok.select_v(fs.wi, out.wi);
+            out.li = ok.select_v(fs.li, out.li);
+            out.pdf = ok.select(pmf * fs.pdf, out.pdf);
+            out.dist = ok.select(fs.dist, out.dist);
+        }
+        out
+    }
+
     /// [`World::sample_light`], or with `mis` its MIS-compensated form.
     #[inline]
     fn sample_light_as(
@@ -816,6 +888,21 @@ fn prefetch<T>(p: *const T) {
     };
     #[cfg(not(target_arch = "x86_64"))]
     let _ = p;
+}
+
+/// Light samples of a packet's lanes ([`World::sample_light_mis_lanes`]):
+/// per lane whether it has one, and the direction, incident radiance,
+/// density (the choice's probability times the sample's solid-angle
+/// density), distance, whether the light is a delta light and the
+/// instance its shadow ray must ignore.
+pub(crate) struct LightLanes<const N: usize> {
+    pub has: M<N>,
+    pub wi: V<N>,
+    pub li: V<N>,
+    pub pdf: F<N>,
+    pub dist: F<N>,
+    pub delta: M<N>,
+    pub ignore: [Option<u32>; N],
 }
 
 #[cfg(test)]

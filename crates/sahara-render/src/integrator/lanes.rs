@@ -18,8 +18,11 @@
 //! 3. in the lanes: the shading frame, the light sample's draws, the
 //!    BSDF's value for the light's direction (lane by lane for BSDFs
 //!    without lane formulas, [`BsdfLanes`]), the MIS weights, the shadow
-//!    rays' origins; the light's sample itself lane by lane
-//!    ([`World::sample_light_mis`]);
+//!    rays' origins; the light's choice (the light tree walked by all
+//!    lanes together) and its sample where the light is a flat piece (an
+//!    untextured triangle of a mesh light, a quad), other lights lane by
+//!    lane ([`World::sample_light_mis_lanes`]), each lane's sample the
+//!    scalar one bit for bit;
 //! 4. the shadow rays as one batch ([`World::visible_batch`]);
 //! 5. in the lanes: the BSDF sample, the next ray, Russian roulette.
 //!
@@ -522,33 +525,13 @@ impl<'a, 'w> Shared<'a, 'w> {
             let u = paths
                 .sampler
                 .get_2d(depth.map(|d| dims::bounce(d, dims::LIGHT_POINT)));
-            let mut wi = V::<N>::default();
-            let mut li = V::<N>::default();
-            let mut light_pdf = one;
-            let mut dist = zero;
-            let mut delta = M::<N>::splat(false);
-            let mut has = M::<N>::splat(false);
-            for i in 0..N {
-                if !nee.0[i] {
-                    continue;
-                }
-                let uv = glam::Vec2::new(u.0 .0[i], u.1 .0[i]);
-                if let Some((ls, pmf)) =
-                    world.sample_light_mis(pt.p.get(i), pt.ns.get(i), u_pick.0[i], uv)
-                {
-                    has.0[i] = true;
-                    wi.set(i, ls.wi);
-                    li.set(i, ls.li);
-                    light_pdf.0[i] = pmf * ls.pdf;
-                    dist.0[i] = ls.dist;
-                    delta.0[i] = ls.delta;
-                    pt.ignore[i] = ls.ignore;
-                }
-            }
+            let ls = world.sample_light_mis_lanes(nee, pt.p, pt.ns, u_pick, u);
+            let (wi, li, light_pdf, dist, delta) = (ls.wi, ls.li, ls.pdf, ls.dist, ls.delta);
+            pt.ignore = ls.ignore;
             let wi_local = to_local(wi);
             let (f, bsdf_pdf) = pt.bsdf.eval(wo, wi_local);
             let c = f * wi_local.z.abs() * li;
-            let has = has & side_ok(wi) & c.max_element().gt(zero);
+            let has = ls.has & side_ok(wi) & c.max_element().gt(zero);
             if has.any() {
                 let w = delta.select(one, power_heuristic(light_pdf, bsdf_pdf));
                 round.pending = paths.beta * c * (w / light_pdf);

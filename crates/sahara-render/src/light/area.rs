@@ -6,6 +6,7 @@ use std::f32::consts::PI;
 
 use super::tree::LightBounds;
 use super::LightSample;
+use crate::math::lanes::{F, M, V};
 use crate::math::piecewise::Distribution1D;
 use crate::math::warp::{
     concentric_disc, luminance, uniform_cone, uniform_sphere, uniform_triangle, Frame,
@@ -409,6 +410,46 @@ impl AreaLight {
         self.sample_at(p, s, 2.0 / e.length())
     }
 
+    /// The flat piece next-event estimation samples in the lanes
+    /// ([`sample_flat_lanes`]): triangle `tri` of a mesh light (None:
+    /// the whole light) where no emission texture covers it, or a quad;
+    /// None for the others (discs, spheres, textured triangles), which
+    /// are sampled lane by lane.
+    pub(crate) fn flat_piece(&self, tri: Option<usize>) -> Option<FlatPiece> {
+        match (&self.emitter, tri) {
+            (
+                Emitter::Mesh {
+                    tris,
+                    radiance,
+                    two_sided,
+                    textures,
+                    ..
+                },
+                Some(i),
+            ) if textures[i].is_none() => Some(FlatPiece {
+                a: tris[i][0],
+                b: tris[i][1],
+                c: tris[i][2],
+                n: Vec3::ZERO,
+                radiance: radiance[i],
+                pdf_area: 0.0,
+                two_sided: two_sided[i],
+                mesh: true,
+            }),
+            (Emitter::Quad { corner, u, v, n }, None) => Some(FlatPiece {
+                a: *corner,
+                b: *u,
+                c: *v,
+                n: *n,
+                radiance: self.radiance,
+                pdf_area: 1.0 / self.area,
+                two_sided: self.two_sided,
+                mesh: false,
+            }),
+            _ => None,
+        }
+    }
+
     /// The light of the point `s` of the surface (drawn with density
     /// `pdf_area` by area) seen from `p`.
     fn sample_at(&self, p: Vec3, s: SurfacePoint, pdf_area: f32) -> Option<LightSample> {
@@ -556,5 +597,163 @@ impl AreaLight {
             return 0.0;
         }
         (q - p).length_squared() / (cos * area)
+    }
+}
+
+/// A flat emitting piece as the lanes sample it ([`AreaLight::flat_piece`]):
+/// a mesh light's triangle `a, b, c`, or a quad's corner `a`, sides `b`,
+/// `c` and normal `n`.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct FlatPiece {
+    a: Vec3,
+    b: Vec3,
+    c: Vec3,
+    /// A quad's unit front normal (a triangle's is computed).
+    n: Vec3,
+    radiance: Vec3,
+    /// A quad's density by area (a triangle's is computed).
+    pdf_area: f32,
+    two_sided: bool,
+    /// A triangle (else a quad).
+    mesh: bool,
+}
+
+/// Light samples of `N` lanes: per lane the direction, distance, incident
+/// radiance and solid-angle density, and whether the lane has one.
+pub(crate) struct FlatSamples<const N: usize> {
+    pub wi: V<N>,
+    pub dist: F<N>,
+    pub li: V<N>,
+    pub pdf: F<N>,
+    pub ok: M<N>,
+}
+
+/// [`AreaLight::sample_triangle`] (a triangle) or [`AreaLight::sample`]
+/// (a quad) of each lane's piece from `p` with `u`, in the lanes: each
+/// lane's sample is the scalar one, bit for bit (the same operations in
+/// the same order; a triangle's emission faces the way `p − q` says, a
+/// quad's the way `−wi` says, as there).
+#[inline(always)]
+pub(crate) fn sample_flat_lanes<const N: usize>(
+    pieces: &[FlatPiece; N],
+    p: V<N>,
+    u: (F<N>, F<N>),
+) -> FlatSamples<N> {
+    let zero = F::splat(0.0);
+    let one = F::splat(1.0);
+    let a = V::from_fn(|i| pieces[i].a);
+    let b = V::from_fn(|i| pieces[i].b);
+    let c = V::from_fn(|i| pieces[i].c);
+    let mesh = M(std::array::from_fn(|i| pieces[i].mesh));
+    // A triangle: a point uniform by area (`uniform_triangle`), the
+    // normal normalised as glam's `normalize_or_zero`.
+    let s = u.0.sqrt();
+    let (b1, b2) = (s * (one - u.1), s * u.1);
+    let b0 = one - b1 - b2;
+    let q_tri = a * b0 + b * b1 + c * b2;
+    let e = (b - a).cross(c - a);
+    let len = e.length_squared().sqrt();
+    let rcp = one / len;
+    let unit = rcp.test(rcp, |r, _| r.is_finite() && r > 0.0);
+    let n_tri = unit.select_v(e * rcp, V::default());
+    let pdf_tri = F::splat(2.0) / len;
+    // A quad: its corner plus its sides scaled.
+    let q_quad = a + b * u.0 + c * u.1;
+    let q = mesh.select_v(q_tri, q_quad);
+    let n = mesh.select_v(n_tri, V::from_fn(|i| pieces[i].n));
+    let pdf_area = mesh.select(pdf_tri, F::from_fn(|i| pieces[i].pdf_area));
+    let d = q - p;
+    let dist2 = d.length_squared();
+    let dist = dist2.sqrt();
+    let wi = d / dist;
+    let cos = n.dot(-wi).abs();
+    let facing = mesh.select(n.dot(p - q), n.dot(-wi));
+    let two = M(std::array::from_fn(|i| pieces[i].two_sided));
+    let lit = facing.gt(zero) | (two & facing.lt(zero));
+    let radiance = V::from_fn(|i| pieces[i].radiance);
+    let li = lit.select_v(radiance, V::default());
+    let black = li.x.eq(zero) & li.y.eq(zero) & li.z.eq(zero);
+    let ok = !dist2.eq(zero) & !cos.eq(zero) & !black;
+    FlatSamples {
+        wi,
+        dist,
+        li,
+        pdf: pdf_area * dist2 / cos,
+        ok,
+    }
+}
+
+#[cfg(test)]
+mod lane_tests {
+    use super::*;
+
+    /// The lanes' samples of flat pieces are the scalar samples, bit for
+    /// bit: triangles of a mesh light (one- and two-sided, seen from both
+    /// sides) and a quad, from points all around, a degenerate triangle
+    /// among them.
+    #[test]
+    fn flat_lanes_are_the_scalar_samples() {
+        const N: usize = 16;
+        let mut s = 0x2545_f491_4f6c_dd1d_u64;
+        let mut r = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut rv = || Vec3::new(r(), r(), r()) * 4.0 - 2.0;
+        let mut tris: Vec<[Vec3; 3]> = (0..12).map(|_| [rv(), rv(), rv()]).collect();
+        tris.push([Vec3::ZERO, Vec3::X, Vec3::X * 2.0]);
+        let k = tris.len();
+        let radiance = (0..k).map(|i| Vec3::new(1.0, 0.5, i as f32)).collect();
+        let two = (0..k).map(|i| i % 3 == 0).collect();
+        let mesh = AreaLight::mesh(tris, radiance, two, EmissionTextures::default());
+        let quad = |two_sided| {
+            let (u, v) = (Vec3::new(1.5, 0.0, 0.2), Vec3::new(0.0, 0.0, -1.0));
+            AreaLight::analytic(
+                Emitter::Quad {
+                    corner: Vec3::new(-0.5, 1.0, 0.3),
+                    u,
+                    v,
+                    n: u.cross(v).normalize(),
+                },
+                Vec3::new(4.0, 3.0, 2.0),
+                two_sided,
+                0,
+            )
+        };
+        let quads = [quad(false), quad(true)];
+        let mut r = move || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1);
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for _ in 0..500 {
+            let which: [usize; N] = std::array::from_fn(|_| (r() * (k + 2) as f32) as usize);
+            let pieces: [FlatPiece; N] = std::array::from_fn(|i| match which[i] {
+                t if t < k => mesh.flat_piece(Some(t)).unwrap(),
+                q => quads[q - k].flat_piece(None).unwrap(),
+            });
+            let p = V::<N>::from_fn(|_| Vec3::new(r(), r(), r()) * 6.0 - 3.0);
+            let u = (F::<N>::from_fn(|_| r()), F::<N>::from_fn(|_| r()));
+            let got = sample_flat_lanes(&pieces, p, u);
+            for (i, &piece) in which.iter().enumerate() {
+                let uv = Vec2::new(u.0 .0[i], u.1 .0[i]);
+                let want = match piece {
+                    t if t < k => mesh.sample_triangle(p.get(i), t, uv),
+                    q => quads[q - k].sample(p.get(i), uv),
+                };
+                let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+                assert_eq!(
+                    want.map(|w| (bits(w.wi), w.dist.to_bits(), bits(w.li), w.pdf.to_bits())),
+                    got.ok.0[i].then(|| (
+                        bits(got.wi.get(i)),
+                        got.dist.0[i].to_bits(),
+                        bits(got.li.get(i)),
+                        got.pdf.0[i].to_bits()
+                    )),
+                    "lane {i}: piece {piece}"
+                );
+            }
+        }
     }
 }

@@ -7,6 +7,7 @@ use glam::Vec3;
 
 use super::tree::{LightBounds, LightTree};
 use super::{Light, LightSource};
+use crate::math::lanes::{F, M, V};
 use crate::math::piecewise::Distribution1D;
 use crate::names::name_table;
 
@@ -158,6 +159,52 @@ impl LightChoice {
             tri: (piece.tri != NO_TRIANGLE).then_some(piece.tri as usize),
             pmf: (1.0 - pi) * pmf,
         })
+    }
+
+    /// [`LightChoice::sample`] for the lanes `on` (points `p`, normals `n`,
+    /// numbers `u`), each lane's choice the scalar one's: the tree's walk
+    /// in the lanes, the choices by power or among the lights at infinity
+    /// (a search in a table) lane by lane.
+    #[inline(always)]
+    pub(crate) fn sample_lanes<const N: usize>(
+        &self,
+        on: M<N>,
+        p: V<N>,
+        n: V<N>,
+        u: F<N>,
+    ) -> [Option<Chosen>; N] {
+        // Lane by lane where the tree does not choose.
+        let scalar = |take: M<N>| -> [Option<Chosen>; N] {
+            std::array::from_fn(|i| {
+                take.0[i]
+                    .then(|| self.sample(p.get(i), n.get(i), u.0[i]))
+                    .flatten()
+            })
+        };
+        if self.kind != LightSampler::Tree {
+            return scalar(on);
+        }
+        let pi = self.p_infinite;
+        let far = u.lt(F::splat(pi));
+        let mut out = scalar(on & far);
+        let near = on & !far;
+        if !near.any() {
+            return out;
+        }
+        let u = ((u - F::splat(pi)) / F::splat(1.0 - pi))
+            .map(|x| x.clamp(0.0, 1.0 - f32::EPSILON / 2.0));
+        let (piece, pmf, found) = self.tree.sample_lanes(near, p, n, u);
+        for (i, out) in out.iter_mut().enumerate() {
+            if found.0[i] {
+                let piece = self.pieces[piece.0[i] as usize];
+                *out = Some(Chosen {
+                    light: piece.light as usize,
+                    tri: (piece.tri != NO_TRIANGLE).then_some(piece.tri as usize),
+                    pmf: (1.0 - pi) * pmf.0[i],
+                });
+            }
+        }
+        out
     }
 
     /// The probability that [`LightChoice::sample`] at `p` with normal `n`

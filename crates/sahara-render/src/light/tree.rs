@@ -28,6 +28,8 @@
 use glam::{Quat, Vec3};
 use std::f32::consts::PI;
 
+use crate::math::lanes::{F, M, U, V};
+
 /// A bound on a set of lights: where they are, how much they emit and
 /// which ways.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -273,6 +275,113 @@ impl Packed {
     }
 }
 
+/// `N` bounds side by side, one per lane, for [`LightTree::sample_lanes`].
+struct PackedLanes<const N: usize> {
+    centre: V<N>,
+    r2: F<N>,
+    lo: V<N>,
+    r: F<N>,
+    hi: V<N>,
+    phi: F<N>,
+    w: V<N>,
+    cos_o: F<N>,
+    sin_o: F<N>,
+    cos_e: F<N>,
+    two_sided: M<N>,
+    omni: M<N>,
+}
+
+impl<const N: usize> PackedLanes<N> {
+    /// Lane `i` holds the bound `of(i)`.
+    #[inline(always)]
+    fn gather<'a>(of: impl Fn(usize) -> &'a Packed) -> Self {
+        let b: [&Packed; N] = std::array::from_fn(of);
+        Self {
+            centre: V::from_fn(|i| b[i].centre),
+            r2: F::from_fn(|i| b[i].r2),
+            lo: V::from_fn(|i| b[i].lo),
+            r: F::from_fn(|i| b[i].r),
+            hi: V::from_fn(|i| b[i].hi),
+            phi: F::from_fn(|i| b[i].phi),
+            w: V::from_fn(|i| b[i].w),
+            cos_o: F::from_fn(|i| b[i].cos_o),
+            sin_o: F::from_fn(|i| b[i].sin_o),
+            cos_e: F::from_fn(|i| b[i].cos_e),
+            two_sided: M(std::array::from_fn(|i| b[i].two_sided)),
+            omni: M(std::array::from_fn(|i| b[i].omni)),
+        }
+    }
+
+    /// [`Packed::importance`] lane by lane: every branch computed and the
+    /// lanes' results selected, in the same operations and order, so each
+    /// lane's value is the scalar one bit for bit.
+    #[inline(always)]
+    fn importance(&self, p: V<N>, n: V<N>) -> F<N> {
+        let zero = F::splat(0.0);
+        let one = F::splat(1.0);
+        let to_p = p - self.centre;
+        let dist2 = to_p.length_squared();
+        let in_box = p.x.ge(self.lo.x)
+            & p.y.ge(self.lo.y)
+            & p.z.ge(self.lo.z)
+            & p.x.le(self.hi.x)
+            & p.y.le(self.hi.y)
+            & p.z.le(self.hi.z);
+        let inside = dist2.le(self.r2) | in_box;
+        let inside_value = one.gt(self.cos_e).select(
+            (self.phi / self.r2.zip(F::splat(1e-20), f32::max)).zip(F::splat(f32::MAX), f32::min),
+            zero,
+        );
+        let cos2_b_d2 = dist2 - self.r2;
+        // The cone's angle, skipped where every lane's lights shine every
+        // way (points, spheres).
+        let cos_t = if self.omni.all() {
+            one
+        } else {
+            let d = dist2.sqrt();
+            let cos_w = self.w.dot(to_p) / d;
+            let cos_w = self.two_sided.select(cos_w.abs(), cos_w);
+            let within = cos_w.ge(self.cos_o);
+            let sin_w = (one - cos_w * cos_w).zip(zero, f32::max).sqrt();
+            let (sin_x, cos_x) = less_clamped_lanes(sin_w, cos_w, self.sin_o, self.cos_o);
+            let (sin_b, cos_b) = (self.r / d, cos2_b_d2.sqrt() / d);
+            let spread = less_clamped_lanes(sin_x, cos_x, sin_b, cos_b).1;
+            (self.omni | within).select(one, spread)
+        };
+        let dark = cos_t.le(self.cos_e);
+        let at_surface = !(n.x.eq(zero) & n.y.eq(zero) & n.z.eq(zero));
+        let a = to_p.dot(n).abs();
+        let narrow = at_surface & (a * a).lt(cos2_b_d2);
+        let mut importance = self.phi * cos_t;
+        if narrow.any() {
+            let cos_ib = (a * cos2_b_d2.sqrt()
+                + self.r * (dist2 - a * a).zip(zero, f32::max).sqrt())
+                / dist2;
+            importance = narrow.select(importance * cos_ib.zip(one, f32::min), importance);
+        }
+        let value =
+            (importance / dist2.zip(F::splat(1e-20), f32::max)).map(|x| x.clamp(0.0, f32::MAX));
+        let value = dark.select(zero, value);
+        let value = inside.select(inside_value, value);
+        self.phi.le(zero).select(zero, value)
+    }
+}
+
+/// [`less_clamped`]'s cosine and sine, lane by lane.
+#[inline(always)]
+fn less_clamped_lanes<const N: usize>(
+    sin_a: F<N>,
+    cos_a: F<N>,
+    sin_b: F<N>,
+    cos_b: F<N>,
+) -> (F<N>, F<N>) {
+    let none = cos_a.ge(cos_b);
+    (
+        none.select(F::splat(0.0), sin_a * cos_b - cos_a * sin_b),
+        none.select(F::splat(1.0), cos_a * cos_b + sin_a * sin_b),
+    )
+}
+
 /// The smallest cone (axis, cosine of the half-angle) holding both cones.
 fn cone_union(wa: Vec3, cos_a: f32, wb: Vec3, cos_b: f32) -> (Vec3, f32) {
     if cos_a <= -1.0 || cos_b <= -1.0 {
@@ -430,6 +539,69 @@ impl LightTree {
                 i = b;
             }
         }
+    }
+
+    /// [`LightTree::sample`] for the `N` points of the lanes `on` at once:
+    /// per lane the light chosen, the probability of the choice and
+    /// whether a light was chosen. The lanes walk down together, each
+    /// level's two importances computed in the lanes; each lane's answer
+    /// is the scalar walk's, bit for bit.
+    #[inline(always)]
+    pub(crate) fn sample_lanes<const N: usize>(
+        &self,
+        on: M<N>,
+        p: V<N>,
+        n: V<N>,
+        mut u: F<N>,
+    ) -> (U<N>, F<N>, M<N>) {
+        let mut light = U([0; N]);
+        let mut pmf = F::splat(1.0);
+        let mut found = M::splat(false);
+        let Some(root) = self.nodes.first() else {
+            return (light, pmf, found);
+        };
+        let zero = F::splat(0.0);
+        if root.leaf {
+            let lit = PackedLanes::<N>::gather(|_| &root.bounds)
+                .importance(p, n)
+                .gt(zero);
+            return (U([root.index; N]), pmf, on & lit);
+        }
+        let one_below = F::splat(ONE_BELOW);
+        let mut node = U([0u32; N]);
+        let mut walking = on;
+        while walking.any() {
+            // Lanes that are not walking look at the root's children, whose
+            // answers are not used.
+            let at = walking.select_u(node, U([0; N]));
+            let first = at.map(|i| i + 1);
+            let second = U(std::array::from_fn(|i| self.nodes[at.0[i] as usize].index));
+            let ia = PackedLanes::<N>::gather(|i| &self.nodes[first.0[i] as usize].bounds)
+                .importance(p, n);
+            let ib = PackedLanes::<N>::gather(|i| &self.nodes[second.0[i] as usize].bounds)
+                .importance(p, n);
+            let sum = ia + ib;
+            let dead = sum.test(sum, |s, _| s.is_nan() || s <= 0.0);
+            walking = walking & !dead;
+            let pa = ia / sum;
+            let left = u.lt(pa);
+            let u_left = (u / pa).zip(one_below, f32::min);
+            let u_right = ((u - pa) / (F::splat(1.0) - pa)).map(|x| x.clamp(0.0, ONE_BELOW));
+            u = walking.select(left.select(u_left, u_right), u);
+            pmf = walking.select(left.select(pmf * pa, pmf * (F::splat(1.0) - pa)), pmf);
+            node = walking.select_u(left.select_u(first, second), node);
+            for i in 0..N {
+                if walking.0[i] {
+                    let at = &self.nodes[node.0[i] as usize];
+                    if at.leaf {
+                        light.0[i] = at.index;
+                        found.0[i] = true;
+                        walking.0[i] = false;
+                    }
+                }
+            }
+        }
+        (light, pmf, found)
     }
 
     /// The probability that [`LightTree::sample`] chooses `light` at `p`
@@ -655,6 +827,53 @@ mod tests {
         // (a node's bound reaches the point, none of its lights does).
         for sum in check(&lights()) {
             assert!(sum > 0.5 && sum <= 1.0 + 1e-4, "sum {sum}");
+        }
+    }
+
+    /// The walk in lanes answers each lane as the scalar walk does, bit
+    /// for bit: at points among, beside and far from the lights, at a
+    /// surface and in a medium, with lanes switched off; for many lights,
+    /// one light and none.
+    #[test]
+    fn the_lanes_walk_is_the_scalar_walk() {
+        const N: usize = 16;
+        let mut s = 0x9e37_79b9_u64;
+        let mut r = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let many = lights();
+        for b in [many.clone(), many[3..4].to_vec(), Vec::new()] {
+            let tree = LightTree::new(&b);
+            for _ in 0..400 {
+                let p = V::<N>::from_fn(|_| Vec3::new(r(), r(), r()) * 14.0 - 2.0);
+                let n = V::<N>::from_fn(|i| {
+                    if i % 4 == 0 {
+                        Vec3::ZERO
+                    } else {
+                        Vec3::new(r() - 0.5, r() - 0.5, r() - 0.5).normalize()
+                    }
+                });
+                let u = F::<N>::from_fn(|_| r());
+                let on = M(std::array::from_fn(|_| r() < 0.8));
+                let (light, pmf, found) = tree.sample_lanes(on, p, n, u);
+                for i in 0..N {
+                    let scalar = if on.0[i] {
+                        tree.sample(p.get(i), n.get(i), u.0[i])
+                    } else {
+                        None
+                    };
+                    let lanes = found.0[i].then(|| (light.0[i], pmf.0[i]));
+                    assert_eq!(
+                        scalar.map(|(l, q)| (l, q.to_bits())),
+                        lanes.map(|(l, q)| (l, q.to_bits())),
+                        "lane {i} at {}",
+                        p.get(i)
+                    );
+                }
+            }
         }
     }
 
