@@ -6,6 +6,9 @@ reach 5 % and 1 % relative MSE is read off a fit, with the ratios between the re
 Error: relative MSE, the mean over pixels and channels of (x - r)^2 / (r^2 + 0.01), where r is the
 reference. The reference's own error is taken out: given as two independent halves A and B (two
 seeds), the reference is their mean and its expected relative MSE is that of A against B over four.
+With --reference-spp N, halves that do not exist yet are rendered first with Mitsuba 3 `llvm_ad_rgb`,
+each the mean of N / 128 independent renders of 128 spp (one kernel over every sample of a frame
+would not fit in memory at thousands of samples per pixel).
 Time: the CPU time (user + system) of the whole renderer process, reading the scene and building
 its trees included, which is what a user waits for. Fit: error = c / spp over the sample counts
 rendered (the variance of a Monte Carlo estimate falls as 1 / spp), time = a + b spp; the time to
@@ -20,8 +23,8 @@ Renderers (repeatable --renderer):
 
 usage (the Python that has Mitsuba 3 and numpy):
     V/bin/python scripts/clean_time.py SCENE.xml --reference A.exr B.exr [--spp 4,16,64]
-        [--renderer sahara] [--renderer 'sahara:--light-sampler power'] [--renderer mitsuba]
-        [--work DIR] [--json OUT.json]
+        [--reference-spp N] [--renderer sahara] [--renderer 'sahara:--light-sampler power']
+        [--renderer mitsuba] [--work DIR] [--json OUT.json]
 """
 import argparse
 import json
@@ -57,6 +60,34 @@ s = mi.load_file(scene)
 mi.Bitmap(mi.render(s, spp=spp, seed=7)).write(out)
 """
 
+# A reference half: the mean of independent llvm_ad_rgb renders of CHUNK spp, seeds first, first + 1, ...
+REFERENCE_CHILD = r"""
+import os, sys, numpy as np, mitsuba as mi
+scene, spp, chunk, first, out = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4]), sys.argv[5]
+mi.set_variant("llvm_ad_rgb")
+s = mi.load_file(scene)
+chunk = min(chunk, spp)
+runs = spp // chunk
+acc = sum(np.array(mi.render(s, spp=chunk, seed=first + k), dtype=np.float64) for k in range(runs))
+tmp = out + ".part.exr"
+mi.Bitmap((acc / runs).astype(np.float32)).write(tmp)
+os.replace(tmp, out)
+"""
+REFERENCE_CHUNK = 128
+
+
+def make_reference(scene, halves, spp):
+    """Renders the halves of a reference that are missing (two independent sets of seeds)."""
+    for k, out in enumerate(halves):
+        if os.path.exists(out):
+            continue
+        print(f"rendering reference half {out}: {spp} spp of llvm_ad_rgb", flush=True)
+        first = 1000 + k * 100000
+        cmd = [sys.executable, "-c", REFERENCE_CHILD, scene, str(spp), str(REFERENCE_CHUNK), str(first), out]
+        p = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        if p.returncode != 0:
+            sys.exit(f"{shlex.join(cmd)} failed:\n{p.stderr}")
+
 
 def command(renderer, scene, spp, out):
     kind, _, arg = renderer.partition(":")
@@ -82,6 +113,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scene")
     ap.add_argument("--reference", nargs=2, required=True, metavar=("A", "B"))
+    ap.add_argument("--reference-spp", type=int, default=None,
+                    help="render the missing reference halves with this many spp each")
     ap.add_argument("--spp", default="4,16,64")
     ap.add_argument("--renderer", action="append")
     ap.add_argument("--work", default=None)
@@ -91,6 +124,8 @@ def main():
     spps = [int(s) for s in a.spp.split(",")]
     work = a.work or tempfile.mkdtemp(prefix="clean_time_")
     os.makedirs(work, exist_ok=True)
+    if a.reference_spp:
+        make_reference(a.scene, a.reference, a.reference_spp)
     ra, rb = read_exr(a.reference[0]), read_exr(a.reference[1])
     ref = 0.5 * (ra + rb)
     ref_err = rel_mse(ra, rb) / 4.0
