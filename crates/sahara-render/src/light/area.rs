@@ -694,13 +694,7 @@ mod lane_tests {
     #[test]
     fn flat_lanes_are_the_scalar_samples() {
         const N: usize = 16;
-        let mut s = 0x2545_f491_4f6c_dd1d_u64;
-        let mut r = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut r = crate::math::hash::test_numbers(1);
         let mut rv = || Vec3::new(r(), r(), r()) * 4.0 - 2.0;
         let mut tris: Vec<[Vec3; 3]> = (0..12).map(|_| [rv(), rv(), rv()]).collect();
         tris.push([Vec3::ZERO, Vec3::X, Vec3::X * 2.0]);
@@ -723,10 +717,7 @@ mod lane_tests {
             )
         };
         let quads = [quad(false), quad(true)];
-        let mut r = move || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut r = crate::math::hash::test_numbers(3);
         for _ in 0..500 {
             let which: [usize; N] = std::array::from_fn(|_| (r() * (k + 2) as f32) as usize);
             let pieces: [FlatPiece; N] = std::array::from_fn(|i| match which[i] {

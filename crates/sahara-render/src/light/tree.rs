@@ -837,13 +837,7 @@ mod tests {
     #[test]
     fn the_lanes_walk_is_the_scalar_walk() {
         const N: usize = 16;
-        let mut s = 0x9e37_79b9_u64;
-        let mut r = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut r = crate::math::hash::test_numbers(2);
         let many = lights();
         for b in [many.clone(), many[3..4].to_vec(), Vec::new()] {
             let tree = LightTree::new(&b);

@@ -63,6 +63,16 @@ pub fn permute(mut i: u32, n: u32, key: u64) -> u32 {
     }
 }
 
+/// Numbers in `[0, 1)` for tests: the hashes of `seed` and a count.
+#[cfg(test)]
+pub(crate) fn test_numbers(seed: u64) -> impl FnMut() -> f32 {
+    let mut k = 0u64;
+    move || {
+        k += 1;
+        unit_f32(hash2(seed, k))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
