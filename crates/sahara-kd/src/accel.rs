@@ -303,4 +303,19 @@ impl TriangleAccel {
     pub fn closest_hit_packet16(&self, rays: &[Ray], out: &mut [Option<Hit>]) {
         each!(self, t => t.closest_hit_packet16(rays, out))
     }
+
+    /// Whether each of up to 16 rays hits anything: on the hierarchy one
+    /// packet ([`Bvh::any_hit_packet16`]), on the kd-tree ray by ray; the
+    /// same answers as [`TriangleAccel::any_hit`].
+    pub fn any_hit_packet16(&self, rays: &[Ray], out: &mut [bool]) {
+        assert_eq!(rays.len(), out.len(), "one output slot per ray");
+        match self {
+            TriangleAccel::Kd(t) => {
+                for (r, o) in rays.iter().zip(out.iter_mut()) {
+                    *o = t.any_hit(r);
+                }
+            }
+            TriangleAccel::Bvh(t) => t.any_hit_packet16(rays, out),
+        }
+    }
 }

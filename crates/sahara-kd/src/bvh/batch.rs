@@ -128,6 +128,52 @@ impl Bvh {
             },
         );
     }
+
+    /// Whether each of up to [`crate::PACKET16`] (sixteen) rays hits
+    /// anything, the rays traced as one packet by the closest-hit packet
+    /// walk with each lane ending at its first hit; `out[i]` answers
+    /// `rays[i]` exactly as [`Bvh::any_hit`] would. Shadow rays from one
+    /// pixel's samples towards one light share the packet's boxes.
+    ///
+    /// # Panics
+    /// If there are more than sixteen rays or `out` differs in length.
+    pub fn any_hit_packet16(&self, rays: &[Ray], out: &mut [bool]) {
+        assert!(rays.len() <= PACKET16, "{} rays in a packet", rays.len());
+        assert_eq!(rays.len(), out.len(), "one output slot per ray");
+        dispatch(
+            self.max_level,
+            PacketAnyQuery {
+                bvh: self,
+                wide16: true,
+                switch: SWITCH,
+                rays,
+                out,
+            },
+        );
+    }
+}
+
+/// An any-hit packet walk in one dispatch.
+pub(super) struct PacketAnyQuery<'a> {
+    pub(super) bvh: &'a Bvh,
+    /// Sixteen lanes (else eight).
+    pub(super) wide16: bool,
+    /// As [`PacketQuery::switch`].
+    pub(super) switch: u32,
+    pub(super) rays: &'a [Ray],
+    pub(super) out: &'a mut [bool],
+}
+
+impl Kernel for PacketAnyQuery<'_> {
+    type Output = ();
+    #[inline(always)]
+    unsafe fn run<const LEVEL: u8>(self) {
+        // SAFETY: the level's instructions (the caller's contract).
+        unsafe {
+            self.bvh
+                .trace_packet_any::<LEVEL>(self.wide16, self.switch, self.rays, self.out)
+        }
+    }
 }
 
 /// Rays in an eight-ray packet.

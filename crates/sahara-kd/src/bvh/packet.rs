@@ -185,6 +185,43 @@ impl Bvh {
             *o = self.walk_closest::<_, SIMD>(r, &mut NoCounters);
         }
     }
+
+    /// Whether each of up to [`LANES`] rays hits anything, traced as
+    /// packets as [`Bvh::trace_packet`] traces them; `out[i]` answers
+    /// `rays[i]` as [`Bvh::any_hit`] would.
+    ///
+    /// # Safety
+    /// As [`Bvh::trace_packet`].
+    #[inline(always)]
+    pub(crate) unsafe fn trace_packet_any<const SIMD: u8>(
+        &self,
+        wide16: bool,
+        switch: u32,
+        rays: &[Ray],
+        out: &mut [bool],
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if SIMD >= level::AVX2 && !self.nodes.is_empty() {
+            use std::arch::x86_64::{__m256, __m512};
+            // SAFETY: the level's instructions (the caller's contract).
+            unsafe {
+                if !wide16 || rays.len() <= 8 {
+                    for (r, o) in rays.chunks(8).zip(out.chunks_mut(8)) {
+                        x86::trace_any::<__m256, SIMD>(self, switch, r, o);
+                    }
+                } else if SIMD >= level::AVX512 {
+                    x86::trace_any::<__m512, SIMD>(self, switch, rays, out);
+                } else {
+                    x86::trace_any::<x86::Pair, SIMD>(self, switch, rays, out);
+                }
+            }
+            return;
+        }
+        let _ = (wide16, switch);
+        for (r, o) in rays.iter().zip(out.iter_mut()) {
+            *o = self.walk_any::<_, SIMD>(r, &mut NoCounters);
+        }
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -194,7 +231,7 @@ pub(crate) mod x86 {
     use super::{is_leaf, leaf_parts, set_bits, ChildRef, Packet, Quad, Row, LANES};
     use crate::bvh::quad::sse::{quad_edges, QuadRay};
     use crate::bvh::walk::x86::{compact, step, Lanes};
-    use crate::bvh::walk::{leaf_closest, BoxRay, STACK};
+    use crate::bvh::walk::{leaf_any, leaf_closest, BoxRay, STACK};
     use crate::bvh::Bvh;
     use crate::isect::{keep_closer, permutation, Hit, RayShear};
     use crate::kd::NoCounters;
@@ -857,6 +894,42 @@ pub(crate) mod x86 {
     ) {
         debug_assert!(rays.len() <= W::N && rays.len() == out.len());
         // SAFETY: the caller's contract.
+        let p = unsafe { run::<W, SIMD, false>(bvh, switch, rays) };
+        p.finish(out);
+    }
+
+    /// Trace `rays` (at most `W::N`) as a packet for any hit into `out`.
+    ///
+    /// # Safety
+    /// As [`trace`].
+    #[inline(always)]
+    pub(crate) unsafe fn trace_any<W: Wide, const SIMD: u8>(
+        bvh: &Bvh,
+        switch: u32,
+        rays: &[Ray],
+        out: &mut [bool],
+    ) {
+        debug_assert!(rays.len() <= W::N && rays.len() == out.len());
+        // SAFETY: the caller's contract.
+        let p = unsafe { run::<W, SIMD, true>(bvh, switch, rays) };
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = p.best_tri.0[l] != u32::MAX;
+        }
+    }
+
+    /// The packet of `rays` walked, octant by octant; with `ANY`, a lane
+    /// stops at its first hit (its `best_t` set to `-inf`, which no box
+    /// and no triangle passes, and its `best_tri` to the triangle).
+    ///
+    /// # Safety
+    /// As [`trace`].
+    #[inline(always)]
+    unsafe fn run<W: Wide, const SIMD: u8, const ANY: bool>(
+        bvh: &Bvh,
+        switch: u32,
+        rays: &[Ray],
+    ) -> Packet {
+        // SAFETY: the caller's contract.
         let mut p = unsafe { packet::<W>(bvh, rays) };
         let mut todo = p.valid;
         while todo != 0 {
@@ -867,9 +940,9 @@ pub(crate) mod x86 {
             }
             todo &= !group;
             // SAFETY: the caller's contract.
-            unsafe { walk::<W, SIMD>(bvh, &mut p, rays, switch, group, octant as u32) };
+            unsafe { walk::<W, SIMD, ANY>(bvh, &mut p, rays, switch, group, octant as u32) };
         }
-        p.finish(out);
+        p
     }
 
     /// The packet of `rays` (at most `W::N`) for `bvh`: each lane
@@ -1017,7 +1090,7 @@ pub(crate) mod x86 {
     /// # Safety
     /// As [`trace`].
     #[inline(always)]
-    unsafe fn walk<W: Wide, const SIMD: u8>(
+    unsafe fn walk<W: Wide, const SIMD: u8, const ANY: bool>(
         bvh: &Bvh,
         p: &mut Packet,
         rays: &[Ray],
@@ -1055,10 +1128,14 @@ pub(crate) mod x86 {
             loop {
                 if active.count_ones() <= switch {
                     for l in set_bits(active) {
-                        single::<SIMD>(bvh, p, rays, l, c);
+                        if ANY {
+                            single_any::<SIMD>(bvh, p, rays, l, c);
+                        } else {
+                            single::<SIMD>(bvh, p, rays, l, c);
+                        }
                     }
                 } else if is_leaf(c) {
-                    leaf::<W>(bvh, p, rays, c, active, octant);
+                    leaf::<W, ANY>(bvh, p, rays, c, active, octant);
                 } else {
                     let n = bvh.node(c);
                     if let Some((next, rays_next)) =
@@ -1185,7 +1262,7 @@ pub(crate) mod x86 {
     /// # Safety
     /// As [`trace`].
     #[inline(always)]
-    unsafe fn leaf<W: Wide>(
+    unsafe fn leaf<W: Wide, const ANY: bool>(
         bvh: &Bvh,
         p: &mut Packet,
         rays: &[Ray],
@@ -1204,7 +1281,7 @@ pub(crate) mod x86 {
             let k = permutation(kz, octant >> kz & 1 == 1);
             for j in 0..count {
                 // SAFETY: the caller's contract.
-                unsafe { triangle::<W>(p, rays, q, j, k, m) };
+                unsafe { triangle::<W, ANY>(p, rays, q, j, k, m) };
             }
         }
     }
@@ -1252,7 +1329,7 @@ pub(crate) mod x86 {
     /// # Safety
     /// As [`trace`].
     #[inline(always)]
-    unsafe fn triangle<W: Wide>(
+    unsafe fn triangle<W: Wide, const ANY: bool>(
         p: &mut Packet,
         rays: &[Ray],
         q: &Quad,
@@ -1297,7 +1374,13 @@ pub(crate) mod x86 {
                 let inside = W::and(t.gt(ld::<W>(&p.tmin)), t.le(best));
                 let closer = W::or_m(t.lt(best), W::splat_u32(tri).ult(best_tri));
                 let upd = W::bits(W::and(inside, closer)) & fast;
-                if upd != 0 {
+                if upd != 0 && ANY {
+                    // A lane that hits anything is done.
+                    let um = W::from_bits(upd);
+                    W::select(um, W::splat(f32::NEG_INFINITY), best).store(p.best_t.0.as_mut_ptr());
+                    W::select(um, W::splat_u32(tri), best_tri)
+                        .store(p.best_tri.0.as_mut_ptr() as *mut f32);
+                } else if upd != 0 {
                     let um = W::from_bits(upd);
                     let rcp = W::splat(1.0).div(det);
                     W::select(um, t.add(W::splat(0.0)), best).store(p.best_t.0.as_mut_ptr());
@@ -1315,6 +1398,11 @@ pub(crate) mod x86 {
                 let s = RayShear::from_ray(rays.get_unchecked(l));
                 let mut best_t = p.best_t.0[l];
                 if let Some(h) = s.intersect(&q.triangle(j), p.tmin.0[l], best_t) {
+                    if ANY {
+                        p.best_t.0[l] = f32::NEG_INFINITY;
+                        p.best_tri.0[l] = q.tri[j];
+                        continue;
+                    }
                     let mut best = p.best(l);
                     keep_closer(&mut best_t, &mut best, h, q.tri[j]);
                     p.set_best(l, best_t, best);
@@ -1379,6 +1467,55 @@ pub(crate) mod x86 {
                 }
             }
             p.set_best(l, best_t, best);
+        }
+    }
+
+    /// Lane `l`'s ray through the subtree of `c` alone for any hit, with
+    /// the single-ray walk (`Bvh::walk_any`'s loop from a node other than
+    /// the root); a hit ends the lane as [`run`] says.
+    ///
+    /// # Safety
+    /// As [`trace`].
+    #[inline(always)]
+    unsafe fn single_any<const SIMD: u8>(
+        bvh: &Bvh,
+        p: &mut Packet,
+        rays: &[Ray],
+        l: usize,
+        c: ChildRef,
+    ) {
+        // SAFETY: the caller's contract; `l` is a lane of a ray.
+        unsafe {
+            let ray = rays.get_unchecked(l);
+            let r = BoxRay::new(ray, bvh.scale);
+            let shear = RayShear::from_ray(ray);
+            let qr = QuadRay::new(&shear);
+            let edges = |q: &Quad, n| quad_edges(&qr, q, n);
+            let mut stack = crate::bvh::walk::Stack::new();
+            let lanes = Lanes::new(&r);
+            let tfar = _mm256_set1_ps(ray.tmax);
+            let mut c = c;
+            loop {
+                while !is_leaf(c) {
+                    match step::<SIMD, false>(bvh.node(c), &lanes, tfar, &mut stack) {
+                        Some(next) => c = next,
+                        None => match stack.pop() {
+                            Some((next, _)) => c = next,
+                            None => return,
+                        },
+                    }
+                }
+                if leaf_any(bvh, c, edges, &shear, ray.tmin, ray.tmax, &mut NoCounters) {
+                    p.best_t.0[l] = f32::NEG_INFINITY;
+                    // Any triangle index but `u32::MAX`: the lane hit.
+                    p.best_tri.0[l] = 0;
+                    return;
+                }
+                match stack.pop() {
+                    Some((next, _)) => c = next,
+                    None => return,
+                }
+            }
         }
     }
 
@@ -1570,6 +1707,48 @@ mod tests {
                 }
             }
             assert!(hits > 2000, "{hits} hits");
+        }
+    }
+
+    /// The any-hit packet walk, at every level, both widths, with and
+    /// without the switch to single rays: every ray's answer is brute
+    /// force's, on every builder.
+    #[test]
+    fn any_hit_packets_agree_with_brute_force() {
+        let mut f = floats(1717);
+        let tris = scene(&mut f);
+        for builder in [BvhBuilder::Binned, BvhBuilder::Spatial, BvhBuilder::FromKd] {
+            let bvh = Bvh::build(tris.clone(), &BvhParams::new(builder));
+            let (mut hit, mut missed) = (0, 0);
+            for p in 0..600 {
+                let rays = packet(&mut f, &tris, p);
+                let want: Vec<bool> = rays.iter().map(|r| brute::any_hit(&tris, r)).collect();
+                hit += want.iter().filter(|&&h| h).count();
+                missed += want.iter().filter(|&&h| !h).count();
+                let mut out = vec![false; rays.len()];
+                bvh.any_hit_packet16(&rays, &mut out);
+                assert_eq!(out, want, "{builder:?} packet {p}");
+                for top in [level::PORTABLE, level::AVX2, level::AVX512] {
+                    for wide16 in [false, true] {
+                        for switch in [0, SWITCH, 8] {
+                            out.fill(false);
+                            let q = crate::bvh::batch::PacketAnyQuery {
+                                bvh: &bvh,
+                                wide16,
+                                switch,
+                                rays: &rays,
+                                out: &mut out,
+                            };
+                            dispatch(top, q);
+                            assert_eq!(
+                                out, want,
+                                "{builder:?} packet {p} level {top} wide16 {wide16} switch {switch}"
+                            );
+                        }
+                    }
+                }
+            }
+            assert!(hit > 2000 && missed > 500, "{hit} hit, {missed} missed");
         }
     }
 
