@@ -171,7 +171,7 @@ impl Kernel for PacketAnyQuery<'_> {
         // SAFETY: the level's instructions (the caller's contract).
         unsafe {
             self.bvh
-                .trace_packet_any::<LEVEL>(self.wide16, self.switch, self.rays, self.out)
+                .trace_packet::<LEVEL, bool>(self.wide16, self.switch, self.rays, self.out)
         }
     }
 }
@@ -200,8 +200,12 @@ impl Kernel for PacketQuery<'_> {
     unsafe fn run<const LEVEL: u8>(self) {
         // SAFETY: the level's instructions (the caller's contract).
         unsafe {
-            self.bvh
-                .trace_packet::<LEVEL>(self.wide16, self.switch, self.rays, self.out)
+            self.bvh.trace_packet::<LEVEL, Option<Hit>>(
+                self.wide16,
+                self.switch,
+                self.rays,
+                self.out,
+            )
         }
     }
 }

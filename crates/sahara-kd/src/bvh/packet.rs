@@ -68,7 +68,7 @@ struct IntRow([u32; LANES]);
 
 /// A packet's rays lane by lane, prepared for the box and triangle tests,
 /// and their closest hits so far.
-struct Packet {
+pub(crate) struct Packet {
     /// `1 / d` by axis.
     inv: [Row; 3],
     /// `near_origin * inv` and `far_origin * inv` of [`BoxRay`] by axis.
@@ -126,13 +126,6 @@ impl Packet {
         self.best_u.0[l] = h.u;
         self.best_v.0[l] = h.v;
     }
-
-    /// Write the closest hits of the first `out.len()` lanes.
-    fn finish(&self, out: &mut [Option<Hit>]) {
-        for (l, o) in out.iter_mut().enumerate() {
-            *o = (self.best_tri.0[l] != u32::MAX).then(|| self.best(l));
-        }
-    }
 }
 
 /// The indices of the set bits of `mask`, lowest first.
@@ -147,21 +140,57 @@ fn set_bits(mut mask: u32) -> impl Iterator<Item = usize> {
     })
 }
 
+/// What a packet walk answers for each ray: its closest hit, or whether
+/// it hits anything.
+pub(crate) trait Answer: Sized {
+    /// A lane ends at its first hit.
+    const ANY: bool;
+    /// The single-ray walk's answer (at the portable level).
+    fn single<const SIMD: u8>(bvh: &Bvh, ray: &Ray) -> Self;
+    /// Lane `l`'s answer once the packet has been walked.
+    fn of(p: &Packet, l: usize) -> Self;
+}
+
+impl Answer for Option<Hit> {
+    const ANY: bool = false;
+    #[inline(always)]
+    fn single<const SIMD: u8>(bvh: &Bvh, ray: &Ray) -> Self {
+        bvh.walk_closest::<_, SIMD>(ray, &mut NoCounters)
+    }
+    #[inline(always)]
+    fn of(p: &Packet, l: usize) -> Self {
+        (p.best_tri.0[l] != u32::MAX).then(|| p.best(l))
+    }
+}
+
+impl Answer for bool {
+    const ANY: bool = true;
+    #[inline(always)]
+    fn single<const SIMD: u8>(bvh: &Bvh, ray: &Ray) -> Self {
+        bvh.walk_any::<_, SIMD>(ray, &mut NoCounters)
+    }
+    #[inline(always)]
+    fn of(p: &Packet, l: usize) -> Self {
+        p.best_tri.0[l] != u32::MAX
+    }
+}
+
 impl Bvh {
-    /// Closest hits of up to [`LANES`] rays traced as packets of `W`'s
-    /// width, at level `SIMD` (the single-ray walk per ray at the portable
-    /// level); `out[i]` answers `rays[i]`.
+    /// Closest hits (`A = Option<Hit>`) or any hits (`A = bool`) of up to
+    /// [`LANES`] rays traced as packets, sixteen lanes wide with `wide16`
+    /// (else eight), at level `SIMD` (the single-ray walk per ray at the
+    /// portable level); `out[i]` answers `rays[i]`.
     ///
     /// # Safety
     /// The CPU must have the level's instructions, and the caller must be
-    /// compiled for them; `W` must be a lane form of the level.
+    /// compiled for them.
     #[inline(always)]
-    pub(crate) unsafe fn trace_packet<const SIMD: u8>(
+    pub(crate) unsafe fn trace_packet<const SIMD: u8, A: Answer>(
         &self,
         wide16: bool,
         switch: u32,
         rays: &[Ray],
-        out: &mut [Option<Hit>],
+        out: &mut [A],
     ) {
         #[cfg(target_arch = "x86_64")]
         if SIMD >= level::AVX2 && !self.nodes.is_empty() {
@@ -170,56 +199,19 @@ impl Bvh {
             unsafe {
                 if !wide16 || rays.len() <= 8 {
                     for (r, o) in rays.chunks(8).zip(out.chunks_mut(8)) {
-                        x86::trace::<__m256, SIMD>(self, switch, r, o);
+                        x86::trace::<__m256, SIMD, A>(self, switch, r, o);
                     }
                 } else if SIMD >= level::AVX512 {
-                    x86::trace::<__m512, SIMD>(self, switch, rays, out);
+                    x86::trace::<__m512, SIMD, A>(self, switch, rays, out);
                 } else {
-                    x86::trace::<x86::Pair, SIMD>(self, switch, rays, out);
+                    x86::trace::<x86::Pair, SIMD, A>(self, switch, rays, out);
                 }
             }
             return;
         }
         let _ = (wide16, switch);
         for (r, o) in rays.iter().zip(out.iter_mut()) {
-            *o = self.walk_closest::<_, SIMD>(r, &mut NoCounters);
-        }
-    }
-
-    /// Whether each of up to [`LANES`] rays hits anything, traced as
-    /// packets as [`Bvh::trace_packet`] traces them; `out[i]` answers
-    /// `rays[i]` as [`Bvh::any_hit`] would.
-    ///
-    /// # Safety
-    /// As [`Bvh::trace_packet`].
-    #[inline(always)]
-    pub(crate) unsafe fn trace_packet_any<const SIMD: u8>(
-        &self,
-        wide16: bool,
-        switch: u32,
-        rays: &[Ray],
-        out: &mut [bool],
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        if SIMD >= level::AVX2 && !self.nodes.is_empty() {
-            use std::arch::x86_64::{__m256, __m512};
-            // SAFETY: the level's instructions (the caller's contract).
-            unsafe {
-                if !wide16 || rays.len() <= 8 {
-                    for (r, o) in rays.chunks(8).zip(out.chunks_mut(8)) {
-                        x86::trace_any::<__m256, SIMD>(self, switch, r, o);
-                    }
-                } else if SIMD >= level::AVX512 {
-                    x86::trace_any::<__m512, SIMD>(self, switch, rays, out);
-                } else {
-                    x86::trace_any::<x86::Pair, SIMD>(self, switch, rays, out);
-                }
-            }
-            return;
-        }
-        let _ = (wide16, switch);
-        for (r, o) in rays.iter().zip(out.iter_mut()) {
-            *o = self.walk_any::<_, SIMD>(r, &mut NoCounters);
+            *o = A::single::<SIMD>(self, r);
         }
     }
 }
@@ -233,7 +225,7 @@ pub(crate) mod x86 {
     use crate::bvh::walk::x86::{compact, step, Lanes};
     use crate::bvh::walk::{leaf_any, leaf_closest, BoxRay, STACK};
     use crate::bvh::Bvh;
-    use crate::isect::{keep_closer, permutation, Hit, RayShear};
+    use crate::isect::{keep_closer, permutation, RayShear};
     use crate::kd::NoCounters;
     use crate::math::Ray;
 
@@ -886,34 +878,23 @@ pub(crate) mod x86 {
     /// The level's instructions (`W`'s among them); the caller is compiled
     /// for them. `bvh` is not empty.
     #[inline(always)]
-    pub(crate) unsafe fn trace<W: Wide, const SIMD: u8>(
+    pub(crate) unsafe fn trace<W: Wide, const SIMD: u8, A: super::Answer>(
         bvh: &Bvh,
         switch: u32,
         rays: &[Ray],
-        out: &mut [Option<Hit>],
+        out: &mut [A],
     ) {
         debug_assert!(rays.len() <= W::N && rays.len() == out.len());
         // SAFETY: the caller's contract.
-        let p = unsafe { run::<W, SIMD, false>(bvh, switch, rays) };
-        p.finish(out);
-    }
-
-    /// Trace `rays` (at most `W::N`) as a packet for any hit into `out`.
-    ///
-    /// # Safety
-    /// As [`trace`].
-    #[inline(always)]
-    pub(crate) unsafe fn trace_any<W: Wide, const SIMD: u8>(
-        bvh: &Bvh,
-        switch: u32,
-        rays: &[Ray],
-        out: &mut [bool],
-    ) {
-        debug_assert!(rays.len() <= W::N && rays.len() == out.len());
-        // SAFETY: the caller's contract.
-        let p = unsafe { run::<W, SIMD, true>(bvh, switch, rays) };
+        let p = unsafe {
+            if A::ANY {
+                run::<W, SIMD, true>(bvh, switch, rays)
+            } else {
+                run::<W, SIMD, false>(bvh, switch, rays)
+            }
+        };
         for (l, o) in out.iter_mut().enumerate() {
-            *o = p.best_tri.0[l] != u32::MAX;
+            *o = A::of(&p, l);
         }
     }
 
@@ -1128,11 +1109,7 @@ pub(crate) mod x86 {
             loop {
                 if active.count_ones() <= switch {
                     for l in set_bits(active) {
-                        if ANY {
-                            single_any::<SIMD>(bvh, p, rays, l, c);
-                        } else {
-                            single::<SIMD>(bvh, p, rays, l, c);
-                        }
+                        single::<SIMD, ANY>(bvh, p, rays, l, c);
                     }
                 } else if is_leaf(c) {
                     leaf::<W, ANY>(bvh, p, rays, c, active, octant);
@@ -1413,12 +1390,13 @@ pub(crate) mod x86 {
 
     /// Lane `l`'s ray through the subtree of `c` alone, from its closest
     /// hit so far, with the single-ray walk (`Bvh::walk_closest`'s loop
-    /// from a node other than the root).
+    /// from a node other than the root); with `ANY`, `Bvh::walk_any`'s
+    /// loop, a hit ending the lane as [`run`] says.
     ///
     /// # Safety
     /// As [`trace`].
     #[inline(always)]
-    unsafe fn single<const SIMD: u8>(
+    unsafe fn single<const SIMD: u8, const ANY: bool>(
         bvh: &Bvh,
         p: &mut Packet,
         rays: &[Ray],
@@ -1440,7 +1418,13 @@ pub(crate) mod x86 {
             let mut c = c;
             'walk: loop {
                 while !is_leaf(c) {
-                    match step::<SIMD, true>(bvh.node(c), &lanes, tfar, &mut stack) {
+                    // Occlusion rays take the children in slot order.
+                    let next = if ANY {
+                        step::<SIMD, false>(bvh.node(c), &lanes, tfar, &mut stack)
+                    } else {
+                        step::<SIMD, true>(bvh.node(c), &lanes, tfar, &mut stack)
+                    };
+                    match next {
                         Some(next) => c = next,
                         None => match stack.pop() {
                             Some((next, _)) => c = next,
@@ -1448,7 +1432,14 @@ pub(crate) mod x86 {
                         },
                     }
                 }
-                if leaf_closest(
+                if ANY {
+                    if leaf_any(bvh, c, edges, &shear, ray.tmin, ray.tmax, &mut NoCounters) {
+                        best_t = f32::NEG_INFINITY;
+                        // Any triangle index but `u32::MAX`: the lane hit.
+                        best.tri = 0;
+                        break;
+                    }
+                } else if leaf_closest(
                     bvh,
                     c,
                     edges,
@@ -1467,55 +1458,6 @@ pub(crate) mod x86 {
                 }
             }
             p.set_best(l, best_t, best);
-        }
-    }
-
-    /// Lane `l`'s ray through the subtree of `c` alone for any hit, with
-    /// the single-ray walk (`Bvh::walk_any`'s loop from a node other than
-    /// the root); a hit ends the lane as [`run`] says.
-    ///
-    /// # Safety
-    /// As [`trace`].
-    #[inline(always)]
-    unsafe fn single_any<const SIMD: u8>(
-        bvh: &Bvh,
-        p: &mut Packet,
-        rays: &[Ray],
-        l: usize,
-        c: ChildRef,
-    ) {
-        // SAFETY: the caller's contract; `l` is a lane of a ray.
-        unsafe {
-            let ray = rays.get_unchecked(l);
-            let r = BoxRay::new(ray, bvh.scale);
-            let shear = RayShear::from_ray(ray);
-            let qr = QuadRay::new(&shear);
-            let edges = |q: &Quad, n| quad_edges(&qr, q, n);
-            let mut stack = crate::bvh::walk::Stack::new();
-            let lanes = Lanes::new(&r);
-            let tfar = _mm256_set1_ps(ray.tmax);
-            let mut c = c;
-            loop {
-                while !is_leaf(c) {
-                    match step::<SIMD, false>(bvh.node(c), &lanes, tfar, &mut stack) {
-                        Some(next) => c = next,
-                        None => match stack.pop() {
-                            Some((next, _)) => c = next,
-                            None => return,
-                        },
-                    }
-                }
-                if leaf_any(bvh, c, edges, &shear, ray.tmin, ray.tmax, &mut NoCounters) {
-                    p.best_t.0[l] = f32::NEG_INFINITY;
-                    // Any triangle index but `u32::MAX`: the lane hit.
-                    p.best_tri.0[l] = 0;
-                    return;
-                }
-                match stack.pop() {
-                    Some((next, _)) => c = next,
-                    None => return,
-                }
-            }
         }
     }
 
