@@ -8,7 +8,7 @@ use sahara_kd::{AccelParams, Counters, NoCounters, Ray};
 use crate::accel::{Accel, BatchBuffers, RawHit};
 use crate::integrator::guiding::Guide;
 use crate::light::area::{sample_flat_lanes, FlatPiece};
-use crate::light::choice::LightChoice;
+use crate::light::choice::{Chosen, LightChoice};
 use crate::light::gather::SceneLights;
 use crate::light::{AreaLight, LightSample, LightSampler, LightSource};
 use crate::material::Material;
@@ -699,12 +699,8 @@ impl<'a> World<'a> {
                 pmf.0[i] = c.pmf;
                 continue;
             }
-            let (pi, ui) = (p.get(i), Vec2::new(u.0 .0[i], u.1 .0[i]));
-            let s = match (light, c.tri) {
-                (LightSource::Area(a), Some(tri)) => a.sample_triangle(pi, tri, ui),
-                (l, _) => l.sample_mis(pi, ui),
-            };
-            if let Some(ls) = s {
+            let ui = Vec2::new(u.0 .0[i], u.1 .0[i]);
+            if let Some(ls) = self.sample_chosen(c, p.get(i), ui, true) {
                 out.has.0[i] = true;
                 out.wi.set(i, ls.wi);
                 out.li.set(i, ls.li);
@@ -740,12 +736,19 @@ impl<'a> World<'a> {
             return None;
         }
         let c = self.nee.sample(p, n, u_pick)?;
-        let s = match (&self.lights[c.light], c.tri) {
-            (LightSource::Area(a), Some(tri)) => a.sample_triangle(p, tri, u)?,
-            (l, _) if mis => l.sample_mis(p, u)?,
-            (l, _) => l.sample(p, u)?,
-        };
-        Some((s, c.pmf))
+        Some((self.sample_chosen(&c, p, u, mis)?, c.pmf))
+    }
+
+    /// The chosen light `c` sampled from `p` with `u`: a mesh light's
+    /// chosen triangle alone, or the whole light (with `mis`, its
+    /// MIS-compensated form).
+    #[inline]
+    fn sample_chosen(&self, c: &Chosen, p: Vec3, u: Vec2, mis: bool) -> Option<LightSample> {
+        match (&self.lights[c.light], c.tri) {
+            (LightSource::Area(a), Some(tri)) => a.sample_triangle(p, tri, u),
+            (l, _) if mis => l.sample_mis(p, u),
+            (l, _) => l.sample(p, u),
+        }
     }
 
     /// One light chosen by power (`u_pick`), as its index and the

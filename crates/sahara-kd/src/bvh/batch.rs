@@ -1,7 +1,7 @@
 //! Batch queries: many rays on the calling thread or in parallel work
 //! items.
 
-use super::packet::SWITCH;
+use super::packet::{Answer, SWITCH};
 use super::Bvh;
 use crate::isect::Hit;
 use crate::kd::batch::in_parallel;
@@ -142,7 +142,7 @@ impl Bvh {
         assert_eq!(rays.len(), out.len(), "one output slot per ray");
         dispatch(
             self.max_level,
-            PacketAnyQuery {
+            PacketQuery {
                 bvh: self,
                 wide16: true,
                 switch: SWITCH,
@@ -153,37 +153,15 @@ impl Bvh {
     }
 }
 
-/// An any-hit packet walk in one dispatch.
-pub(super) struct PacketAnyQuery<'a> {
-    pub(super) bvh: &'a Bvh,
-    /// Sixteen lanes (else eight).
-    pub(super) wide16: bool,
-    /// As [`PacketQuery::switch`].
-    pub(super) switch: u32,
-    pub(super) rays: &'a [Ray],
-    pub(super) out: &'a mut [bool],
-}
-
-impl Kernel for PacketAnyQuery<'_> {
-    type Output = ();
-    #[inline(always)]
-    unsafe fn run<const LEVEL: u8>(self) {
-        // SAFETY: the level's instructions (the caller's contract).
-        unsafe {
-            self.bvh
-                .trace_packet::<LEVEL, bool>(self.wide16, self.switch, self.rays, self.out)
-        }
-    }
-}
-
 /// Rays in an eight-ray packet.
 const PACKET8: usize = 8;
 
 /// Rays in a sixteen-ray packet.
 const PACKET16: usize = super::packet::LANES;
 
-/// A packet walk in one dispatch.
-pub(super) struct PacketQuery<'a> {
+/// A packet walk in one dispatch: closest hits (`A = Option<Hit>`) or
+/// any hits (`A = bool`).
+pub(super) struct PacketQuery<'a, A> {
     pub(super) bvh: &'a Bvh,
     /// Sixteen lanes (else eight).
     pub(super) wide16: bool,
@@ -191,21 +169,17 @@ pub(super) struct PacketQuery<'a> {
     /// ray by ray.
     pub(super) switch: u32,
     pub(super) rays: &'a [Ray],
-    pub(super) out: &'a mut [Option<Hit>],
+    pub(super) out: &'a mut [A],
 }
 
-impl Kernel for PacketQuery<'_> {
+impl<A: Answer> Kernel for PacketQuery<'_, A> {
     type Output = ();
     #[inline(always)]
     unsafe fn run<const LEVEL: u8>(self) {
         // SAFETY: the level's instructions (the caller's contract).
         unsafe {
-            self.bvh.trace_packet::<LEVEL, Option<Hit>>(
-                self.wide16,
-                self.switch,
-                self.rays,
-                self.out,
-            )
+            self.bvh
+                .trace_packet::<LEVEL, A>(self.wide16, self.switch, self.rays, self.out)
         }
     }
 }

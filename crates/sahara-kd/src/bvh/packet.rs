@@ -1674,7 +1674,7 @@ mod tests {
                     for wide16 in [false, true] {
                         for switch in [0, SWITCH, 8] {
                             out.fill(false);
-                            let q = crate::bvh::batch::PacketAnyQuery {
+                            let q = PacketQuery {
                                 bvh: &bvh,
                                 wide16,
                                 switch,

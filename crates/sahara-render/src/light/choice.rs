@@ -153,12 +153,19 @@ impl LightChoice {
         }
         let u = ((u - pi) / (1.0 - pi)).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
         let (piece, pmf) = self.tree.sample(p, n, u)?;
+        Some(self.chosen_piece(piece, pmf))
+    }
+
+    /// The tree's piece `piece`, chosen by the tree with probability
+    /// `pmf`, as a light choice.
+    #[inline]
+    fn chosen_piece(&self, piece: u32, pmf: f32) -> Chosen {
         let piece = self.pieces[piece as usize];
-        Some(Chosen {
+        Chosen {
             light: piece.light as usize,
             tri: (piece.tri != NO_TRIANGLE).then_some(piece.tri as usize),
-            pmf: (1.0 - pi) * pmf,
-        })
+            pmf: (1.0 - self.p_infinite) * pmf,
+        }
     }
 
     /// [`LightChoice::sample`] for the lanes `on` (points `p`, normals `n`,
@@ -196,12 +203,7 @@ impl LightChoice {
         let (piece, pmf, found) = self.tree.sample_lanes(near, p, n, u);
         for (i, out) in out.iter_mut().enumerate() {
             if found.0[i] {
-                let piece = self.pieces[piece.0[i] as usize];
-                *out = Some(Chosen {
-                    light: piece.light as usize,
-                    tri: (piece.tri != NO_TRIANGLE).then_some(piece.tri as usize),
-                    pmf: (1.0 - pi) * pmf.0[i],
-                });
+                *out = Some(self.chosen_piece(piece.0[i], pmf.0[i]));
             }
         }
         out
